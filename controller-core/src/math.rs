@@ -1,0 +1,120 @@
+//! Scalar math backend for the f32 control path.
+//!
+//! Every transcendental call of the f32 law goes through this module so that one cargo feature
+//! decides what runs on the board:
+//!
+//! * default — [`libm`]: correctly rounded to an ulp or two;
+//! * feature `micromath` — micromath's fast approximations for `sin`, `cos` and `sqrt`
+//!   (the product design names micromath). Measured here (`tests/math_backend.rs`): sin/cos
+//!   absolute error ≈ 1e-3, `sqrt` relative error up to ≈ 6 % (√2 → 1.5).
+//!
+//! `cbrt` and `floor` are always libm (micromath has no `cbrt`; `floor` is exact in both).
+//!
+//! Call these functions by path (`math::sqrt(x)`), never as methods: a method call `x.sqrt()`
+//! resolves to std on the host and to a trait method on the target, which is exactly the
+//! silent backend switch this module exists to prevent.
+
+use core::f32::consts::{PI, TAU};
+
+/// Name of the backend compiled in, for logs and benchmarks.
+pub const BACKEND: &str = if cfg!(feature = "micromath") {
+    "micromath"
+} else {
+    "libm"
+};
+
+/// sin(x).
+#[inline]
+pub fn sin(x: f32) -> f32 {
+    #[cfg(feature = "micromath")]
+    {
+        micromath::F32(x).sin().0
+    }
+    #[cfg(not(feature = "micromath"))]
+    {
+        libm::sinf(x)
+    }
+}
+
+/// cos(x).
+#[inline]
+pub fn cos(x: f32) -> f32 {
+    #[cfg(feature = "micromath")]
+    {
+        micromath::F32(x).cos().0
+    }
+    #[cfg(not(feature = "micromath"))]
+    {
+        libm::cosf(x)
+    }
+}
+
+/// (sin x, cos x).
+#[inline]
+pub fn sin_cos(x: f32) -> (f32, f32) {
+    (sin(x), cos(x))
+}
+
+/// √x for x ≥ 0 (NaN for x < 0 in both backends).
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    #[cfg(feature = "micromath")]
+    {
+        micromath::F32(x).sqrt().0
+    }
+    #[cfg(not(feature = "micromath"))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
+/// ∛x (always libm).
+#[inline]
+pub fn cbrt(x: f32) -> f32 {
+    libm::cbrtf(x)
+}
+
+/// Euclidean norm of a slice of fixed length, through the backend's `sqrt`.
+#[inline]
+pub fn norm<const N: usize>(v: &[f32; N]) -> f32 {
+    let mut s = 0.0f32;
+    for x in v {
+        s += x * x;
+    }
+    sqrt(s)
+}
+
+/// Wraps an angle to (−π, π] with a fixed amount of work (no loop).
+///
+/// Used for the yaw component of e₁ (AUV150.md §4, **Choice**) and for trajectory phases.
+/// Non-finite input gives NaN (the caller checks finiteness).
+#[inline]
+pub fn wrap_pi(x: f32) -> f32 {
+    // r ∈ [−π, π) up to rounding; map −π to +π to make the interval (−π, π].
+    let r = x - TAU * libm::floorf((x + PI) / TAU);
+    if r <= -PI {
+        r + TAU
+    } else if r > PI {
+        r - TAU
+    } else {
+        r
+    }
+}
+
+/// Reduces the phase ω·t, with t = `ticks` / `rate_hz` seconds, to [0, 2π) in f64 before it
+/// becomes f32 (AUV150.md §8, "Time"): an f32 `t` would lose a millisecond per tick after a few
+/// hours, and ω·t in f32 loses the phase itself. Fixed work (one floor, no loop).
+#[inline]
+pub fn phase(omega: f32, ticks: u64, rate_hz: u32) -> f32 {
+    let t = ticks as f64 / rate_hz as f64;
+    let p = omega as f64 * t;
+    let r = p - core::f64::consts::TAU * libm::floor(p / core::f64::consts::TAU);
+    r as f32
+}
+
+/// Seconds since mission start as f64 (for terms linear in t, such as the lawn-mower's surge
+/// advance or the helix depth rate, which must not be computed from an f32 time).
+#[inline]
+pub fn seconds(ticks: u64, rate_hz: u32) -> f64 {
+    ticks as f64 / rate_hz as f64
+}
