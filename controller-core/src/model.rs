@@ -1,0 +1,276 @@
+//! The AUV-150 body-frame model of Eq (1): M ν̇ + C(ν) ν + D(ν) ν + g(η) = τ.
+//!
+//! Everything here is generic over the scalar (`nalgebra::RealField`) so that the f32 controller
+//! (nominal parameters) and the f64 plant of `host-sim` (varying parameters) build their matrices
+//! with the same code. Nothing here calls a transcendental function: the attitude enters g(η)
+//! through precomputed sines and cosines ([`crate::kinematics::Attitude`]), so the math backend
+//! of the f32 path stays in one place.
+//!
+//! Parameter values are Table 2 of the paper plus the choices of AUV150.md §2:
+//! −Z_ẇ = −Y_v̇ (axisymmetric hull), −K_ṗ = 0, −M_q̇ = −N_ṙ = 1204 kg m² (inferred from the
+//! printed M), d_p = 0, and buoyancy arms fixed so that the nominal g(η) is the printed one.
+
+use nalgebra::{Matrix3, Matrix6, RealField, Vector3, Vector6};
+
+use crate::kinematics::Attitude;
+
+/// Gravitational acceleration used for W = m g (m/s²).
+pub const GRAVITY: f64 = 9.81;
+/// Printed roll restoring coefficient of g(η) at nominal: g₄ = 296.1 cθ sφ (N m).
+pub const ROLL_RESTORING: f64 = 296.1;
+/// Printed pitch restoring coefficient of g(η) at nominal: g₅ = 291.1 sθ (N m).
+pub const PITCH_RESTORING: f64 = 291.1;
+
+/// Rigid-body, added-mass, damping and hydrostatic parameters of Eq (1).
+///
+/// Added-mass fields hold the positive numbers −X_u̇, −Y_v̇, … (kg, kg m²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct VehicleParams<T> {
+    /// Mass m (kg). Table 2: 490.
+    pub mass: T,
+    /// Centre of gravity r_G = (x_G, y_G, z_G) from CO (m). Table 2: (0, 0, 0.012).
+    pub r_g: [T; 3],
+    /// Principal inertias I_x, I_y, I_z about CO (kg m²). Table 2: 17.1, 632, 630.
+    pub inertia: [T; 3],
+    /// Added mass [−X_u̇, −Y_v̇, −Z_ẇ, −K_ṗ, −M_q̇, −N_ṙ]. Table 2 gives −X_u̇ = 49, −Y_v̇ = 836;
+    /// **Choice** (AUV150.md §2): −Z_ẇ = −Y_v̇, −K_ṗ = 0, −M_q̇ = −N_ṙ = 1204.
+    pub added_mass: [T; 6],
+    /// Quadratic damping coefficients: D(ν) = diag(dᵢ |νᵢ|). Printed: 120, 1224, 1224, d_p, 2731,
+    /// 2731 with **Choice** d_p = 0.
+    pub damping: [T; 6],
+    /// Buoyancy B (N). **Choice**: B = W₀ = 490 · 9.81 (neutral at nominal), fixed when the
+    /// payload changes.
+    pub buoyancy: T,
+    /// Centre of buoyancy (x_B, y_B) in the horizontal plane (m). **Choice**: 0, 0.
+    pub r_b_xy: [T; 2],
+    /// Vertical buoyancy arm seen by the roll moment, z_B (m): chosen so that the nominal g₄ is
+    /// the printed 296.1 cθ sφ, i.e. z_G W₀ − z_B B = 296.1.
+    pub z_b_roll: T,
+    /// Vertical buoyancy arm seen by the pitch moment (m): nominal g₅ = 291.1 sθ. The paper
+    /// prints different roll and pitch coefficients; AUV150.md §2 keeps both.
+    pub z_b_pitch: T,
+    /// Gravitational acceleration (m/s²).
+    pub gravity: T,
+}
+
+impl VehicleParams<f64> {
+    /// Nominal AUV-150 parameters (Table 2 and the AUV150.md §2 choices), in f64.
+    pub fn auv150() -> Self {
+        let w0 = 490.0 * GRAVITY;
+        let z_g = 0.012;
+        VehicleParams {
+            mass: 490.0,
+            r_g: [0.0, 0.0, z_g],
+            inertia: [17.1, 632.0, 630.0],
+            added_mass: [49.0, 836.0, 836.0, 0.0, 1204.0, 1204.0],
+            damping: [120.0, 1224.0, 1224.0, 0.0, 2731.0, 2731.0],
+            buoyancy: w0,
+            r_b_xy: [0.0, 0.0],
+            z_b_roll: (z_g * w0 - ROLL_RESTORING) / w0,
+            z_b_pitch: (z_g * w0 - PITCH_RESTORING) / w0,
+            gravity: GRAVITY,
+        }
+    }
+}
+
+impl<T: RealField + Copy> VehicleParams<T> {
+    /// The parameters with a Table-3 variation added (plant only; AUV150.md §2).
+    ///
+    /// The −Y_v̇ variation acts on −Z_ẇ as well (the hull is axisymmetric). Buoyancy and its
+    /// arms do not change: a payload adds weight, not displacement.
+    pub fn with_variation(&self, d: &ParamVariation<T>) -> Self {
+        let mut p = *self;
+        p.mass += d.mass;
+        for i in 0..3 {
+            p.r_g[i] += d.r_g[i];
+            p.inertia[i] += d.inertia[i];
+        }
+        p.added_mass[0] += d.x_udot;
+        p.added_mass[1] += d.y_vdot;
+        p.added_mass[2] += d.y_vdot;
+        p
+    }
+
+    /// Converts the parameter set to another scalar type (e.g. the f64 defaults to the
+    /// controller's f32).
+    pub fn cast<U: RealField + Copy>(&self, f: impl Fn(T) -> U) -> VehicleParams<U> {
+        VehicleParams {
+            mass: f(self.mass),
+            r_g: self.r_g.map(&f),
+            inertia: self.inertia.map(&f),
+            added_mass: self.added_mass.map(&f),
+            damping: self.damping.map(&f),
+            buoyancy: f(self.buoyancy),
+            r_b_xy: self.r_b_xy.map(&f),
+            z_b_roll: f(self.z_b_roll),
+            z_b_pitch: f(self.z_b_pitch),
+            gravity: f(self.gravity),
+        }
+    }
+
+    /// Weight W = m g (N).
+    pub fn weight(&self) -> T {
+        self.mass * self.gravity
+    }
+
+    /// True if every parameter is finite.
+    pub fn is_finite(&self) -> bool {
+        let scalars = [
+            self.mass,
+            self.buoyancy,
+            self.z_b_roll,
+            self.z_b_pitch,
+            self.gravity,
+        ];
+        scalars
+            .iter()
+            .chain(self.r_g.iter())
+            .chain(self.inertia.iter())
+            .chain(self.added_mass.iter())
+            .chain(self.damping.iter())
+            .chain(self.r_b_xy.iter())
+            .all(|x| x.is_finite())
+    }
+}
+
+/// A Table-3 parameter variation Δp, added to the nominal parameters of the plant.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct ParamVariation<T> {
+    /// Δm (kg).
+    pub mass: T,
+    /// Δx_G, Δy_G, Δz_G (m).
+    pub r_g: [T; 3],
+    /// ΔI_x, ΔI_y, ΔI_z (kg m²).
+    pub inertia: [T; 3],
+    /// Δ(−X_u̇) (kg).
+    pub x_udot: T,
+    /// Δ(−Y_v̇) (kg), applied to −Z_ẇ as well.
+    pub y_vdot: T,
+}
+
+impl<T: RealField + Copy> ParamVariation<T> {
+    /// Converts to another scalar type.
+    pub fn cast<U: RealField + Copy>(&self, f: impl Fn(T) -> U) -> ParamVariation<U> {
+        ParamVariation {
+            mass: f(self.mass),
+            r_g: self.r_g.map(&f),
+            inertia: self.inertia.map(&f),
+            x_udot: f(self.x_udot),
+            y_vdot: f(self.y_vdot),
+        }
+    }
+}
+
+impl ParamVariation<f64> {
+    /// The "max" column of Table 3 (AUV150.md §2): every Δ at its largest printed value.
+    pub const TABLE3_MAX: ParamVariation<f64> = ParamVariation {
+        mass: 30.0,
+        r_g: [0.05, 0.02, 0.02],
+        inertia: [2.0, 5.0, 10.0],
+        x_udot: 3.0,
+        y_vdot: 50.0,
+    };
+
+    /// Multiplies every component by `s` (the abs-sin and staircase profiles of Table 3 scale
+    /// or replace this vector).
+    pub fn scaled(&self, s: f64) -> Self {
+        ParamVariation {
+            mass: self.mass * s,
+            r_g: self.r_g.map(|x| x * s),
+            inertia: self.inertia.map(|x| x * s),
+            x_udot: self.x_udot * s,
+            y_vdot: self.y_vdot * s,
+        }
+    }
+}
+
+/// Skew-symmetric matrix S(a) with S(a) b = a × b.
+pub fn skew<T: RealField + Copy>(a: &Vector3<T>) -> Matrix3<T> {
+    let z = T::zero();
+    Matrix3::new(z, -a.z, a.y, a.z, z, -a.x, -a.y, a.x, z)
+}
+
+/// Rigid-body inertia M_RB = [[m I₃, −m S(r_G)], [m S(r_G), diag(I_x, I_y, I_z)]]
+/// (AUV150.md §2; Eq 1's M_RB).
+pub fn rigid_body_mass<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
+    let m = p.mass;
+    let s = skew(&Vector3::from(p.r_g)) * m;
+    let mut out = Matrix6::zeros();
+    out.fixed_view_mut::<3, 3>(0, 0)
+        .copy_from(&(Matrix3::identity() * m));
+    out.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-s));
+    out.fixed_view_mut::<3, 3>(3, 0).copy_from(&s);
+    out.fixed_view_mut::<3, 3>(3, 3)
+        .copy_from(&Matrix3::from_diagonal(&Vector3::from(p.inertia)));
+    out
+}
+
+/// Added mass M_A = diag(−X_u̇, −Y_v̇, −Z_ẇ, −K_ṗ, −M_q̇, −N_ṙ) (Eq 1's M_A).
+pub fn added_mass<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
+    Matrix6::from_diagonal(&Vector6::from(p.added_mass))
+}
+
+/// System inertia M = M_RB + M_A (Eq 1). At nominal this is the printed M of the paper:
+/// diagonal 539, 1326, 1326, 17.1, 1836, 1834 and M₁₅ = M₅₁ = 5.88, M₂₄ = M₄₂ = −5.88.
+pub fn mass_matrix<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
+    rigid_body_mass(p) + added_mass(p)
+}
+
+/// Coriolis–centripetal matrix of a symmetric inertia `m` in Kirchhoff form (AUV150.md §2):
+/// C(ν) = [[0, −S(a)], [−S(a), −S(b)]] with [a; b] = M ν, so C(ν) ν = [ω × a; v × a + ω × b]
+/// and νᵀ C(ν) ν = 0.
+///
+/// **Choice** (AUV150.md §2): the paper prints every entry with the opposite sign; with the
+/// printed sign the closed loop diverges on the lawn-mower case.
+///
+/// Linear in `m`, so C_RB(ν) = `coriolis(&M_RB, ν)` and C_A(ν_r) = `coriolis(&M_A, ν_r)` for
+/// the plant's current model.
+pub fn coriolis<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Matrix6<T> {
+    let ab = m * nu;
+    let sa = skew(&Vector3::new(ab[0], ab[1], ab[2]));
+    let sb = skew(&Vector3::new(ab[3], ab[4], ab[5]));
+    let mut c = Matrix6::zeros();
+    c.fixed_view_mut::<3, 3>(0, 3).copy_from(&(-sa));
+    c.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-sa));
+    c.fixed_view_mut::<3, 3>(3, 3).copy_from(&(-sb));
+    c
+}
+
+/// Quadratic damping D(ν) = diag(120|u|, 1224|v|, 1224|w|, d_p|p|, 2731|q|, 2731|r|) (Eq 1,
+/// printed D(ν)).
+pub fn damping<T: RealField + Copy>(p: &VehicleParams<T>, nu: &Vector6<T>) -> Matrix6<T> {
+    Matrix6::from_fn(|i, j| {
+        if i == j {
+            p.damping[i] * nu[i].abs()
+        } else {
+            T::zero()
+        }
+    })
+}
+
+/// Restoring forces g(η) (Fossen's vector, AUV150.md §2), from the attitude's sines/cosines:
+///
+/// g₁ = ΔW sθ, g₂ = −ΔW cθ sφ, g₃ = −ΔW cθ cφ, with ΔW = W − B;
+/// g₄ = −(y_G W − y_B B) cθ cφ + k₄ cθ sφ, g₅ = k₅ sθ + (x_G W − x_B B) cθ cφ,
+/// g₆ = −(x_G W − x_B B) cθ sφ − (y_G W − y_B B) sθ,
+/// with k₄ = z_G W − z_B,roll B and k₅ = z_G W − z_B,pitch B.
+///
+/// At nominal this is the printed g(η) = [0, 0, 0, 296.1 cθ sφ, 291.1 sθ, 0]ᵀ.
+pub fn restoring<T: RealField + Copy>(p: &VehicleParams<T>, att: &Attitude<T>) -> Vector6<T> {
+    let w = p.weight();
+    let b = p.buoyancy;
+    let dw = w - b;
+    let mx = p.r_g[0] * w - p.r_b_xy[0] * b;
+    let my = p.r_g[1] * w - p.r_b_xy[1] * b;
+    let k4 = p.r_g[2] * w - p.z_b_roll * b;
+    let k5 = p.r_g[2] * w - p.z_b_pitch * b;
+    let (sphi, cphi, sth, cth) = (att.sphi, att.cphi, att.stheta, att.ctheta);
+    Vector6::new(
+        dw * sth,
+        -dw * cth * sphi,
+        -dw * cth * cphi,
+        -my * cth * cphi + k4 * cth * sphi,
+        k5 * sth + mx * cth * cphi,
+        -mx * cth * sphi - my * sth,
+    )
+}
