@@ -1,1 +1,649 @@
-//! placeholder
+//! Reference trajectories of the paper's missions: η_d(t), η̇_d(t), η̈_d(t).
+//!
+//! This module owns the desired state fed to the control law (ū = η̈_d − K₁e₁ − K₂e₂, Eq 17, with
+//! e₁ = η − η_d and e₂ = η̇ − η̇_d, Eqs 12–13) and the bound K_d ≥ ‖η̈_d(t)‖ of Assumption 1
+//! (Eq 19) that enters δ (Eq 29). The missions are the paper's "Simulation Results" section, as
+//! cleaned up in AUV150.md §6; all have φ_d = θ_d = 0 (and zero roll/pitch rates):
+//!
+//! | kind | x_d | y_d | z_d | ψ_d |
+//! |---|---|---|---|---|
+//! | circle | R sin ωt | R cos ωt | depth | ωt |
+//! | figure-eight | A sin ωt | A cos(ωt/2) | depth | triangle series, base ω |
+//! | lawn-mower | s(0.25t + 2.5 sin 2ωt) | 15s cos ωt | depth | trapezoid series, base ω |
+//! | helix | R sin ωt | R cos ωt | depth + ż·t | ωt |
+//!
+//! The paper's values are ω = 0.1 (circle, figure-eight) and ω = 0.05 (lawn-mower, so that
+//! 2ω = 0.1 in x_d), depth 5 m. The helix is ours (a circle that changes depth).
+//!
+//! **Choices** (AUV150.md §6):
+//! * The circle's printed "x_d = 10 sin(0.1)t" is read as R sin(0.1t) (a misplaced parenthesis:
+//!   y_d = 10 cos(0.1t) beside it and the circular plot fix it).
+//! * Both heading series use the prefactor 8/π (it makes the triangle and the trapezoid reach
+//!   ±π, matching the paper's Fig. 5) and are truncated at N = [`Trajectory::SERIES_TERMS`] = 9.
+//!   Every even-n term is identically zero in both series (for the lawn-mower,
+//!   sin(3nπ/4) = −(−1)ⁿ sin(nπ/4), so sin(nπ/4) + sin(3nπ/4) = 2 sin(nπ/4) for odd n and 0 for
+//!   even n), so only n = 1, 3, 5, 7, 9 are evaluated.
+//! * All derivatives are analytic (term-by-term derivatives of the truncated series).
+//!
+//! **Time and precision** (AUV150.md §8): time is the integer tick count; no f32 `t` is ever
+//! formed. For each base frequency one phase θ = ω·t is reduced modulo 2π in f64
+//! ([`math::phase`]); harmonics use n·θ (n an integer, so n·θ ≡ nωt mod 2π), wrapped to (−π, π]
+//! before the f32 `sin`/`cos`. Terms linear in t (lawn-mower surge advance, helix depth rate)
+//! use [`math::seconds`] in f64 and are rounded to f32 once, at the end. Positions that grow
+//! with t (lawn-mower x_d, helix z_d) are still f32 in the result, so they lose resolution as
+//! they grow (≈ 8 mm at 90 km); see §8 "Position".
+//!
+//! **Heading** ψ_d is returned wrapped to (−π, π]. For the circle and helix ψ_d = ωt grows
+//! without bound and wraps once per revolution. The truncated lawn-mower series overshoots π
+//! on its plateau (its maximum is ≈ 3.198 rad), so there too ψ_d jumps by 2π while the
+//! heading itself is continuous; ψ̇_d and ψ̈_d are continuous everywhere. Consumers compare
+//! headings modulo 2π (AUV150.md §4 wraps the yaw error).
+//!
+//! Every [`Trajectory::sample`] does a fixed amount of work (a `match` on the kind and, for the
+//! series, a loop over a constant five harmonics), never allocates and never panics.
+
+use core::f32::consts::{FRAC_1_SQRT_2, PI};
+use core::fmt;
+
+use nalgebra::Vector6;
+
+use crate::math;
+
+/// Desired state at one instant (earth frame, components [x y z φ θ ψ]).
+///
+/// `eta` = η_d (m, rad; ψ wrapped to (−π, π]), `eta_dot` = η̇_d (m/s and Euler-angle rates,
+/// rad/s), `eta_ddot` = η̈_d (m/s², rad/s²).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Desired {
+    /// η_d = [x y z φ θ ψ].
+    pub eta: Vector6<f32>,
+    /// η̇_d.
+    pub eta_dot: Vector6<f32>,
+    /// η̈_d.
+    pub eta_ddot: Vector6<f32>,
+}
+
+/// Shape and parameters of a mission (the paper's "Simulation Results"; AUV150.md §6).
+///
+/// All frequencies ω are in rad/s and must be positive; sizes in metres; z is positive down (NED).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TrajectoryKind {
+    /// x = R sin ωt, y = R cos ωt, z = depth, ψ = ωt (paper: ω = 0.1; "10 sin(0.1)t" read as
+    /// R sin 0.1t).
+    Circle {
+        /// R (m).
+        radius: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d (m, positive down).
+        depth: f32,
+    },
+    /// x = A sin ωt, y = A cos(ωt/2), z = depth,
+    /// ψ = (8/π) Σ_{n odd ≤ N} (−1)^((n−1)/2) sin(nωt)/n² (a triangle wave of amplitude π;
+    /// paper: ω = 0.1, A = 15 or 20 for the 30×30 and 40×40 cases).
+    FigureEight {
+        /// A (m): x and y each span 2A.
+        amplitude: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d (m, positive down).
+        depth: f32,
+    },
+    /// x = s(0.25 t + 2.5 sin 2ωt), y = 15 s cos ωt, z = depth,
+    /// ψ = (8/π) Σ_{n ≤ N} [sin(nπ/4) + sin(3nπ/4)] sin(nωt)/n² (a trapezoid of amplitude π;
+    /// paper: ω = 0.05, so 2ω = 0.1; s = 1 is the paper's 30×15 case).
+    LawnMower {
+        /// s (dimensionless): loop height 30 s m, loop width ≈ 15.7 s m.
+        scale: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d (m, positive down).
+        depth: f32,
+    },
+    /// A circle whose depth changes linearly: z = depth + depth_rate·t (not in the paper).
+    Helix {
+        /// R (m).
+        radius: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d at t = 0 (m, positive down).
+        depth: f32,
+        /// ż_d (m/s, positive = descending).
+        depth_rate: f32,
+    },
+}
+
+/// Why a [`TrajectoryKind`] was rejected by [`Trajectory::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TrajectoryError {
+    /// The parameter is NaN or infinite.
+    NonFinite {
+        /// Field name in [`TrajectoryKind`].
+        parameter: &'static str,
+    },
+    /// A size or frequency that must be strictly positive is zero or negative.
+    NotPositive {
+        /// Field name in [`TrajectoryKind`].
+        parameter: &'static str,
+        /// The rejected value.
+        value: f32,
+    },
+    /// The parameter lies outside [min, max] (for a positive parameter `min` is 0 and exclusive;
+    /// values at or below it are reported as [`TrajectoryError::NotPositive`]).
+    OutOfRange {
+        /// Field name in [`TrajectoryKind`].
+        parameter: &'static str,
+        /// The rejected value.
+        value: f32,
+        /// Lower limit.
+        min: f32,
+        /// Upper limit.
+        max: f32,
+    },
+}
+
+impl fmt::Display for TrajectoryError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::NonFinite { parameter } => write!(f, "trajectory {parameter} is not finite"),
+            Self::NotPositive { parameter, value } => {
+                write!(f, "trajectory {parameter} = {value} must be > 0")
+            }
+            Self::OutOfRange {
+                parameter,
+                value,
+                min,
+                max,
+            } => write!(
+                f,
+                "trajectory {parameter} = {value} is outside [{min}, {max}]"
+            ),
+        }
+    }
+}
+
+/// The six missions of the paper's Table 1 (AUV150.md §6–7).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Table1Case {
+    /// Circle, R = 10 m.
+    Circular10R,
+    /// Circle, R = 20 m.
+    Circular20R,
+    /// Figure-eight in a 30 m × 30 m square, A = 15 m.
+    FigureEight30x30,
+    /// Figure-eight in a 40 m × 40 m square, A = 20 m.
+    FigureEight40x40,
+    /// Lawn-mower, loop 20 m high × ≈10 m wide, s = 2/3.
+    LawnMower20x10,
+    /// Lawn-mower, loop 30 m high × ≈15 m wide, s = 1 (the paper's printed equations).
+    LawnMower30x15,
+}
+
+impl Table1Case {
+    /// All six cases, in the order of the paper's Table 1.
+    pub const ALL: [Self; 6] = [
+        Self::Circular10R,
+        Self::Circular20R,
+        Self::FigureEight30x30,
+        Self::FigureEight40x40,
+        Self::LawnMower20x10,
+        Self::LawnMower30x15,
+    ];
+
+    /// Stable name for logs and command lines, e.g. `"figure-eight-30x30"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Self::Circular10R => "circular-10R",
+            Self::Circular20R => "circular-20R",
+            Self::FigureEight30x30 => "figure-eight-30x30",
+            Self::FigureEight40x40 => "figure-eight-40x40",
+            Self::LawnMower20x10 => "lawn-mower-20x10",
+            Self::LawnMower30x15 => "lawn-mower-30x15",
+        }
+    }
+
+    /// The case whose [`name`](Self::name) is `name` (exact match).
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|c| c.name() == name)
+    }
+
+    /// The mission: paper frequencies (ω = 0.1, lawn-mower ω = 0.05) and depth 5 m, with the
+    /// Table-1 sizes R = 10, 20; A = 15, 20; s = 2/3, 1.
+    pub const fn kind(self) -> TrajectoryKind {
+        match self {
+            Self::Circular10R => circle_kind(10.0),
+            Self::Circular20R => circle_kind(20.0),
+            Self::FigureEight30x30 => figure_eight_kind(15.0),
+            Self::FigureEight40x40 => figure_eight_kind(20.0),
+            Self::LawnMower20x10 => lawn_mower_kind(2.0 / 3.0),
+            Self::LawnMower30x15 => lawn_mower_kind(1.0),
+        }
+    }
+}
+
+const fn circle_kind(radius: f32) -> TrajectoryKind {
+    TrajectoryKind::Circle {
+        radius,
+        omega: Trajectory::PAPER_OMEGA,
+        depth: Trajectory::PAPER_DEPTH,
+    }
+}
+
+const fn figure_eight_kind(amplitude: f32) -> TrajectoryKind {
+    TrajectoryKind::FigureEight {
+        amplitude,
+        omega: Trajectory::PAPER_OMEGA,
+        depth: Trajectory::PAPER_DEPTH,
+    }
+}
+
+const fn lawn_mower_kind(scale: f32) -> TrajectoryKind {
+    TrajectoryKind::LawnMower {
+        scale,
+        omega: Trajectory::PAPER_LAWN_MOWER_OMEGA,
+        depth: Trajectory::PAPER_DEPTH,
+    }
+}
+
+/// Number of odd harmonics n = 1, 3, …, N evaluated by the heading series.
+const ODD_TERMS: usize = (Trajectory::SERIES_TERMS as usize).div_ceil(2);
+
+/// Heading-series shape: ψ = (8/π) Σ_{n odd ≤ N} sign_n sin(nθ)/n² · `gain`.
+#[derive(Clone, Copy)]
+enum Series {
+    /// Figure-eight: sign_n = (−1)^((n−1)/2), gain 1.
+    Triangle,
+    /// Lawn-mower: sin(nπ/4) + sin(3nπ/4) = 2 sin(nπ/4) = √2·sign_n for odd n, with
+    /// sign_n = +1 for n ≡ 1, 3 (mod 8) and −1 for n ≡ 5, 7 (mod 8); gain √2.
+    Trapezoid,
+}
+
+/// Per-harmonic coefficients of ψ_d, ψ̇_d, ψ̈_d: for harmonic n (odd),
+/// ψ = Σ a_n sin(nθ), ψ̇ = Σ a_n nω cos(nθ), ψ̈ = −Σ a_n n²ω² sin(nθ).
+const fn series_coefficients(series: Series, omega: f32) -> [[f32; 3]; ODD_TERMS] {
+    let mut out = [[0.0; 3]; ODD_TERMS];
+    let mut i = 0;
+    while i < ODD_TERMS {
+        let n = 2 * i as u32 + 1;
+        let (sign, gain) = match series {
+            Series::Triangle => (if i % 2 == 0 { 1.0 } else { -1.0 }, 1.0),
+            Series::Trapezoid => (
+                if n % 8 == 1 || n % 8 == 3 { 1.0 } else { -1.0 },
+                2.0 * FRAC_1_SQRT_2,
+            ),
+        };
+        let nf = n as f32;
+        let a = 8.0 / PI * gain * sign / (nf * nf);
+        out[i] = [a, a * nf * omega, a * nf * nf * omega * omega];
+        i += 1;
+    }
+    out
+}
+
+/// A validated mission with its precomputed constants; sample it with [`Trajectory::sample`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Trajectory {
+    kind: TrajectoryKind,
+    /// `[a_n, a_n nω, a_n n²ω²]` for the odd harmonics (zero for circle/helix).
+    psi: [[f32; 3]; ODD_TERMS],
+    /// K_d of Assumption 1.
+    accel_bound: f32,
+}
+
+impl Trajectory {
+    /// N, the last harmonic of the heading series (AUV150.md §6 **Choice**: truncate at N = 9).
+    pub const SERIES_TERMS: u32 = 9;
+    /// The paper's ω for the circle and the figure-eight (rad/s).
+    pub const PAPER_OMEGA: f32 = 0.1;
+    /// The paper's ω for the lawn-mower (rad/s): y_d = 15 cos(0.05t), x_d uses 2ω = 0.1.
+    pub const PAPER_LAWN_MOWER_OMEGA: f32 = 0.05;
+    /// The paper's z_d (m).
+    pub const PAPER_DEPTH: f32 = 5.0;
+    /// Largest amplitude of any oscillating position term (R, A, 15 s), m. A sanity limit that
+    /// keeps every output finite, not a feasibility check.
+    pub const MAX_SIZE: f32 = 10_000.0;
+    /// Largest |depth| (m).
+    pub const MAX_DEPTH: f32 = 10_000.0;
+    /// Largest ω (rad/s). A sanity limit; the vehicle cannot follow anything near it.
+    pub const MAX_OMEGA: f32 = 10.0;
+    /// Largest |depth_rate| of a helix (m/s).
+    pub const MAX_DEPTH_RATE: f32 = 10.0;
+
+    /// Validates `kind` and precomputes the series coefficients and K_d.
+    ///
+    /// Checks, in field order: every parameter finite; radius/amplitude in (0, [`MAX_SIZE`]],
+    /// lawn-mower scale in (0, [`MAX_SIZE`]/15]; omega in (0, [`MAX_OMEGA`]];
+    /// |depth| ≤ [`MAX_DEPTH`]; |depth_rate| ≤ [`MAX_DEPTH_RATE`]. The error names the field.
+    ///
+    /// [`MAX_SIZE`]: Self::MAX_SIZE
+    /// [`MAX_OMEGA`]: Self::MAX_OMEGA
+    /// [`MAX_DEPTH`]: Self::MAX_DEPTH
+    /// [`MAX_DEPTH_RATE`]: Self::MAX_DEPTH_RATE
+    pub fn new(kind: TrajectoryKind) -> Result<Self, TrajectoryError> {
+        match kind {
+            TrajectoryKind::Circle {
+                radius,
+                omega,
+                depth,
+            } => {
+                positive("radius", radius, Self::MAX_SIZE)?;
+                positive("omega", omega, Self::MAX_OMEGA)?;
+                symmetric("depth", depth, Self::MAX_DEPTH)?;
+            }
+            TrajectoryKind::FigureEight {
+                amplitude,
+                omega,
+                depth,
+            } => {
+                positive("amplitude", amplitude, Self::MAX_SIZE)?;
+                positive("omega", omega, Self::MAX_OMEGA)?;
+                symmetric("depth", depth, Self::MAX_DEPTH)?;
+            }
+            TrajectoryKind::LawnMower {
+                scale,
+                omega,
+                depth,
+            } => {
+                positive("scale", scale, Self::MAX_SIZE / 15.0)?;
+                positive("omega", omega, Self::MAX_OMEGA)?;
+                symmetric("depth", depth, Self::MAX_DEPTH)?;
+            }
+            TrajectoryKind::Helix {
+                radius,
+                omega,
+                depth,
+                depth_rate,
+            } => {
+                positive("radius", radius, Self::MAX_SIZE)?;
+                positive("omega", omega, Self::MAX_OMEGA)?;
+                symmetric("depth", depth, Self::MAX_DEPTH)?;
+                symmetric("depth_rate", depth_rate, Self::MAX_DEPTH_RATE)?;
+            }
+        }
+        Ok(Self::build(kind))
+    }
+
+    /// Precomputes the constants of an already validated kind.
+    fn build(kind: TrajectoryKind) -> Self {
+        let psi = match kind {
+            TrajectoryKind::FigureEight { omega, .. } => {
+                series_coefficients(Series::Triangle, omega)
+            }
+            TrajectoryKind::LawnMower { omega, .. } => {
+                series_coefficients(Series::Trapezoid, omega)
+            }
+            TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. } => [[0.0; 3]; ODD_TERMS],
+        };
+        // Assumption 1 (Eq 19): per component Σ |amplitude|·frequency² over its harmonics
+        // (|sin|, |cos| ≤ 1), then the Euclidean norm over the components. Linear-in-t terms
+        // (lawn-mower 0.25 s t, helix z) and the circle's ψ = ωt have no acceleration.
+        let mut series_bound = 0.0f32;
+        for c in &psi {
+            series_bound += libm::fabsf(c[2]);
+        }
+        let (x, y) = match kind {
+            TrajectoryKind::Circle { radius, omega, .. }
+            | TrajectoryKind::Helix { radius, omega, .. } => {
+                (radius * omega * omega, radius * omega * omega)
+            }
+            TrajectoryKind::FigureEight {
+                amplitude, omega, ..
+            } => {
+                let half = 0.5 * omega;
+                (amplitude * omega * omega, amplitude * half * half)
+            }
+            TrajectoryKind::LawnMower { scale, omega, .. } => {
+                let two = 2.0 * omega;
+                (2.5 * scale * two * two, 15.0 * scale * omega * omega)
+            }
+        };
+        let accel_bound = sqrt_upper(x * x + y * y + series_bound * series_bound);
+        Self {
+            kind,
+            psi,
+            accel_bound,
+        }
+    }
+
+    /// Circle of radius `radius` with the paper's ω = 0.1 rad/s and depth 5 m.
+    pub fn circle(radius: f32) -> Result<Self, TrajectoryError> {
+        Self::new(circle_kind(radius))
+    }
+
+    /// Figure-eight of amplitude `amplitude` (a 2A × 2A square) with the paper's ω = 0.1 rad/s
+    /// and depth 5 m.
+    pub fn figure_eight(amplitude: f32) -> Result<Self, TrajectoryError> {
+        Self::new(figure_eight_kind(amplitude))
+    }
+
+    /// Lawn-mower of scale `scale` with the paper's ω = 0.05 rad/s and depth 5 m.
+    pub fn lawn_mower(scale: f32) -> Result<Self, TrajectoryError> {
+        Self::new(lawn_mower_kind(scale))
+    }
+
+    /// Helix: circle of radius `radius`, ω = 0.1 rad/s, starting at depth 5 m and descending at
+    /// `depth_rate` m/s (negative rises).
+    pub fn helix(radius: f32, depth_rate: f32) -> Result<Self, TrajectoryError> {
+        Self::new(TrajectoryKind::Helix {
+            radius,
+            omega: Self::PAPER_OMEGA,
+            depth: Self::PAPER_DEPTH,
+            depth_rate,
+        })
+    }
+
+    /// One of the paper's Table-1 missions (always valid, so no `Result`).
+    pub fn table1(case: Table1Case) -> Self {
+        Self::build(case.kind())
+    }
+
+    /// The mission's shape and parameters.
+    pub fn kind(&self) -> TrajectoryKind {
+        self.kind
+    }
+
+    /// K_d of Assumption 1 (Eq 19): an upper bound on ‖η̈_d(t)‖ for all t.
+    ///
+    /// Computed from the amplitudes: for each component of η̈_d the sum of |amplitude|·(frequency)²
+    /// over its harmonics, then the Euclidean norm over the components. For the circle this is
+    /// √2·Rω² (the true maximum is Rω²); for the paper's figure-eight it is within 1 % of the true
+    /// maximum (all the bounds are reached together at ωt = π/2). The square root is the
+    /// backend's followed by one Newton step, which can only round up (AM–GM), so the bound holds
+    /// with micromath's ≈ 6 % `sqrt` too.
+    pub fn accel_bound(&self) -> f32 {
+        self.accel_bound
+    }
+
+    /// η_d, η̇_d, η̈_d at t = `ticks` / `rate_hz` seconds since mission start.
+    ///
+    /// Phases are reduced in f64 from the tick count (see the module doc), so the result at
+    /// 100 h is as accurate as at 1 s. `rate_hz == 0` has no meaningful time: it returns the
+    /// t = 0 sample. Never panics; every component is finite for every `ticks` and `rate_hz`
+    /// (for absurd t the lawn-mower x_d and helix z_d are huge but finite).
+    pub fn sample(&self, ticks: u64, rate_hz: u32) -> Desired {
+        let (ticks, rate_hz) = if rate_hz == 0 {
+            (0, 1)
+        } else {
+            (ticks, rate_hz)
+        };
+        let mut eta = Vector6::<f32>::zeros();
+        let mut eta_dot = Vector6::<f32>::zeros();
+        let mut eta_ddot = Vector6::<f32>::zeros();
+        match self.kind {
+            TrajectoryKind::Circle {
+                radius,
+                omega,
+                depth,
+            } => {
+                circle(
+                    radius,
+                    omega,
+                    ticks,
+                    rate_hz,
+                    &mut eta,
+                    &mut eta_dot,
+                    &mut eta_ddot,
+                );
+                eta[2] = depth;
+            }
+            TrajectoryKind::Helix {
+                radius,
+                omega,
+                depth,
+                depth_rate,
+            } => {
+                circle(
+                    radius,
+                    omega,
+                    ticks,
+                    rate_hz,
+                    &mut eta,
+                    &mut eta_dot,
+                    &mut eta_ddot,
+                );
+                let t = math::seconds(ticks, rate_hz);
+                eta[2] = (depth as f64 + depth_rate as f64 * t) as f32;
+                eta_dot[2] = depth_rate;
+            }
+            TrajectoryKind::FigureEight {
+                amplitude,
+                omega,
+                depth,
+            } => {
+                let theta = math::phase(omega, ticks, rate_hz);
+                let half = 0.5 * omega;
+                let theta_half = math::phase(half, ticks, rate_hz);
+                let (s1, c1) = harmonic(1, theta);
+                let (sh, ch) = harmonic(1, theta_half);
+                eta[0] = amplitude * s1;
+                eta_dot[0] = amplitude * omega * c1;
+                eta_ddot[0] = -amplitude * omega * omega * s1;
+                eta[1] = amplitude * ch;
+                eta_dot[1] = -amplitude * half * sh;
+                eta_ddot[1] = -amplitude * half * half * ch;
+                eta[2] = depth;
+                self.heading_series(theta, &mut eta, &mut eta_dot, &mut eta_ddot);
+            }
+            TrajectoryKind::LawnMower {
+                scale,
+                omega,
+                depth,
+            } => {
+                let theta = math::phase(omega, ticks, rate_hz);
+                let (s1, c1) = harmonic(1, theta);
+                let (s2, c2) = harmonic(2, theta);
+                let two = 2.0 * omega;
+                let t = math::seconds(ticks, rate_hz);
+                let wave = 2.5 * scale * s2;
+                eta[0] = (0.25 * scale as f64 * t + wave as f64) as f32;
+                eta_dot[0] = scale * (0.25 + 2.5 * two * c2);
+                eta_ddot[0] = -2.5 * scale * two * two * s2;
+                let amp_y = 15.0 * scale;
+                eta[1] = amp_y * c1;
+                eta_dot[1] = -amp_y * omega * s1;
+                eta_ddot[1] = -amp_y * omega * omega * c1;
+                eta[2] = depth;
+                self.heading_series(theta, &mut eta, &mut eta_dot, &mut eta_ddot);
+            }
+        }
+        Desired {
+            eta,
+            eta_dot,
+            eta_ddot,
+        }
+    }
+
+    /// ψ_d, ψ̇_d, ψ̈_d from the precomputed odd-harmonic coefficients (fixed five terms).
+    fn heading_series(
+        &self,
+        theta: f32,
+        eta: &mut Vector6<f32>,
+        eta_dot: &mut Vector6<f32>,
+        eta_ddot: &mut Vector6<f32>,
+    ) {
+        let (mut psi, mut rate, mut accel) = (0.0f32, 0.0f32, 0.0f32);
+        for (i, c) in self.psi.iter().enumerate() {
+            let (s, co) = harmonic(2 * i as u32 + 1, theta);
+            psi += c[0] * s;
+            rate += c[1] * co;
+            accel -= c[2] * s;
+        }
+        eta[5] = math::wrap_pi(psi);
+        eta_dot[5] = rate;
+        eta_ddot[5] = accel;
+    }
+}
+
+/// Circle part shared by the circle and the helix: x, y, ψ and their derivatives.
+fn circle(
+    radius: f32,
+    omega: f32,
+    ticks: u64,
+    rate_hz: u32,
+    eta: &mut Vector6<f32>,
+    eta_dot: &mut Vector6<f32>,
+    eta_ddot: &mut Vector6<f32>,
+) {
+    let theta = math::phase(omega, ticks, rate_hz);
+    let (s, c) = harmonic(1, theta);
+    eta[0] = radius * s;
+    eta_dot[0] = radius * omega * c;
+    eta_ddot[0] = -radius * omega * omega * s;
+    eta[1] = radius * c;
+    eta_dot[1] = -radius * omega * s;
+    eta_ddot[1] = -radius * omega * omega * c;
+    eta[5] = math::wrap_pi(theta);
+    eta_dot[5] = omega;
+}
+
+/// (sin nθ, cos nθ) with n·θ wrapped to (−π, π] first (θ is a reduced phase; n·θ ≡ nωt mod 2π
+/// because n is an integer).
+#[inline]
+fn harmonic(n: u32, theta: f32) -> (f32, f32) {
+    math::sin_cos(math::wrap_pi(n as f32 * theta))
+}
+
+/// √s rounded up: the backend's `sqrt`, one Newton step (never below √s, by AM–GM) and a few
+/// ulps of margin for the final rounding.
+fn sqrt_upper(s: f32) -> f32 {
+    let y = math::sqrt(s);
+    if y > 0.0 && y.is_finite() {
+        0.5 * (y + s / y) * (1.0 + 4.0 * f32::EPSILON)
+    } else {
+        y
+    }
+}
+
+/// `value` finite and in (0, max].
+fn positive(parameter: &'static str, value: f32, max: f32) -> Result<(), TrajectoryError> {
+    if !value.is_finite() {
+        Err(TrajectoryError::NonFinite { parameter })
+    } else if value <= 0.0 {
+        Err(TrajectoryError::NotPositive { parameter, value })
+    } else if value > max {
+        Err(TrajectoryError::OutOfRange {
+            parameter,
+            value,
+            min: 0.0,
+            max,
+        })
+    } else {
+        Ok(())
+    }
+}
+
+/// `value` finite and in [−max, max].
+fn symmetric(parameter: &'static str, value: f32, max: f32) -> Result<(), TrajectoryError> {
+    if !value.is_finite() {
+        Err(TrajectoryError::NonFinite { parameter })
+    } else if !(-max..=max).contains(&value) {
+        Err(TrajectoryError::OutOfRange {
+            parameter,
+            value,
+            min: -max,
+            max,
+        })
+    } else {
+        Ok(())
+    }
+}
