@@ -3,5 +3,16 @@
 #![forbid(unsafe_code)]
 
 pub mod allocation;
+pub mod config;
+pub mod controller;
+pub mod kinematics;
+pub mod law;
 pub mod math;
+pub mod model;
 pub mod trajectory;
+pub mod uncertainty;
+
+pub use config::{BBound, ConfigError, ControllerConfig};
+pub use controller::{Controller, Fault, Output, Status};
+pub use law::RobustLaw;
+pub use trajectory::{Desired, Table1Case, Trajectory, TrajectoryKind};

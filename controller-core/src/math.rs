@@ -101,7 +101,8 @@ pub fn wrap_pi(x: f32) -> f32 {
     }
 }
 
-/// Reduces the phase ω·t, with t = `ticks` / `rate_hz` seconds, to [0, 2π) in f64 before it
+/// Reduces the phase ω·t, with t = `ticks` / `rate_hz` seconds, to [0, 2π] (up to one rounding
+/// either side; callers wrap before sin/cos) in f64 before it
 /// becomes f32 (AUV150.md §8, "Time"): an f32 `t` would lose a millisecond per tick after a few
 /// hours, and ω·t in f32 loses the phase itself. Fixed work (one floor, no loop).
 #[inline]

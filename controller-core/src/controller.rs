@@ -1,0 +1,352 @@
+//! [`Controller`]: a validated configuration and its precomputed constants, and
+//! [`Controller::update`], one step of the sampled robust law.
+//!
+//! `update` does a fixed amount of work (no loop whose length depends on data, no allocation)
+//! and never panics. Any non-finite or implausible input, a pitch beyond the configured limit,
+//! or a non-finite intermediate result gives the fail-safe output — all thrusters off — with a
+//! [`Status`] that says why. Nothing non-finite ever leaves it.
+
+use nalgebra::{Matrix6, Vector6};
+
+use crate::allocation::{self, Actuation, Allocation, ThrusterMap, THRUSTERS};
+use crate::config::{BBound, ConfigError, ControllerConfig};
+use crate::kinematics::{self, Attitude};
+use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
+use crate::model::{self, VehicleParams};
+use crate::trajectory::Trajectory;
+use crate::uncertainty::UncertaintyBounds;
+
+/// Largest |position| accepted (m). Positions are relative to a mission origin near the
+/// vehicle (AUV150.md §8): f32 keeps ≈ 1 mm at 10 km.
+pub const MAX_POSITION: f32 = 10_000.0;
+/// Largest |Euler angle| accepted (rad). Angles are wrapped internally; this only rejects
+/// absurd values.
+pub const MAX_ANGLE: f32 = 1_000.0;
+/// Largest |linear velocity| accepted (m/s); the AUV-150 cruises at ≈ 2 m/s.
+pub const MAX_LINEAR_SPEED: f32 = 50.0;
+/// Largest |angular velocity| accepted (rad/s).
+pub const MAX_ANGULAR_RATE: f32 = 50.0;
+
+/// Why the output is the fail-safe one.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fault {
+    /// η or ν contains NaN or ±∞.
+    NonFiniteInput,
+    /// η or ν is finite but outside the plausible range (see the `MAX_*` constants).
+    InputOutOfRange,
+    /// |θ| beyond the configured pitch limit (J is singular at ±90°, AUV150.md §8).
+    PitchLimit,
+    /// An intermediate result was not finite (overflow on extreme but accepted inputs).
+    NonFiniteResult,
+}
+
+/// Outcome of one `update`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Status {
+    /// The law ran; see the flags in [`Output`] for δ clamping and saturation.
+    Ok,
+    /// Fail-safe: every thruster off.
+    Fault(Fault),
+}
+
+/// Everything one step produces. All fields are finite, always.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Output {
+    pub status: Status,
+    /// Commanded body force τ = [X Y Z K M N] (N, N m). K is not actuated.
+    pub tau: [f32; 6],
+    /// Body force the thrusters actually give (B · achieved thrusts).
+    pub tau_achieved: [f32; 6],
+    /// Achieved thrust per thruster (N), order [main, vert fore, vert aft, horz fore, horz aft].
+    pub thrust: [f32; THRUSTERS],
+    /// Voltage per thruster (V), within ±voltage_limit.
+    pub voltage: [f32; THRUSTERS],
+    /// Bit i set: thruster i saturated.
+    pub saturated: u8,
+    /// δ(e,t) after the clamp, Eq (29). Computed (and reported) also when Δu is off.
+    pub delta: f32,
+    /// True when the δ clamp (AUV150.md §8) limited Δu this step (never when Δu is off).
+    pub delta_clamped: bool,
+    /// ‖w‖ = ‖BᵀPe‖.
+    pub w_norm: f32,
+    /// η_d this step.
+    pub eta_d: [f32; 6],
+    /// e₁ = η − η_d (yaw wrapped).
+    pub e1: [f32; 6],
+}
+
+impl Output {
+    /// The fail-safe output: thrusters off, everything zero, `status` = the fault.
+    pub const fn fail_safe(fault: Fault) -> Self {
+        Output {
+            status: Status::Fault(fault),
+            tau: [0.0; 6],
+            tau_achieved: [0.0; 6],
+            thrust: Actuation::OFF.thrusts,
+            voltage: Actuation::OFF.voltages,
+            saturated: 0,
+            delta: 0.0,
+            delta_clamped: false,
+            w_norm: 0.0,
+            eta_d: [0.0; 6],
+            e1: [0.0; 6],
+        }
+    }
+
+    fn all_finite(&self) -> bool {
+        self.tau
+            .iter()
+            .chain(self.tau_achieved.iter())
+            .chain(self.thrust.iter())
+            .chain(self.voltage.iter())
+            .chain(self.eta_d.iter())
+            .chain(self.e1.iter())
+            .chain([self.delta, self.w_norm].iter())
+            .all(|x| x.is_finite())
+    }
+}
+
+/// A validated configuration with everything `update` needs precomputed.
+#[derive(Clone, Debug)]
+pub struct Controller {
+    config: ControllerConfig,
+    m_hat: Matrix6<f32>,
+    k1: Vector6<f32>,
+    k2: Vector6<f32>,
+    lyapunov: [AxisLyapunov<f32>; 6],
+    delta_constants: DeltaConstants,
+    bounds: UncertaintyBounds<f32>,
+    allocation: Allocation,
+    maps: [ThrusterMap; THRUSTERS],
+    cos_pitch_limit: f32,
+}
+
+impl Controller {
+    /// Validates `config` and precomputes the law's constants. Every check of AUV150.md §4
+    /// and §8 is made here; see [`ConfigError`] for the list.
+    pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
+        config.check_scalars()?;
+        let allocation = Allocation::new(&config.geometry)?;
+
+        let bounds = UncertaintyBounds::compute(&config.params, &config.uncertainty)?;
+        let beta_hat = bounds.beta_hat;
+        if !(beta_hat < 1.0 && beta_hat <= config.beta) {
+            return Err(ConfigError::Assumption2 {
+                beta_hat,
+                beta: config.beta,
+            });
+        }
+        if !bounds.theorem2.holds() {
+            return Err(ConfigError::Theorem2 {
+                lhs: bounds.theorem2.lhs,
+                rhs: bounds.theorem2.rhs,
+            });
+        }
+
+        let mut lyapunov = [AxisLyapunov::default(); 6];
+        let mut k_norm = 0.0f32;
+        for &i in CONTROLLED.iter() {
+            let (k1, k2) = (config.k1[i], config.k2[i]);
+            lyapunov[i] = AxisLyapunov::solve(k1, k2, config.q[0], config.q[1]);
+            // ‖[K₁ K₂]‖₂ of diagonal blocks: max over axes of √(k₁² + k₂²).
+            k_norm = k_norm.max(libm::sqrtf(k1 * k1 + k2 * k2));
+        }
+
+        // AUV150.md §8: Δu inside the boundary layer is the gain δ/μ on w, a closed-loop pole
+        // near −(k₂ + p₂₂ δ/μ); forward-Euler sampling of it is stable for T·(…) < 2. The
+        // discontinuous law has no such pole (it chatters, bounded by δ), so only the
+        // nominal gain is checked for it.
+        let period = 1.0 / config.rate_hz as f32;
+        for &i in CONTROLLED.iter() {
+            let layer_gain = match (config.robust, config.law) {
+                (true, RobustLaw::BoundaryLayer) => lyapunov[i].p22 * config.delta_max / config.mu,
+                _ => 0.0,
+            };
+            let max_period = 2.0 / (config.k2[i] + layer_gain);
+            if period >= max_period {
+                return Err(ConfigError::LoopRate {
+                    axis: i,
+                    period,
+                    max_period,
+                    delta_max: config.delta_max,
+                    mu: config.mu,
+                });
+            }
+        }
+
+        let (b_level, b_sec_power) = match config.b_bound {
+            BBound::ControlledRows => (bounds.b_controlled, 1),
+            BBound::Literal => (bounds.b_full, 2),
+        };
+        let delta_constants = DeltaConstants {
+            beta: config.beta,
+            k_norm,
+            delta_m: bounds.delta_m,
+            delta_g: bounds.delta_g,
+            b_level,
+            b_sec_power,
+        };
+
+        Ok(Controller {
+            m_hat: model::mass_matrix(&config.params),
+            k1: Vector6::from(config.k1),
+            k2: Vector6::from(config.k2),
+            lyapunov,
+            delta_constants,
+            bounds,
+            allocation,
+            maps: allocation::default_maps(),
+            cos_pitch_limit: libm::cosf(config.pitch_limit),
+            config,
+        })
+    }
+
+    /// The configuration this controller was built from.
+    pub fn config(&self) -> &ControllerConfig {
+        &self.config
+    }
+
+    /// The bounds over the parameter box (for reports).
+    pub fn bounds(&self) -> &UncertaintyBounds<f32> {
+        &self.bounds
+    }
+
+    /// The constants of δ(e,t).
+    pub fn delta_constants(&self) -> &DeltaConstants {
+        &self.delta_constants
+    }
+
+    /// Per-axis Lyapunov solutions (roll entries zero).
+    pub fn lyapunov(&self) -> &[AxisLyapunov<f32>; 6] {
+        &self.lyapunov
+    }
+
+    /// The thrust allocation.
+    pub fn allocation(&self) -> &Allocation {
+        &self.allocation
+    }
+
+    /// Nominal M̂.
+    pub fn mass_matrix(&self) -> &Matrix6<f32> {
+        &self.m_hat
+    }
+
+    /// Nominal parameters.
+    pub fn params(&self) -> &VehicleParams<f32> {
+        &self.config.params
+    }
+
+    /// One control step at t = `ticks` / rate_hz seconds since mission start, with the vehicle
+    /// at pose `eta` (relative to the mission origin) and body velocity `nu`, tracking
+    /// `trajectory`.
+    pub fn update(
+        &self,
+        ticks: u64,
+        eta: &[f32; 6],
+        nu: &[f32; 6],
+        trajectory: &Trajectory,
+    ) -> Output {
+        match self.step(ticks, eta, nu, trajectory) {
+            Ok(out) if out.all_finite() => out,
+            Ok(_) => Output::fail_safe(Fault::NonFiniteResult),
+            Err(fault) => Output::fail_safe(fault),
+        }
+    }
+
+    fn step(
+        &self,
+        ticks: u64,
+        eta: &[f32; 6],
+        nu: &[f32; 6],
+        trajectory: &Trajectory,
+    ) -> Result<Output, Fault> {
+        check_inputs(eta, nu)?;
+        let eta = Vector6::from(*eta);
+        let nu = Vector6::from(*nu);
+        let att = Attitude::from_eta_f32(&eta);
+        // |cos θ| below cos(limit) ⇔ |θ| (mod 2π, folded) beyond the limit. θ is finite here,
+        // so cos θ is not NaN.
+        let cos_theta_abs = att.ctheta.abs();
+        if cos_theta_abs < self.cos_pitch_limit {
+            return Err(Fault::PitchLimit);
+        }
+
+        let desired = trajectory.sample(ticks, self.config.rate_hz);
+        let eta_dot = kinematics::eta_dot(&att, &nu).map_err(|_| Fault::PitchLimit)?;
+        let (e1, e2) = law::tracking_errors(&eta, &eta_dot, &desired.eta, &desired.eta_dot);
+        let u_bar = law::nominal_input(&desired.eta_ddot, &self.k1, &self.k2, &e1, &e2);
+        let jjn = kinematics::jinv_jdot_nu(&att, &nu).map_err(|_| Fault::PitchLimit)?;
+
+        let mut e_sq = 0.0f32;
+        for &i in CONTROLLED.iter() {
+            e_sq += e1[i] * e1[i] + e2[i] * e2[i];
+        }
+        let delta_raw = law::uncertainty_bound(
+            &self.delta_constants,
+            &DeltaInputs {
+                accel_bound: trajectory.accel_bound(),
+                error_norm: crate::math::sqrt(e_sq),
+                nu_norm: crate::math::norm(&nu.into()),
+                jinv_jdot_nu_norm: crate::math::norm(&jjn.into()),
+                cos_theta_abs,
+            },
+        );
+        if !delta_raw.is_finite() {
+            return Err(Fault::NonFiniteResult);
+        }
+        let delta_clamped = delta_raw > self.config.delta_max;
+        let delta = if delta_clamped {
+            self.config.delta_max
+        } else {
+            delta_raw
+        };
+
+        let w = law::switching_signal(&self.lyapunov, &e1, &e2);
+        let w_norm = crate::math::norm(&w.into());
+        let u = if self.config.robust {
+            u_bar + law::robust_term(self.config.law, &w, w_norm, delta, self.config.mu)
+        } else {
+            u_bar
+        };
+
+        let tau = law::body_force(&self.m_hat, &self.config.params, &att, &nu, &u, &jjn);
+        if !tau.iter().all(|x| x.is_finite()) {
+            return Err(Fault::NonFiniteResult);
+        }
+        let act = allocation::actuate(
+            &self.maps,
+            &self.allocation.thrusts(&tau),
+            self.config.voltage_limit,
+        );
+        let tau_achieved = self.allocation.wrench(&act.thrusts);
+
+        Ok(Output {
+            status: Status::Ok,
+            tau: tau.into(),
+            tau_achieved: tau_achieved.into(),
+            thrust: act.thrusts,
+            voltage: act.voltages,
+            saturated: act.saturated,
+            delta,
+            delta_clamped: self.config.robust && delta_clamped,
+            w_norm,
+            eta_d: desired.eta.into(),
+            e1: e1.into(),
+        })
+    }
+}
+
+fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {
+    if !eta.iter().chain(nu.iter()).all(|x| x.is_finite()) {
+        return Err(Fault::NonFiniteInput);
+    }
+    let plausible = eta[..3].iter().all(|x| x.abs() <= MAX_POSITION)
+        && eta[3..].iter().all(|x| x.abs() <= MAX_ANGLE)
+        && nu[..3].iter().all(|x| x.abs() <= MAX_LINEAR_SPEED)
+        && nu[3..].iter().all(|x| x.abs() <= MAX_ANGULAR_RATE);
+    if plausible {
+        Ok(())
+    } else {
+        Err(Fault::InputOutOfRange)
+    }
+}

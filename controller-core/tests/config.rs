@@ -1,0 +1,167 @@
+//! Every configuration check rejects what it should, with an error that names it and its
+//! numbers, and accepts the paper's defaults.
+// Tests change one field of the defaults at a time; that reads best as an assignment.
+#![allow(clippy::field_reassign_with_default)]
+
+use controller_core::config::{BBound, ConfigError, ControllerConfig};
+use controller_core::controller::Controller;
+use controller_core::law::RobustLaw;
+
+fn err(cfg: ControllerConfig) -> ConfigError {
+    match Controller::new(cfg) {
+        Ok(_) => panic!("configuration was accepted"),
+        Err(e) => e,
+    }
+}
+
+#[test]
+fn paper_defaults_are_accepted() {
+    let c = Controller::new(ControllerConfig::default()).expect("paper defaults");
+    let cfg = c.config();
+    assert_eq!(cfg.k1, [4.0, 4.0, 4.0, 0.0, 4.0, 4.0]);
+    assert_eq!(cfg.k2, [4.0, 4.0, 4.0, 0.0, 4.0, 4.0]);
+    assert_eq!((cfg.beta, cfg.mu), (0.605, 0.1));
+    assert_eq!(cfg.law, RobustLaw::BoundaryLayer);
+    // ‖[K₁ K₂]‖₂ = √(4² + 4²).
+    assert!((c.delta_constants().k_norm - 32f32.sqrt()).abs() < 1e-6);
+}
+
+#[test]
+fn gains_must_be_positive_on_controlled_axes_and_zero_on_roll() {
+    let mut c = ControllerConfig::default();
+    c.k1[4] = -1.0;
+    assert!(matches!(err(c), ConfigError::Gain { name: "K1", axis: 4, value } if value == -1.0));
+    let mut c = ControllerConfig::default();
+    c.k2[0] = f32::NAN;
+    assert!(matches!(
+        err(c),
+        ConfigError::Gain {
+            name: "K2",
+            axis: 0,
+            ..
+        }
+    ));
+    let mut c = ControllerConfig::default();
+    c.k1[3] = 4.0;
+    assert!(matches!(err(c), ConfigError::RollGain { k1, .. } if k1 == 4.0));
+}
+
+#[test]
+fn scalar_ranges_are_checked_by_name() {
+    type Setter = fn(&mut ControllerConfig);
+    let cases: [(&str, Setter); 6] = [
+        ("beta", |c| c.beta = 1.0),
+        ("beta", |c| c.beta = 0.0),
+        ("mu", |c| c.mu = 0.0),
+        ("delta_max", |c| c.delta_max = -3.0),
+        ("pitch_limit", |c| c.pitch_limit = 95f32.to_radians()),
+        ("voltage_limit", |c| c.voltage_limit = f32::INFINITY),
+    ];
+    for (name, set) in cases {
+        let mut c = ControllerConfig::default();
+        set(&mut c);
+        match err(c) {
+            ConfigError::OutOfRange { name: n, .. } => assert_eq!(n, name),
+            other => panic!("{name}: got {other:?}"),
+        }
+    }
+    let mut c = ControllerConfig::default();
+    c.rate_hz = 0;
+    assert_eq!(err(c), ConfigError::ZeroRate);
+    let mut c = ControllerConfig::default();
+    c.q = [1.0, 0.0];
+    assert!(matches!(err(c), ConfigError::LyapunovWeight { .. }));
+    let mut c = ControllerConfig::default();
+    c.params.mass = f32::NAN;
+    assert_eq!(err(c), ConfigError::NonFiniteParams);
+    let mut c = ControllerConfig::default();
+    c.uncertainty.lower.mass = 40.0; // above the upper end (30)
+    assert_eq!(err(c), ConfigError::InvalidBox);
+}
+
+#[test]
+fn assumption_2_rejects_a_box_beyond_beta() {
+    // Half the vehicle's mass again as payload: β̂ ≈ 0.3…0.5 > a tight β.
+    let mut c = ControllerConfig::default();
+    c.uncertainty.upper.mass = 250.0;
+    c.beta = 0.2;
+    match err(c) {
+        ConfigError::Assumption2 { beta_hat, beta } => {
+            assert_eq!(beta, 0.2);
+            assert!(beta_hat > 0.2 && beta_hat < 1.0, "β̂ = {beta_hat}");
+            let text = err(c).to_string();
+            assert!(
+                text.contains("Assumption 2") && text.contains("0.2"),
+                "{text}"
+            );
+        }
+        other => panic!("got {other:?}"),
+    }
+    // The same box is fine with the paper's β = 0.605 if β̂ is below it.
+    let mut c = ControllerConfig::default();
+    c.uncertainty.upper.mass = 250.0;
+    let b = Controller::new(c).map(|c| c.bounds().beta_hat);
+    if let Ok(beta_hat) = b {
+        assert!(beta_hat <= 0.605);
+    }
+}
+
+#[test]
+fn theorem_2_as_printed_is_evaluated() {
+    // A large forward CG shift couples heave and pitch through m·x_G ≈ 74 kg m, pushing
+    // λmin(ΔM) far below −λmin(M): the printed criterion fails.
+    let mut c = ControllerConfig::default();
+    c.uncertainty.upper.r_g[0] = 0.15;
+    match err(c) {
+        ConfigError::Theorem2 { lhs, rhs } => {
+            assert!(lhs >= rhs);
+            assert!(err(c).to_string().contains("Theorem 2"));
+        }
+        other => panic!("got {other:?}"),
+    }
+    let ok = Controller::new(ControllerConfig::default()).unwrap();
+    assert!(ok.bounds().theorem2.holds());
+}
+
+#[test]
+fn loop_period_is_checked_against_the_boundary_layer_gain() {
+    // AUV150.md §8: with δ_max = 25, μ = 0.1, p₂₂ = 0.15625, k₂ = 4 the loop needs
+    // T < 2/(4 + 39.06) = 46 ms: 10 Hz must fail, 25 Hz pass.
+    let mut c = ControllerConfig::default();
+    c.rate_hz = 10;
+    match err(c) {
+        ConfigError::LoopRate {
+            period, max_period, ..
+        } => {
+            assert!((period - 0.1).abs() < 1e-6);
+            assert!((max_period - 2.0 / (4.0 + 0.15625 * 25.0 / 0.1)).abs() < 1e-5);
+        }
+        other => panic!("got {other:?}"),
+    }
+    let mut c = ControllerConfig::default();
+    c.rate_hz = 25;
+    assert!(Controller::new(c).is_ok());
+    // The literal ‖b‖ bound lets δ reach ≈ 200: unclamped at 100 Hz it cannot be stable.
+    let mut c = ControllerConfig::default();
+    c.b_bound = BBound::Literal;
+    c.delta_max = 250.0;
+    assert!(matches!(err(c), ConfigError::LoopRate { .. }));
+    assert!(err(c).to_string().contains("AUV150.md §8"));
+    // …with the default clamp it is accepted.
+    let mut c = ControllerConfig::default();
+    c.b_bound = BBound::Literal;
+    assert!(Controller::new(c).is_ok());
+    // Without Δu only the nominal gain matters: 10 Hz is fine.
+    let mut c = ControllerConfig::default();
+    c.robust = false;
+    c.rate_hz = 10;
+    assert!(Controller::new(c).is_ok());
+}
+
+#[test]
+fn degenerate_thruster_geometry_is_rejected() {
+    let mut c = ControllerConfig::default();
+    c.geometry.position[2] = c.geometry.position[1];
+    c.geometry.direction[2] = c.geometry.direction[1];
+    assert!(matches!(err(c), ConfigError::Allocation(_)));
+}
