@@ -1,0 +1,133 @@
+//! What one simulation run is: mission, plant, disturbances, actuators and controller.
+//!
+//! [`SimConfig`] is plain data; `scenario.rs` reads it from TOML, `table1.rs` builds the
+//! paper's six cases.
+
+use controller_core::model::ParamVariation;
+use controller_core::{ControllerConfig, TrajectoryKind};
+
+/// How the plant's parameters vary with time (Table 3, AUV150.md §2). Δp is added to the
+/// nominal parameters of the **plant only**; the controller keeps the nominal model.
+#[derive(Clone, Debug, PartialEq)]
+pub enum VariationProfile {
+    /// No variation: the plant is the nominal model.
+    None,
+    /// Δp constant in time (the paper's figure-eight: Table 3's maximum).
+    Constant(ParamVariation<f64>),
+    /// Δp(t) = max · |sin(ω t)| (the paper's circle, ω = 0.1).
+    AbsSin {
+        max: ParamVariation<f64>,
+        omega: f64,
+    },
+    /// Piecewise constant: `steps[i].1` holds until `steps[i].0` seconds; the last value holds
+    /// after. The paper's lawn-mower: max until 25 s, then the 25–50 s row, then the last row.
+    Staircase(Vec<(f64, ParamVariation<f64>)>),
+}
+
+impl VariationProfile {
+    /// Δp at time t (s).
+    pub fn at(&self, t: f64) -> ParamVariation<f64> {
+        match self {
+            VariationProfile::None => ParamVariation::default(),
+            VariationProfile::Constant(d) => *d,
+            VariationProfile::AbsSin { max, omega } => max.scaled((omega * t).sin().abs()),
+            VariationProfile::Staircase(steps) => {
+                for (until, d) in steps {
+                    if t <= *until {
+                        return *d;
+                    }
+                }
+                steps.last().map(|s| s.1).unwrap_or_default()
+            }
+        }
+    }
+
+    /// The paper's lawn-mower staircase (Table 3).
+    pub fn table3_staircase() -> Self {
+        let row = |mass, xg, yg, zg, ix, iy, iz, xu, yv| ParamVariation {
+            mass,
+            r_g: [xg, yg, zg],
+            inertia: [ix, iy, iz],
+            x_udot: xu,
+            y_vdot: yv,
+        };
+        VariationProfile::Staircase(vec![
+            (25.0, row(30.0, 0.05, 0.02, 0.02, 2.0, 5.0, 10.0, 3.0, 50.0)),
+            (50.0, row(20.0, 0.03, 0.01, 0.018, 1.5, 3.5, 7.0, 2.0, 35.0)),
+            (
+                f64::INFINITY,
+                row(10.0, 0.02, 0.005, 0.015, 1.0, 2.5, 5.0, 1.5, 25.0),
+            ),
+        ])
+    }
+}
+
+/// Earth-fixed ocean current (AUV150.md §2): the plant sees ν_r = ν − [Rᵀ v_c; 0] in C_A and D.
+#[derive(Clone, Debug, PartialEq)]
+pub enum CurrentModel {
+    None,
+    /// Constant v_c (m/s, NED).
+    Constant([f64; 3]),
+    /// First-order Gauss–Markov per axis: v̇ = −(v − mean)/tau + sigma·√(2/tau)·w(t), seeded.
+    GaussMarkov {
+        mean: [f64; 3],
+        sigma: [f64; 3],
+        tau: f64,
+        seed: u64,
+    },
+}
+
+/// Gaussian noise added to the measured η and ν the controller sees (seeded).
+#[derive(Clone, Debug, PartialEq)]
+pub struct SensorNoise {
+    pub eta_sigma: [f64; 6],
+    pub nu_sigma: [f64; 6],
+    pub seed: u64,
+}
+
+/// One run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SimConfig {
+    /// Case name, used for file names and reports.
+    pub name: String,
+    pub trajectory: TrajectoryKind,
+    /// Simulated time (s). Paper: 70.
+    pub duration: f64,
+    /// Plant RK4 step (s). Default 1 ms.
+    pub plant_step: f64,
+    /// The controller (its `rate_hz` is the sampled loop's rate; zero-order hold in between).
+    pub controller: ControllerConfig,
+    pub variation: VariationProfile,
+    pub current: CurrentModel,
+    pub noise: Option<SensorNoise>,
+    /// First-order thruster lag time constant (s), if any.
+    pub thruster_lag: Option<f64>,
+    /// Ideal actuators: the thrusters deliver the allocated thrust whatever the voltage limit
+    /// (the Table-1 reproduction; AUV150.md §5). Voltages are still computed and reported.
+    pub ideal_actuators: bool,
+    /// Added to η(0) = η_d(0) (m, rad).
+    pub initial_offset: [f64; 6],
+    /// A position error beyond this (m) is a runaway: the run stops and says so.
+    pub divergence_limit: f64,
+}
+
+impl SimConfig {
+    /// Defaults around a mission: 70 s, 1 ms plant step, the paper's controller at 100 Hz,
+    /// no variation, no current, no noise, ideal actuators, starting on the reference.
+    pub fn new(name: impl Into<String>, trajectory: TrajectoryKind) -> Self {
+        SimConfig {
+            name: name.into(),
+            trajectory,
+            duration: 70.0,
+            plant_step: 0.001,
+            controller: ControllerConfig::default(),
+            variation: VariationProfile::None,
+            current: CurrentModel::None,
+            noise: None,
+            thruster_lag: None,
+            ideal_actuators: true,
+            initial_offset: [0.0; 6],
+            divergence_limit: 50.0,
+        }
+    }
+}

@@ -1,0 +1,163 @@
+//! The full nonlinear 6-DOF AUV-150 plant of Eq (1), in f64, with Fossen's current model:
+//!
+//! M_RB ν̇ + C_RB(ν) ν + M_A ν̇_r + C_A(ν_r) ν_r + D(ν_r) ν_r + g(η) = τ,  η̇ = J(η) ν,
+//!
+//! with ν_r = ν − ν_c, ν_c = [Rᵀ v_c; 0] for an earth-fixed current v_c (AUV150.md §2). The
+//! matrices come from `controller_core::model` with the plant's (varying) parameters, so the
+//! plant and the controller share one implementation of Eq (1) and differ only in parameters.
+//!
+//! For a current that is constant over a step, ν̇_c = [−ω × Rᵀv_c; 0]. The payload's dm/dt
+//! is not modelled (the paper's variations are parameter changes, not mass flow).
+
+use controller_core::kinematics::{self, Attitude, GimbalLock};
+use controller_core::model::{self, VehicleParams};
+use nalgebra::{Matrix6, Vector3, Vector6};
+
+/// Position and velocity of the vehicle.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlantState {
+    /// η = [x y z φ θ ψ] (NED, m, rad).
+    pub eta: Vector6<f64>,
+    /// ν = [u v w p q r] (body, m/s, rad/s).
+    pub nu: Vector6<f64>,
+}
+
+impl PlantState {
+    pub fn is_finite(&self) -> bool {
+        self.eta.iter().chain(self.nu.iter()).all(|x| x.is_finite())
+    }
+}
+
+/// Which physical terms the plant includes (all on for simulation; tests switch some off to
+/// check invariants).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PlantTerms {
+    pub damping: bool,
+    pub restoring: bool,
+}
+
+impl Default for PlantTerms {
+    fn default() -> Self {
+        PlantTerms {
+            damping: true,
+            restoring: true,
+        }
+    }
+}
+
+/// The plant at one set of parameters, for one integration step: M and its factorisation are
+/// formed once per step.
+pub struct Plant {
+    params: VehicleParams<f64>,
+    m_rb: Matrix6<f64>,
+    m_a: Matrix6<f64>,
+    m_chol: nalgebra::Cholesky<f64, nalgebra::U6>,
+    terms: PlantTerms,
+}
+
+/// The plant cannot go on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum PlantError {
+    /// M(p) is not positive definite for these parameters.
+    MassNotPositiveDefinite,
+    /// Pitch reached ±90°, where the Euler-angle kinematics are singular.
+    GimbalLock,
+}
+
+impl From<GimbalLock> for PlantError {
+    fn from(_: GimbalLock) -> Self {
+        PlantError::GimbalLock
+    }
+}
+
+impl std::fmt::Display for PlantError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            PlantError::MassNotPositiveDefinite => write!(f, "plant M(p) is not positive definite"),
+            PlantError::GimbalLock => {
+                write!(f, "plant pitch reached ±90° (Euler kinematics singular)")
+            }
+        }
+    }
+}
+
+impl Plant {
+    pub fn new(params: VehicleParams<f64>, terms: PlantTerms) -> Result<Self, PlantError> {
+        let m_rb = model::rigid_body_mass(&params);
+        let m_a = model::added_mass(&params);
+        let m_chol = (m_rb + m_a)
+            .cholesky()
+            .ok_or(PlantError::MassNotPositiveDefinite)?;
+        Ok(Plant {
+            params,
+            m_rb,
+            m_a,
+            m_chol,
+            terms,
+        })
+    }
+
+    pub fn params(&self) -> &VehicleParams<f64> {
+        &self.params
+    }
+
+    /// M = M_RB + M_A.
+    pub fn mass_matrix(&self) -> Matrix6<f64> {
+        self.m_rb + self.m_a
+    }
+
+    /// (η̇, ν̇) of Eqs (1)–(2) under body force `tau` and earth-fixed current `current`.
+    pub fn derivative(
+        &self,
+        s: &PlantState,
+        tau: &Vector6<f64>,
+        current: &Vector3<f64>,
+    ) -> Result<(Vector6<f64>, Vector6<f64>), PlantError> {
+        let att = Attitude::from_eta(&s.eta);
+        let eta_dot = kinematics::eta_dot(&att, &s.nu)?;
+        let omega = Vector3::new(s.nu[3], s.nu[4], s.nu[5]);
+        let vc_body = kinematics::rotation(&att).transpose() * current;
+        let nu_c = Vector6::new(vc_body.x, vc_body.y, vc_body.z, 0.0, 0.0, 0.0);
+        let dvc = -omega.cross(&vc_body);
+        let nu_c_dot = Vector6::new(dvc.x, dvc.y, dvc.z, 0.0, 0.0, 0.0);
+        let nu_r = s.nu - nu_c;
+        let mut rhs = tau
+            - model::coriolis(&self.m_rb, &s.nu) * s.nu
+            - model::coriolis(&self.m_a, &nu_r) * nu_r
+            + self.m_a * nu_c_dot;
+        if self.terms.damping {
+            rhs -= model::damping(&self.params, &nu_r) * nu_r;
+        }
+        if self.terms.restoring {
+            rhs -= model::restoring(&self.params, &att);
+        }
+        Ok((eta_dot, self.m_chol.solve(&rhs)))
+    }
+
+    /// One classical RK4 step of length `h` with τ and the current held (zero-order hold).
+    pub fn rk4_step(
+        &self,
+        s: &PlantState,
+        tau: &Vector6<f64>,
+        current: &Vector3<f64>,
+        h: f64,
+    ) -> Result<PlantState, PlantError> {
+        let at = |eta: Vector6<f64>, nu: Vector6<f64>| PlantState { eta, nu };
+        let (k1e, k1n) = self.derivative(s, tau, current)?;
+        let s2 = at(s.eta + k1e * (h / 2.0), s.nu + k1n * (h / 2.0));
+        let (k2e, k2n) = self.derivative(&s2, tau, current)?;
+        let s3 = at(s.eta + k2e * (h / 2.0), s.nu + k2n * (h / 2.0));
+        let (k3e, k3n) = self.derivative(&s3, tau, current)?;
+        let s4 = at(s.eta + k3e * h, s.nu + k3n * h);
+        let (k4e, k4n) = self.derivative(&s4, tau, current)?;
+        Ok(at(
+            s.eta + (k1e + k2e * 2.0 + k3e * 2.0 + k4e) * (h / 6.0),
+            s.nu + (k1n + k2n * 2.0 + k3n * 2.0 + k4n) * (h / 6.0),
+        ))
+    }
+
+    /// Kinetic energy ½ νᵀ M ν.
+    pub fn kinetic_energy(&self, nu: &Vector6<f64>) -> f64 {
+        0.5 * nu.dot(&(self.mass_matrix() * nu))
+    }
+}

@@ -1,0 +1,287 @@
+//! Software in the loop: the f32 `controller-core` as the firmware runs it, sampled at its own
+//! rate with zero-order hold, around the f64 plant integrated with RK4 at the plant step.
+//!
+//! Per control period k (t = k/rate):
+//! 1. measure η, ν (plus seeded sensor noise), round to f32, call `Controller::update(k, …)`;
+//! 2. actuation: ideal — the allocated thrusts B₅⁻¹τ are delivered whatever the voltage;
+//!    real — the controller's (clamped) voltages go through the inverse of Eqs 31–32 to
+//!    thrust; a controller fault means every thruster off (0 N);
+//! 3. optional first-order thruster lag, then τ_applied = B·thrust;
+//! 4. RK4 substeps with τ held, the plant's parameters and the current evaluated per substep.
+//!
+//! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
+//! run with a reason; every sample recorded until then is kept.
+
+use controller_core::allocation::{self, THRUSTERS};
+use controller_core::kinematics::{self, Attitude};
+use controller_core::model::VehicleParams;
+use controller_core::{ConfigError, Controller, Status, Trajectory};
+use nalgebra::{Vector3, Vector6};
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+
+use crate::config::{CurrentModel, SimConfig};
+use crate::metrics;
+use crate::plant::{Plant, PlantState, PlantTerms};
+use crate::record::{Outcome, RunResult, Sample};
+
+/// A run could not start.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SimError {
+    Controller(ConfigError),
+    Trajectory(controller_core::trajectory::TrajectoryError),
+    /// The plant step must divide the control period into a whole number of steps.
+    PlantStep {
+        plant_step: f64,
+        period: f64,
+    },
+    /// Duration not finite or not positive.
+    Duration(f64),
+}
+
+impl std::fmt::Display for SimError {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            SimError::Controller(e) => write!(f, "controller configuration: {e}"),
+            SimError::Trajectory(e) => write!(f, "trajectory: {e}"),
+            SimError::PlantStep { plant_step, period } => write!(
+                f,
+                "plant_step {plant_step} s does not divide the control period {period} s into whole steps"
+            ),
+            SimError::Duration(d) => write!(f, "duration {d} s must be finite and > 0"),
+        }
+    }
+}
+
+impl std::error::Error for SimError {}
+
+/// Ocean current state (Gauss–Markov is a random process, stepped with the plant).
+struct Current {
+    model: CurrentModel,
+    v: Vector3<f64>,
+    rng: rand::rngs::StdRng,
+}
+
+impl Current {
+    fn new(model: &CurrentModel) -> Self {
+        let (v, seed) = match model {
+            CurrentModel::None => (Vector3::zeros(), 0),
+            CurrentModel::Constant(v) => (Vector3::from(*v), 0),
+            CurrentModel::GaussMarkov { mean, seed, .. } => (Vector3::from(*mean), *seed),
+        };
+        Current {
+            model: model.clone(),
+            v,
+            rng: rand::rngs::StdRng::seed_from_u64(seed),
+        }
+    }
+
+    /// Euler–Maruyama step of v̇ = −(v − mean)/τ + σ√(2/τ)·w: stationary std σ.
+    fn step(&mut self, h: f64) {
+        if let CurrentModel::GaussMarkov {
+            mean, sigma, tau, ..
+        } = &self.model
+        {
+            for i in 0..3 {
+                let w: f64 = StandardNormal.sample(&mut self.rng);
+                self.v[i] +=
+                    -(self.v[i] - mean[i]) / tau * h + sigma[i] * (2.0 * h / tau).sqrt() * w;
+            }
+        }
+    }
+}
+
+fn wrap_pi(x: f64) -> f64 {
+    let r = (x + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU) - std::f64::consts::PI;
+    if r <= -std::f64::consts::PI {
+        r + std::f64::consts::TAU
+    } else {
+        r
+    }
+}
+
+fn to_f64<const N: usize>(a: &[f32; N]) -> [f64; N] {
+    a.map(|x| x as f64)
+}
+
+/// Runs one simulation.
+pub fn run(cfg: &SimConfig) -> Result<RunResult, SimError> {
+    let controller = Controller::new(cfg.controller).map_err(SimError::Controller)?;
+    let trajectory = Trajectory::new(cfg.trajectory).map_err(SimError::Trajectory)?;
+    if !(cfg.duration.is_finite() && cfg.duration > 0.0) {
+        return Err(SimError::Duration(cfg.duration));
+    }
+    let rate = cfg.controller.rate_hz;
+    let period = 1.0 / rate as f64;
+    let substeps = (period / cfg.plant_step).round();
+    if !(substeps >= 1.0 && (substeps * cfg.plant_step - period).abs() < 1e-9 * period) {
+        return Err(SimError::PlantStep {
+            plant_step: cfg.plant_step,
+            period,
+        });
+    }
+    let substeps = substeps as usize;
+    let h = period / substeps as f64;
+    let steps = (cfg.duration * rate as f64).round() as u64;
+
+    let nominal = VehicleParams::auv150();
+    let alloc_b = controller.allocation().matrix().cast::<f64>();
+    let maps = allocation::default_maps();
+
+    // Start on the reference (AUV150.md §6), plus the configured offset.
+    let d0 = trajectory.sample(0, rate);
+    let mut state = PlantState {
+        eta: d0.eta.cast::<f64>() + Vector6::from(cfg.initial_offset),
+        nu: Vector6::zeros(),
+    };
+    state.nu = kinematics::jacobian_inv(&Attitude::from_eta(&state.eta)) * d0.eta_dot.cast::<f64>();
+
+    let mut current = Current::new(&cfg.current);
+    let mut noise_rng = rand::rngs::StdRng::seed_from_u64(cfg.noise.as_ref().map_or(0, |n| n.seed));
+    let lag_alpha = cfg.thruster_lag.map(|tl| 1.0 - (-h / tl).exp());
+    let mut thrust_applied: Option<[f64; THRUSTERS]> = None;
+
+    let mut samples = Vec::with_capacity(steps as usize + 1);
+    let mut outcome = Outcome::Completed;
+
+    for k in 0..=steps {
+        let t = k as f64 * period;
+        let d = trajectory.sample(k, rate);
+        let eta_d = to_f64(&d.eta.into());
+        let mut error = [0.0; 6];
+        for i in 0..6 {
+            error[i] = state.eta[i] - eta_d[i];
+        }
+        error[5] = wrap_pi(error[5]);
+        let pos_err = (error[0] * error[0] + error[1] * error[1] + error[2] * error[2]).sqrt();
+        if !state.is_finite() {
+            outcome = Outcome::Diverged {
+                t,
+                reason: "plant state is not finite".into(),
+            };
+            break;
+        }
+        if pos_err > cfg.divergence_limit {
+            outcome = Outcome::Diverged {
+                t,
+                reason: format!(
+                    "position error {pos_err:.1} m exceeds the divergence limit {} m",
+                    cfg.divergence_limit
+                ),
+            };
+            break;
+        }
+
+        // 1. Measure and control.
+        let (mut eta_m, mut nu_m) = (state.eta, state.nu);
+        if let Some(n) = &cfg.noise {
+            for i in 0..6 {
+                let a: f64 = StandardNormal.sample(&mut noise_rng);
+                let b: f64 = StandardNormal.sample(&mut noise_rng);
+                eta_m[i] += n.eta_sigma[i] * a;
+                nu_m[i] += n.nu_sigma[i] * b;
+            }
+        }
+        let out = controller.update(
+            k,
+            &eta_m.cast::<f32>().into(),
+            &nu_m.cast::<f32>().into(),
+            &trajectory,
+        );
+
+        // 2. Actuation.
+        let target: [f64; THRUSTERS] = match out.status {
+            Status::Fault(_) => [0.0; THRUSTERS],
+            Status::Ok if cfg.ideal_actuators => {
+                to_f64(&controller.allocation().thrusts(&Vector6::from(out.tau)))
+            }
+            Status::Ok => {
+                let mut t = [0.0; THRUSTERS];
+                for i in 0..THRUSTERS {
+                    t[i] = maps[i].thrust(out.voltage[i]) as f64;
+                }
+                t
+            }
+        };
+        let mut rec = Sample {
+            t,
+            eta: state.eta.into(),
+            eta_d,
+            error,
+            tau: to_f64(&out.tau),
+            tau_applied: [0.0; 6],
+            thrust: [0.0; THRUSTERS],
+            voltage: to_f64(&out.voltage),
+            saturated: out.saturated,
+            delta: out.delta as f64,
+            delta_clamped: out.delta_clamped,
+            w_norm: out.w_norm as f64,
+            payload: cfg.variation.at(t).mass,
+            status: status_name(out.status),
+        };
+        if k == steps {
+            rec.thrust = thrust_applied.unwrap_or(target);
+            rec.tau_applied =
+                (alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(rec.thrust)).into();
+            samples.push(rec);
+            break;
+        }
+
+        // 3.–4. Lag, wrench, integrate.
+        let mut applied = thrust_applied.unwrap_or(target);
+        let mut first_applied = None;
+        for j in 0..substeps {
+            if let Some(alpha) = lag_alpha {
+                for i in 0..THRUSTERS {
+                    applied[i] += alpha * (target[i] - applied[i]);
+                }
+            } else {
+                applied = target;
+            }
+            if first_applied.is_none() {
+                first_applied = Some(applied);
+            }
+            let tau = alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(applied);
+            let ts = t + j as f64 * h;
+            let params = nominal.with_variation(&cfg.variation.at(ts));
+            let stepped = Plant::new(params, PlantTerms::default())
+                .and_then(|plant| plant.rk4_step(&state, &tau, &current.v, h));
+            match stepped {
+                Ok(s) => state = s,
+                Err(e) => {
+                    outcome = Outcome::Diverged {
+                        t: ts,
+                        reason: e.to_string(),
+                    };
+                    break;
+                }
+            }
+            current.step(h);
+        }
+        rec.thrust = first_applied.unwrap_or(target);
+        rec.tau_applied = (alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(rec.thrust)).into();
+        samples.push(rec);
+        thrust_applied = Some(applied);
+        if matches!(outcome, Outcome::Diverged { .. }) {
+            break;
+        }
+    }
+
+    Ok(RunResult {
+        name: cfg.name.clone(),
+        robust: cfg.controller.robust,
+        metrics: metrics::compute(&samples),
+        outcome,
+        samples,
+    })
+}
+
+fn status_name(s: Status) -> &'static str {
+    match s {
+        Status::Ok => "ok",
+        Status::Fault(controller_core::Fault::NonFiniteInput) => "fault:non-finite-input",
+        Status::Fault(controller_core::Fault::InputOutOfRange) => "fault:input-out-of-range",
+        Status::Fault(controller_core::Fault::PitchLimit) => "fault:pitch-limit",
+        Status::Fault(controller_core::Fault::NonFiniteResult) => "fault:non-finite-result",
+    }
+}
