@@ -1,0 +1,458 @@
+//! Scenario files: the shipped Table-1 files, the example, unknown keys and bad values.
+
+use std::path::{Path, PathBuf};
+
+use controller_core::model::ParamVariation;
+use controller_core::{BBound, ControllerConfig, RobustLaw, Table1Case, TrajectoryKind};
+use host_sim::config::{CurrentModel, SimConfig, VariationProfile};
+use host_sim::scenario::{load_scenario, parse_scenario, table1_scenario, ScenarioError};
+
+fn scenarios_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+}
+
+/// A minimal valid scenario followed by `extra` (tables appended after [trajectory]).
+fn circle_with(extra: &str) -> String {
+    format!("name = \"t\"\n[trajectory]\nkind = \"circle\"\nradius = 10.0\n{extra}")
+}
+
+#[track_caller]
+fn invalid_key(text: &str) -> (String, String) {
+    match parse_scenario(text) {
+        Err(ScenarioError::Invalid { key, message }) => (key, message),
+        other => panic!("expected Invalid, got {other:?}"),
+    }
+}
+
+#[track_caller]
+fn toml_error(text: &str) -> String {
+    match parse_scenario(text) {
+        Err(e @ ScenarioError::Toml(_)) => e.to_string(),
+        other => panic!("expected a Toml error, got {other:?}"),
+    }
+}
+
+#[test]
+fn shipped_table1_files_equal_table1_scenario() {
+    for case in Table1Case::ALL {
+        let path = scenarios_dir().join(format!("{}.toml", case.name()));
+        let loaded = load_scenario(&path).unwrap_or_else(|e| panic!("{e}"));
+        let expected = table1_scenario(case, true);
+        assert_eq!(loaded, expected, "{}", path.display());
+        assert_eq!(loaded.name, case.name());
+        assert_eq!(loaded.trajectory, case.kind());
+    }
+}
+
+#[test]
+fn table1_scenario_without_du_differs_only_in_robust() {
+    for case in Table1Case::ALL {
+        let mut without = table1_scenario(case, false);
+        assert!(!without.controller.robust);
+        without.controller.robust = true;
+        assert_eq!(without, table1_scenario(case, true));
+    }
+}
+
+#[test]
+fn table1_profiles_are_the_papers() {
+    let c = table1_scenario(Table1Case::Circular20R, true);
+    assert_eq!(
+        c.variation,
+        VariationProfile::AbsSin {
+            max: ParamVariation::TABLE3_MAX,
+            omega: 0.1
+        }
+    );
+    let f = table1_scenario(Table1Case::FigureEight30x30, true);
+    assert_eq!(
+        f.variation,
+        VariationProfile::Constant(ParamVariation::TABLE3_MAX)
+    );
+    let l = table1_scenario(Table1Case::LawnMower20x10, true);
+    assert_eq!(l.variation, VariationProfile::table3_staircase());
+    for s in [c, f, l] {
+        assert_eq!(s.duration, 70.0);
+        assert_eq!(s.plant_step, 0.001);
+        assert_eq!(s.controller, ControllerConfig::default());
+        assert!(s.ideal_actuators);
+        assert_eq!(s.current, CurrentModel::None);
+        assert_eq!(s.noise, None);
+        assert_eq!(s.thruster_lag, None);
+    }
+}
+
+#[test]
+fn example_file_parses_with_every_section() {
+    let path = scenarios_dir().join("example-all-knobs.toml");
+    let s = load_scenario(&path).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.name, "example-all-knobs");
+    assert!(matches!(s.trajectory, TrajectoryKind::Helix { .. }));
+    assert!(matches!(s.current, CurrentModel::GaussMarkov { .. }));
+    assert!(s.noise.is_some());
+    assert_eq!(s.thruster_lag, Some(0.02));
+    match &s.variation {
+        VariationProfile::Staircase(steps) => {
+            assert_eq!(steps.len(), 2);
+            assert_eq!(steps[0].0, 35.0);
+            assert_eq!(steps[1], (f64::INFINITY, ParamVariation::default()));
+        }
+        other => panic!("expected a staircase, got {other:?}"),
+    }
+    // Its [controller] spells out the defaults.
+    assert_eq!(s.controller, ControllerConfig::default());
+}
+
+#[test]
+fn example_file_runs() {
+    // The example, shortened: noise, current, lag and staircase through the SIL loop.
+    let mut s = load_scenario(&scenarios_dir().join("example-all-knobs.toml")).unwrap();
+    s.duration = 5.0;
+    let result = host_sim::sil::run(&s).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(result.outcome, host_sim::record::Outcome::Completed);
+}
+
+#[test]
+fn minimal_scenario_takes_defaults() {
+    let s = parse_scenario("[trajectory]\nkind = \"lawn-mower\"\nscale = 1\n").unwrap();
+    assert_eq!(
+        s,
+        SimConfig::new("scenario", Table1Case::LawnMower30x15.kind())
+    );
+}
+
+#[test]
+fn missing_name_takes_the_file_stem() {
+    let dir = std::env::temp_dir().join(format!("host-sim-scenario-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("my-run.toml");
+    std::fs::write(&path, "[trajectory]\nkind = \"circle\"\nradius = 5\n").unwrap();
+    let s = load_scenario(&path);
+    std::fs::remove_dir_all(&dir).unwrap();
+    assert_eq!(s.unwrap().name, "my-run");
+}
+
+#[test]
+fn every_knob_is_read() {
+    let text = r#"
+        name = "all"
+        duration = 12.5
+        plant_step = 0.002
+        ideal_actuators = false
+        initial_offset = [0.1, 0.2, 0.3, 0.0, 0.01, -0.02]
+        divergence_limit = 20
+        thruster_lag = 0.1
+        [trajectory]
+        kind = "figure-eight"
+        amplitude = 12.0
+        omega = 0.2
+        depth = 3.0
+        [variation]
+        profile = "abs-sin"
+        omega = 0.3
+        mass = 10.0
+        [current]
+        model = "constant"
+        velocity = [0.3, -0.1, 0.0]
+        [noise]
+        nu_sigma = [0.1, 0.1, 0.1, 0.0, 0.0, 0.0]
+        seed = 9
+        [controller]
+        robust = false
+        law = "discontinuous"
+        k1 = [1.0, 2.0, 3.0, 0.0, 4.0, 5.0]
+        k2 = [2.0, 3.0, 4.0, 0.0, 5.0, 6.0]
+        q = [2.0, 3.0]
+        beta = 0.9
+        mu = 0.2
+        delta_max = 10.0
+        rate_hz = 50
+        pitch_limit_deg = 60.0
+        voltage_limit = 12.0
+        b_bound = "literal"
+    "#;
+    let s = parse_scenario(text).unwrap_or_else(|e| panic!("{e}"));
+    assert_eq!(s.name, "all");
+    assert_eq!(s.duration, 12.5);
+    assert_eq!(s.plant_step, 0.002);
+    assert!(!s.ideal_actuators);
+    assert_eq!(s.initial_offset, [0.1, 0.2, 0.3, 0.0, 0.01, -0.02]);
+    assert_eq!(s.divergence_limit, 20.0);
+    assert_eq!(s.thruster_lag, Some(0.1));
+    assert_eq!(
+        s.trajectory,
+        TrajectoryKind::FigureEight {
+            amplitude: 12.0,
+            omega: 0.2,
+            depth: 3.0
+        }
+    );
+    let max = ParamVariation {
+        mass: 10.0,
+        ..ParamVariation::default()
+    };
+    assert_eq!(s.variation, VariationProfile::AbsSin { max, omega: 0.3 });
+    assert_eq!(s.current, CurrentModel::Constant([0.3, -0.1, 0.0]));
+    let noise = s.noise.unwrap();
+    assert_eq!(noise.eta_sigma, [0.0; 6]);
+    assert_eq!(noise.nu_sigma, [0.1, 0.1, 0.1, 0.0, 0.0, 0.0]);
+    assert_eq!(noise.seed, 9);
+    let c = s.controller;
+    assert!(!c.robust);
+    assert_eq!(c.law, RobustLaw::Discontinuous);
+    assert_eq!(c.k1, [1.0, 2.0, 3.0, 0.0, 4.0, 5.0]);
+    assert_eq!(c.k2, [2.0, 3.0, 4.0, 0.0, 5.0, 6.0]);
+    assert_eq!(c.q, [2.0, 3.0]);
+    assert_eq!(c.beta, 0.9);
+    assert_eq!(c.mu, 0.2);
+    assert_eq!(c.delta_max, 10.0);
+    assert_eq!(c.rate_hz, 50);
+    assert_eq!(c.pitch_limit, 60.0_f32.to_radians());
+    assert_eq!(c.voltage_limit, 12.0);
+    assert_eq!(c.b_bound, BBound::Literal);
+}
+
+#[test]
+fn variation_defaults_to_table3_max_only_when_no_delta_is_given() {
+    let s = parse_scenario(&circle_with("[variation]\nprofile = \"constant\"\n")).unwrap();
+    assert_eq!(
+        s.variation,
+        VariationProfile::Constant(ParamVariation::TABLE3_MAX)
+    );
+    let s = parse_scenario(&circle_with("[variation]\nprofile = \"abs-sin\"\n")).unwrap();
+    assert_eq!(
+        s.variation,
+        VariationProfile::AbsSin {
+            max: ParamVariation::TABLE3_MAX,
+            omega: 0.1
+        }
+    );
+    let s = parse_scenario(&circle_with(
+        "[variation]\nprofile = \"constant\"\ny_g = 0.01\n",
+    ))
+    .unwrap();
+    let expected = ParamVariation {
+        r_g: [0.0, 0.01, 0.0],
+        ..ParamVariation::default()
+    };
+    assert_eq!(s.variation, VariationProfile::Constant(expected));
+}
+
+#[test]
+fn gauss_markov_current_defaults() {
+    let s = parse_scenario(&circle_with(
+        "[current]\nmodel = \"gauss-markov\"\nsigma = [0.1, 0.1, 0.0]\ntau = 10\n",
+    ))
+    .unwrap();
+    assert_eq!(
+        s.current,
+        CurrentModel::GaussMarkov {
+            mean: [0.0; 3],
+            sigma: [0.1, 0.1, 0.0],
+            tau: 10.0,
+            seed: 1
+        }
+    );
+}
+
+#[test]
+fn unknown_top_level_key_is_named() {
+    let msg = toml_error(&circle_with("").replace("name = \"t\"", "name = \"t\"\nspeed = 3"));
+    assert!(msg.contains("speed"), "{msg}");
+    assert!(msg.contains("line 2"), "{msg}");
+}
+
+#[test]
+fn unknown_controller_key_is_named() {
+    let msg = toml_error(&circle_with("[controller]\nmu = 0.1\ngain_k3 = 2.0\n"));
+    assert!(msg.contains("gain_k3"), "{msg}");
+}
+
+#[test]
+fn unknown_keys_in_every_table_are_errors() {
+    for table in [
+        "[trajectory]\nkind = \"circle\"\nradius = 1\nradiu = 2\n",
+        "[trajectory]\nkind = \"circle\"\nradius = 1\n[variation]\nprofile = \"none\"\nbogus = 1\n",
+        "[trajectory]\nkind = \"circle\"\nradius = 1\n[variation]\nprofile = \"staircase\"\n\
+         [[variation.steps]]\nbogus = 1\n",
+        "[trajectory]\nkind = \"circle\"\nradius = 1\n[current]\nmodel = \"none\"\nbogus = 1\n",
+        "[trajectory]\nkind = \"circle\"\nradius = 1\n[noise]\nbogus = 1\n",
+    ] {
+        let msg = toml_error(table);
+        assert!(msg.contains("bogus") || msg.contains("radiu"), "{msg}");
+    }
+}
+
+#[test]
+fn unknown_enum_value_is_a_toml_error() {
+    let msg = toml_error("[trajectory]\nkind = \"square\"\nradius = 1\n");
+    assert!(msg.contains("square"), "{msg}");
+}
+
+#[test]
+fn missing_trajectory_is_a_toml_error() {
+    let msg = toml_error("name = \"x\"\n");
+    assert!(msg.contains("trajectory"), "{msg}");
+}
+
+#[test]
+fn negative_mu_names_the_key() {
+    let (key, message) = invalid_key(&circle_with("[controller]\nmu = -1\n"));
+    assert_eq!(key, "controller.mu");
+    assert_eq!(message, "must be > 0, got -1");
+    let e = parse_scenario(&circle_with("[controller]\nmu = -1\n")).unwrap_err();
+    assert!(e.to_string().contains("controller.mu"), "{e}");
+}
+
+#[test]
+fn negative_radius_names_the_key() {
+    let (key, message) = invalid_key("[trajectory]\nkind = \"circle\"\nradius = -5\n");
+    assert_eq!(key, "trajectory.radius");
+    assert!(message.contains("radius"), "{message}");
+}
+
+#[test]
+fn trajectory_parameters_are_checked() {
+    let (key, _) = invalid_key("[trajectory]\nkind = \"lawn-mower\"\nscale = 1\nomega = 0\n");
+    assert_eq!(key, "trajectory.omega");
+    let (key, _) = invalid_key("[trajectory]\nkind = \"circle\"\nradius = nan\n");
+    assert_eq!(key, "trajectory.radius");
+    let (key, _) = invalid_key("[trajectory]\nkind = \"helix\"\nradius = 5\n");
+    assert_eq!(key, "trajectory.depth_rate");
+    let (key, message) = invalid_key("[trajectory]\nkind = \"circle\"\namplitude = 5\n");
+    assert_eq!(key, "trajectory.amplitude");
+    assert!(message.contains("circle"), "{message}");
+    let (key, _) = invalid_key("[trajectory]\nkind = \"figure-eight\"\n");
+    assert_eq!(key, "trajectory.amplitude");
+}
+
+#[test]
+fn slow_loop_is_refused_by_the_controller_check() {
+    let (key, message) = invalid_key(&circle_with("[controller]\nrate_hz = 5\n"));
+    assert_eq!(key, "controller");
+    assert!(message.contains("loop period"), "{message}");
+}
+
+#[test]
+fn decreasing_staircase_times_are_refused() {
+    let text = circle_with(
+        "[variation]\nprofile = \"staircase\"\n\
+         [[variation.steps]]\nuntil = 30.0\nmass = 10\n\
+         [[variation.steps]]\nuntil = 20.0\nmass = 5\n\
+         [[variation.steps]]\nmass = 0\n",
+    );
+    let (key, message) = invalid_key(&text);
+    assert_eq!(key, "variation.steps[1].until");
+    assert!(message.contains("increase"), "{message}");
+}
+
+#[test]
+fn staircase_needs_until_on_all_but_the_last_step() {
+    let text = circle_with(
+        "[variation]\nprofile = \"staircase\"\n\
+         [[variation.steps]]\nmass = 10\n[[variation.steps]]\nmass = 5\n",
+    );
+    let (key, _) = invalid_key(&text);
+    assert_eq!(key, "variation.steps[0].until");
+}
+
+#[test]
+fn wrong_type_is_a_toml_error_naming_the_key() {
+    let msg = toml_error(&circle_with("[controller]\nmu = \"small\"\n"));
+    assert!(msg.contains("mu"), "{msg}");
+    assert!(msg.contains("line 6"), "{msg}");
+    let msg = toml_error("duration = \"long\"\n[trajectory]\nkind = \"circle\"\nradius = 1\n");
+    assert!(msg.contains("duration"), "{msg}");
+}
+
+#[test]
+fn other_bad_values_name_their_keys() {
+    let cases: &[(&str, &str)] = &[
+        ("duration = 0\n", "duration"),
+        ("duration = 90000\n", "duration"),
+        ("duration = inf\n", "duration"),
+        ("plant_step = 0.2\n", "plant_step"),
+        ("plant_step = 0.02\n", "plant_step"), // > the 10 ms control period
+        ("plant_step = 0.003\n", "plant_step"), // does not divide 10 ms
+        ("divergence_limit = 0\n", "divergence_limit"),
+        ("thruster_lag = 0\n", "thruster_lag"),
+        (
+            "initial_offset = [0, 0, nan, 0, 0, 0]\n",
+            "initial_offset[2]",
+        ),
+        ("name = \"a/b\"\n", "name"),
+        ("name = \"\"\n", "name"),
+    ];
+    for (top, expected) in cases {
+        let text = format!("{top}[trajectory]\nkind = \"circle\"\nradius = 10\n");
+        let (key, _) = invalid_key(&text);
+        assert_eq!(&key, expected, "{top}");
+    }
+    let tables: &[(&str, &str)] = &[
+        ("[controller]\nrate_hz = 0\n", "controller.rate_hz"),
+        ("[controller]\nbeta = 1.0\n", "controller.beta"),
+        ("[controller]\ndelta_max = 0\n", "controller.delta_max"),
+        (
+            "[controller]\npitch_limit_deg = 90\n",
+            "controller.pitch_limit_deg",
+        ),
+        (
+            "[controller]\nvoltage_limit = -24\n",
+            "controller.voltage_limit",
+        ),
+        (
+            "[controller]\nk1 = [4, 4, 4, 1, 4, 4]\n",
+            "controller.k1[3]",
+        ),
+        (
+            "[controller]\nk2 = [4, 0, 4, 0, 4, 4]\n",
+            "controller.k2[1]",
+        ),
+        ("[controller]\nq = [1, -1]\n", "controller.q[1]"),
+        ("[controller]\nmu = 0.001\n", "controller"), // δ_max/μ too high for 100 Hz
+        (
+            "[noise]\neta_sigma = [0, 0, -0.1, 0, 0, 0]\n",
+            "noise.eta_sigma[2]",
+        ),
+        (
+            "[current]\nmodel = \"gauss-markov\"\nsigma = [0, 0, 0]\ntau = 0\n",
+            "current.tau",
+        ),
+        (
+            "[current]\nmodel = \"gauss-markov\"\ntau = 1\n",
+            "current.sigma",
+        ),
+        ("[current]\nmodel = \"constant\"\n", "current.velocity"),
+        ("[current]\nmodel = \"none\"\ntau = 1\n", "current.tau"),
+        (
+            "[variation]\nprofile = \"abs-sin\"\nomega = -1\n",
+            "variation.omega",
+        ),
+        (
+            "[variation]\nprofile = \"constant\"\nomega = 1\n",
+            "variation.omega",
+        ),
+        (
+            "[variation]\nprofile = \"none\"\nmass = 1\n",
+            "variation.mass",
+        ),
+        (
+            "[variation]\nprofile = \"constant\"\nmass = -600\n",
+            "variation",
+        ),
+        ("[variation]\nprofile = \"staircase\"\n", "variation.steps"),
+    ];
+    for (table, expected) in tables {
+        let (key, _) = invalid_key(&circle_with(table));
+        assert_eq!(&key, expected, "{table}");
+    }
+}
+
+#[test]
+fn missing_file_error_names_the_path() {
+    let path = scenarios_dir().join("no-such-scenario.toml");
+    let e = load_scenario(&path).unwrap_err();
+    assert!(matches!(e, ScenarioError::Io { .. }), "{e:?}");
+    assert!(e.to_string().contains("no-such-scenario.toml"), "{e}");
+    assert!(std::error::Error::source(&e).is_some());
+}
