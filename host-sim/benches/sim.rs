@@ -1,0 +1,37 @@
+//! Plant and mission benchmarks: `cargo bench -p host-sim --bench sim`.
+//! The real-time factor is 70 s divided by the mission time reported here.
+
+use std::hint::black_box;
+
+use controller_core::model::{ParamVariation, VehicleParams};
+use controller_core::Table1Case;
+use criterion::{criterion_group, criterion_main, Criterion};
+use host_sim::plant::{Plant, PlantState, PlantTerms};
+use host_sim::scenario::table1_scenario;
+use nalgebra::{Vector3, Vector6};
+
+fn bench(c: &mut Criterion) {
+    let params = VehicleParams::auv150().with_variation(&ParamVariation::TABLE3_MAX);
+    let s = PlantState {
+        eta: Vector6::new(1.0, 2.0, 5.0, 0.1, 0.05, 0.3),
+        nu: Vector6::new(1.5, 0.1, 0.05, 0.02, 0.01, 0.1),
+    };
+    let tau = Vector6::new(500.0, 100.0, -50.0, 0.0, 20.0, 30.0);
+    let current = Vector3::new(0.2, 0.0, 0.0);
+    c.bench_function("plant RK4 step (incl. M and its Cholesky)", |b| {
+        b.iter(|| {
+            let plant = Plant::new(black_box(params), PlantTerms::default()).unwrap();
+            plant.rk4_step(black_box(&s), black_box(&tau), black_box(&current), 0.001)
+        })
+    });
+    let cfg = table1_scenario(Table1Case::LawnMower30x15, true);
+    let mut group = c.benchmark_group("mission");
+    group.sample_size(20);
+    group.bench_function("lawn-mower-30x15, 70 s, 1 ms plant, 100 Hz loop", |b| {
+        b.iter(|| host_sim::sil::run(black_box(&cfg)).unwrap())
+    });
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

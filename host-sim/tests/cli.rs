@@ -1,0 +1,205 @@
+//! The CLI's paths from the README, run as a user would, with their messages and exit codes.
+
+use std::process::Command;
+
+fn host_sim() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+}
+
+fn scenario_dir() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+}
+
+#[test]
+fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
+    let out_dir = tempdir("table1");
+    let out = host_sim()
+        .args(["table1", "--json", "--out"])
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value =
+        serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
+    let cases = v["cases"].as_array().unwrap();
+    assert_eq!(cases.len(), 12);
+    for name in [
+        "circular-10R",
+        "circular-20R",
+        "figure-eight-30x30",
+        "figure-eight-40x40",
+        "lawn-mower-20x10",
+        "lawn-mower-30x15",
+    ] {
+        for robust in [true, false] {
+            let c = cases
+                .iter()
+                .find(|c| c["case"] == name && c["robust"] == robust)
+                .unwrap_or_else(|| panic!("{name} robust={robust} missing"));
+            for key in [
+                "max_x",
+                "max_y",
+                "max_z",
+                "max_path",
+                "rms_path",
+                "max_roll",
+                "max_pitch",
+                "max_yaw",
+                "peak_voltage",
+                "saturated_fraction",
+            ] {
+                assert!(c[key].is_f64(), "{name}: {key}");
+            }
+            // The paper's path definition.
+            let p = (c["max_x"].as_f64().unwrap().powi(2)
+                + c["max_y"].as_f64().unwrap().powi(2)
+                + c["max_z"].as_f64().unwrap().powi(2))
+            .sqrt();
+            assert!((p - c["max_path"].as_f64().unwrap()).abs() < 1e-12);
+        }
+    }
+    let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
+    assert!(report.contains("circular-10R") && report.contains(".png"));
+    assert!(out_dir.join("circular-10R-with.csv").exists());
+}
+
+#[test]
+fn run_with_a_shipped_scenario_writes_csv_plots_and_report() {
+    let out_dir = tempdir("run");
+    let out = host_sim()
+        .args(["run", "--scenario"])
+        .arg(scenario_dir().join("lawn-mower-20x10.toml"))
+        .arg("--out")
+        .arg(&out_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for f in [
+        "lawn-mower-20x10-with.csv",
+        "lawn-mower-20x10-xy.png",
+        "report.md",
+    ] {
+        assert!(out_dir.join(f).exists(), "{f} missing");
+    }
+}
+
+#[test]
+fn a_bad_scenario_file_names_the_file_and_the_key_and_exits_2() {
+    let dir = tempdir("bad");
+    let path = dir.join("bad.toml");
+    std::fs::write(
+        &path,
+        "[trajectory]\nkind = \"circle\"\nradius = 10\n[controller]\nmu = -1\n",
+    )
+    .unwrap();
+    let out = host_sim()
+        .args(["run", "--scenario"])
+        .arg(&path)
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("bad.toml") && err.contains("controller.mu"),
+        "{err}"
+    );
+
+    let out = host_sim()
+        .args(["run", "--scenario", "/nonexistent/x.toml"])
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("/nonexistent/x.toml"));
+}
+
+#[test]
+fn a_diverging_run_says_so_keeps_its_data_and_exits_1() {
+    let dir = tempdir("diverge");
+    let path = dir.join("runaway.toml");
+    // Without Δu and with a thousandth of the paper's gains the vehicle cannot hold the
+    // circle against the payload: the error grows past the 2 m limit.
+    std::fs::write(
+        &path,
+        "name = \"runaway\"\ndivergence_limit = 2.0\n[trajectory]\nkind = \"circle\"\nradius = 20\n\
+         [variation]\nprofile = \"constant\"\n\
+         [controller]\nrobust = false\nk1 = [0.004, 0.004, 0.004, 0, 0.004, 0.004]\nk2 = [0.004, 0.004, 0.004, 0, 0.004, 0.004]\n",
+    )
+    .unwrap();
+    let out = host_sim()
+        .args(["run", "--json", "--scenario"])
+        .arg(&path)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+    let d = &v["cases"][0]["diverged"];
+    assert!(
+        d["reason"].as_str().unwrap().contains("divergence limit"),
+        "{v}"
+    );
+    let t = d["t"].as_f64().unwrap();
+    assert!(t > 0.0 && t < 70.0);
+    // Everything up to the stop is on disk.
+    let csv = std::fs::read_to_string(dir.join("out").join("runaway-with.csv")).unwrap();
+    assert!(csv.lines().count() > 10);
+    let report = std::fs::read_to_string(dir.join("out").join("report.md")).unwrap();
+    assert!(report.contains("DIVERGED"), "{report}");
+}
+
+#[test]
+fn monte_carlo_is_deterministic_per_seed() {
+    let run = |seed: &str| {
+        let dir = tempdir(&format!("mc{seed}"));
+        let out = host_sim()
+            .args([
+                "monte-carlo",
+                "--runs",
+                "4",
+                "--seed",
+                seed,
+                "--json",
+                "--out",
+            ])
+            .arg(&dir)
+            .output()
+            .unwrap();
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        v
+    };
+    let a = run("7");
+    let b = run("7");
+    assert_eq!(a, b);
+    assert_eq!(a["runs"], 4);
+    assert!(a["metrics"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .any(|m| m["name"] == "max_path"));
+}
+
+fn tempdir(tag: &str) -> std::path::PathBuf {
+    let d = std::env::temp_dir().join(format!("host-sim-cli-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
