@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 # rust-toolchain.toml pins stable + the thumbv7em target; make sure both are present.
 rustup target add thumbv7em-none-eabihf >/dev/null
 
-echo "== host tests (libm backend)"
+echo "== host tests (libm backend): controller-core, host-sim (plant, scenarios, CLI), closed loop"
 cargo test --workspace --release
 
 echo "== controller-core tests with the micromath backend"
