@@ -1,0 +1,315 @@
+//! Frames: encoding, one-shot decoding and the streaming [`FrameDecoder`].
+
+use crate::cobs;
+use crate::msg::{Envelope, PROTOCOL_VERSION};
+use core::fmt;
+
+/// CRC-16/IBM-3740 (a.k.a. CRC-16/CCITT-FALSE): poly 0x1021, init 0xFFFF, no reflection,
+/// no final XOR; check value ("123456789") 0x29B1.
+pub(crate) const CRC: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740);
+
+/// Length of the CRC trailer (bytes, little-endian).
+pub const CRC_LEN: usize = 2;
+
+/// Worst-case length of the un-stuffed frame body: postcard(Envelope) ‖ CRC.
+pub const MAX_BODY: usize = Envelope::MAX_SIZE + CRC_LEN;
+
+/// Worst-case length of a complete frame on the wire: COBS of the body plus the `0x00`
+/// delimiter. An `out` buffer of this size makes [`encode`] infallible, and a receiver never
+/// needs more.
+pub const MAX_FRAME: usize = cobs::max_encoded_len(MAX_BODY) + 1;
+
+/// Why a frame was not encoded or not accepted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum LinkError {
+    /// More than `MAX_FRAME − 1` bytes without a delimiter: the bytes up to the next `0x00`
+    /// are dropped.
+    Overflow,
+    /// Not a valid COBS encoding (a code byte runs past the end of the frame).
+    Cobs,
+    /// The CRC does not match (or the frame is too short to hold one).
+    Crc,
+    /// The CRC matched but the body is not a postcard `Envelope` of this version (unknown
+    /// variant, bad `Option`/`bool` tag, bytes missing or left over).
+    Deserialize,
+    /// The CRC matched but the sender speaks another protocol version.
+    Version {
+        /// The version byte received.
+        got: u8,
+    },
+    /// [`encode`]: `out` is too short for this frame (`MAX_FRAME` bytes always suffice).
+    BufferTooSmall,
+    /// [`encode`]: postcard refused the message (cannot happen while `Envelope::MAX_SIZE` is
+    /// right).
+    Serialize,
+}
+
+impl fmt::Display for LinkError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            LinkError::Overflow => write!(f, "frame longer than {} bytes", MAX_FRAME - 1),
+            LinkError::Cobs => f.write_str("invalid COBS encoding"),
+            LinkError::Crc => f.write_str("CRC mismatch"),
+            LinkError::Deserialize => f.write_str("malformed message"),
+            LinkError::Version { got } => {
+                write!(f, "protocol version {got}, expected {PROTOCOL_VERSION}")
+            }
+            LinkError::BufferTooSmall => f.write_str("output buffer too small for the frame"),
+            LinkError::Serialize => f.write_str("message could not be serialized"),
+        }
+    }
+}
+
+impl core::error::Error for LinkError {}
+
+/// Encodes `env` as one complete frame, delimiter included, into `out`, and returns the frame's
+/// length. Never panics; fails only if `out` is too short (`out.len() >= MAX_FRAME` always
+/// suffices). The version field is sent as it is (use [`Envelope::new`] for the current one).
+pub fn encode(env: &Envelope, out: &mut [u8]) -> Result<usize, LinkError> {
+    let mut body = [0u8; MAX_BODY];
+    let n = postcard::to_slice(env, &mut body[..Envelope::MAX_SIZE])
+        .map_err(|_| LinkError::Serialize)?
+        .len();
+    let crc = CRC.checksum(&body[..n]).to_le_bytes();
+    body[n..n + CRC_LEN].copy_from_slice(&crc);
+    let len = cobs::encode(&body[..n + CRC_LEN], out).ok_or(LinkError::BufferTooSmall)?;
+    *out.get_mut(len).ok_or(LinkError::BufferTooSmall)? = 0;
+    Ok(len + 1)
+}
+
+/// Decodes one frame given without its `0x00` delimiter. The buffer is used as scratch (COBS is
+/// undone in place). Checks, in order: length (≤ `MAX_FRAME − 1`, else `Overflow`), COBS, CRC,
+/// version byte, then the postcard body, which must use every byte. Never panics.
+pub fn decode_frame(frame: &mut [u8]) -> Result<Envelope, LinkError> {
+    if frame.len() > MAX_FRAME - 1 {
+        return Err(LinkError::Overflow);
+    }
+    let n = cobs::decode_in_place(frame).map_err(|_| LinkError::Cobs)?;
+    let body = frame.get(..n).ok_or(LinkError::Cobs)?;
+    let split = n.checked_sub(CRC_LEN).ok_or(LinkError::Crc)?;
+    let (payload, crc) = body.split_at(split);
+    if CRC.checksum(payload).to_le_bytes() != crc {
+        return Err(LinkError::Crc);
+    }
+    match payload.first() {
+        None => return Err(LinkError::Deserialize),
+        Some(&v) if v != PROTOCOL_VERSION => return Err(LinkError::Version { got: v }),
+        Some(_) => {}
+    }
+    match postcard::take_from_bytes::<Envelope>(payload) {
+        Ok((env, [])) => Ok(env),
+        _ => Err(LinkError::Deserialize),
+    }
+}
+
+/// Streaming receiver: feed it every received byte; it hands back a result each time a `0x00`
+/// completes a frame.
+///
+/// Fixed memory (`MAX_FRAME − 1` bytes of buffer), no heap, never panics. `push` is O(1) except
+/// on a delimiter that completes a frame, where [`decode_frame`] runs over at most
+/// `MAX_FRAME − 1` bytes. Empty frames (consecutive delimiters) are ignored. After any error the
+/// decoder starts afresh at the next delimiter.
+#[derive(Clone, Debug)]
+pub struct FrameDecoder {
+    buf: [u8; MAX_FRAME - 1],
+    len: usize,
+    /// Dropping bytes until the next delimiter (after an overflow or [`resync`](Self::resync)).
+    discarding: bool,
+    frames: u32,
+    errors: u32,
+}
+
+impl Default for FrameDecoder {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+impl FrameDecoder {
+    /// An empty decoder; the first frame may start at the first byte.
+    pub const fn new() -> Self {
+        FrameDecoder {
+            buf: [0; MAX_FRAME - 1],
+            len: 0,
+            discarding: false,
+            frames: 0,
+            errors: 0,
+        }
+    }
+
+    /// Takes one received byte. Returns `Some` when the byte completes a frame (a `0x00` after
+    /// a non-empty frame) and when a frame overflows (`Err(Overflow)`, reported once, at the
+    /// byte that overflows; the rest of that frame up to the next `0x00` is dropped).
+    pub fn push(&mut self, byte: u8) -> Option<Result<Envelope, LinkError>> {
+        if byte == 0 {
+            let len = core::mem::take(&mut self.len);
+            if core::mem::take(&mut self.discarding) || len == 0 {
+                return None;
+            }
+            let result = match self.buf.get_mut(..len) {
+                Some(frame) => decode_frame(frame),
+                None => Err(LinkError::Overflow),
+            };
+            return Some(self.count(result));
+        }
+        if self.discarding {
+            return None;
+        }
+        match self.buf.get_mut(self.len) {
+            Some(slot) => {
+                *slot = byte;
+                self.len += 1;
+                None
+            }
+            None => {
+                self.len = 0;
+                self.discarding = true;
+                Some(self.count(Err(LinkError::Overflow)))
+            }
+        }
+    }
+
+    /// Pushes every byte of `bytes` and calls `on_frame` with each result, in order.
+    pub fn push_slice(
+        &mut self,
+        bytes: &[u8],
+        mut on_frame: impl FnMut(Result<Envelope, LinkError>),
+    ) {
+        for &b in bytes {
+            if let Some(result) = self.push(b) {
+                on_frame(result);
+            }
+        }
+    }
+
+    /// Drops the partial frame and every byte up to the next delimiter (call after a UART
+    /// overrun or framing error: the frame in progress has lost bytes).
+    pub fn resync(&mut self) {
+        self.len = 0;
+        self.discarding = true;
+    }
+
+    /// Frames accepted since creation (wrapping).
+    pub const fn rx_frames(&self) -> u32 {
+        self.frames
+    }
+
+    /// Errors reported since creation (wrapping): every `Err` that `push` returned.
+    pub const fn rx_errors(&self) -> u32 {
+        self.errors
+    }
+
+    fn count(&mut self, result: Result<Envelope, LinkError>) -> Result<Envelope, LinkError> {
+        match result {
+            Ok(_) => self.frames = self.frames.wrapping_add(1),
+            Err(_) => self.errors = self.errors.wrapping_add(1),
+        }
+        result
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::msg::{Command, Msg};
+
+    #[test]
+    fn crc_is_ccitt_false() {
+        assert_eq!(CRC.checksum(b"123456789"), 0x29B1);
+    }
+
+    #[test]
+    fn frame_layout() {
+        let env = Envelope::new(0x0102, Msg::Command(Command::Arm));
+        let mut out = [0u8; MAX_FRAME];
+        let n = encode(&env, &mut out).unwrap();
+        // postcard: version 01, seq varint 0x0102 = 82 02, Msg::Command = 01, Command::Arm = 00.
+        let body = [0x01, 0x82, 0x02, 0x01, 0x00];
+        let crc = CRC.checksum(&body).to_le_bytes();
+        let mut raw = [0u8; 7];
+        raw[..5].copy_from_slice(&body);
+        raw[5..].copy_from_slice(&crc);
+        let mut want = [0u8; 16];
+        let m = cobs::encode(&raw, &mut want).unwrap();
+        want[m] = 0;
+        assert_eq!(&out[..n], &want[..m + 1]);
+        assert_eq!(out[n - 1], 0);
+        assert!(!out[..n - 1].contains(&0));
+    }
+
+    #[test]
+    fn short_frames_are_errors_not_panics() {
+        for frame in [&[][..], &[0x01], &[0x02, 0x05], &[0x01, 0x01, 0x01]] {
+            let mut buf = [0u8; 4];
+            buf[..frame.len()].copy_from_slice(frame);
+            assert!(decode_frame(&mut buf[..frame.len()]).is_err());
+        }
+        // A valid CRC over an empty payload: no version byte.
+        let crc = CRC.checksum(&[]).to_le_bytes();
+        let mut buf = [0u8; 4];
+        let n = cobs::encode(&crc, &mut buf).unwrap();
+        assert_eq!(decode_frame(&mut buf[..n]), Err(LinkError::Deserialize));
+    }
+
+    #[test]
+    fn trailing_bytes_are_rejected() {
+        let env = Envelope::new(7, Msg::Command(Command::Disarm));
+        let mut body = [0u8; MAX_BODY + 1];
+        let n = postcard::to_slice(&env, &mut body).unwrap().len();
+        body[n] = 0xAA; // one extra byte, covered by the CRC
+        let crc = CRC.checksum(&body[..n + 1]).to_le_bytes();
+        body[n + 1..n + 3].copy_from_slice(&crc);
+        let mut frame = [0u8; MAX_FRAME + 1];
+        let m = cobs::encode(&body[..n + 3], &mut frame).unwrap();
+        assert_eq!(decode_frame(&mut frame[..m]), Err(LinkError::Deserialize));
+    }
+
+    #[test]
+    fn encode_reports_short_output() {
+        let env = Envelope::new(1, Msg::Command(Command::StopMission));
+        let mut out = [0u8; MAX_FRAME];
+        let n = encode(&env, &mut out).unwrap();
+        for len in 0..n {
+            assert_eq!(
+                encode(&env, &mut out[..len]),
+                Err(LinkError::BufferTooSmall),
+                "len {len}"
+            );
+        }
+        assert_eq!(encode(&env, &mut out[..n]), Ok(n));
+    }
+
+    #[test]
+    fn resync_drops_the_partial_frame() {
+        let env = Envelope::new(3, Msg::Command(Command::Arm));
+        let mut out = [0u8; MAX_FRAME];
+        let n = encode(&env, &mut out).unwrap();
+        let mut dec = FrameDecoder::new();
+        for &b in &out[..n / 2] {
+            assert_eq!(dec.push(b), None);
+        }
+        dec.resync();
+        for &b in &out[n / 2..n] {
+            assert_eq!(dec.push(b), None);
+        }
+        let mut got = None;
+        dec.push_slice(&out[..n], |r| got = Some(r));
+        assert_eq!(got, Some(Ok(env)));
+        assert_eq!((dec.rx_frames(), dec.rx_errors()), (1, 0));
+    }
+
+    #[test]
+    fn display_names_the_problem() {
+        extern crate std;
+        use std::string::ToString;
+        assert_eq!(
+            LinkError::Version { got: 2 }.to_string(),
+            "protocol version 2, expected 1"
+        );
+        assert_eq!(
+            LinkError::Overflow.to_string(),
+            std::format!("frame longer than {} bytes", MAX_FRAME - 1)
+        );
+    }
+}

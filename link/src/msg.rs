@@ -1,0 +1,297 @@
+//! The messages and their worst-case postcard sizes.
+//!
+//! **Wire compatibility:** postcard writes fields in declaration order and enum variants by
+//! their index (declaration order, from 0). Reordering, removing or retyping a field or variant
+//! changes the protocol: bump [`PROTOCOL_VERSION`] and update the `MAX_SIZE` constants (the
+//! `max_sizes_are_exact` test fails until they match).
+
+use serde::{Deserialize, Serialize};
+
+/// The protocol version this crate speaks; sent as the first byte of every frame.
+pub const PROTOCOL_VERSION: u8 = 1;
+
+// Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
+// little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
+// one-byte tag plus the value, an enum is its variant index as a varint (one byte below 128)
+// plus the variant's fields, and `[T; N]` is N times T with no length prefix.
+const U8: usize = 1;
+const BOOL: usize = 1;
+const F32: usize = 4;
+const fn varint(bits: usize) -> usize {
+    bits.div_ceil(7)
+}
+const U16: usize = varint(16);
+const U32: usize = varint(32);
+const U64: usize = varint(64);
+const TAG: usize = 1;
+const fn option(n: usize) -> usize {
+    1 + n
+}
+const fn max(a: usize, b: usize) -> usize {
+    if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// One frame: protocol version, sequence number, message.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Envelope {
+    /// [`PROTOCOL_VERSION`] of the sender. Receivers reject any other value
+    /// ([`LinkError::Version`](crate::LinkError::Version)) without looking at the rest.
+    pub version: u8,
+    /// Sender's frame counter: +1 per frame sent, wrapping. Each direction has its own.
+    pub seq: u16,
+    /// The payload.
+    pub msg: Msg,
+}
+
+impl Envelope {
+    /// Worst-case postcard size of an `Envelope` (bytes).
+    pub const MAX_SIZE: usize = U8 + U16 + Msg::MAX_SIZE;
+
+    /// An envelope of the current [`PROTOCOL_VERSION`].
+    pub const fn new(seq: u16, msg: Msg) -> Self {
+        Envelope {
+            version: PROTOCOL_VERSION,
+            seq,
+            msg,
+        }
+    }
+}
+
+/// What a frame carries.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Msg {
+    /// Navigation computer → board: the vehicle state for the next control step.
+    State(StateFrame),
+    /// Navigation computer → board: an operator or mission command.
+    Command(Command),
+    /// Board → navigation computer: the board's report, one per control step (or fewer).
+    Telemetry(Telemetry),
+}
+
+impl Msg {
+    /// Worst-case postcard size of a `Msg` (bytes).
+    pub const MAX_SIZE: usize = TAG
+        + max(
+            StateFrame::MAX_SIZE,
+            max(Command::MAX_SIZE, Telemetry::MAX_SIZE),
+        );
+}
+
+/// The navigation solution the controller runs on.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct StateFrame {
+    /// Navigation time in control ticks (time = `t_ticks / rate_hz`), the time η and ν hold at.
+    pub t_ticks: u64,
+    /// η = [x, y, z, φ, θ, ψ]: earth-fixed position (m, z positive down) and Euler angles (rad).
+    pub eta: [f32; 6],
+    /// ν = [u, v, w, p, q, r]: body-fixed linear (m/s) and angular (rad/s) velocity.
+    pub nu: [f32; 6],
+}
+
+impl StateFrame {
+    /// Worst-case postcard size of a `StateFrame` (bytes).
+    pub const MAX_SIZE: usize = U64 + 12 * F32;
+}
+
+/// Commands to the board.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Command {
+    /// Allow the thrusters to run (no mission yet: [`BoardStatus::Armed`]).
+    Arm,
+    /// Thrusters off, mission dropped.
+    Disarm,
+    /// Start (or restart) a mission: the trajectory's t = 0 is the first control step after.
+    StartMission(MissionSpec),
+    /// End the mission; the board stays armed.
+    StopMission,
+    /// Change the fields that are `Some`; the others keep their values.
+    SetConfig(ConfigPatch),
+}
+
+impl Command {
+    /// Worst-case postcard size of a `Command` (bytes).
+    pub const MAX_SIZE: usize = TAG + max(MissionSpec::MAX_SIZE, ConfigPatch::MAX_SIZE);
+}
+
+/// A mission trajectory and its parameters. Mirrors `controller_core::TrajectoryKind` field
+/// for field (this crate does not depend on controller-core; the firmware and host-sim convert).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum MissionSpec {
+    /// x = R sin ωt, y = R cos ωt, z = depth, ψ = ωt.
+    Circle {
+        /// R (m).
+        radius: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d (m, positive down).
+        depth: f32,
+    },
+    /// Figure eight: x = A sin ωt, y = A cos(ωt/2), z = depth.
+    FigureEight {
+        /// A (m).
+        amplitude: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d (m, positive down).
+        depth: f32,
+    },
+    /// Lawn-mower pattern, scaled by s (s = 1: the paper's 30 × 15 case).
+    LawnMower {
+        /// s (dimensionless).
+        scale: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d (m, positive down).
+        depth: f32,
+    },
+    /// A circle whose depth changes linearly: z = depth + depth_rate·t.
+    Helix {
+        /// R (m).
+        radius: f32,
+        /// ω (rad/s).
+        omega: f32,
+        /// z_d at t = 0 (m, positive down).
+        depth: f32,
+        /// ż_d (m/s, positive = descending).
+        depth_rate: f32,
+    },
+}
+
+impl MissionSpec {
+    /// Worst-case postcard size of a `MissionSpec` (bytes).
+    pub const MAX_SIZE: usize = TAG + 4 * F32;
+}
+
+/// A partial configuration change: `None` leaves a setting as it is.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct ConfigPatch {
+    /// Control-loop rate (Hz).
+    pub rate_hz: Option<u32>,
+    /// Add Δu (the robust term) or not.
+    pub robust: Option<bool>,
+    /// Clamp on δ.
+    pub delta_max: Option<f32>,
+    /// Thruster voltages are clamped to ±`voltage_limit` (V).
+    pub voltage_limit: Option<f32>,
+    /// Control periods without a fresh [`Msg::State`] before the board fails safe
+    /// ([`FailSafeReason::StaleState`]).
+    pub stale_periods: Option<u8>,
+    /// Lockstep: the board runs one control step per received [`Msg::State`] (simulation),
+    /// instead of on its own timer.
+    pub lockstep: Option<bool>,
+}
+
+impl ConfigPatch {
+    /// Worst-case postcard size of a `ConfigPatch` (bytes).
+    pub const MAX_SIZE: usize =
+        option(U32) + option(BOOL) + option(F32) + option(F32) + option(U8) + option(BOOL);
+
+    /// Changes nothing.
+    pub const EMPTY: ConfigPatch = ConfigPatch {
+        rate_hz: None,
+        robust: None,
+        delta_max: None,
+        voltage_limit: None,
+        stale_periods: None,
+        lockstep: None,
+    };
+}
+
+/// The board's report.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct Telemetry {
+    /// Board control tick this report belongs to.
+    pub tick: u64,
+    /// What the board is doing.
+    pub status: BoardStatus,
+    /// Voltage per thruster (V), order [main, vert fore, vert aft, horz fore, horz aft].
+    pub voltages: [f32; 5],
+    /// Achieved thrust per thruster (N), same order.
+    pub thrusts: [f32; 5],
+    /// Bit i set: thruster i saturated.
+    pub saturated: u8,
+    /// δ(e, t) after the clamp.
+    pub delta: f32,
+    /// The δ clamp limited Δu this step.
+    pub delta_clamped: bool,
+    /// ‖w‖ = ‖BᵀPe‖.
+    pub w_norm: f32,
+    /// 0: no controller fault; otherwise a firmware-defined fault code.
+    pub controller_fault: u8,
+    /// Control steps that missed their deadline since boot.
+    pub loop_overruns: u32,
+    /// Longest control update since boot, in the board's timer ticks (firmware-defined).
+    pub worst_update_ticks: u32,
+    /// Frames received and accepted since boot.
+    pub rx_frames: u32,
+    /// Frames received and rejected since boot (any [`LinkError`](crate::LinkError)).
+    pub rx_errors: u32,
+    /// `seq` of the last [`Msg::State`] the board accepted.
+    pub last_state_seq: u16,
+}
+
+impl Telemetry {
+    /// Worst-case postcard size of a `Telemetry` (bytes).
+    pub const MAX_SIZE: usize = U64
+        + BoardStatus::MAX_SIZE
+        + 5 * F32
+        + 5 * F32
+        + U8
+        + F32
+        + BOOL
+        + F32
+        + U8
+        + 4 * U32
+        + U16;
+}
+
+/// What the board is doing.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BoardStatus {
+    /// Thrusters off; waiting for [`Command::Arm`].
+    Disarmed,
+    /// Armed, no mission: thrusters off.
+    Armed,
+    /// Flying a mission.
+    Running,
+    /// Thrusters forced off, for the reason given.
+    FailSafe(FailSafeReason),
+}
+
+impl BoardStatus {
+    /// Worst-case postcard size of a `BoardStatus` (bytes).
+    pub const MAX_SIZE: usize = TAG + FailSafeReason::MAX_SIZE;
+}
+
+/// Why the board failed safe.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum FailSafeReason {
+    /// No fresh [`Msg::State`] within `stale_periods` control periods.
+    StaleState,
+    /// The controller reported a fault (see [`Telemetry::controller_fault`]).
+    ControllerFault,
+    /// The control loop overran its deadline.
+    Overrun,
+    /// The board was disarmed while a mission ran.
+    Disarmed,
+    /// Running was requested without a mission.
+    NoMission,
+}
+
+impl FailSafeReason {
+    /// Worst-case postcard size of a `FailSafeReason` (bytes).
+    pub const MAX_SIZE: usize = TAG;
+}
