@@ -1,0 +1,117 @@
+//! What the firmware needs from a board, and one control period over it.
+//!
+//! A board provides five thruster PWM channels (`embedded_hal::pwm::SetDutyCycle`), the
+//! navigation link (`embedded_io` serial), a period timer and a free-running tick counter.
+//! [`period`] is the whole loop body; it is the same on every board.
+
+use auv_link::{encode, FrameDecoder, MAX_FRAME};
+use embedded_hal::pwm::SetDutyCycle;
+use embedded_io::{Read, ReadReady, Write};
+
+use crate::pwm;
+use crate::supervisor::{Step, Supervisor};
+
+/// A thruster board.
+pub trait Board {
+    type Thruster: SetDutyCycle;
+    type Link: Read + Write + ReadReady;
+
+    /// H-bridge supply voltage V_s (V).
+    fn supply_voltage(&self) -> f32;
+    /// The five thruster channels, order [main, vert fore, vert aft, horz fore, horz aft].
+    fn thrusters(&mut self) -> &mut [Self::Thruster; 5];
+    /// The navigation link.
+    fn link(&mut self) -> &mut Self::Link;
+    /// Sets the control-loop rate (Hz).
+    fn set_rate(&mut self, hz: u32);
+    /// Blocks until the next period boundary. Returns true if that boundary had already passed
+    /// when called: the previous period overran.
+    fn wait_period(&mut self) -> bool;
+    /// A free-running up-counting timer, for timing `update` (board-specific unit).
+    fn now(&self) -> u32;
+    /// Feeds the watchdog (boards without one do nothing).
+    fn feed_watchdog(&mut self) {}
+}
+
+/// Link buffers: the streaming decoder and one frame of transmit space.
+pub struct LinkBuffers {
+    pub decoder: FrameDecoder,
+    pub tx: [u8; MAX_FRAME],
+}
+
+impl LinkBuffers {
+    pub fn new() -> Self {
+        LinkBuffers {
+            decoder: FrameDecoder::new(),
+            tx: [0; MAX_FRAME],
+        }
+    }
+}
+
+impl Default for LinkBuffers {
+    fn default() -> Self {
+        Self::new()
+    }
+}
+
+/// Reads whatever bytes are waiting (without blocking) into the supervisor.
+pub fn pump<L: Read + ReadReady>(link: &mut L, sup: &mut Supervisor, bufs: &mut LinkBuffers) {
+    let mut chunk = [0u8; 64];
+    // Bounded: at most 16 chunks per period, so a flooding link cannot stall the loop.
+    for _ in 0..16 {
+        match link.read_ready() {
+            Ok(true) => {}
+            _ => return,
+        }
+        let n = match link.read(&mut chunk) {
+            Ok(n) if n > 0 => n,
+            _ => return,
+        };
+        for &b in &chunk[..n] {
+            match bufs.decoder.push(b) {
+                Some(Ok(env)) => sup.on_envelope(&env),
+                Some(Err(_)) => sup.on_rx_error(),
+                None => {}
+            }
+        }
+    }
+}
+
+/// Applies voltages to the thrusters (neutral duty for 0 V).
+pub fn drive<B: Board>(board: &mut B, voltages: &[f32; 5]) {
+    let vs = board.supply_voltage();
+    for (ch, v) in board.thrusters().iter_mut().zip(voltages.iter()) {
+        // A PWM channel error leaves that channel as it was; there is nothing better to do
+        // from here, and the next period retries.
+        let _ = pwm::set_voltage(ch, *v, vs);
+    }
+}
+
+/// One control period: wait for the period (or, in lock-step, for a state frame), read the
+/// link, run the supervisor, drive the thrusters, send telemetry, feed the watchdog.
+pub fn period<B: Board>(board: &mut B, sup: &mut Supervisor, bufs: &mut LinkBuffers) -> Step {
+    let overrun = if sup.lockstep() {
+        // Paced by state frames; a silent link still ends the wait after one period so the
+        // stale-state fail-safe can act.
+        let mut waited = false;
+        while !sup.state_fresh() && !waited {
+            pump(board.link(), sup, bufs);
+            waited = board.wait_period();
+        }
+        false
+    } else {
+        board.wait_period()
+    };
+    pump(board.link(), sup, bufs);
+    let step = {
+        let now = || board.now();
+        sup.step(overrun, &now)
+    };
+    drive(board, &step.voltages);
+    let env = sup.envelope(step.telemetry);
+    if let Ok(n) = encode(&env, &mut bufs.tx) {
+        let _ = board.link().write_all(&bufs.tx[..n]);
+    }
+    board.feed_watchdog();
+    step
+}
