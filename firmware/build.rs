@@ -1,0 +1,133 @@
+//! Puts the board's memory map on the linker path as `memory.x`, and computes the self-test's
+//! golden vectors with the same `controller-core`, built for the host.
+
+use std::env;
+use std::fmt::Write as _;
+use std::fs;
+use std::path::PathBuf;
+
+use controller_core::kinematics::{self, Attitude};
+use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
+
+fn main() {
+    let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
+    let root = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it")).join("..");
+    let map = if env::var_os("CARGO_FEATURE_STM32F405").is_some() {
+        "memory-stm32f405.x"
+    } else {
+        "memory-qemu.x"
+    };
+    let src = root.join(map);
+    fs::copy(&src, out.join("memory.x"))
+        .unwrap_or_else(|e| panic!("copying {}: {e}", src.display()));
+    println!("cargo:rustc-link-search={}", out.display());
+    println!("cargo:rerun-if-changed={}", src.display());
+    println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=../controller-core/src");
+
+    fs::write(out.join("golden.rs"), golden()).expect("writing golden.rs");
+}
+
+/// Deterministic inputs around each Table-1 mission (on and off the reference, with and
+/// without Δu, and two fault cases), and the host core's outputs for them.
+fn golden() -> String {
+    let with = Controller::new(ControllerConfig::default()).expect("defaults");
+    let without = Controller::new(ControllerConfig {
+        robust: false,
+        ..ControllerConfig::default()
+    })
+    .expect("defaults without Δu");
+    let mut s = String::new();
+    let mut n = 0usize;
+    let mut body = String::new();
+    for (ci, case) in Table1Case::ALL.iter().enumerate() {
+        let tr = Trajectory::table1(*case);
+        for (k, ticks) in [0u64, 1234, 4567, 6999].iter().enumerate() {
+            let d = tr.sample(*ticks, 100);
+            let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
+            let mut eta: [f32; 6] = d.eta.into();
+            let mut nu: [f32; 6] = nu.into();
+            // Off the reference by a few centimetres and degrees, different per vector.
+            let w = (ci * 4 + k) as f32;
+            eta[0] += 0.03 * (w * 0.7).sin();
+            eta[1] -= 0.02 * (w * 1.3).cos();
+            eta[2] += 0.01 * w / 24.0;
+            eta[3] += 0.2 * (w * 0.5).sin();
+            eta[4] += 0.05 * (w * 0.9).cos();
+            eta[5] += 0.03 * (w * 1.1).sin();
+            nu[0] += 0.05 * (w * 0.3).cos();
+            nu[4] += 0.01 * (w * 0.4).sin();
+            for robust in [true, false] {
+                let c = if robust { &with } else { &without };
+                let o = c.update(*ticks, &eta, &nu, &tr);
+                push(&mut body, ci, *ticks, robust, &eta, &nu, &o);
+                n += 1;
+            }
+        }
+    }
+    // Faults: pitch beyond the limit, and a NaN.
+    let tr = Trajectory::table1(Table1Case::Circular10R);
+    let eta = [0.0, 10.0, 5.0, 0.0, 1.5, 0.0];
+    let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 0.1];
+    push(
+        &mut body,
+        0,
+        0,
+        true,
+        &eta,
+        &nu,
+        &with.update(0, &eta, &nu, &tr),
+    );
+    let eta = [0.0, 10.0, f32::NAN, 0.0, 0.0, 0.0];
+    push(
+        &mut body,
+        0,
+        0,
+        true,
+        &eta,
+        &nu,
+        &with.update(0, &eta, &nu, &tr),
+    );
+    n += 2;
+    writeln!(s, "pub const GOLDEN: [Golden; {n}] = [\n{body}];").ok();
+    s
+}
+
+fn f(x: f32) -> String {
+    if x.is_nan() {
+        "f32::NAN".into()
+    } else {
+        format!("f32::from_bits({:#010x})", x.to_bits())
+    }
+}
+
+fn arr(a: &[f32]) -> String {
+    let items: Vec<String> = a.iter().map(|x| f(*x)).collect();
+    format!("[{}]", items.join(", "))
+}
+
+fn push(
+    body: &mut String,
+    case: usize,
+    ticks: u64,
+    robust: bool,
+    eta: &[f32; 6],
+    nu: &[f32; 6],
+    o: &controller_core::Output,
+) {
+    let status = match o.status {
+        Status::Ok => 0,
+        Status::Fault(_) => 1,
+    };
+    writeln!(
+        body,
+        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
+        arr(eta),
+        arr(nu),
+        arr(&o.voltage),
+        arr(&o.tau),
+        f(o.delta),
+        f(o.w_norm)
+    )
+    .ok();
+}

@@ -1,0 +1,190 @@
+//! Board: QEMU `mps2-an386` (ARM MPS2 with a Cortex-M4F, 25 MHz).
+//!
+//! - Navigation link: CMSDK APB UART0 at 0x4000_4000 (`-serial` of QEMU).
+//! - Period timer: SysTick on the 25 MHz core clock. Under `-icount shift=0` one instruction
+//!   takes 1 ns of virtual time, so one SysTick count is 40 instructions — the unit of
+//!   [`Board::now`] here, which makes update timings deterministic instruction counts.
+//! - Thrusters: the board has no PWM; [`MemPwm`] channels keep the commanded duty in RAM (they
+//!   implement `SetDutyCycle` like a real timer channel would).
+//! - No watchdog.
+
+use core::convert::Infallible;
+use core::ptr::{read_volatile, write_volatile};
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m::peripheral::SYST;
+use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
+use embedded_io::{ErrorType, Read, ReadReady, Write};
+use firmware::board::Board;
+
+/// Core clock of mps2-an386 (Hz).
+pub const CORE_HZ: u32 = 25_000_000;
+/// Instructions per SysTick count under `-icount shift=0` (1 GHz virtual / 25 MHz).
+#[cfg_attr(not(feature = "selftest"), allow(dead_code))]
+pub const INSTRUCTIONS_PER_TICK: u32 = 40;
+/// Nominal H-bridge supply (V).
+pub const SUPPLY_VOLTAGE: f32 = 24.0;
+
+const UART0: usize = 0x4000_4000;
+const DATA: usize = 0x00;
+const STATE: usize = 0x04;
+const CTRL: usize = 0x08;
+const BAUDDIV: usize = 0x10;
+const STATE_TX_FULL: u32 = 1 << 0;
+const STATE_RX_FULL: u32 = 1 << 1;
+
+/// CMSDK APB UART as an `embedded_io` serial port.
+pub struct CmsdkUart {
+    base: usize,
+}
+
+impl CmsdkUart {
+    /// # Safety
+    /// `base` must be the address of a CMSDK UART owned by nobody else.
+    unsafe fn new(base: usize, baud: u32) -> Self {
+        let u = CmsdkUart { base };
+        // SAFETY: registers of a UART the caller gives us exclusive use of.
+        unsafe {
+            write_volatile((base + BAUDDIV) as *mut u32, CORE_HZ / baud);
+            write_volatile((base + CTRL) as *mut u32, 0b11); // TX and RX enable
+        }
+        u
+    }
+
+    fn reg(&self, off: usize) -> u32 {
+        // SAFETY: a register of our UART.
+        unsafe { read_volatile((self.base + off) as *const u32) }
+    }
+}
+
+impl ErrorType for CmsdkUart {
+    type Error = Infallible;
+}
+
+impl ReadReady for CmsdkUart {
+    fn read_ready(&mut self) -> Result<bool, Infallible> {
+        Ok(self.reg(STATE) & STATE_RX_FULL != 0)
+    }
+}
+
+impl Read for CmsdkUart {
+    /// Blocks for the first byte, then returns what is available without waiting.
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        while self.reg(STATE) & STATE_RX_FULL == 0 {}
+        let mut n = 0;
+        while n < buf.len() && self.reg(STATE) & STATE_RX_FULL != 0 {
+            buf[n] = self.reg(DATA) as u8;
+            n += 1;
+        }
+        Ok(n)
+    }
+}
+
+impl Write for CmsdkUart {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        for &b in buf {
+            while self.reg(STATE) & STATE_TX_FULL != 0 {}
+            // SAFETY: the data register of our UART.
+            unsafe { write_volatile((self.base + DATA) as *mut u32, b as u32) };
+        }
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> Result<(), Infallible> {
+        Ok(())
+    }
+}
+
+/// A PWM channel that keeps its duty in RAM (QEMU has no timer PWM on this machine).
+pub struct MemPwm {
+    pub duty: u16,
+}
+
+/// Counts of full duty: 10-bit resolution, like a 24 kHz timer channel at 25 MHz.
+pub const MAX_DUTY: u16 = 1000;
+
+impl PwmErrorType for MemPwm {
+    type Error = Infallible;
+}
+
+impl SetDutyCycle for MemPwm {
+    fn max_duty_cycle(&self) -> u16 {
+        MAX_DUTY
+    }
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
+        self.duty = duty.min(MAX_DUTY);
+        Ok(())
+    }
+}
+
+pub struct QemuBoard {
+    syst: SYST,
+    uart: CmsdkUart,
+    thrusters: [MemPwm; 5],
+    reload: u32,
+    periods: u32,
+}
+
+impl QemuBoard {
+    /// Takes SysTick and UART0. Call once.
+    pub fn init(syst: SYST, rate_hz: u32) -> Self {
+        // SAFETY: UART0 is used by this board only.
+        let uart = unsafe { CmsdkUart::new(UART0, 115_200) };
+        let mut b = QemuBoard {
+            syst,
+            uart,
+            thrusters: [
+                MemPwm { duty: MAX_DUTY / 2 },
+                MemPwm { duty: MAX_DUTY / 2 },
+                MemPwm { duty: MAX_DUTY / 2 },
+                MemPwm { duty: MAX_DUTY / 2 },
+                MemPwm { duty: MAX_DUTY / 2 },
+            ],
+            reload: 0,
+            periods: 0,
+        };
+        b.syst.set_clock_source(SystClkSource::Core);
+        b.set_rate(rate_hz);
+        b.syst.enable_counter();
+        b
+    }
+}
+
+impl Board for QemuBoard {
+    type Thruster = MemPwm;
+    type Link = CmsdkUart;
+
+    fn supply_voltage(&self) -> f32 {
+        SUPPLY_VOLTAGE
+    }
+    fn thrusters(&mut self) -> &mut [MemPwm; 5] {
+        &mut self.thrusters
+    }
+    fn link(&mut self) -> &mut CmsdkUart {
+        &mut self.uart
+    }
+    fn set_rate(&mut self, hz: u32) {
+        let reload = (CORE_HZ / hz.max(2)).clamp(2, 0x0100_0000) - 1;
+        self.reload = reload;
+        self.syst.set_reload(reload);
+        self.syst.clear_current();
+    }
+    fn wait_period(&mut self) -> bool {
+        // COUNTFLAG is set at each wrap and cleared by reading it.
+        let overrun = self.syst.has_wrapped();
+        if !overrun {
+            while !self.syst.has_wrapped() {}
+        }
+        self.periods = self.periods.wrapping_add(1);
+        overrun
+    }
+    fn now(&self) -> u32 {
+        let elapsed = self.reload - SYST::get_current();
+        self.periods
+            .wrapping_mul(self.reload + 1)
+            .wrapping_add(elapsed)
+    }
+}
