@@ -1,0 +1,567 @@
+//! Board: STM32F405 (Cortex-M4F at 168 MHz), e.g. STM32F405RGT6, with stm32f4xx-hal 0.23.
+//!
+//! Built only for `target_os = "none"` with `--features stm32f405`.
+//!
+//! # Clocks
+//!
+//! **Assumes an 8 MHz crystal on HSE** (OSC_IN/OSC_OUT). The PLL makes SYSCLK = HCLK =
+//! 168 MHz, PCLK2 = 84 MHz (APB2 timers 168 MHz), PCLK1 = 42 MHz (APB1 timers 84 MHz). A
+//! different crystal needs [`HSE_HZ`] changed; with no crystal fitted, `init` waits forever
+//! for HSE to start (before the watchdog is running, with every thruster pin still floating:
+//! see *Safe state* below).
+//!
+//! # Pin map
+//!
+//! | thruster            | `thrusters()` index | timer / channel | pin  |
+//! |---------------------|---------------------|-----------------|------|
+//! | main (surge)        | 0                   | TIM1 CH1        | PA8  |
+//! | vertical fore       | 1                   | TIM1 CH2        | PA9  |
+//! | vertical aft        | 2                   | TIM1 CH3        | PA10 |
+//! | horizontal fore     | 3                   | TIM1 CH4        | PA11 |
+//! | horizontal aft      | 4                   | TIM8 CH1        | PC6  |
+//! | nav link TX         | –                   | USART2 TX (AF7) | PA2  |
+//! | nav link RX         | –                   | USART2 RX (AF7) | PA3  |
+//!
+//! SWD (PA13/PA14) is left alone. PA9/PA11 are also USB OTG FS VBUS/DM, so USB FS is not
+//! available with this map; PA9/PA10 are USART1's usual pins, USART1 is not used.
+//!
+//! - **PWM**: [`PWM_HZ`] = 20 kHz, edge-aligned PWM mode 1 on the two advanced timers (168 MHz
+//!   timer clock, no prescaler: 8400 counts per period, [`Thruster::max_duty_cycle`] = 8400).
+//!   Duty d gives a mean H-bridge voltage (2d − 1)·V_s (locked anti-phase, see
+//!   [`firmware::pwm`]); **neutral is 50 %**. `init` sets all five channels to neutral and
+//!   lets the timers load it before it enables any output.
+//! - **Navigation link**: USART2 at 115200 baud, 8 data bits, no parity, 1 stop bit (8N1), no
+//!   flow control. [`Usart2Link`] is interrupt driven: the `USART2` interrupt moves bytes
+//!   between the data register and two RAM rings ([`RX_RING`] / [`TX_RING`] bytes), so
+//!   nothing is lost while the loop computes or waits for the period (the USART has a
+//!   one-byte receive register: a polled receiver would drop almost every byte of a frame that
+//!   arrives during `wait_period`), and telemetry goes out in the background instead of
+//!   blocking the loop for a frame time (~87 µs per byte).
+//! - **Period timer**: SysTick on the 168 MHz core clock (HCLK/8 = 21 MHz below 11 Hz, where
+//!   the 24-bit reload would overflow). The period is 1/hz to within one count for hz ≥ 2;
+//!   1 Hz is clamped to the longest SysTick period, 0.8 s.
+//! - **`now()`**: the DWT cycle counter CYCCNT, a free-running 32-bit up-counter in CPU cycles
+//!   ([`SYSCLK_HZ`] per second; wraps every 25.6 s, `wrapping_sub` differences are fine). The
+//!   real Cortex-M4 has it (`init` enables DCB trace and the counter); QEMU does not model
+//!   the DWT cycle counter (the QEMU board times with SysTick).
+//! - **Supply**: [`SUPPLY_VOLTAGE`] = 24 V, a constant (the board does not measure it).
+//! - **Watchdog**: the independent watchdog (IWDG, on the ~32 kHz LSI) is started at the end of
+//!   `init` with a 50 ms timeout — five periods at 100 Hz — and fed by `feed_watchdog()` once
+//!   per period. [`Board::set_rate`] lengthens it to four periods for rates below 80 Hz (up to
+//!   4.1 s), so a slow rate does not reset a healthy board. The LSI is only specified to
+//!   17–47 kHz: the real timeout is 0.68–1.9 × nominal (≥ 2.7 periods).
+//!
+//! # Safe state
+//!
+//! A hang (a stuck loop, or a fault or panic handler that neither resets nor returns) stops the
+//! feeding, and the IWDG resets the MCU. Reset returns every GPIO to a floating input, so the five PWM pins stop driving
+//! and the **H-bridge inputs must be pulled low on the board** (pull-downs on the PWM/enable
+//! lines, or the driver's own): low = H-bridge disabled, which is the safe state. The same
+//! holds from power-on until `init` drives the channels to neutral, and while a debugger halts
+//! the core: `init` sets the DBGMCU freeze bits, so TIM1/TIM8 stop with their outputs disabled
+//! (RM0090, advanced timers in debug mode: as if MOE were cleared; with OSSI = 0 the timer no
+//! longer drives the pins) and the IWDG pauses.
+//!
+//! # Timing notes
+//!
+//! Each received or sent byte costs one short interrupt (a few dozen cycles, ~11.5 k/s each
+//! way at full line rate); it can land inside a timed `Controller::update` and lengthen the
+//! measured ticks by that much.
+
+#![cfg(all(target_os = "none", feature = "stm32f405"))]
+
+use core::cell::UnsafeCell;
+use core::convert::Infallible;
+use core::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
+
+use cortex_m::peripheral::syst::SystClkSource;
+use cortex_m::peripheral::{DWT, NVIC, SYST};
+use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
+use embedded_io::{ErrorType, Read, ReadReady, Write};
+use firmware::board::Board;
+use firmware::pwm;
+use stm32f4xx_hal::pac::{self, interrupt};
+use stm32f4xx_hal::prelude::*;
+use stm32f4xx_hal::rcc::Config as ClockConfig;
+use stm32f4xx_hal::serial::config::StopBits;
+use stm32f4xx_hal::serial::{Config as SerialConfig, Event as SerialEvent, Serial};
+use stm32f4xx_hal::timer::{ErasedChannel, PwmHzManager};
+
+/// HSE crystal frequency (Hz). **Assumption: an 8 MHz crystal.**
+pub const HSE_HZ: u32 = 8_000_000;
+/// Core clock SYSCLK = HCLK (Hz); also the unit of [`Board::now`] (CPU cycles).
+pub const SYSCLK_HZ: u32 = 168_000_000;
+/// APB1 clock (USART2; APB1 timers run at twice this).
+pub const PCLK1_HZ: u32 = 42_000_000;
+/// APB2 clock (TIM1, TIM8 run at twice this: 168 MHz).
+pub const PCLK2_HZ: u32 = 84_000_000;
+/// Thruster PWM frequency (Hz).
+pub const PWM_HZ: u32 = 20_000;
+/// Navigation-link baud rate (8N1).
+pub const LINK_BAUD: u32 = 115_200;
+/// H-bridge supply voltage V_s (V): nominal, not measured. The duty for a commanded voltage
+/// is computed against it ([`firmware::pwm::duty_fraction`]).
+pub const SUPPLY_VOLTAGE: f32 = 24.0;
+/// Control rate set up by [`Stm32Board::init`] (Hz), the controller's default; call
+/// [`Board::set_rate`] for another.
+pub const DEFAULT_RATE_HZ: u32 = 100;
+/// Shortest watchdog timeout (ms, nominal at a 32 kHz LSI).
+pub const WATCHDOG_MIN_MS: u32 = 50;
+/// Receive ring (bytes): 44 ms of line at 115200 baud.
+pub const RX_RING: usize = 512;
+/// Transmit ring (bytes): more than one telemetry frame.
+pub const TX_RING: usize = 512;
+
+/// Nominal LSI frequency (Hz) clocking the IWDG.
+const LSI_HZ: u32 = 32_000;
+/// IWDG prescaler /32: one watchdog count per ms at the nominal LSI.
+const IWDG_DIV: u32 = 32;
+
+// ---------------------------------------------------------------------------------------------
+// Thrusters
+// ---------------------------------------------------------------------------------------------
+
+/// One thruster PWM channel: a TIM1 or TIM8 output channel behind one type, so the five can
+/// live in one array. Implements `embedded_hal::pwm::SetDutyCycle` (the HAL's channels do;
+/// this only dispatches).
+pub enum Thruster {
+    Tim1(ErasedChannel<pac::TIM1>),
+    Tim8(ErasedChannel<pac::TIM8>),
+}
+
+impl Thruster {
+    fn enable(&mut self) {
+        match self {
+            Thruster::Tim1(c) => c.enable(),
+            Thruster::Tim8(c) => c.enable(),
+        }
+    }
+}
+
+impl PwmErrorType for Thruster {
+    type Error = Infallible;
+}
+
+impl SetDutyCycle for Thruster {
+    fn max_duty_cycle(&self) -> u16 {
+        match self {
+            Thruster::Tim1(c) => c.max_duty_cycle(),
+            Thruster::Tim8(c) => c.max_duty_cycle(),
+        }
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
+        match self {
+            Thruster::Tim1(c) => c.set_duty_cycle(duty),
+            Thruster::Tim8(c) => c.set_duty_cycle(duty),
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Navigation link: USART2, interrupt driven through two single-producer/single-consumer rings
+// ---------------------------------------------------------------------------------------------
+
+/// A byte ring with one producer and one consumer on the same core (main loop and the
+/// `USART2` interrupt). `head`/`tail` count bytes pushed/popped (wrapping); N is a power of
+/// two. Each index is written by one side only, and a byte is written before `head` is
+/// published (Release) and read after it is observed (Acquire).
+struct Ring<const N: usize> {
+    buf: UnsafeCell<[u8; N]>,
+    head: AtomicUsize,
+    tail: AtomicUsize,
+}
+
+// SAFETY: the producer only writes slots in [head, tail + N) and the consumer only reads slots
+// in [tail, head); the atomics order those accesses (see `push`/`pop`).
+unsafe impl<const N: usize> Sync for Ring<N> {}
+
+impl<const N: usize> Ring<N> {
+    const fn new() -> Self {
+        const { assert!(N.is_power_of_two()) };
+        Ring {
+            buf: UnsafeCell::new([0; N]),
+            head: AtomicUsize::new(0),
+            tail: AtomicUsize::new(0),
+        }
+    }
+
+    fn len(&self) -> usize {
+        let tail = self.tail.load(Ordering::Acquire);
+        self.head.load(Ordering::Acquire).wrapping_sub(tail)
+    }
+
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn is_full(&self) -> bool {
+        self.len() >= N
+    }
+
+    /// Appends `b`; false if full. Call from the producer side only.
+    fn push(&self, b: u8) -> bool {
+        let head = self.head.load(Ordering::Relaxed);
+        if head.wrapping_sub(self.tail.load(Ordering::Acquire)) >= N {
+            return false;
+        }
+        // SAFETY: the slot is outside [tail, head), so the consumer does not read it, and only
+        // this (single) producer writes; no reference to the array is formed.
+        unsafe { self.buf.get().cast::<u8>().add(head % N).write_volatile(b) };
+        self.head.store(head.wrapping_add(1), Ordering::Release);
+        true
+    }
+
+    /// Removes the oldest byte. Call from the consumer side only.
+    fn pop(&self) -> Option<u8> {
+        let tail = self.tail.load(Ordering::Relaxed);
+        if self.head.load(Ordering::Acquire) == tail {
+            return None;
+        }
+        // SAFETY: the slot is in [tail, head): written and published by the producer, which
+        // does not touch it again until `tail` moves past it.
+        let b = unsafe { self.buf.get().cast::<u8>().add(tail % N).read_volatile() };
+        self.tail.store(tail.wrapping_add(1), Ordering::Release);
+        Some(b)
+    }
+}
+
+/// Received bytes: produced by the interrupt, consumed by [`Usart2Link::read`].
+static RX: Ring<RX_RING> = Ring::new();
+/// Bytes to send: produced by [`Usart2Link::write`], consumed by the interrupt.
+static TX: Ring<TX_RING> = Ring::new();
+/// Received bytes dropped because the receive ring was full.
+static RX_DROPPED: AtomicU32 = AtomicU32::new(0);
+/// Receive line errors seen by the USART (overrun, framing, noise, parity).
+static RX_LINE_ERRORS: AtomicU32 = AtomicU32::new(0);
+
+fn usart2() -> &'static pac::usart1::RegisterBlock {
+    // SAFETY: USART2's register block is always mapped. `Usart2Link` owns the peripheral; the
+    // interrupt only reads SR/DR, writes DR and clears TXEIE, the main side only sets TXEIE
+    // (in a critical section) and reads SR — see `USART2` and `Usart2Link::write`.
+    unsafe { &*pac::USART2::ptr() }
+}
+
+#[interrupt]
+fn USART2() {
+    let u = usart2();
+    let sr = u.sr().read();
+    let errors = sr.ore().bit_is_set()
+        || sr.fe().bit_is_set()
+        || sr.nf().bit_is_set()
+        || sr.pe().bit_is_set();
+    if sr.rxne().bit_is_set() || errors {
+        // Reading DR after SR clears RXNE and the error flags (ORE would otherwise keep the
+        // interrupt pending). A byte with a framing/noise/parity error is kept: the frame's
+        // CRC rejects it.
+        let b = u.dr().read().dr().bits() as u8;
+        if errors {
+            RX_LINE_ERRORS.fetch_add(1, Ordering::Relaxed);
+        }
+        if sr.rxne().bit_is_set() && !RX.push(b) {
+            RX_DROPPED.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+    if sr.txe().bit_is_set() && u.cr1().read().txeie().bit_is_set() {
+        match TX.pop() {
+            Some(b) => {
+                u.dr().write(|w| w.dr().set(b as u16));
+            }
+            // Nothing left: stop the TXE interrupt until `write` queues more.
+            None => {
+                u.cr1().modify(|_, w| w.txeie().clear_bit());
+            }
+        }
+    }
+}
+
+/// The navigation link on USART2 (PA2 TX, PA3 RX), 115200 8N1, as an `embedded_io` port.
+///
+/// - [`Read::read`] never waits when a byte is waiting: it returns every buffered byte that
+///   fits (at least one). With nothing buffered it waits for the first byte, as `embedded_io`
+///   requires; the control loop only reads after [`ReadReady::read_ready`] says true.
+/// - [`ReadReady::read_ready`]: a received byte is waiting (the buffered equivalent of RXNE).
+/// - [`Write::write`] queues bytes for the interrupt and returns at once; it waits only while
+///   the transmit ring is full. [`Write::flush`] waits until the last bit is on the line.
+///
+/// Line errors are never returned (the error type is `Infallible`): damaged bytes are passed
+/// on and the frame's CRC rejects them; they are counted in [`Usart2Link::rx_line_errors`],
+/// and bytes lost to a full ring in [`Usart2Link::rx_dropped`].
+pub struct Usart2Link {
+    _serial: Serial<pac::USART2, u8>,
+}
+
+// Diagnostics for the binary's logs; the control loop itself does not need them.
+#[allow(dead_code)]
+impl Usart2Link {
+    /// Receive line errors so far (overrun, framing, noise, parity).
+    pub fn rx_line_errors(&self) -> u32 {
+        RX_LINE_ERRORS.load(Ordering::Relaxed)
+    }
+
+    /// Received bytes dropped because the receive ring was full (the loop stalled > 44 ms).
+    pub fn rx_dropped(&self) -> u32 {
+        RX_DROPPED.load(Ordering::Relaxed)
+    }
+}
+
+impl ErrorType for Usart2Link {
+    type Error = Infallible;
+}
+
+impl ReadReady for Usart2Link {
+    fn read_ready(&mut self) -> Result<bool, Infallible> {
+        Ok(!RX.is_empty())
+    }
+}
+
+impl Read for Usart2Link {
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        while RX.is_empty() {}
+        let mut n = 0;
+        for slot in buf.iter_mut() {
+            match RX.pop() {
+                Some(b) => {
+                    *slot = b;
+                    n += 1;
+                }
+                None => break,
+            }
+        }
+        Ok(n)
+    }
+}
+
+impl Write for Usart2Link {
+    fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
+        if buf.is_empty() {
+            return Ok(0);
+        }
+        // The interrupt drains the ring (TXEIE is on whenever it holds bytes).
+        while TX.is_full() {}
+        let mut n = 0;
+        for &b in buf {
+            if !TX.push(b) {
+                break;
+            }
+            n += 1;
+        }
+        // The interrupt clears TXEIE (read-modify-write of CR1): set it where it cannot
+        // interleave.
+        cortex_m::interrupt::free(|_| usart2().cr1().modify(|_, w| w.txeie().set_bit()));
+        Ok(n)
+    }
+
+    fn flush(&mut self) -> Result<(), Infallible> {
+        while !TX.is_empty() {}
+        while usart2().sr().read().tc().bit_is_clear() {}
+        Ok(())
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The board
+// ---------------------------------------------------------------------------------------------
+
+/// The STM32F405 thruster board. See the module docs for clocks, pins and the safe state.
+pub struct Stm32Board {
+    thrusters: [Thruster; 5],
+    link: Usart2Link,
+    syst: SYST,
+    iwdg: pac::IWDG,
+    rate_hz: u32,
+    // Held so nothing else can reconfigure them.
+    _pwm_tim1: PwmHzManager<pac::TIM1>,
+    _pwm_tim8: PwmHzManager<pac::TIM8>,
+    _dwt: DWT,
+}
+
+impl Stm32Board {
+    /// Brings the board up: clocks, thruster PWM at neutral, the link, the period timer at
+    /// [`DEFAULT_RATE_HZ`], the cycle counter and, last, the watchdog — from then on the caller
+    /// must call [`Board::feed_watchdog`] (the control loop does, once per period) at least
+    /// every 50 ms.
+    ///
+    /// `cp` is the core peripherals (`cortex_m::Peripherals::take()`, done by the caller); the
+    /// board uses SYST, DWT, DCB and NVIC from it and drops the rest.
+    ///
+    /// # Panics
+    ///
+    /// Takes the device peripherals (`stm32f4xx_hal::pac::Peripherals::take()`): **call it
+    /// once**. A second call, or a call after anything else took them, panics.
+    pub fn init(cp: cortex_m::Peripherals) -> Self {
+        let mut cp = cp;
+        let dp = pac::Peripherals::take().expect("device peripherals already taken");
+
+        // Halting the core in a debugger disables the thruster outputs and pauses the IWDG.
+        dp.DBGMCU.apb2_fz().modify(|_, w| {
+            w.dbg_tim1_stop().set_bit();
+            w.dbg_tim8_stop().set_bit()
+        });
+        dp.DBGMCU
+            .apb1_fz()
+            .modify(|_, w| w.dbg_iwdg_stop().set_bit());
+
+        let mut rcc = dp.RCC.freeze(
+            ClockConfig::hse(HSE_HZ.Hz())
+                .sysclk(SYSCLK_HZ.Hz())
+                .hclk(SYSCLK_HZ.Hz())
+                .pclk1(PCLK1_HZ.Hz())
+                .pclk2(PCLK2_HZ.Hz()),
+        );
+        defmt::info!(
+            "stm32f405: sysclk {} Hz, pclk1 {} Hz, pclk2 {} Hz",
+            rcc.clocks.sysclk().raw(),
+            rcc.clocks.pclk1().raw(),
+            rcc.clocks.pclk2().raw()
+        );
+
+        let gpioa = dp.GPIOA.split(&mut rcc);
+        let gpioc = dp.GPIOC.split(&mut rcc);
+
+        // Thrusters: the timers run from here on, every channel output still disabled.
+        let (pwm_tim1, (t1c1, t1c2, t1c3, t1c4)) = dp.TIM1.pwm_hz(PWM_HZ.Hz(), &mut rcc);
+        let (pwm_tim8, (t8c1, ..)) = dp.TIM8.pwm_hz(PWM_HZ.Hz(), &mut rcc);
+        let mut thrusters = [
+            Thruster::Tim1(t1c1.with(gpioa.pa8).erase()),
+            Thruster::Tim1(t1c2.with(gpioa.pa9).erase()),
+            Thruster::Tim1(t1c3.with(gpioa.pa10).erase()),
+            Thruster::Tim1(t1c4.with(gpioa.pa11).erase()),
+            Thruster::Tim8(t8c1.with(gpioc.pc6).erase()),
+        ];
+        for t in thrusters.iter_mut() {
+            let Ok(()) = pwm::set_neutral(t);
+        }
+        // The compare registers are preloaded: the neutral duty takes effect at the next update
+        // event. Two PWM periods make sure it has before any output is enabled.
+        cortex_m::asm::delay(2 * SYSCLK_HZ / PWM_HZ);
+        for t in thrusters.iter_mut() {
+            t.enable();
+        }
+
+        // Navigation link.
+        let mut serial: Serial<pac::USART2, u8> = Serial::new(
+            dp.USART2,
+            (gpioa.pa2, gpioa.pa3),
+            SerialConfig::default()
+                .baudrate(LINK_BAUD.bps())
+                .wordlength_8()
+                .parity_none()
+                .stopbits(StopBits::STOP1),
+            &mut rcc,
+        )
+        .expect("USART2 115200 8N1 from PCLK1");
+        serial.listen(SerialEvent::RxNotEmpty);
+        // SAFETY: the handler above only touches USART2 and the rings; unmasking it cannot break
+        // a critical section (none is active here).
+        unsafe { NVIC::unmask(pac::Interrupt::USART2) };
+        let link = Usart2Link { _serial: serial };
+
+        // Cycle counter for `now()`.
+        cp.DCB.enable_trace();
+        cp.DWT.enable_cycle_counter();
+
+        let mut board = Stm32Board {
+            thrusters,
+            link,
+            syst: cp.SYST,
+            iwdg: dp.IWDG,
+            rate_hz: DEFAULT_RATE_HZ,
+            _pwm_tim1: pwm_tim1,
+            _pwm_tim8: pwm_tim8,
+            _dwt: cp.DWT,
+        };
+
+        // Watchdog last: once started it cannot be stopped. Starting also starts the LSI.
+        board.iwdg.kr().write(|w| w.key().start());
+        board.set_rate(DEFAULT_RATE_HZ);
+        defmt::info!(
+            "stm32f405: PWM {} Hz ({} counts), link {} baud, rate {} Hz, watchdog {} ms",
+            PWM_HZ,
+            board.thrusters[0].max_duty_cycle(),
+            LINK_BAUD,
+            board.rate_hz,
+            watchdog_timeout_ms(board.rate_hz)
+        );
+        board
+    }
+
+    /// Sets the IWDG timeout (the counter must be running) and restarts the count with it.
+    fn set_watchdog_ms(&mut self, ms: u32) {
+        let reload = (ms * LSI_HZ / IWDG_DIV / 1000).clamp(1, 0x1000) - 1;
+        // PR/RLR can be written only when no earlier update is in flight (a few LSI cycles).
+        while self.iwdg.sr().read().bits() != 0 {}
+        self.iwdg.kr().write(|w| w.key().unlock());
+        self.iwdg.pr().write(|w| w.pr().divide_by32());
+        self.iwdg.rlr().write(|w| w.rl().set(reload as u16));
+        // Wait until the new values reached the LSI domain, so that the reload below uses them.
+        while self.iwdg.sr().read().bits() != 0 {}
+        self.iwdg.kr().write(|w| w.key().feed());
+    }
+}
+
+/// Nominal watchdog timeout (ms) for a control rate: four periods, at least 50 ms, at most
+/// what the /32 prescaler reaches (4096 ms).
+fn watchdog_timeout_ms(rate_hz: u32) -> u32 {
+    (4000 / rate_hz.max(1)).clamp(WATCHDOG_MIN_MS, 4096)
+}
+
+impl Board for Stm32Board {
+    type Thruster = Thruster;
+    type Link = Usart2Link;
+
+    fn supply_voltage(&self) -> f32 {
+        SUPPLY_VOLTAGE
+    }
+
+    fn thrusters(&mut self) -> &mut [Thruster; 5] {
+        &mut self.thrusters
+    }
+
+    fn link(&mut self) -> &mut Usart2Link {
+        &mut self.link
+    }
+
+    /// SysTick period 1/`hz` (`hz` = 0 is taken as 1). Also sets the watchdog to four periods
+    /// (at least 50 ms) and restarts the period count: the next `wait_period` waits a full
+    /// period and reports no overrun.
+    fn set_rate(&mut self, hz: u32) {
+        let hz = hz.max(1);
+        // SysTick's reload is 24 bits: at 168 MHz that is ≥ 10.02 Hz; below, use HCLK/8.
+        let (source, clock) = if SYSCLK_HZ / hz <= 1 << 24 {
+            (SystClkSource::Core, SYSCLK_HZ)
+        } else {
+            (SystClkSource::External, SYSCLK_HZ / 8)
+        };
+        let reload = (clock / hz).clamp(2, 1 << 24) - 1;
+        self.syst.disable_counter();
+        self.syst.set_clock_source(source);
+        self.syst.set_reload(reload);
+        // Writing the current value clears it and COUNTFLAG.
+        self.syst.clear_current();
+        self.syst.enable_counter();
+        self.rate_hz = hz;
+        self.set_watchdog_ms(watchdog_timeout_ms(hz));
+    }
+
+    fn wait_period(&mut self) -> bool {
+        // COUNTFLAG is set at each wrap and cleared by reading it.
+        let overrun = self.syst.has_wrapped();
+        if !overrun {
+            while !self.syst.has_wrapped() {}
+        }
+        overrun
+    }
+
+    /// CPU cycles (DWT CYCCNT, [`SYSCLK_HZ`] per second, wrapping).
+    fn now(&self) -> u32 {
+        DWT::cycle_count()
+    }
+
+    fn feed_watchdog(&mut self) {
+        self.iwdg.kr().write(|w| w.key().feed());
+    }
+}
