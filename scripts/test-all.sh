@@ -1,21 +1,23 @@
 #!/usr/bin/env bash
-# Every test of the workspace: host tests (both math backends of the core), the
-# thumbv7em-none-eabihf cross-builds. Set-up included: safe to run on a fresh machine.
+# Every test of the workspace, set-up included (safe on a fresh machine):
+# host tests with both math backends of the core, the simulator and the closed loop, the
+# firmware's host tests, and the firmware on the target: both boards built, the QEMU
+# self-test (golden vectors, instruction counts, fail-safe, snapshots, failure injection).
 set -euo pipefail
 cd "$(dirname "$0")/.."
+bash scripts/setup.sh
 
-# rust-toolchain.toml pins stable + the thumbv7em target; make sure both are present.
-rustup target add thumbv7em-none-eabihf >/dev/null
-
-echo "== host tests (libm backend): controller-core, host-sim (plant, scenarios, CLI), closed loop"
+echo "== host tests (libm backend): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic"
 cargo test --workspace --release
 
 echo "== controller-core tests with the micromath backend"
 cargo test -p controller-core --release --features micromath
 
-echo "== cross-build for thumbv7em-none-eabihf"
+echo "== controller-core cross-build for thumbv7em-none-eabihf"
 cargo build -p controller-core --release --target thumbv7em-none-eabihf
 cargo build -p controller-core --release --target thumbv7em-none-eabihf --features micromath
-cargo build -p firmware --release --target thumbv7em-none-eabihf
+
+echo "== firmware on the target (QEMU mps2-an386) and the STM32F405 build"
+bash scripts/firmware-ci.sh
 
 echo "all tests passed"

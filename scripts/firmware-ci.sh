@@ -1,0 +1,80 @@
+#!/usr/bin/env bash
+# The firmware's CI: builds both boards, runs the QEMU self-test with each math backend,
+# compares its decoded defmt log and the flash/RAM sizes with the snapshots, and proves that a
+# wrong answer, a panic, a HardFault and a hang each fail visibly.
+#
+#   UPDATE_SNAPSHOTS=1 bash scripts/firmware-ci.sh   # rewrite firmware/snapshots/*
+set -uo pipefail
+cd "$(dirname "$0")/.."
+target=thumbv7em-none-eabihf
+elf=target/$target/release/firmware
+snap=firmware/snapshots
+flash_budget=$((128 * 1024))
+ram_budget=$((32 * 1024))
+fail=0
+say() { printf '%s\n' "$*"; }
+bad() { say "FIRMWARE CI FAILURE: $*"; fail=1; }
+
+# Lines whose numbers depend on the compiler (instruction counts, stack depth) are compared
+# with their digits masked; every other line must match exactly. Budgets check the numbers.
+normalise() { sed -E '/instructions|stack high-water/ s/[0-9]+/#/g' "$1"; }
+
+for backend in libm micromath; do
+  feats=selftest
+  [ "$backend" = micromath ] && feats=selftest,micromath
+  say "== self-test image, $backend backend"
+  cargo build --release -p firmware --target $target --features "$feats" || { bad "build ($backend)"; continue; }
+  log=$(mktemp)
+  QEMU_TIMEOUT=120 bash scripts/qemu-run.sh "$elf" >"$log" 2>&1
+  status=$?
+  cat "$log"
+  [ "$status" -eq 0 ] || bad "self-test ($backend) exited $status"
+  grep -q "^INFO  update instructions: max=" "$log" || bad "no instruction count line ($backend)"
+  sizes=$(bash scripts/firmware-size.sh "$elf")
+  say "sizes ($backend): $sizes"
+  flash=${sizes#flash=}; flash=${flash%% *}; ram=${sizes##*ram=}
+  [ "$flash" -le "$flash_budget" ] || bad "flash $flash > budget $flash_budget ($backend)"
+  [ "$ram" -le "$ram_budget" ] || bad "static RAM $ram > budget $ram_budget ($backend)"
+  if [ "${UPDATE_SNAPSHOTS:-0}" = 1 ]; then
+    mkdir -p "$snap"
+    cp "$log" "$snap/selftest-$backend.log"
+    echo "$sizes" > "$snap/size-$backend.txt"
+  else
+    if ! diff -u <(normalise "$snap/selftest-$backend.log") <(normalise "$log"); then
+      bad "defmt log differs from $snap/selftest-$backend.log (UPDATE_SNAPSHOTS=1 to accept)"
+    fi
+    read -r snapped < "$snap/size-$backend.txt"
+    sf=${snapped#flash=}; sf=${sf%% *}
+    # ±10 % around the snapshot: a size jump is a review item, not noise.
+    if [ $((flash * 10)) -gt $((sf * 11)) ] || [ $((flash * 10)) -lt $((sf * 9)) ]; then
+      bad "flash $flash is more than 10 % from the snapshot $sf ($backend)"
+    fi
+  fi
+  if [ "$backend" = libm ]; then
+    say "== failure injection: each must fail visibly"
+    for inj in wrong panic hardfault hang; do
+      QEMU_TIMEOUT=15 bash scripts/qemu-run.sh "$elf" -append "inject=$inj" >"$log" 2>&1
+      s=$?
+      say "inject=$inj → exit $s: $(grep -E 'ERROR|TIMEOUT' "$log" | head -1)"
+      [ "$s" -ne 0 ] || bad "inject=$inj did not fail"
+    done
+  fi
+  rm -f "$log"
+done
+
+say "== flying image (QEMU board) and the STM32F405 board"
+cargo build --release -p firmware --target $target || bad "QEMU board build"
+say "QEMU board sizes: $(bash scripts/firmware-size.sh "$elf")"
+cargo build --release -p firmware --target $target --no-default-features --features stm32f405 || bad "STM32F405 build"
+say "STM32F405 sizes: $(bash scripts/firmware-size.sh "$elf")"
+# The STM32 image must be linked with its own memory map (flash at 0x0800_0000, 128 KiB RAM).
+reset=$(readelf -s "$elf" | awk '$8 == "__RESET_VECTOR" { print $2 }')
+stack=$(readelf -s "$elf" | awk '$8 == "_stack_start" { print $2 }')
+say "STM32F405 reset vector at 0x$reset, stack top 0x$stack"
+[ "$reset" = 08000004 ] && [ "$stack" = 20020000 ] || bad "STM32F405 image linked with the wrong memory map"
+
+if [ "$fail" -ne 0 ]; then
+  say "firmware CI: FAILED"
+  exit 1
+fi
+say "firmware CI: passed"
