@@ -7,6 +7,7 @@
 //! | [`plant`] | the 6-DOF plant with varying parameters, current and RK4 |
 //! | [`sil`] | the sampled-data loop: ZOH, actuator chain, noise, divergence |
 //! | [`metrics`] | the paper's Table-1 metrics from a run |
+//! | [`link`] | what the simulator sends the board over `auv-link` |
 //! | [`record`] | samples, outcome, metrics of a run |
 //! | `scenario` | TOML scenario files |
 //! | [`table1`] | the paper's six missions with and without Δu |
@@ -14,6 +15,7 @@
 //! | `output` | CSV, plots, report |
 
 pub mod config;
+pub mod link;
 pub mod metrics;
 pub mod montecarlo;
 pub mod output;
