@@ -24,9 +24,17 @@ pub trait Board {
     fn link(&mut self) -> &mut Self::Link;
     /// Sets the control-loop rate (Hz).
     fn set_rate(&mut self, hz: u32);
+    /// True if a period boundary passed since the last call (non-blocking; clears the flag).
+    fn period_elapsed(&mut self) -> bool;
     /// Blocks until the next period boundary. Returns true if that boundary had already passed
     /// when called: the previous period overran.
-    fn wait_period(&mut self) -> bool;
+    fn wait_period(&mut self) -> bool {
+        let overrun = self.period_elapsed();
+        if !overrun {
+            while !self.period_elapsed() {}
+        }
+        overrun
+    }
     /// A free-running up-counting timer, for timing `update` (board-specific unit).
     fn now(&self) -> u32;
     /// Feeds the watchdog (boards without one do nothing).
@@ -91,12 +99,15 @@ pub fn drive<B: Board>(board: &mut B, voltages: &[f32; 5]) {
 /// link, run the supervisor, drive the thrusters, send telemetry, feed the watchdog.
 pub fn period<B: Board>(board: &mut B, sup: &mut Supervisor, bufs: &mut LinkBuffers) -> Step {
     let overrun = if sup.lockstep() {
-        // Paced by state frames; a silent link still ends the wait after one period so the
-        // stale-state fail-safe can act.
-        let mut waited = false;
-        while !sup.state_fresh() && !waited {
+        // Paced by state frames (processor in the loop): poll the link until a state frame
+        // arrives. A silent link still ends the wait after one period, so the stale-state
+        // fail-safe acts as it would on the timer.
+        let _ = board.period_elapsed();
+        while !sup.state_fresh() {
             pump(board.link(), sup, bufs);
-            waited = board.wait_period();
+            if board.period_elapsed() {
+                break;
+            }
         }
         false
     } else {

@@ -8,6 +8,7 @@
 //!   implement `SetDutyCycle` like a real timer channel would).
 //! - No watchdog.
 
+use core::cell::Cell;
 use core::convert::Infallible;
 use core::ptr::{read_volatile, write_volatile};
 
@@ -125,7 +126,10 @@ pub struct QemuBoard {
     uart: CmsdkUart,
     thrusters: [MemPwm; 5],
     reload: u32,
-    periods: u32,
+    /// Software extension of the 24-bit SysTick for `now()`: last counter value seen and the
+    /// ticks accumulated so far. Correct while `now()` is called at least once per period.
+    last_cvr: Cell<u32>,
+    ticks: Cell<u32>,
 }
 
 impl QemuBoard {
@@ -144,7 +148,8 @@ impl QemuBoard {
                 MemPwm { duty: MAX_DUTY / 2 },
             ],
             reload: 0,
-            periods: 0,
+            last_cvr: Cell::new(0),
+            ticks: Cell::new(0),
         };
         b.syst.set_clock_source(SystClkSource::Core);
         b.set_rate(rate_hz);
@@ -172,19 +177,21 @@ impl Board for QemuBoard {
         self.syst.set_reload(reload);
         self.syst.clear_current();
     }
-    fn wait_period(&mut self) -> bool {
+    fn period_elapsed(&mut self) -> bool {
         // COUNTFLAG is set at each wrap and cleared by reading it.
-        let overrun = self.syst.has_wrapped();
-        if !overrun {
-            while !self.syst.has_wrapped() {}
-        }
-        self.periods = self.periods.wrapping_add(1);
-        overrun
+        self.syst.has_wrapped()
     }
     fn now(&self) -> u32 {
-        let elapsed = self.reload - SYST::get_current();
-        self.periods
-            .wrapping_mul(self.reload + 1)
-            .wrapping_add(elapsed)
+        // Down-counter: elapsed = last − current, modulo the period.
+        let cvr = SYST::get_current();
+        let last = self.last_cvr.replace(cvr);
+        let elapsed = if cvr <= last {
+            last - cvr
+        } else {
+            last + (self.reload + 1 - cvr)
+        };
+        let t = self.ticks.get().wrapping_add(elapsed);
+        self.ticks.set(t);
+        t
     }
 }

@@ -30,7 +30,7 @@
 //!   Duty d gives a mean H-bridge voltage (2d − 1)·V_s (locked anti-phase, see
 //!   [`firmware::pwm`]); **neutral is 50 %**. `init` sets all five channels to neutral and
 //!   lets the timers load it before it enables any output.
-//! - **Navigation link**: USART2 at 115200 baud, 8 data bits, no parity, 1 stop bit (8N1), no
+//! - **Navigation link**: USART2 at 460800 baud, 8 data bits, no parity, 1 stop bit (8N1), no
 //!   flow control. [`Usart2Link`] is interrupt driven: the `USART2` interrupt moves bytes
 //!   between the data register and two RAM rings ([`RX_RING`] / [`TX_RING`] bytes), so
 //!   nothing is lost while the loop computes or waits for the period (the USART has a
@@ -98,7 +98,7 @@ pub const PCLK2_HZ: u32 = 84_000_000;
 /// Thruster PWM frequency (Hz).
 pub const PWM_HZ: u32 = 20_000;
 /// Navigation-link baud rate (8N1).
-pub const LINK_BAUD: u32 = 115_200;
+pub const LINK_BAUD: u32 = 460_800;
 /// H-bridge supply voltage V_s (V): nominal, not measured. The duty for a commanded voltage
 /// is computed against it ([`firmware::pwm::duty_fraction`]).
 pub const SUPPLY_VOLTAGE: f32 = 24.0;
@@ -107,7 +107,7 @@ pub const SUPPLY_VOLTAGE: f32 = 24.0;
 pub const DEFAULT_RATE_HZ: u32 = 100;
 /// Shortest watchdog timeout (ms, nominal at a 32 kHz LSI).
 pub const WATCHDOG_MIN_MS: u32 = 50;
-/// Receive ring (bytes): 44 ms of line at 115200 baud.
+/// Receive ring (bytes): 11 ms of line at 460800 baud.
 pub const RX_RING: usize = 512;
 /// Transmit ring (bytes): more than one telemetry frame.
 pub const TX_RING: usize = 512;
@@ -275,7 +275,7 @@ fn USART2() {
     }
 }
 
-/// The navigation link on USART2 (PA2 TX, PA3 RX), 115200 8N1, as an `embedded_io` port.
+/// The navigation link on USART2 (PA2 TX, PA3 RX), 460800 8N1, as an `embedded_io` port.
 ///
 /// - [`Read::read`] never waits when a byte is waiting: it returns every buffered byte that
 ///   fits (at least one). With nothing buffered it waits for the first byte, as `embedded_io`
@@ -453,7 +453,7 @@ impl Stm32Board {
                 .stopbits(StopBits::STOP1),
             &mut rcc,
         )
-        .expect("USART2 115200 8N1 from PCLK1");
+        .expect("USART2 460800 8N1 from PCLK1");
         serial.listen(SerialEvent::RxNotEmpty);
         // SAFETY: the handler above only touches USART2 and the rings; unmasking it cannot break
         // a critical section (none is active here).
@@ -547,13 +547,9 @@ impl Board for Stm32Board {
         self.set_watchdog_ms(watchdog_timeout_ms(hz));
     }
 
-    fn wait_period(&mut self) -> bool {
+    fn period_elapsed(&mut self) -> bool {
         // COUNTFLAG is set at each wrap and cleared by reading it.
-        let overrun = self.syst.has_wrapped();
-        if !overrun {
-            while !self.syst.has_wrapped() {}
-        }
-        overrun
+        self.syst.has_wrapped()
     }
 
     /// CPU cycles (DWT CYCCNT, [`SYSCLK_HZ`] per second, wrapping).

@@ -136,7 +136,8 @@ impl Supervisor {
         self.controller.config().rate_hz
     }
 
-    /// Lock-step mode (processor in the loop): one period per state frame.
+    /// Lock-step mode (processor in the loop): one period per state frame, and the state
+    /// frame's `t_ticks` is the mission time.
     pub fn lockstep(&self) -> bool {
         self.lockstep
     }
@@ -247,6 +248,7 @@ impl Supervisor {
         }
         let mut voltages = [0.0f32; 5];
         let mut thrusts = [0.0f32; 5];
+        let mut tau = [0.0f32; 6];
         let (mut saturated, mut delta, mut delta_clamped, mut w_norm, mut fault) =
             (0u8, 0.0f32, false, 0.0f32, 0u8);
         let stale = self.periods_since_state > self.stale_periods as u32;
@@ -258,16 +260,23 @@ impl Supervisor {
             (true, None, Some(_), None) => self.latch(FailSafeReason::StaleState),
             (true, None, Some(_), Some(_)) if stale => self.latch(FailSafeReason::StaleState),
             (true, None, Some((traj, start)), Some(s)) => {
+                // Mission time: the board's own ticks since StartMission; in lock-step the
+                // state frame's t_ticks, which the navigation computer counts from the
+                // mission start (so PIL does not depend on host speed).
+                let mission_ticks = if self.lockstep {
+                    s.t_ticks
+                } else {
+                    self.tick.wrapping_sub(start)
+                };
                 let t0 = now();
-                let out =
-                    self.controller
-                        .update(self.tick.wrapping_sub(start), &s.eta, &s.nu, &traj);
+                let out = self.controller.update(mission_ticks, &s.eta, &s.nu, &traj);
                 let dt = now().wrapping_sub(t0);
                 self.worst_update_ticks = self.worst_update_ticks.max(dt);
                 match out.status {
                     Status::Ok => {
                         voltages = out.voltage;
                         thrusts = out.thrust;
+                        tau = out.tau;
                         saturated = out.saturated;
                         delta = out.delta;
                         delta_clamped = out.delta_clamped;
@@ -286,6 +295,7 @@ impl Supervisor {
             status,
             voltages,
             thrusts,
+            tau,
             saturated,
             delta,
             delta_clamped,

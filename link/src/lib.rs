@@ -20,10 +20,11 @@
 //!   `c` = 1..=255 followed by `c − 1` non-zero bytes, `c < 0xFF` implying a zero after them.
 //!   The stuffed frame contains no `0x00`; a single `0x00` ends each frame. A sender may also
 //!   send a `0x00` before a frame (e.g. after reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 95 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 91 postcard bytes + 2 CRC bytes + 1 COBS code byte + 1
-//!   delimiter). At 115 200 baud (11 520 bytes/s) that is 8.2 ms, so a State frame in one
-//!   direction and a Telemetry frame in the other both fit in a 10 ms (100 Hz) control period.
+//! - **Size:** at most [`MAX_FRAME`] = 119 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 115 postcard bytes + 2 CRC bytes + 1 COBS code byte + 1
+//!   delimiter). At 460 800 baud (46 080 bytes/s, the STM32 board's link) that is 2.6 ms, so a
+//!   State frame in one direction and a Telemetry frame in the other fit in a 10 ms (100 Hz)
+//!   control period with room to spare; 115 200 baud (10.3 ms) would not.
 //!
 //! # Receiving
 //!

@@ -219,6 +219,9 @@ pub struct Telemetry {
     pub voltages: [f32; 5],
     /// Achieved thrust per thruster (N), same order.
     pub thrusts: [f32; 5],
+    /// Commanded body force τ = [X Y Z K M N] (N, N m): what ideal actuators would apply
+    /// (processor in the loop with ideal actuators).
+    pub tau: [f32; 6],
     /// Bit i set: thruster i saturated.
     pub saturated: u8,
     /// δ(e, t) after the clamp.
@@ -247,6 +250,7 @@ impl Telemetry {
         + BoardStatus::MAX_SIZE
         + 5 * F32
         + 5 * F32
+        + 6 * F32
         + U8
         + F32
         + BOOL

@@ -92,6 +92,7 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         status,
         voltages: [24.0, -24.0, 3.5, -0.25, 0.0],
         thrusts: [120.0, -80.5, 0.0, 1.0e-3, -3.0],
+        tau: [500.0, -20.0, 3.0, 0.0, -7.5, 1.0e4],
         saturated: 0b1_0011,
         delta: 12.5,
         delta_clamped: true,
@@ -178,6 +179,7 @@ fn largest() -> Envelope {
             status: BoardStatus::FailSafe(FailSafeReason::NoMission),
             voltages: [f32::MAX; 5],
             thrusts: [f32::MIN; 5],
+            tau: [f32::MAX; 6],
             saturated: u8::MAX,
             delta: f32::MAX,
             delta_clamped: true,
@@ -304,9 +306,9 @@ fn max_sizes_are_exact() {
 
 #[test]
 fn largest_message_fits_max_frame_exactly() {
-    assert_eq!(Envelope::MAX_SIZE, 91);
-    assert_eq!(MAX_BODY, 93);
-    assert_eq!(MAX_FRAME, 95);
+    assert_eq!(Envelope::MAX_SIZE, 115);
+    assert_eq!(MAX_BODY, 117);
+    assert_eq!(MAX_FRAME, 119);
     let env = largest();
     let mut out = [0u8; MAX_FRAME];
     assert_eq!(encode(&env, &mut out), Ok(MAX_FRAME));
@@ -565,6 +567,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any_status(),
             prop::array::uniform5(any_f32()),
             prop::array::uniform5(any_f32()),
+            prop::array::uniform6(any_f32()),
             any::<u8>(),
             any_f32(),
             any::<bool>(),
@@ -581,7 +584,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
     )
         .prop_map(
             |(
-                (tick, status, voltages, thrusts, saturated, delta, delta_clamped),
+                (tick, status, voltages, thrusts, tau, saturated, delta, delta_clamped),
                 (
                     w_norm,
                     controller_fault,
@@ -596,6 +599,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 status,
                 voltages,
                 thrusts,
+                tau,
                 saturated,
                 delta,
                 delta_clamped,
