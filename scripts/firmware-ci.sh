@@ -65,13 +65,43 @@ done
 say "== flying image (QEMU board) and the STM32F405 board"
 cargo build --release -p firmware --target $target || bad "QEMU board build"
 say "QEMU board sizes: $(bash scripts/firmware-size.sh "$elf")"
-cargo build --release -p firmware --target $target --no-default-features --features stm32f405 || bad "STM32F405 build"
-say "STM32F405 sizes: $(bash scripts/firmware-size.sh "$elf")"
+# Its own target dir, so target/$target/release/firmware stays the QEMU image (host-sim pil).
+stm32=target/stm32/$target/release/firmware
+cargo build --release -p firmware --target $target --target-dir target/stm32 --no-default-features --features stm32f405 || bad "STM32F405 build"
+say "STM32F405 sizes: $(bash scripts/firmware-size.sh "$stm32")"
 # The STM32 image must be linked with its own memory map (flash at 0x0800_0000, 128 KiB RAM).
-reset=$(readelf -s "$elf" | awk '$8 == "__RESET_VECTOR" { print $2 }')
-stack=$(readelf -s "$elf" | awk '$8 == "_stack_start" { print $2 }')
+reset=$(readelf -s "$stm32" | awk '$8 == "__RESET_VECTOR" { print $2 }')
+stack=$(readelf -s "$stm32" | awk '$8 == "_stack_start" { print $2 }')
 say "STM32F405 reset vector at 0x$reset, stack top 0x$stack"
 [ "$reset" = 08000004 ] && [ "$stack" = 20020000 ] || bad "STM32F405 image linked with the wrong memory map"
+
+say "== processor in the loop: a short mission (PIL must equal SIL) and a link-fault case"
+cargo build --release -p host-sim || bad "host-sim build"
+pil=target/release/host-sim
+out=$(mktemp -d)
+if $pil pil --scenario host-sim/scenarios/lawn-mower-20x10.toml --duration 10 --json --out "$out/short" > "$out/short.json"; then
+  python3 -c "import json,sys; c=json.load(open('$out/short.json'))['cases'][0]; print('PIL max path %.5f m, SIL %.5f m, %.0f frames/s, worst update %d instructions' % (c['max_path'], c['sil_max_path'], c['pil']['frames_per_second'], c['pil']['worst_update_instructions']))"
+else
+  bad "PIL short mission (PIL differs from SIL by more than 1 mm, or diverged)"
+fi
+if $pil pil --scenario host-sim/scenarios/circular-10R.toml --duration 8 --json --out "$out/faults" \
+     --drop 100..101 --corrupt 150..152 --delay 200..210 --silent 300..310 > "$out/faults.json"; then
+  python3 - "$out/faults.json" <<'PY' || bad "link-fault case: fail-safe not entered and left as expected"
+import json, sys
+c = json.load(open(sys.argv[1]))["cases"][0]
+ev = c["pil"]["failsafe_events"]
+print("fail-safe events:", [(e["kind"], e["tick"], e["reason"]) for e in ev], "rx_errors", c["pil"]["board_rx_errors"])
+# Silent from tick 300: the third period without a frame (tick 302) is fail-safe; the re-arm
+# at tick 310 (first healthy frame) brings it back. Drop/corrupt/delay stay within 2 periods.
+assert [e["kind"] for e in ev] == ["enter", "exit"], ev
+assert ev[0]["tick"] == 302 and ev[0]["reason"] == "stale state", ev
+assert ev[1]["tick"] == 310, ev
+assert c["pil"]["board_rx_errors"] >= 2
+PY
+else
+  bad "PIL link-fault case failed to run"
+fi
+rm -rf "$out"
 
 if [ "$fail" -ne 0 ]; then
   say "firmware CI: FAILED"

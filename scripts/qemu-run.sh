@@ -9,7 +9,8 @@ elf="$1"
 shift
 command -v qemu-system-arm >/dev/null || { echo "qemu-system-arm not found (see .ci/run)" >&2; exit 127; }
 command -v defmt-print >/dev/null || { echo "defmt-print not found: cargo install defmt-print --locked" >&2; exit 127; }
-timeout "${QEMU_TIMEOUT:-120}" qemu-system-arm \
+# --foreground: stay in the caller's process group, so that stopping the runner stops QEMU.
+timeout --foreground "${QEMU_TIMEOUT:-120}" qemu-system-arm \
   -machine mps2-an386 -cpu cortex-m4 \
   -nographic -monitor none -serial "${QEMU_SERIAL:-none}" \
   -semihosting-config enable=on,target=native \

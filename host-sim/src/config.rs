@@ -85,6 +85,65 @@ pub struct SensorNoise {
     pub seed: u64,
 }
 
+/// A half-open range of control ticks [from, to).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct TickRange {
+    pub from: u64,
+    pub to: u64,
+}
+
+impl TickRange {
+    pub fn contains(&self, k: u64) -> bool {
+        self.from <= k && k < self.to
+    }
+
+    /// Parses "A..B" (ticks).
+    pub fn parse(s: &str) -> Result<Self, String> {
+        let (a, b) = s
+            .split_once("..")
+            .ok_or_else(|| format!("tick range `{s}` must be A..B"))?;
+        let from = a
+            .trim()
+            .parse()
+            .map_err(|_| format!("bad tick `{a}` in `{s}`"))?;
+        let to = b
+            .trim()
+            .parse()
+            .map_err(|_| format!("bad tick `{b}` in `{s}`"))?;
+        if to <= from {
+            return Err(format!("tick range `{s}` is empty"));
+        }
+        Ok(TickRange { from, to })
+    }
+}
+
+/// Faults injected on the board link, by control tick (processor in the loop only; a SIL run
+/// has no link and ignores them).
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct LinkFaults {
+    /// State frames not sent.
+    pub drop: Vec<TickRange>,
+    /// State frames sent with one byte flipped (the board must count and drop them).
+    pub corrupt: Vec<TickRange>,
+    /// State frames replaced by the frame from `delay_ticks` earlier (stale data).
+    pub delay: Vec<TickRange>,
+    pub delay_ticks: u64,
+    /// Nothing is sent at all (no state, no commands).
+    pub silent: Vec<TickRange>,
+}
+
+impl LinkFaults {
+    pub fn any(v: &[TickRange], k: u64) -> bool {
+        v.iter().any(|r| r.contains(k))
+    }
+    pub fn is_empty(&self) -> bool {
+        self.drop.is_empty()
+            && self.corrupt.is_empty()
+            && self.delay.is_empty()
+            && self.silent.is_empty()
+    }
+}
+
 /// One run.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SimConfig {
@@ -109,6 +168,8 @@ pub struct SimConfig {
     pub initial_offset: [f64; 6],
     /// A position error beyond this (m) is a runaway: the run stops and says so.
     pub divergence_limit: f64,
+    /// Faults on the board link (PIL only).
+    pub link_faults: LinkFaults,
 }
 
 impl SimConfig {
@@ -128,6 +189,7 @@ impl SimConfig {
             ideal_actuators: true,
             initial_offset: [0.0; 6],
             divergence_limit: 50.0,
+            link_faults: LinkFaults::default(),
         }
     }
 }

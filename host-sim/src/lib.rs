@@ -11,6 +11,7 @@
 //! | [`record`] | samples, outcome, metrics of a run |
 //! | `scenario` | TOML scenario files |
 //! | [`table1`] | the paper's six missions with and without Δu |
+//! | [`pil`] | processor in the loop: the firmware in QEMU flies the plant |
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box |
 //! | `output` | CSV, plots, report |
 
@@ -19,6 +20,7 @@ pub mod link;
 pub mod metrics;
 pub mod montecarlo;
 pub mod output;
+pub mod pil;
 pub mod plant;
 pub mod record;
 pub mod scenario;

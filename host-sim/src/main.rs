@@ -12,8 +12,10 @@ use std::process::ExitCode;
 
 use anyhow::{bail, Context, Result};
 use clap::{Parser, Subcommand};
+use host_sim::config::{LinkFaults, TickRange};
 use host_sim::montecarlo::{self, MonteCarloOptions};
 use host_sim::output::{self, ReportRow};
+use host_sim::pil::BoardInTheLoop;
 use host_sim::record::{Outcome, RunResult};
 use host_sim::{scenario, sil, table1};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -49,6 +51,39 @@ enum Command {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Processor in the loop: the firmware ELF in QEMU flies the simulated vehicle over a
+    /// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).
+    Pil {
+        #[arg(long, conflicts_with = "table1")]
+        scenario: Option<PathBuf>,
+        /// The six Table-1 missions (with Δu).
+        #[arg(long)]
+        table1: bool,
+        #[arg(long)]
+        json: bool,
+        #[arg(long, default_value = "runs/pil")]
+        out: PathBuf,
+        /// Firmware ELF (the QEMU flying image).
+        #[arg(long)]
+        elf: Option<PathBuf>,
+        /// Override the scenario's duration (s).
+        #[arg(long)]
+        duration: Option<f64>,
+        /// Drop the state frames of these ticks.
+        #[arg(long, value_parser = TickRange::parse)]
+        drop: Vec<TickRange>,
+        /// Flip a byte in the state frames of these ticks.
+        #[arg(long, value_parser = TickRange::parse)]
+        corrupt: Vec<TickRange>,
+        /// Send the state from `--delay-ticks` earlier during these ticks.
+        #[arg(long, value_parser = TickRange::parse)]
+        delay: Vec<TickRange>,
+        #[arg(long, default_value_t = 5)]
+        delay_ticks: u64,
+        /// Send nothing at all during these ticks.
+        #[arg(long, value_parser = TickRange::parse)]
+        silent: Vec<TickRange>,
+    },
     /// Draws the Table-3 parameters uniformly in their box, runs in parallel, reports
     /// percentiles and the worst case. Deterministic per seed.
     MonteCarlo {
@@ -81,6 +116,33 @@ fn main() -> ExitCode {
             json,
             out,
         } => cmd_run(&scenario, json, out),
+        Command::Pil {
+            scenario,
+            table1,
+            json,
+            out,
+            elf,
+            duration,
+            drop,
+            corrupt,
+            delay,
+            delay_ticks,
+            silent,
+        } => cmd_pil(
+            scenario,
+            table1,
+            json,
+            &out,
+            elf,
+            duration,
+            LinkFaults {
+                drop,
+                corrupt,
+                delay,
+                delay_ticks,
+                silent,
+            },
+        ),
         Command::MonteCarlo {
             runs,
             seed,
@@ -303,6 +365,128 @@ fn cmd_monte_carlo(
         println!("report: {}", report.display());
     }
     Ok(if summary.diverged > 0 {
+        ExitCode::from(1)
+    } else {
+        ExitCode::SUCCESS
+    })
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+fn cmd_pil(
+    scenario_path: Option<PathBuf>,
+    table1_cases: bool,
+    json: bool,
+    out: &Path,
+    elf: Option<PathBuf>,
+    duration: Option<f64>,
+    faults: LinkFaults,
+) -> Result<ExitCode> {
+    let mut configs = Vec::new();
+    match (&scenario_path, table1_cases) {
+        (Some(p), false) => configs
+            .push(scenario::load_scenario(p).with_context(|| format!("scenario {}", p.display()))?),
+        (None, true) => {
+            for case in controller_core::Table1Case::ALL {
+                configs.push(scenario::table1_scenario(case, true));
+            }
+        }
+        _ => bail!("give --scenario FILE or --table1"),
+    }
+    if let Some(d) = duration {
+        if !(d.is_finite() && d > 0.0) {
+            bail!("--duration must be > 0 s, got {d}");
+        }
+        for c in &mut configs {
+            c.duration = d;
+        }
+    }
+    // Flags add to the scenario's [link_faults].
+    for c in &mut configs {
+        let f = &mut c.link_faults;
+        f.drop.extend(faults.drop.iter().copied());
+        f.corrupt.extend(faults.corrupt.iter().copied());
+        f.delay.extend(faults.delay.iter().copied());
+        f.silent.extend(faults.silent.iter().copied());
+        if !faults.delay.is_empty() {
+            f.delay_ticks = faults.delay_ticks;
+        }
+    }
+    let root = workspace_root();
+    let elf = elf.unwrap_or_else(|| root.join("target/thumbv7em-none-eabihf/release/firmware"));
+    let runner = root.join("scripts/qemu-run.sh");
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
+    let pb = progress(configs.len(), "PIL", json);
+    let mut cases = Vec::new();
+    let mut pairs = Vec::new();
+    let mut failed = false;
+    for cfg in &configs {
+        let sil_run = sil::run(cfg).map_err(|e| anyhow::anyhow!("{}: {e}", cfg.name))?;
+        let log = out.join(format!("{}-qemu.log", cfg.name));
+        let mut board = BoardInTheLoop::start(&elf, &runner, cfg, cfg.link_faults.clone(), &log)
+            .map_err(|e| anyhow::anyhow!("{}: {e}", cfg.name))?;
+        let pil_run =
+            sil::run_with(cfg, &mut board).map_err(|e| anyhow::anyhow!("{}: {e}", cfg.name))?;
+        let stats = board.finish();
+        pb.inc(1);
+        let diff = pil_run.metrics.max_path - sil_run.metrics.max_path;
+        if matches!(pil_run.outcome, Outcome::Diverged { .. })
+            || (cfg.link_faults.is_empty() && diff.abs() > 1e-3)
+        {
+            failed = true;
+        }
+        let mut v = json_cases(&[&pil_run])["cases"][0].clone();
+        v["mode"] = serde_json::json!("pil");
+        v["sil_max_path"] = serde_json::json!(sil_run.metrics.max_path);
+        v["pil_minus_sil_max_path"] = serde_json::json!(diff);
+        v["pil"] = serde_json::to_value(&stats).context("serialising PIL stats")?;
+        cases.push(v);
+        pairs.push((pil_run, None));
+    }
+    pb.finish_and_clear();
+    let mut notes = String::from("## Processor in the loop vs software in the loop\n\n| case | PIL max path (m) | SIL max path (m) | PIL − SIL (m) | frames/s | worst update (instructions) | fail-safe events | re-arms |\n|---|---|---|---|---|---|---|---|\n");
+    for c in &cases {
+        notes += &format!(
+            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} |\n",
+            c["case"].as_str().unwrap_or("?"),
+            c["max_path"].as_f64().unwrap_or(f64::NAN),
+            c["sil_max_path"].as_f64().unwrap_or(f64::NAN),
+            c["pil_minus_sil_max_path"].as_f64().unwrap_or(f64::NAN),
+            c["pil"]["frames_per_second"].as_f64().unwrap_or(f64::NAN),
+            c["pil"]["worst_update_instructions"],
+            c["pil"]["failsafe_events"]
+                .as_array()
+                .map_or(0, |a| a.len()),
+            c["pil"]["rearms"],
+        );
+    }
+    let report = write_outputs(
+        out,
+        "AUV-150 processor in the loop (firmware in QEMU)",
+        &pairs,
+        &notes,
+        output::DEFAULT_VOLTAGE_LIMIT,
+    )?;
+    if json {
+        println!("{}", serde_json::json!({ "cases": cases }));
+    } else {
+        println!("{notes}");
+        for c in &cases {
+            for e in c["pil"]["failsafe_events"].as_array().into_iter().flatten() {
+                println!(
+                    "{}: fail-safe {} at t = {} s: {}",
+                    c["case"].as_str().unwrap_or("?"),
+                    e["kind"].as_str().unwrap_or("?"),
+                    e["t"],
+                    e["reason"].as_str().unwrap_or("?")
+                );
+            }
+        }
+        println!("report: {}", report.display());
+    }
+    Ok(if failed {
         ExitCode::from(1)
     } else {
         ExitCode::SUCCESS

@@ -97,7 +97,9 @@ use controller_core::{
 };
 use serde::Deserialize;
 
-use crate::config::{CurrentModel, SensorNoise, SimConfig, VariationProfile};
+use crate::config::{
+    CurrentModel, LinkFaults, SensorNoise, SimConfig, TickRange, VariationProfile,
+};
 
 /// Longest accepted `duration` (s): one day.
 pub const MAX_DURATION: f64 = 86_400.0;
@@ -211,6 +213,18 @@ struct RawScenario {
     current: Option<RawCurrent>,
     noise: Option<RawNoise>,
     controller: Option<RawController>,
+    link_faults: Option<RawLinkFaults>,
+}
+
+/// `[link_faults]`: tick ranges "A..B" (processor in the loop only).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawLinkFaults {
+    drop: Option<Vec<String>>,
+    corrupt: Option<Vec<String>>,
+    delay: Option<Vec<String>>,
+    delay_ticks: Option<u64>,
+    silent: Option<Vec<String>>,
 }
 
 #[derive(Clone, Copy, Deserialize)]
@@ -591,8 +605,31 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
         config.noise = Some(build_noise(&raw)?);
     }
 
+    if let Some(raw) = raw.link_faults {
+        config.link_faults = build_link_faults(&raw)?;
+    }
+
     Controller::new(config.controller).map_err(|e| invalid("controller", e.to_string()))?;
     Ok(config)
+}
+
+fn build_link_faults(raw: &RawLinkFaults) -> Res<LinkFaults> {
+    let ranges = |key: &str, v: &Option<Vec<String>>| -> Res<Vec<TickRange>> {
+        v.iter()
+            .flatten()
+            .enumerate()
+            .map(|(i, s)| {
+                TickRange::parse(s).map_err(|m| invalid(format!("link_faults.{key}[{i}]"), m))
+            })
+            .collect()
+    };
+    Ok(LinkFaults {
+        drop: ranges("drop", &raw.drop)?,
+        corrupt: ranges("corrupt", &raw.corrupt)?,
+        delay: ranges("delay", &raw.delay)?,
+        delay_ticks: raw.delay_ticks.unwrap_or(5),
+        silent: ranges("silent", &raw.silent)?,
+    })
 }
 
 fn build_trajectory(raw: &RawTrajectory) -> Res<TrajectoryKind> {

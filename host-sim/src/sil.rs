@@ -104,8 +104,70 @@ fn to_f64<const N: usize>(a: &[f32; N]) -> [f64; N] {
     a.map(|x| x as f64)
 }
 
-/// Runs one simulation.
+/// What one control period returns, whether the law ran here (SIL) or on the board (PIL).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControlOut {
+    /// False: the controller is in fail-safe (thrusters off).
+    pub ok: bool,
+    /// "ok" or why not.
+    pub status: &'static str,
+    /// Commanded body force (used by ideal actuators).
+    pub tau: [f32; 6],
+    /// Voltages (used by the real actuator chain).
+    pub voltage: [f32; 5],
+    pub saturated: u8,
+    pub delta: f32,
+    pub delta_clamped: bool,
+    pub w_norm: f32,
+}
+
+/// Where the control law runs.
+pub trait ControlSource {
+    /// The control for period `k` from the measured state. An `Err` ends the run (e.g. the
+    /// board's link is gone) with the message as the reason; what was recorded is kept.
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String>;
+}
+
+/// The f32 core on the host, as the firmware runs it (software in the loop).
+pub struct LocalController {
+    controller: Controller,
+    trajectory: Trajectory,
+}
+
+impl LocalController {
+    pub fn new(cfg: &SimConfig) -> Result<Self, SimError> {
+        Ok(LocalController {
+            controller: Controller::new(cfg.controller).map_err(SimError::Controller)?,
+            trajectory: Trajectory::new(cfg.trajectory).map_err(SimError::Trajectory)?,
+        })
+    }
+}
+
+impl ControlSource for LocalController {
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
+        let out = self.controller.update(k, eta, nu, &self.trajectory);
+        Ok(ControlOut {
+            ok: out.status == Status::Ok,
+            status: status_name(out.status),
+            tau: out.tau,
+            voltage: out.voltage,
+            saturated: out.saturated,
+            delta: out.delta,
+            delta_clamped: out.delta_clamped,
+            w_norm: out.w_norm,
+        })
+    }
+}
+
+/// Runs one simulation with the law on the host (software in the loop).
 pub fn run(cfg: &SimConfig) -> Result<RunResult, SimError> {
+    let mut local = LocalController::new(cfg)?;
+    run_with(cfg, &mut local)
+}
+
+/// Runs one simulation with the law wherever `source` runs it.
+pub fn run_with(cfg: &SimConfig, source: &mut dyn ControlSource) -> Result<RunResult, SimError> {
+    // Validates the configuration and gives the allocation the plant's thrusters use.
     let controller = Controller::new(cfg.controller).map_err(SimError::Controller)?;
     let trajectory = Trajectory::new(cfg.trajectory).map_err(SimError::Trajectory)?;
     if !(cfg.duration.is_finite() && cfg.duration > 0.0) {
@@ -182,20 +244,21 @@ pub fn run(cfg: &SimConfig) -> Result<RunResult, SimError> {
                 nu_m[i] += n.nu_sigma[i] * b;
             }
         }
-        let out = controller.update(
-            k,
-            &eta_m.cast::<f32>().into(),
-            &nu_m.cast::<f32>().into(),
-            &trajectory,
-        );
+        let out = match source.control(k, &eta_m.cast::<f32>().into(), &nu_m.cast::<f32>().into()) {
+            Ok(o) => o,
+            Err(reason) => {
+                outcome = Outcome::Diverged { t, reason };
+                break;
+            }
+        };
 
         // 2. Actuation.
-        let target: [f64; THRUSTERS] = match out.status {
-            Status::Fault(_) => [0.0; THRUSTERS],
-            Status::Ok if cfg.ideal_actuators => {
+        let target: [f64; THRUSTERS] = match out.ok {
+            false => [0.0; THRUSTERS],
+            true if cfg.ideal_actuators => {
                 to_f64(&controller.allocation().thrusts(&Vector6::from(out.tau)))
             }
-            Status::Ok => {
+            true => {
                 let mut t = [0.0; THRUSTERS];
                 for i in 0..THRUSTERS {
                     t[i] = maps[i].thrust(out.voltage[i]) as f64;
@@ -217,7 +280,7 @@ pub fn run(cfg: &SimConfig) -> Result<RunResult, SimError> {
             delta_clamped: out.delta_clamped,
             w_norm: out.w_norm as f64,
             payload: cfg.variation.at(t).mass,
-            status: status_name(out.status),
+            status: out.status,
         };
         if k == steps {
             rec.thrust = thrust_applied.unwrap_or(target);

@@ -456,3 +456,26 @@ fn missing_file_error_names_the_path() {
     assert!(e.to_string().contains("no-such-scenario.toml"), "{e}");
     assert!(std::error::Error::source(&e).is_some());
 }
+
+#[test]
+fn link_faults_section_parses_and_names_bad_ranges() {
+    let base = "[trajectory]\nkind = \"circle\"\nradius = 10\n";
+    let cfg = host_sim::scenario::parse_scenario(&format!(
+        "{base}[link_faults]\ndrop = [\"5..7\"]\nsilent = [\"300..310\", \"400..401\"]\n"
+    ))
+    .unwrap();
+    let f = &cfg.link_faults;
+    assert_eq!(f.drop.len(), 1);
+    assert!(f.drop[0].contains(5) && f.drop[0].contains(6) && !f.drop[0].contains(7));
+    assert_eq!(f.silent.len(), 2);
+    assert_eq!(f.delay_ticks, 5);
+    let err =
+        host_sim::scenario::parse_scenario(&format!("{base}[link_faults]\ncorrupt = [\"9..3\"]\n"))
+            .unwrap_err()
+            .to_string();
+    assert!(err.contains("link_faults.corrupt[0]"), "{err}");
+    let err = host_sim::scenario::parse_scenario(&format!("{base}[link_faults]\nstall = []\n"))
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("stall"), "{err}");
+}

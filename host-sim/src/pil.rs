@@ -1,0 +1,411 @@
+//! Processor in the loop: the firmware ELF runs in QEMU (`mps2-an386`) with its UART0 — the
+//! navigation link — on a loopback TCP socket; the simulator plays the vehicle and its
+//! navigation computer.
+//!
+//! Set-up: `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods }`,
+//! `Arm`, then `StartMission` with the first state frame. In lock-step the board runs one
+//! control period per state frame and takes the frame's `t_ticks` as mission time, so the
+//! result does not depend on host speed. Each period the simulator sends a state frame from
+//! the plant and applies the returned telemetry (voltages, or τ for ideal actuators) through
+//! the same actuator chain as SIL ([`crate::sil::run_with`]).
+//!
+//! Link faults ([`LinkFaults`]) drop, corrupt, delay or silence state frames over tick ranges.
+//! The board must go to fail-safe within its stale-state limit; once the link is healthy
+//! again the simulator re-arms it (disarm + arm) and it must resume. Every fail-safe entry and
+//! exit is recorded.
+
+use std::io::{Read, Write};
+use std::net::{TcpListener, TcpStream};
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use auv_link::{
+    encode, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope, FailSafeReason,
+    FrameDecoder, Msg, StateFrame, Telemetry, MAX_FRAME, PROTOCOL_VERSION,
+};
+use serde::Serialize;
+
+use crate::config::{LinkFaults, SimConfig};
+use crate::link::mission_spec;
+use crate::sil::{ControlOut, ControlSource};
+
+/// QEMU mps2-an386 SysTick counts per instruction ratio (`-icount shift=0`, 25 MHz).
+pub const INSTRUCTIONS_PER_TICK: u32 = 40;
+
+/// A change of the board's fail-safe state, as reported by its telemetry.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FailSafeEvent {
+    pub tick: u64,
+    pub t: f64,
+    /// "enter" or "exit".
+    pub kind: &'static str,
+    pub reason: String,
+}
+
+/// Link and board figures of one PIL run.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PilStats {
+    pub state_frames_sent: u64,
+    pub telemetry_frames: u64,
+    pub wall_seconds: f64,
+    /// State frames per wall-clock second.
+    pub frames_per_second: f64,
+    /// Longest `update` the board measured, in instructions (`-icount shift=0`).
+    pub worst_update_instructions: u64,
+    pub board_rx_errors: u32,
+    pub board_loop_overruns: u32,
+    pub rearms: u32,
+    pub failsafe_events: Vec<FailSafeEvent>,
+}
+
+/// The firmware in QEMU, on a socket.
+pub struct BoardInTheLoop {
+    child: Child,
+    stream: TcpStream,
+    decoder: FrameDecoder,
+    seq: u16,
+    rate_hz: u32,
+    faults: LinkFaults,
+    mission: auv_link::MissionSpec,
+    started: bool,
+    history: Vec<StateFrame>,
+    pending: std::collections::VecDeque<Telemetry>,
+    last_tick: Option<u64>,
+    last_status: Option<BoardStatus>,
+    needs_rearm: bool,
+    t0: Instant,
+    pub stats: PilStats,
+    log_path: PathBuf,
+}
+
+fn reason_name(s: BoardStatus) -> String {
+    match s {
+        BoardStatus::FailSafe(FailSafeReason::StaleState) => "stale state".into(),
+        BoardStatus::FailSafe(FailSafeReason::ControllerFault) => "controller fault".into(),
+        BoardStatus::FailSafe(FailSafeReason::Overrun) => "loop overrun".into(),
+        BoardStatus::FailSafe(FailSafeReason::Disarmed) => "disarmed".into(),
+        BoardStatus::FailSafe(FailSafeReason::NoMission) => "no mission".into(),
+        other => format!("{other:?}"),
+    }
+}
+
+impl BoardInTheLoop {
+    /// Starts QEMU with `elf` (the QEMU flying image), waits for its UART to connect, and
+    /// configures and arms the board. `runner` is `scripts/qemu-run.sh`; QEMU's decoded log
+    /// goes to `log_path`.
+    pub fn start(
+        elf: &Path,
+        runner: &Path,
+        cfg: &SimConfig,
+        faults: LinkFaults,
+        log_path: &Path,
+    ) -> Result<Self, String> {
+        if !elf.exists() {
+            return Err(format!(
+                "firmware ELF {} not found: build it with `cargo build -p firmware --release --target thumbv7em-none-eabihf`",
+                elf.display()
+            ));
+        }
+        let listener = TcpListener::bind("127.0.0.1:0")
+            .map_err(|e| format!("binding a loopback port: {e}"))?;
+        let port = listener.local_addr().map_err(|e| e.to_string())?.port();
+        let log = std::fs::File::create(log_path)
+            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
+        let log_err = log.try_clone().map_err(|e| e.to_string())?;
+        let child = Command::new("bash")
+            // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
+            // under `timeout`, two processes down).
+            .process_group(0)
+            .arg(runner)
+            .arg(elf)
+            .env("QEMU_SERIAL", format!("tcp:127.0.0.1:{port},nodelay=on"))
+            .env("QEMU_TIMEOUT", "3600")
+            .stdin(Stdio::null())
+            .stdout(Stdio::from(log))
+            .stderr(Stdio::from(log_err))
+            .spawn()
+            .map_err(|e| format!("starting QEMU through {}: {e}", runner.display()))?;
+        listener.set_nonblocking(true).map_err(|e| e.to_string())?;
+        let deadline = Instant::now() + Duration::from_secs(30);
+        let stream = loop {
+            match listener.accept() {
+                Ok((s, _)) => break s,
+                Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                    if Instant::now() > deadline {
+                        return Err(format!(
+                            "QEMU did not connect its UART within 30 s (see {})",
+                            log_path.display()
+                        ));
+                    }
+                    std::thread::sleep(Duration::from_millis(20));
+                }
+                Err(e) => return Err(format!("accepting QEMU's UART: {e}")),
+            }
+        };
+        stream.set_nonblocking(false).map_err(|e| e.to_string())?;
+        stream.set_nodelay(true).map_err(|e| e.to_string())?;
+        stream
+            .set_read_timeout(Some(Duration::from_secs(10)))
+            .map_err(|e| e.to_string())?;
+        let mut b = BoardInTheLoop {
+            child,
+            stream,
+            decoder: FrameDecoder::new(),
+            seq: 0,
+            rate_hz: cfg.controller.rate_hz,
+            faults,
+            mission: mission_spec(&cfg.trajectory),
+            started: false,
+            history: Vec::new(),
+            pending: std::collections::VecDeque::new(),
+            last_tick: None,
+            last_status: None,
+            needs_rearm: false,
+            t0: Instant::now(),
+            stats: PilStats::default(),
+            log_path: log_path.to_path_buf(),
+        };
+        let c = &cfg.controller;
+        b.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
+            rate_hz: Some(c.rate_hz),
+            robust: Some(c.robust),
+            delta_max: Some(c.delta_max),
+            voltage_limit: Some(c.voltage_limit),
+            stale_periods: Some(2),
+            lockstep: Some(true),
+        })))?;
+        b.send(Msg::Command(LinkCommand::Arm))?;
+        // Wait until the board reports itself armed: the configuration and arming took.
+        let deadline = Instant::now() + Duration::from_secs(30);
+        loop {
+            let t = b.next_telemetry()?;
+            if t.status == BoardStatus::Armed {
+                break;
+            }
+            if Instant::now() > deadline {
+                return Err(format!("board did not arm (status {:?})", t.status));
+            }
+        }
+        b.t0 = Instant::now();
+        Ok(b)
+    }
+
+    fn send(&mut self, msg: Msg) -> Result<(), String> {
+        let mut buf = [0u8; MAX_FRAME];
+        let n = self.encode(msg, &mut buf)?;
+        self.write(&buf[..n])
+    }
+
+    fn encode(&mut self, msg: Msg, buf: &mut [u8; MAX_FRAME]) -> Result<usize, String> {
+        let env = Envelope {
+            version: PROTOCOL_VERSION,
+            seq: self.seq,
+            msg,
+        };
+        self.seq = self.seq.wrapping_add(1);
+        encode(&env, buf).map_err(|e| format!("encoding: {e}"))
+    }
+
+    fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
+        self.stream.write_all(bytes).map_err(|e| {
+            format!(
+                "board link write failed: {e} (see {})",
+                self.log_path.display()
+            )
+        })
+    }
+
+    /// The next telemetry frame from the board (frames of other kinds are ignored).
+    fn next_telemetry(&mut self) -> Result<Telemetry, String> {
+        let mut chunk = [0u8; 512];
+        loop {
+            if let Some(t) = self.pending.pop_front() {
+                self.stats.telemetry_frames += 1;
+                return Ok(t);
+            }
+            let n = self.stream.read(&mut chunk).map_err(|e| {
+                format!(
+                    "board link read failed: {e} (see {})",
+                    self.log_path.display()
+                )
+            })?;
+            if n == 0 {
+                return Err(format!(
+                    "QEMU closed the link (see {})",
+                    self.log_path.display()
+                ));
+            }
+            for &b in &chunk[..n] {
+                if let Some(Ok(Envelope {
+                    msg: Msg::Telemetry(t),
+                    ..
+                })) = self.decoder.push(b)
+                {
+                    self.pending.push_back(t);
+                }
+            }
+        }
+    }
+
+    /// The telemetry of the board's next control period (later than any seen before).
+    fn next_period(&mut self) -> Result<Telemetry, String> {
+        loop {
+            let t = self.next_telemetry()?;
+            if self.last_tick.is_none_or(|last| t.tick > last) {
+                self.last_tick = Some(t.tick);
+                return Ok(t);
+            }
+        }
+    }
+
+    fn note_status(&mut self, t: &Telemetry, k: u64) {
+        let was_fail = matches!(self.last_status, Some(BoardStatus::FailSafe(_)));
+        let is_fail = matches!(t.status, BoardStatus::FailSafe(_));
+        let time = k as f64 / self.rate_hz as f64;
+        if is_fail && !was_fail {
+            self.stats.failsafe_events.push(FailSafeEvent {
+                tick: k,
+                t: time,
+                kind: "enter",
+                reason: reason_name(t.status),
+            });
+            self.needs_rearm = true;
+        } else if was_fail && !is_fail {
+            self.stats.failsafe_events.push(FailSafeEvent {
+                tick: k,
+                t: time,
+                kind: "exit",
+                reason: format!("{:?}", t.status),
+            });
+        }
+        self.last_status = Some(t.status);
+        self.stats.board_rx_errors = t.rx_errors;
+        self.stats.board_loop_overruns = t.loop_overruns;
+        self.stats.worst_update_instructions =
+            t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
+    }
+
+    fn stop_qemu(&mut self) {
+        // SIGTERM to the whole process group (bash runner, timeout, QEMU, defmt-print).
+        let _ = Command::new("kill")
+            .arg("-TERM")
+            .arg("--")
+            .arg(format!("-{}", self.child.id()))
+            .status();
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+
+    /// Ends the QEMU process and returns the figures.
+    pub fn finish(mut self) -> PilStats {
+        self.stop_qemu();
+        let wall = self.t0.elapsed().as_secs_f64();
+        self.stats.wall_seconds = wall;
+        self.stats.frames_per_second = if wall > 0.0 {
+            self.stats.state_frames_sent as f64 / wall
+        } else {
+            0.0
+        };
+        std::mem::take(&mut self.stats)
+    }
+}
+
+impl Drop for BoardInTheLoop {
+    fn drop(&mut self) {
+        self.stop_qemu();
+    }
+}
+
+impl ControlSource for BoardInTheLoop {
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
+        let frame = StateFrame {
+            t_ticks: k,
+            eta: *eta,
+            nu: *nu,
+        };
+        self.history.push(frame);
+        let silent = LinkFaults::any(&self.faults.silent, k);
+        let dropped = LinkFaults::any(&self.faults.drop, k);
+        let corrupt = LinkFaults::any(&self.faults.corrupt, k);
+        let delayed = LinkFaults::any(&self.faults.delay, k);
+        let healthy = !(silent || dropped || corrupt || delayed);
+        let mut expect_seq = None;
+        let mut out = Vec::with_capacity(4 * MAX_FRAME);
+        let mut buf = [0u8; MAX_FRAME];
+        if !silent {
+            if self.needs_rearm && healthy {
+                // Recovery: the link is good again; re-arm (the fail-safe latches until then).
+                for c in [LinkCommand::Disarm, LinkCommand::Arm] {
+                    let n = self.encode(Msg::Command(c), &mut buf)?;
+                    out.extend_from_slice(&buf[..n]);
+                }
+                self.needs_rearm = false;
+                self.stats.rearms += 1;
+            }
+            if !self.started {
+                let n = self.encode(
+                    Msg::Command(LinkCommand::StartMission(self.mission)),
+                    &mut buf,
+                )?;
+                out.extend_from_slice(&buf[..n]);
+                self.started = true;
+            }
+            if !dropped {
+                let sent = if delayed {
+                    let i = self
+                        .history
+                        .len()
+                        .saturating_sub(1 + self.faults.delay_ticks as usize);
+                    self.history[i]
+                } else {
+                    frame
+                };
+                if !corrupt {
+                    expect_seq = Some(self.seq);
+                }
+                let n = self.encode(Msg::State(sent), &mut buf)?;
+                if corrupt {
+                    buf[n / 2] ^= 0x5A;
+                }
+                out.extend_from_slice(&buf[..n]);
+                self.stats.state_frames_sent += 1;
+            }
+        }
+        if !out.is_empty() {
+            self.write(&out)?;
+        }
+        // The board's answer to this frame; if it timed out before the frame arrived (host
+        // slower than the board's virtual clock), that timeout period is skipped. Without a
+        // valid frame the answer is the board's next (timed-out) period.
+        let t = loop {
+            let t = self.next_period()?;
+            match expect_seq {
+                Some(seq) if t.last_state_seq != seq => continue,
+                _ => break t,
+            }
+        };
+        self.note_status(&t, k);
+        Ok(ControlOut {
+            ok: t.status == BoardStatus::Running,
+            status: match t.status {
+                BoardStatus::Running => "ok",
+                BoardStatus::Armed => "board:armed",
+                BoardStatus::Disarmed => "board:disarmed",
+                BoardStatus::FailSafe(FailSafeReason::StaleState) => "board:fail-safe:stale-state",
+                BoardStatus::FailSafe(FailSafeReason::ControllerFault) => {
+                    "board:fail-safe:controller-fault"
+                }
+                BoardStatus::FailSafe(FailSafeReason::Overrun) => "board:fail-safe:overrun",
+                BoardStatus::FailSafe(_) => "board:fail-safe",
+            },
+            tau: t.tau,
+            voltage: t.voltages,
+            saturated: t.saturated,
+            delta: t.delta,
+            delta_clamped: t.delta_clamped,
+            w_norm: t.w_norm,
+        })
+    }
+}
