@@ -22,13 +22,12 @@ mod stm32f405;
 #[cfg(target_os = "none")]
 #[cfg_attr(feature = "selftest", allow(dead_code, unused_imports))]
 mod rt {
-    use auv_link::{BoardStatus, FailSafeReason};
     #[cfg(not(feature = "selftest"))]
     use controller_core::{Controller, ControllerConfig};
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt::{error, info};
     use firmware::board::{period, Board, LinkBuffers};
-    use firmware::supervisor::Supervisor;
+    use firmware::supervisor::{status_name, Supervisor};
 
     #[cfg(feature = "stm32f405")]
     use defmt_rtt as _;
@@ -52,19 +51,6 @@ mod rt {
         {
             let _ = code;
             cortex_m::peripheral::SCB::sys_reset()
-        }
-    }
-
-    fn status_name(s: BoardStatus) -> &'static str {
-        match s {
-            BoardStatus::Disarmed => "disarmed",
-            BoardStatus::Armed => "armed",
-            BoardStatus::Running => "running",
-            BoardStatus::FailSafe(FailSafeReason::StaleState) => "fail-safe: stale state",
-            BoardStatus::FailSafe(FailSafeReason::ControllerFault) => "fail-safe: controller fault",
-            BoardStatus::FailSafe(FailSafeReason::Overrun) => "fail-safe: overrun",
-            BoardStatus::FailSafe(FailSafeReason::Disarmed) => "fail-safe: disarmed",
-            BoardStatus::FailSafe(FailSafeReason::NoMission) => "fail-safe: no mission",
         }
     }
 

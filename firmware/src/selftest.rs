@@ -11,7 +11,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use defmt::{error, info};
 use firmware::pwm;
-use firmware::supervisor::Supervisor;
+use firmware::supervisor::{status_name, Supervisor};
 
 use crate::qemu::INSTRUCTIONS_PER_TICK;
 use crate::stack;
@@ -151,19 +151,6 @@ fn frame(sup: &mut Supervisor, dec: &mut FrameDecoder, env: &Envelope, corrupt: 
             Some(Err(_)) => sup.on_rx_error(),
             None => {}
         }
-    }
-}
-
-fn status_name(s: BoardStatus) -> &'static str {
-    match s {
-        BoardStatus::Disarmed => "disarmed",
-        BoardStatus::Armed => "armed",
-        BoardStatus::Running => "running",
-        BoardStatus::FailSafe(FailSafeReason::StaleState) => "fail-safe: stale state",
-        BoardStatus::FailSafe(FailSafeReason::ControllerFault) => "fail-safe: controller fault",
-        BoardStatus::FailSafe(FailSafeReason::Overrun) => "fail-safe: overrun",
-        BoardStatus::FailSafe(FailSafeReason::Disarmed) => "fail-safe: disarmed",
-        BoardStatus::FailSafe(FailSafeReason::NoMission) => "fail-safe: no mission",
     }
 }
 

@@ -74,6 +74,20 @@ pub fn trajectory_of(spec: &MissionSpec) -> Option<Trajectory> {
     Trajectory::new(kind).ok()
 }
 
+/// A short name of a board status, for logs.
+pub fn status_name(s: BoardStatus) -> &'static str {
+    match s {
+        BoardStatus::Disarmed => "disarmed",
+        BoardStatus::Armed => "armed",
+        BoardStatus::Running => "running",
+        BoardStatus::FailSafe(FailSafeReason::StaleState) => "fail-safe: stale state",
+        BoardStatus::FailSafe(FailSafeReason::ControllerFault) => "fail-safe: controller fault",
+        BoardStatus::FailSafe(FailSafeReason::Overrun) => "fail-safe: overrun",
+        BoardStatus::FailSafe(FailSafeReason::Disarmed) => "fail-safe: disarmed",
+        BoardStatus::FailSafe(FailSafeReason::NoMission) => "fail-safe: no mission",
+    }
+}
+
 fn fault_code(f: Fault) -> u8 {
     match f {
         Fault::NonFiniteInput => 1,
