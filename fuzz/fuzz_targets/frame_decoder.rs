@@ -2,22 +2,22 @@
 //!
 //! Every input is checked twice:
 //!
-//! 1. **Raw:** the bytes as they are, as a received byte stream.
-//! 2. **Framed:** the bytes read as length-prefixed bodies (`L = byte % 100`, then `L` bytes),
-//!    each given a correct CRC-16, COBS-stuffed and delimited, so that the postcard
+//! 1. **Raw:** the bytes as they are, as a received byte stream (the whole input is also given
+//!    to `decode_frame` as one frame).
+//! 2. **Framed:** the bytes read as length-prefixed bodies (`L = byte % (MAX_BODY + 8)`, then
+//!    `L` bytes), each given a correct CRC-16, COBS-stuffed and delimited, so that the postcard
 //!    deserializer is reached without the fuzzer having to solve the CRC.
 //!
 //! For each stream: [`FrameDecoder::push`] byte by byte never panics and returns exactly what a
 //! model built on [`decode_frame`] (run on a copy of each delimited frame) predicts, its counters
 //! agree, and every `Ok(envelope)` re-encodes with [`encode`] to a well-formed frame that decodes
-//! (streaming and one-shot) to the same envelope, compared bit for bit (NaN-safe). The whole
-//! input is also given to `decode_frame` as a single frame.
+//! (streaming and one-shot) to the same envelope, compared bit for bit (NaN-safe).
 
 #![no_main]
 
 use auv_link::{
     decode_frame, encode, Command, ConfigPatch, Envelope, FrameDecoder, LinkError, MissionSpec,
-    Msg, StateFrame, Telemetry, MAX_FRAME, PROTOCOL_VERSION,
+    Msg, StateFrame, Telemetry, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
 };
 use libfuzzer_sys::fuzz_target;
 
@@ -109,7 +109,8 @@ fn framed(data: &[u8]) -> Vec<u8> {
     let mut out = Vec::new();
     let mut rest = data;
     while let Some((&len, tail)) = rest.split_first() {
-        let len = (len as usize % 100).min(tail.len());
+        // Up to a little beyond the largest body, so that oversize frames occur too.
+        let len = (len as usize % (MAX_BODY + 8)).min(tail.len());
         let (body, tail) = tail.split_at(len);
         let mut raw = body.to_vec();
         raw.extend_from_slice(&crc16(body));
