@@ -43,41 +43,10 @@ fn decode_chunked(bytes: &[u8], chunks: &[usize]) -> Vec<Result<Envelope, LinkEr
     results
 }
 
-/// Reference COBS (plain Vec code, independent of the crate's) plus the delimiter, for frames
-/// built by hand.
-fn stuff(body: &[u8]) -> Vec<u8> {
-    let mut out = vec![0u8];
-    let mut code_at = 0;
-    for &b in body {
-        if b != 0 {
-            out.push(b);
-        }
-        if b == 0 || out.len() - code_at == 0xFF {
-            out[code_at] = (out.len() - code_at) as u8;
-            code_at = out.len();
-            out.push(0);
-        }
-    }
-    out[code_at] = (out.len() - code_at) as u8;
-    out.push(0);
-    out
-}
-
-fn crc16(bytes: &[u8]) -> [u8; 2] {
-    // CRC-16/IBM-3740 bit by bit, independent of the `crc` crate.
-    let mut crc: u16 = 0xFFFF;
-    for &b in bytes {
-        crc ^= u16::from(b) << 8;
-        for _ in 0..8 {
-            crc = if crc & 0x8000 != 0 {
-                (crc << 1) ^ 0x1021
-            } else {
-                crc << 1
-            };
-        }
-    }
-    crc.to_le_bytes()
-}
+// Reference COBS and CRC-16, written independently of the crate's (shared with the fuzz checks).
+#[path = "common/frames.rs"]
+mod frames;
+use frames::{crc16, stuff};
 
 /// A hand-made frame around an arbitrary body with a correct CRC.
 fn frame_from_body(body: &[u8]) -> Vec<u8> {
