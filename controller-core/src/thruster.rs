@@ -49,7 +49,7 @@ const TUN_D: f64 = -1.354;
 const TUN_T0: f64 = -TUN_B / (3.0 * TUN_A);
 const TUN_P: f64 = TUN_C - TUN_B * TUN_B / (3.0 * TUN_A);
 const TUN_V0: f64 = ((TUN_A * TUN_T0 + TUN_B) * TUN_T0 + TUN_C) * TUN_T0 + TUN_D;
-/// √(P/(3A)) = √119.9644… (no const sqrt; checked below).
+/// σ = √(P/(3A)) = √359.893… (no const sqrt; checked below).
 const TUN_SIGMA: f64 = 18.970_854_839_287_906;
 const TUN_K: f64 = TUN_A * TUN_SIGMA * TUN_SIGMA * TUN_SIGMA;
 const _: () = {
