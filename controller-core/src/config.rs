@@ -8,7 +8,8 @@
 
 use core::fmt;
 
-use crate::allocation::{AllocationError, ThrusterGeometry};
+use crate::allocation::AllocationError;
+use crate::effectiveness::ThrusterGeometry;
 use crate::law::{RobustLaw, CONTROLLED, ROLL};
 use crate::model::VehicleParams;
 use crate::uncertainty::{BoundsError, ParamBox};

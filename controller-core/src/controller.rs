@@ -8,11 +8,13 @@
 
 use nalgebra::{Matrix6, Vector6};
 
-use crate::allocation::{self, Actuation, Allocation, ThrusterMap, THRUSTERS};
+use crate::allocation::Allocation;
 use crate::config::{BBound, ConfigError, ControllerConfig};
+use crate::effectiveness::THRUSTERS;
 use crate::kinematics::{self, Attitude};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
 use crate::model::{self, VehicleParams};
+use crate::thruster::{self, Actuation, ThrusterMap};
 use crate::trajectory::Trajectory;
 use crate::uncertainty::UncertaintyBounds;
 
@@ -195,7 +197,7 @@ impl Controller {
             delta_constants,
             bounds,
             allocation,
-            maps: allocation::default_maps(),
+            maps: thruster::default_maps(),
             cos_pitch_limit: libm::cosf(config.pitch_limit),
             config,
         })
@@ -313,7 +315,7 @@ impl Controller {
         if !tau.iter().all(|x| x.is_finite()) {
             return Err(Fault::NonFiniteResult);
         }
-        let act = allocation::actuate(
+        let act = thruster::actuate(
             &self.maps,
             &self.allocation.thrusts(&tau),
             self.config.voltage_limit,

@@ -78,7 +78,8 @@ impl Attitude<f32> {
     }
 }
 
-/// Rotation R(φ,θ,ψ) = R_z(ψ) R_y(θ) R_x(φ), body → earth (Eq 2's J₁).
+/// Rotation R(φ,θ,ψ) = R_z(ψ) R_y(θ) R_x(φ), body → earth (Eq 2's J₁; Fossen's `Rzyx`).
+#[doc(alias = "Rzyx")]
 pub fn rotation<T: RealField + Copy>(a: &Attitude<T>) -> Matrix3<T> {
     let (sf, cf, st, ct, sp, cp) = (a.sphi, a.cphi, a.stheta, a.ctheta, a.spsi, a.cpsi);
     Matrix3::new(
@@ -94,7 +95,8 @@ pub fn rotation<T: RealField + Copy>(a: &Attitude<T>) -> Matrix3<T> {
     )
 }
 
-/// Euler-rate matrix T(φ,θ) of Eq 2's J₂: [φ̇ θ̇ ψ̇]ᵀ = T ω.
+/// Euler-rate matrix T(φ,θ) of Eq 2's J₂: [φ̇ θ̇ ψ̇]ᵀ = T ω (Fossen's `Tzyx`).
+#[doc(alias = "Tzyx")]
 pub fn euler_rate_matrix<T: RealField + Copy>(a: &Attitude<T>) -> Result<Matrix3<T>, GimbalLock> {
     let sec = a.sec_theta()?;
     let tth = a.stheta * sec;
@@ -129,7 +131,8 @@ pub fn euler_rate_matrix_inv<T: RealField + Copy>(a: &Attitude<T>) -> Matrix3<T>
     )
 }
 
-/// J(η) = diag(R, T) of Eq (2).
+/// J(η) = diag(R, T) of Eq (2) (Fossen's `eulerang`, which returns J with R and T).
+#[doc(alias = "eulerang")]
 pub fn jacobian<T: RealField + Copy>(a: &Attitude<T>) -> Result<Matrix6<T>, GimbalLock> {
     let mut j = Matrix6::zeros();
     j.fixed_view_mut::<3, 3>(0, 0).copy_from(&rotation(a));

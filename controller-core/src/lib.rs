@@ -5,10 +5,12 @@
 pub mod allocation;
 pub mod config;
 pub mod controller;
+pub mod effectiveness;
 pub mod kinematics;
 pub mod law;
 pub mod math;
 pub mod model;
+pub mod thruster;
 pub mod trajectory;
 pub mod uncertainty;
 

@@ -87,7 +87,9 @@ pub fn norm<const N: usize>(v: &[f32; N]) -> f32 {
 /// Wraps an angle to (−π, π] with a fixed amount of work (no loop).
 ///
 /// Used for the yaw component of e₁ (AUV150.md §4, **Choice**) and for trajectory phases.
-/// Non-finite input gives NaN (the caller checks finiteness).
+/// Non-finite input gives NaN (the caller checks finiteness). Fossen's `ssa` (smallest signed
+/// angle, which returns [−π, π) where this returns (−π, π]) and MATLAB's `wrapToPi`.
+#[doc(alias("ssa", "wrapToPi"))]
 #[inline]
 pub fn wrap_pi(x: f32) -> f32 {
     // r ∈ [−π, π) up to rounding; map −π to +π to make the interval (−π, π].

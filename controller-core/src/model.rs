@@ -184,7 +184,8 @@ impl ParamVariation<f64> {
     }
 }
 
-/// Skew-symmetric matrix S(a) with S(a) b = a × b.
+/// Skew-symmetric matrix S(a) with S(a) b = a × b (Fossen's `Smtrx`).
+#[doc(alias = "Smtrx")]
 pub fn skew<T: RealField + Copy>(a: &Vector3<T>) -> Matrix3<T> {
     let z = T::zero();
     Matrix3::new(z, -a.z, a.y, a.z, z, -a.x, -a.y, a.x, z)
@@ -224,7 +225,8 @@ pub fn mass_matrix<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
 /// printed sign the closed loop diverges on the lawn-mower case.
 ///
 /// Linear in `m`, so C_RB(ν) = `coriolis(&M_RB, ν)` and C_A(ν_r) = `coriolis(&M_A, ν_r)` for
-/// the plant's current model.
+/// the plant's current model. Fossen's `m2c` (C from M) for a 6×6 M.
+#[doc(alias = "m2c")]
 pub fn coriolis<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Matrix6<T> {
     let ab = m * nu;
     let sa = skew(&Vector3::new(ab[0], ab[1], ab[2]));
@@ -255,7 +257,9 @@ pub fn damping<T: RealField + Copy>(p: &VehicleParams<T>, nu: &Vector6<T>) -> Ma
 /// g₆ = −(x_G W − x_B B) cθ sφ − (y_G W − y_B B) sθ,
 /// with k₄ = z_G W − z_B,roll B and k₅ = z_G W − z_B,pitch B.
 ///
-/// At nominal this is the printed g(η) = [0, 0, 0, 296.1 cθ sφ, 291.1 sθ, 0]ᵀ.
+/// At nominal this is the printed g(η) = [0, 0, 0, 296.1 cθ sφ, 291.1 sθ, 0]ᵀ. Fossen's `gvect`,
+/// with separate roll and pitch buoyancy arms.
+#[doc(alias = "gvect")]
 pub fn restoring<T: RealField + Copy>(p: &VehicleParams<T>, att: &Attitude<T>) -> Vector6<T> {
     let w = p.weight();
     let b = p.buoyancy;

@@ -1,0 +1,299 @@
+//! The thruster characteristic: force → voltage (Eqs 31–32 of Roy et al. 2013), its closed-form
+//! inverse, the thrust envelope at a supply limit, and saturation (docs/design.md §5, §15).
+//!
+//! This module knows what one thruster does with a voltage; it knows nothing about where the
+//! thrusters sit (that is [`crate::effectiveness`]) or how a wrench is split among them (that
+//! is [`crate::allocation`]). In the manner of PX4, it is the actuator-output stage after the
+//! control allocation:
+//!
+//! * [`ThrusterMap`]: Eq 31 (tunnel) and Eq 32 (main), V(T), and the inverse T(V) in closed form;
+//! * [`ThrusterMap::thrust_range`]: the envelope [T_min, T_max] reachable within ±V_limit;
+//! * [`actuate`]: the supply clamp, the main thruster's fold, and the thrust the clamped voltage
+//!   actually gives ([`Actuation`]) — the saturation-honesty signal of docs/design.md §5.
+//!
+//! Thrust is in newtons, voltage in volts. The paper does not state the unit of Eqs 31–32; this
+//! crate reads newtons (docs/design.md §9 discusses the kgf reading).
+//!
+//! Everything here is fixed work: no loops that depend on data, no iteration to convergence,
+//! no heap, no panics.
+//!
+//! # Square roots in the inverse maps
+//!
+//! The inverse maps call [`libm::sqrtf`] directly instead of [`crate::math::sqrt`]. Under the
+//! `micromath` feature `math::sqrt` has up to ≈ 6 % relative error; measured through the
+//! inverse maps over the ±24 V range when this choice was made, that is a thrust error of up
+//! to 1.85 N (4.5 %) on the main thruster and 0.46 N (2.3 %) on a tunnel thruster (Cardano's
+//! square root feeds a cancellation), whose whole ±24 V range is only −9.2…+20.1 N. The
+//! reported thrust is the saturation-honesty signal, so it must not depend on the backend; the
+//! cost is five `sqrtf` per tick. With libm the inverse is within 1.2e-5 N of the exact root
+//! over ±24 V in both backends (asserted by `tests/thruster.rs`). `cbrt` is libm in both
+//! backends and goes through [`crate::math::cbrt`].
+
+use crate::effectiveness::THRUSTERS;
+use crate::math;
+
+/// Default supply limit of the board, V (docs/design.md §5: ±24 V).
+pub const DEFAULT_V_LIMIT: f32 = 24.0;
+
+// Eq 31, tunnel: V = A T³ + B T² + C T + D.
+const TUN_A: f64 = 0.0005;
+const TUN_B: f64 = -0.0468;
+const TUN_C: f64 = 2.0;
+const TUN_D: f64 = -1.354;
+// Shifted and scaled form used by the inverse: with T = T₀ + σ y,
+//   V = V₀ + K (y³ + 3 y),
+// T₀ = −B/(3A) (inflection, 31.2 N), P = C − B²/(3A) = V'(T₀) = 0.53984 V/N > 0 (so the cubic
+// is strictly increasing and has exactly one real root), σ = √(P/(3A)) and K = A σ³.
+// The shift removes the quadratic term, the scale makes the linear coefficient exactly 3, so
+// Cardano's intermediate quantities stay O(1)·|V| instead of 2000·|V|.
+const TUN_T0: f64 = -TUN_B / (3.0 * TUN_A);
+const TUN_P: f64 = TUN_C - TUN_B * TUN_B / (3.0 * TUN_A);
+const TUN_V0: f64 = ((TUN_A * TUN_T0 + TUN_B) * TUN_T0 + TUN_C) * TUN_T0 + TUN_D;
+/// σ = √(P/(3A)) = √359.893… (no const sqrt; checked below).
+const TUN_SIGMA: f64 = 18.970_854_839_287_906;
+const TUN_K: f64 = TUN_A * TUN_SIGMA * TUN_SIGMA * TUN_SIGMA;
+const _: () = {
+    let rel = (3.0 * TUN_A * TUN_SIGMA * TUN_SIGMA - TUN_P) / TUN_P;
+    assert!(rel < 1e-14 && rel > -1e-14);
+    assert!(TUN_P > 0.0);
+};
+
+// Eq 32, main: V = A T² + B T + C.
+const MAIN_A: f64 = -0.003;
+const MAIN_B: f64 = -0.1048;
+const MAIN_C: f64 = -0.1962;
+const MAIN_T_FOLD_F64: f64 = -MAIN_B / (2.0 * MAIN_A);
+const MAIN_V_FOLD_F64: f64 = (MAIN_A * MAIN_T_FOLD_F64 + MAIN_B) * MAIN_T_FOLD_F64 + MAIN_C;
+
+/// Thrust at the fold of the main thruster's parabola (Eq 32), N: T_fold = −0.1048/(2·0.003)
+/// = −17.4667 N. Eq 32 is decreasing for T ≥ T_fold; reverse thrust below T_fold does not
+/// exist.
+pub const MAIN_T_FOLD: f32 = MAIN_T_FOLD_F64 as f32;
+/// Voltage at the fold of Eq 32, V: V_fold = V(T_fold) = 0.719053 V, the largest voltage the
+/// main map produces.
+pub const MAIN_V_FOLD: f32 = MAIN_V_FOLD_F64 as f32;
+
+/// Force→voltage characteristic of one thruster (thrust T in N, voltage V in V).
+///
+/// Both maps are the paper's experimental curve fits, used as printed (docs/design.md §5).
+/// Their value at T = 0 is not 0 V (tunnel −1.354 V, main −0.1962 V): that offset is a
+/// curve-fit artefact, and 0 V means power off (see [`Actuation::OFF`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
+pub enum ThrusterMap {
+    /// Tunnel thruster, Eq 31: V = 0.0005 T³ − 0.0468 T² + 2 T − 1.354.
+    /// Strictly increasing (V′ ≥ 0.53984 V/N at T = 31.2 N), defined for every T.
+    Tunnel,
+    /// Stern main thruster, Eq 32: V = −0.003 T² − 0.1048 T − 0.1962.
+    /// Valid branch T ≥ [`MAIN_T_FOLD`] (= −17.47 N), on which it is strictly decreasing from
+    /// [`MAIN_V_FOLD`] (= 0.719 V); forward thrust needs negative voltage.
+    Main,
+}
+
+impl ThrusterMap {
+    /// Voltage (V) that the map assigns to thrust `t` (N): the polynomial of Eq 31 or Eq 32,
+    /// in Horner form, for every `t` (for the main thruster also below T_fold, where the
+    /// polynomial is outside its valid branch — [`actuate`] never commands that).
+    #[inline]
+    pub fn voltage(self, t: f32) -> f32 {
+        match self {
+            ThrusterMap::Tunnel => {
+                ((TUN_A as f32 * t + TUN_B as f32) * t + TUN_C as f32) * t + TUN_D as f32
+            }
+            ThrusterMap::Main => (MAIN_A as f32 * t + MAIN_B as f32) * t + MAIN_C as f32,
+        }
+    }
+
+    /// Thrust (N) that voltage `v` (V) gives: the inverse of [`voltage`](Self::voltage) on the
+    /// valid branch, in closed form with fixed work.
+    ///
+    /// * Tunnel (Eq 31): Cardano's formula for the monotonic cubic, which has exactly one real
+    ///   root. Written for the depressed, scaled cubic y³ + 3y + 2h = 0 with T = 31.2 + σ y,
+    ///   σ = 18.97 N, h = (V₀ − V)/(2K), V₀ = 30.6747 V, K = 3.4137 V: with
+    ///   s = √(h² + 1), w = −h − sign(h)·s (no cancellation) and u = ∛w, y = u − 1/u.
+    ///   ±∞ gives ±∞.
+    /// * Main (Eq 32): the quadratic formula's root on the branch T ≥ T_fold, in the
+    ///   cancellation-free form T = −2(V + 0.1962)/(0.1048 + √(0.012 (V_fold − V))).
+    ///   A voltage at or above [`MAIN_V_FOLD`] returns [`MAIN_T_FOLD`]; −∞ gives +∞.
+    ///
+    /// NaN gives NaN. Accuracy (asserted by `tests/thruster.rs` against an f64 root of the
+    /// same f32 voltage): within 1.2e-5 N over ±24 V, within 4 ulps of max(|T|, 32 N) over
+    /// tunnel V ∈ [−400, 60] V and main V ∈ [−300, 0.6] V. The round trip
+    /// `thrust(voltage(T))` adds the error of evaluating the polynomial in f32 divided by the
+    /// slope; next to the main fold the inverse is ill-conditioned, ΔT ≈ √(ΔV/0.003).
+    #[inline]
+    pub fn thrust(self, v: f32) -> f32 {
+        match self {
+            ThrusterMap::Tunnel => tunnel_thrust(v),
+            ThrusterMap::Main => main_thrust(v),
+        }
+    }
+
+    /// The thrust envelope at a supply limit: the range of thrust (N) reachable with voltages
+    /// in [−`v_limit`, +`v_limit`], as (lowest, highest).
+    ///
+    /// The envelope is asymmetric: at ±24 V a tunnel thruster gives −9.165 … +20.102 N, the
+    /// main thruster −17.467 (the fold of Eq 32) … +73.306 N (docs/design.md §5).
+    #[doc(alias = "envelope")]
+    #[inline]
+    pub fn thrust_range(self, v_limit: f32) -> (f32, f32) {
+        match self {
+            ThrusterMap::Tunnel => (self.thrust(-v_limit), self.thrust(v_limit)),
+            ThrusterMap::Main => (self.thrust(v_limit), self.thrust(-v_limit)),
+        }
+    }
+}
+
+/// Exact square root for the inverse maps (see the module docs, "Square roots in the inverse
+/// maps": micromath's ≈ 6 % error is not acceptable for the reported thrust).
+#[inline]
+fn exact_sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
+fn tunnel_thrust(v: f32) -> f32 {
+    if v.is_nan() || v.is_infinite() {
+        // NaN → NaN, ±∞ → ±∞ (the map is increasing and unbounded).
+        return v;
+    }
+    // y³ + 3y + 2h = 0.
+    let h = 0.5 * ((TUN_V0 as f32 - v) / TUN_K as f32);
+    // s = √(h² + 1) without overflow of h²: scale by m = max(|h|, 1).
+    let m = if h.abs() > 1.0 { h.abs() } else { 1.0 };
+    let hm = h / m;
+    let im = 1.0 / m;
+    let s = m * exact_sqrt(hm * hm + im * im);
+    // Pick the sign that adds magnitudes: |w| ≥ s ≥ 1, so u ≠ 0.
+    let w = if h >= 0.0 { -h - s } else { s - h };
+    let u = math::cbrt(w);
+    let y = u - 1.0 / u;
+    TUN_T0 as f32 + TUN_SIGMA as f32 * y
+}
+
+fn main_thrust(v: f32) -> f32 {
+    if v.is_nan() {
+        return v;
+    }
+    if v >= MAIN_V_FOLD {
+        // Above the fold no thrust gives this voltage; the closest is the fold itself.
+        return MAIN_T_FOLD;
+    }
+    if v == f32::NEG_INFINITY {
+        return f32::INFINITY;
+    }
+    // 0.003 T² + 0.1048 T + γ = 0 with γ = 0.1962 + V; discriminant
+    // Δ = 0.1048² − 0.012 γ = 0.012 (V_fold − V) ≥ 0 (Sterbenz-exact near the fold).
+    let gamma = v - MAIN_C as f32;
+    let disc = (-4.0 * MAIN_A) as f32 * (MAIN_V_FOLD - v);
+    let root = exact_sqrt(disc);
+    // T = (−β + √Δ)/(2α) = −2γ/(β + √Δ); divide before doubling so huge |V| cannot overflow.
+    -2.0 * (gamma / (-MAIN_B as f32 + root))
+}
+
+/// The AUV-150 layout of maps in thruster order ([`crate::effectiveness`]):
+/// `[Main, Tunnel, Tunnel, Tunnel, Tunnel]`.
+pub const fn default_maps() -> [ThrusterMap; THRUSTERS] {
+    [
+        ThrusterMap::Main,
+        ThrusterMap::Tunnel,
+        ThrusterMap::Tunnel,
+        ThrusterMap::Tunnel,
+        ThrusterMap::Tunnel,
+    ]
+}
+
+/// What the thrusters are actually driven with, and what that gives.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Actuation {
+    /// Voltage applied to each thruster, V, within ±v_limit.
+    pub voltages: [f32; THRUSTERS],
+    /// Thrust each applied voltage actually gives (inverse map of the applied voltage), N.
+    pub thrusts: [f32; THRUSTERS],
+    /// Bit i set ⇔ thruster i did not get its command: voltage clamped at ±v_limit, main
+    /// thruster commanded below T_fold, or a non-finite command.
+    pub saturated: u8,
+}
+
+impl Actuation {
+    /// Fail-safe "all thrusters off": 0 V and 0 N on every thruster, no saturation bit.
+    ///
+    /// 0 V is power off, so 0 N is reported — not the maps' value at 0 V (tunnel ≈ +0.68 N,
+    /// main ≈ −1.98 N), which comes from the curve fits' offset (Eq 31 gives V(0) = −1.354 V,
+    /// Eq 32 V(0) = −0.1962 V) and is an artefact of the fits.
+    pub const OFF: Actuation = Actuation {
+        voltages: [0.0; THRUSTERS],
+        thrusts: [0.0; THRUSTERS],
+        saturated: 0,
+    };
+
+    /// True if thruster `i` is saturated (false for `i` ≥ 5).
+    pub const fn is_saturated(&self, i: usize) -> bool {
+        i < THRUSTERS && self.saturated & (1 << i) != 0
+    }
+}
+
+/// Mask with every thruster's saturation bit set.
+pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
+
+/// Turns thrust commands (N) into voltages (V) within ±`v_limit` and reports the thrust those
+/// voltages actually give (docs/design.md §5, "Saturation").
+///
+/// Per thruster i, with map `maps[i]`:
+/// 1. a non-finite command → 0 V (power off), 0 N reported, bit i set;
+/// 2. main thruster commanded below [`MAIN_T_FOLD`] → voltage [`MAIN_V_FOLD`] (the closest
+///    thrust Eq 32 can give), bit i set;
+/// 3. otherwise V = `maps[i].voltage(cmd)` (Eq 31/32);
+/// 4. V clamped to [−`v_limit`, +`v_limit`], bit i set if the clamp acted;
+/// 5. reported thrust = `maps[i].thrust(V)` of the clamped voltage — also when nothing
+///    saturated, so the report is always what the applied voltage gives (within the inverse
+///    map's f32 round trip, ~1e-5 N).
+///
+/// Each thruster is clipped on its own, so a saturated step distorts the wrench: see
+/// [`crate::allocation`] for where a saturation-aware allocator takes over.
+///
+/// `v_limit` must be finite and > 0; otherwise every thruster is switched off (0 V, 0 N) with
+/// every bit set. Fixed work, never panics; for finite `v_limit` > 0 every output is finite
+/// and |V| ≤ `v_limit`.
+pub fn actuate(
+    maps: &[ThrusterMap; THRUSTERS],
+    thrust_cmd: &[f32; THRUSTERS],
+    v_limit: f32,
+) -> Actuation {
+    if !(v_limit.is_finite() && v_limit > 0.0) {
+        return Actuation {
+            saturated: ALL_SATURATED,
+            ..Actuation::OFF
+        };
+    }
+    let mut out = Actuation::OFF;
+    for i in 0..THRUSTERS {
+        let (v, t, sat) = actuate_one(maps[i], thrust_cmd[i], v_limit);
+        out.voltages[i] = v;
+        out.thrusts[i] = t;
+        if sat {
+            out.saturated |= 1 << i;
+        }
+    }
+    out
+}
+
+/// One thruster of [`actuate`]; `v_limit` is finite and > 0.
+#[inline]
+fn actuate_one(map: ThrusterMap, cmd: f32, v_limit: f32) -> (f32, f32, bool) {
+    if !cmd.is_finite() {
+        return (0.0, 0.0, true);
+    }
+    let (mut v, mut sat) = match map {
+        ThrusterMap::Main if cmd < MAIN_T_FOLD => (MAIN_V_FOLD, true),
+        _ => (map.voltage(cmd), false),
+    };
+    // voltage() of a finite command is never NaN (Horner steps are inf ∘ finite at worst),
+    // and ±∞ is clamped here.
+    if v > v_limit {
+        v = v_limit;
+        sat = true;
+    } else if v < -v_limit {
+        v = -v_limit;
+        sat = true;
+    }
+    (v, map.thrust(v), sat)
+}

@@ -1,0 +1,97 @@
+//! Thruster geometry and the effectiveness matrix B (`controller_core::effectiveness`,
+//! docs/design.md §5): the default layout is the documented choice, B is checked column by
+//! column against r × d worked out by hand, and bad geometries are rejected with their numbers.
+
+use controller_core::allocation::{Allocation, AllocationError};
+use controller_core::effectiveness::{
+    GeometryError, ThrusterGeometry, HORZ_AFT, HORZ_FORE, MAIN, THRUSTERS, VERT_AFT, VERT_FORE,
+};
+
+#[test]
+fn default_layout_is_the_spec_choice() {
+    let g = ThrusterGeometry::default();
+    assert_eq!(g.position[MAIN], [-2.43, 0.0, 0.0]);
+    assert_eq!(g.direction[MAIN], [1.0, 0.0, 0.0]);
+    assert_eq!(g.position[VERT_FORE], [1.8, 0.0, 0.0]);
+    assert_eq!(g.position[VERT_AFT], [-1.8, 0.0, 0.0]);
+    assert_eq!(g.direction[VERT_FORE], [0.0, 0.0, 1.0]);
+    assert_eq!(g.direction[VERT_AFT], [0.0, 0.0, 1.0]);
+    assert_eq!(g.position[HORZ_FORE], [1.8, 0.0, 0.0]);
+    assert_eq!(g.position[HORZ_AFT], [-1.8, 0.0, 0.0]);
+    assert_eq!(g.direction[HORZ_FORE], [0.0, 1.0, 0.0]);
+    assert_eq!(g.direction[HORZ_AFT], [0.0, 1.0, 0.0]);
+    assert_eq!(THRUSTERS, 5);
+}
+
+#[test]
+fn default_effectiveness_matrix_by_hand() {
+    let b = ThrusterGeometry::default()
+        .effectiveness()
+        .expect("default geometry accepted");
+    // Columns [d; r × d] by hand, rows X Y Z K M N: r × d for r = (x, 0, 0) is
+    // (0, −x d_z, x d_y).
+    let want: [[f32; 6]; 5] = [
+        [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],  // main: on the x axis, no moment
+        [0.0, 0.0, 1.0, 0.0, -1.8, 0.0], // vertical fore: M = −1.8·T
+        [0.0, 0.0, 1.0, 0.0, 1.8, 0.0],  // vertical aft: M = +1.8·T
+        [0.0, 1.0, 0.0, 0.0, 0.0, 1.8],  // horizontal fore: N = +1.8·T
+        [0.0, 1.0, 0.0, 0.0, 0.0, -1.8], // horizontal aft: N = −1.8·T
+    ];
+    for (c, col) in want.iter().enumerate() {
+        for (r, &w) in col.iter().enumerate() {
+            assert_eq!(b[(r, c)], w, "B[{r},{c}]");
+        }
+    }
+    // The allocation keeps this very matrix.
+    let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry accepted");
+    assert_eq!(a.matrix(), b);
+}
+
+#[test]
+fn rejects_non_unit_direction() {
+    let mut g = ThrusterGeometry::default();
+    g.direction[VERT_FORE] = [0.0, 0.0, 2.0];
+    let err = g.effectiveness().expect_err("non-unit direction");
+    assert_eq!(
+        err,
+        GeometryError::NotUnitDirection {
+            thruster: VERT_FORE,
+            norm_squared: 4.0
+        }
+    );
+    assert!(err.to_string().contains("thruster 1"), "{err}");
+    // The allocation refuses the geometry with the same error and message.
+    let alloc_err = Allocation::new(&g).expect_err("non-unit direction");
+    assert_eq!(alloc_err, AllocationError::Geometry(err));
+    assert_eq!(alloc_err.to_string(), err.to_string());
+    // Within the 1e-3 tolerance: accepted; just outside: rejected.
+    g.direction[VERT_FORE] = [0.0, 0.0, 1.0009];
+    assert!(g.effectiveness().is_ok());
+    g.direction[VERT_FORE] = [0.0, 0.0, 0.9985];
+    assert!(matches!(
+        g.effectiveness(),
+        Err(GeometryError::NotUnitDirection { thruster: 1, .. })
+    ));
+}
+
+#[test]
+fn rejects_non_finite_geometry() {
+    let mut g = ThrusterGeometry::default();
+    g.position[VERT_AFT][0] = f32::NAN;
+    assert_eq!(
+        g.effectiveness(),
+        Err(GeometryError::NonFinite { thruster: VERT_AFT })
+    );
+    let mut g = ThrusterGeometry::default();
+    g.direction[MAIN][1] = f32::INFINITY;
+    assert_eq!(
+        g.effectiveness(),
+        Err(GeometryError::NonFinite { thruster: MAIN })
+    );
+    assert_eq!(
+        Allocation::new(&g),
+        Err(AllocationError::Geometry(GeometryError::NonFinite {
+            thruster: MAIN
+        }))
+    );
+}
