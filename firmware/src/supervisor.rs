@@ -13,8 +13,7 @@
 //! dropped, never acted on.
 
 use auv_link::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, StateFrame,
-    Telemetry,
+    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Msg, StateFrame, Telemetry,
 };
 use controller_core::{Controller, ControllerConfig, Fault, Status, Trajectory, TrajectoryKind};
 
@@ -27,51 +26,6 @@ pub struct Step {
     /// Voltage per thruster (0 V = neutral duty in fail-safe).
     pub voltages: [f32; 5],
     pub telemetry: Telemetry,
-}
-
-/// Converts the link's mission description to the core's trajectory (validated).
-pub fn trajectory_of(spec: &MissionSpec) -> Option<Trajectory> {
-    let kind = match *spec {
-        MissionSpec::Circle {
-            radius,
-            omega,
-            depth,
-        } => TrajectoryKind::Circle {
-            radius,
-            omega,
-            depth,
-        },
-        MissionSpec::FigureEight {
-            amplitude,
-            omega,
-            depth,
-        } => TrajectoryKind::FigureEight {
-            amplitude,
-            omega,
-            depth,
-        },
-        MissionSpec::LawnMower {
-            scale,
-            omega,
-            depth,
-        } => TrajectoryKind::LawnMower {
-            scale,
-            omega,
-            depth,
-        },
-        MissionSpec::Helix {
-            radius,
-            omega,
-            depth,
-            depth_rate,
-        } => TrajectoryKind::Helix {
-            radius,
-            omega,
-            depth,
-            depth_rate,
-        },
-    };
-    Trajectory::new(kind).ok()
 }
 
 /// A short name of a board status, for logs.
@@ -197,9 +151,10 @@ impl Supervisor {
                 self.latched = None;
             }
             Command::Disarm => self.armed = false,
-            Command::StartMission(spec) => match trajectory_of(spec) {
-                Some(t) => self.mission = Some((t, self.tick)),
-                None => self.rejected_commands = self.rejected_commands.saturating_add(1),
+            // The link's one conversion (auv_link::mission), validated by the core.
+            Command::StartMission(spec) => match Trajectory::new(TrajectoryKind::from(*spec)) {
+                Ok(t) => self.mission = Some((t, self.tick)),
+                Err(_) => self.rejected_commands = self.rejected_commands.saturating_add(1),
             },
             Command::StopMission => self.mission = None,
             Command::SetConfig(patch) => {

@@ -28,7 +28,6 @@ use auv_link::{
 use serde::Serialize;
 
 use crate::config::{LinkFaults, SimConfig};
-use crate::link::mission_spec;
 use crate::sil::{ControlOut, ControlSource};
 
 /// QEMU mps2-an386 SysTick counts per instruction ratio (`-icount shift=0`, 25 MHz).
@@ -156,7 +155,7 @@ impl BoardInTheLoop {
             seq: 0,
             rate_hz: cfg.controller.rate_hz,
             faults,
-            mission: mission_spec(&cfg.trajectory),
+            mission: auv_link::MissionSpec::from(cfg.trajectory),
             started: false,
             history: Vec::new(),
             pending: std::collections::VecDeque::new(),

@@ -121,8 +121,9 @@ impl Command {
     pub const MAX_SIZE: usize = TAG + max(MissionSpec::MAX_SIZE, ConfigPatch::MAX_SIZE);
 }
 
-/// A mission trajectory and its parameters. Mirrors `controller_core::TrajectoryKind` field
-/// for field (this crate does not depend on controller-core; the firmware and host-sim convert).
+/// A mission trajectory and its parameters: the wire form of
+/// [`controller_core::TrajectoryKind`], field for field. Convert with `From` both ways
+/// ([`crate::mission`]); the receiver validates with `controller_core::Trajectory::new`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum MissionSpec {
