@@ -85,5 +85,5 @@ mod msg;
 pub use frame::{decode_frame, encode, FrameDecoder, LinkError, CRC_LEN, MAX_BODY, MAX_FRAME};
 pub use msg::{
     BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, StateFrame,
-    Telemetry, PROTOCOL_VERSION,
+    Telemetry, DEFAULT_STALE_PERIODS, PROTOCOL_VERSION,
 };
