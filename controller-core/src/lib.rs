@@ -12,6 +12,7 @@ pub mod model;
 pub mod trajectory;
 pub mod uncertainty;
 
+pub use allocation::DEFAULT_V_LIMIT;
 pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Status};
 pub use law::RobustLaw;
