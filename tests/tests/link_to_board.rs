@@ -6,7 +6,9 @@ use auv_link::{
     encode, Command, Envelope, FrameDecoder, MissionSpec, Msg, MAX_FRAME, PROTOCOL_VERSION,
 };
 use controller_core::kinematics::{self, Attitude};
-use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory, TrajectoryKind};
+use controller_core::{
+    Controller, ControllerConfig, Status, Table1Case, Trajectory, TrajectoryKind,
+};
 use firmware::supervisor::Supervisor;
 use host_sim::link::state_frame;
 use nalgebra::Vector6;
@@ -88,7 +90,11 @@ fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
             let step = sup.step(false, &|| 0);
             let direct = ctl.update(k, &frame.eta, &frame.nu, &tr);
             assert_eq!(direct.status, Status::Ok);
-            assert_eq!(step.telemetry.status, auv_link::BoardStatus::Running, "{name}");
+            assert_eq!(
+                step.telemetry.status,
+                auv_link::BoardStatus::Running,
+                "{name}"
+            );
             assert_eq!(step.voltages, direct.voltage, "{name} at tick {k}");
             assert_eq!(step.telemetry.thrusts, direct.thrust);
             assert_eq!(step.telemetry.delta, direct.delta);
