@@ -175,10 +175,24 @@ fn load(path: &Path) -> Result<Scenario> {
     load_scenario(path).with_context(|| format!("scenario {}", path.display()))
 }
 
-fn summaries(rows: &[ReportRow]) -> Cases<RunSummary> {
-    Cases {
-        cases: runs(rows).map(RunResult::summary).collect(),
+/// Prints the runs of `rows` (JSON, or the table and the report's path) and says whether one
+/// diverged.
+fn print_runs(
+    stdout: &mut dyn Write,
+    json: bool,
+    rows: &[ReportRow],
+    report: &Path,
+) -> Result<Exit> {
+    if json {
+        let cases: Cases<RunSummary> = Cases {
+            cases: runs(rows).map(RunResult::summary).collect(),
+        };
+        print_json(stdout, &cases)?;
+    } else {
+        writeln!(stdout, "{}", output::table_text(rows))?;
+        writeln!(stdout, "report: {}", report.display())?;
     }
+    Ok(Exit::failed_if(runs(rows).any(RunResult::diverged)))
 }
 
 /// Every run of the rows: with, then without Δu.
@@ -203,14 +217,7 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         paper::NOTES,
         f64::from(DEFAULT_V_LIMIT),
     )?;
-    if args.json {
-        print_json(stdout, &summaries(&rows))?;
-    } else {
-        writeln!(stdout, "{}", output::table_text(&rows))?;
-        writeln!(stdout, "report: {}", report.display())?;
-    }
-    let diverged = runs(&rows).any(RunResult::diverged);
-    Ok(Exit::failed_if(diverged))
+    print_runs(stdout, args.json, &rows, &report)
 }
 
 /// `run`.
@@ -243,14 +250,7 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         "",
         f64::from(cfg.controller.voltage_limit),
     )?;
-    if args.json {
-        print_json(stdout, &summaries(&rows))?;
-    } else {
-        writeln!(stdout, "{}", output::table_text(&rows))?;
-        writeln!(stdout, "report: {}", report.display())?;
-    }
-    let diverged = runs(&rows).any(RunResult::diverged);
-    Ok(Exit::failed_if(diverged))
+    print_runs(stdout, args.json, &rows, &report)
 }
 
 /// `monte-carlo`.

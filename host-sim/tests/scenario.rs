@@ -34,7 +34,7 @@ fn toml_error(text: &str) -> String {
 }
 
 #[test]
-fn shipped_table1_files_equal_table1_scenario() {
+fn shipped_table1_files_equal_the_papers_runs() {
     for case in Table1Case::ALL {
         let path = scenarios_dir().join(format!("{}.toml", case.name()));
         let loaded = load_scenario(&path).unwrap_or_else(|e| panic!("{e}"));
@@ -48,7 +48,7 @@ fn shipped_table1_files_equal_table1_scenario() {
 }
 
 #[test]
-fn table1_scenario_without_du_differs_only_in_robust() {
+fn a_paper_run_without_du_differs_only_in_robust() {
     for case in Table1Case::ALL {
         let mut without = paper::config(case, false);
         assert!(!without.controller.robust);
