@@ -53,7 +53,8 @@ pub struct ControllerConfig {
     /// |θ| beyond which the law faults instead of computing through the singularity of J
     /// (AUV150.md §8), radians. Default 80°.
     pub pitch_limit: f32,
-    /// Thruster supply limit: voltages are clamped to ±`voltage_limit` (V). Default 24.
+    /// Thruster supply limit: voltages are clamped to ±`voltage_limit` (V). Default
+    /// [`DEFAULT_V_LIMIT`](crate::DEFAULT_V_LIMIT), the board's 24 V supply.
     pub voltage_limit: f32,
     /// Nominal model (the hats of Eq 7).
     pub params: VehicleParams<f32>,
@@ -77,7 +78,7 @@ impl Default for ControllerConfig {
             delta_max: 25.0,
             rate_hz: 100,
             pitch_limit: 80.0_f32.to_radians(),
-            voltage_limit: 24.0,
+            voltage_limit: crate::DEFAULT_V_LIMIT,
             params: VehicleParams::auv150().cast(|x| x as f32),
             uncertainty: ParamBox::table3().cast(|x| x as f32),
             geometry: ThrusterGeometry::default(),
@@ -86,9 +87,14 @@ impl Default for ControllerConfig {
 }
 
 /// A failed configuration check, with its numbers.
+///
+/// A check of one setting names it: [`ConfigError::field`] gives the [`ControllerConfig`] field
+/// (and element), e.g. `mu` or `k1[4]`, so a front end can point at its own key for it (a
+/// scenario file's `controller.mu`) without repeating the check.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ConfigError {
     /// A gain of a controlled axis is not finite and positive (K₁ and K₂ must make Ā Hurwitz).
+    /// `name` is the field, `"k1"` or `"k2"`.
     Gain {
         name: &'static str,
         axis: usize,
@@ -96,15 +102,19 @@ pub enum ConfigError {
     },
     /// Roll is not actuated: the paper's K₁₄ = K₂₄ = 0 is required.
     RollGain { k1: f32, k2: f32 },
-    /// Q must be positive definite.
-    LyapunovWeight { q1: f32, q2: f32 },
-    /// A scalar out of its range (β ∈ (0,1), μ > 0, δ_max > 0, 0 < pitch limit < 90°, …).
+    /// Q = diag(q₁, q₂) must be positive definite: `q[index]` is not finite and positive.
+    LyapunovWeight { index: usize, value: f32 },
+    /// A setting that must be finite and > 0 is not (`mu`, `delta_max`, `voltage_limit`).
+    NotPositive { name: &'static str, value: f32 },
+    /// A setting outside its open interval (`beta` ∈ (0, 1)).
     OutOfRange {
         name: &'static str,
         value: f32,
         min: f32,
         max: f32,
     },
+    /// `pitch_limit` (rad) outside (0, π/2): the law must fault before J's singularity at 90°.
+    PitchLimit { value: f32 },
     /// Loop rate of zero.
     ZeroRate,
     /// Nominal parameters contain a non-finite value.
@@ -130,6 +140,38 @@ pub enum ConfigError {
     Allocation(AllocationError),
 }
 
+/// The [`ControllerConfig`] field a [`ConfigError`] is about: `name` is the field's name,
+/// `index` the element of an array field (`k1[4]`: name `"k1"`, index `Some(4)`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ConfigField {
+    pub name: &'static str,
+    pub index: Option<usize>,
+}
+
+impl ConfigError {
+    /// The one field the failed check is about; `None` for checks of the configuration as a
+    /// whole (Assumption 2, Theorem 2, the loop rate against δ_max/μ).
+    pub fn field(&self) -> Option<ConfigField> {
+        let (name, index) = match *self {
+            ConfigError::Gain { name, axis, .. } => (name, Some(axis)),
+            ConfigError::RollGain { k1, .. } => (if k1 != 0.0 { "k1" } else { "k2" }, Some(ROLL)),
+            ConfigError::LyapunovWeight { index, .. } => ("q", Some(index)),
+            ConfigError::NotPositive { name, .. } | ConfigError::OutOfRange { name, .. } => {
+                (name, None)
+            }
+            ConfigError::PitchLimit { .. } => ("pitch_limit", None),
+            ConfigError::ZeroRate => ("rate_hz", None),
+            ConfigError::NonFiniteParams => ("params", None),
+            ConfigError::InvalidBox | ConfigError::Bounds(_) => ("uncertainty", None),
+            ConfigError::Allocation(_) => ("geometry", None),
+            ConfigError::Assumption2 { .. }
+            | ConfigError::Theorem2 { .. }
+            | ConfigError::LoopRate { .. } => return None,
+        };
+        Some(ConfigField { name, index })
+    }
+}
+
 impl From<BoundsError> for ConfigError {
     fn from(e: BoundsError) -> Self {
         ConfigError::Bounds(e)
@@ -147,22 +189,31 @@ impl fmt::Display for ConfigError {
         match *self {
             ConfigError::Gain { name, axis, value } => write!(
                 f,
-                "gain {name}[{axis}] = {value}: controlled axes need a finite gain > 0"
+                "gain {name}[{axis}] must be a finite number > 0 on a controlled axis, got {value}"
             ),
             ConfigError::RollGain { k1, k2 } => write!(
                 f,
-                "roll gains K1[3] = {k1}, K2[3] = {k2}: roll is not actuated, both must be 0"
+                "roll is not actuated: gains k1[{ROLL}] and k2[{ROLL}] must both be 0, got {k1} and {k2}"
             ),
-            ConfigError::LyapunovWeight { q1, q2 } => {
-                write!(f, "Lyapunov weight Q = diag({q1}, {q2}) must be positive definite")
+            ConfigError::LyapunovWeight { index, value } => write!(
+                f,
+                "Lyapunov weight q[{index}] must be a finite number > 0 (Q positive definite), got {value}"
+            ),
+            ConfigError::NotPositive { name, value } => {
+                write!(f, "{name} must be a finite number > 0, got {value}")
             }
             ConfigError::OutOfRange {
                 name,
                 value,
                 min,
                 max,
-            } => write!(f, "{name} = {value} is outside ({min}, {max})"),
-            ConfigError::ZeroRate => write!(f, "loop rate is 0 Hz"),
+            } => write!(f, "{name} must be in ({min}, {max}), got {value}"),
+            ConfigError::PitchLimit { value } => write!(
+                f,
+                "pitch_limit must be in (0°, 90°), got {}° ({value} rad)",
+                value.to_degrees()
+            ),
+            ConfigError::ZeroRate => write!(f, "rate_hz must be ≥ 1 Hz, got 0"),
             ConfigError::NonFiniteParams => write!(f, "nominal vehicle parameters are not finite"),
             ConfigError::InvalidBox => {
                 write!(f, "parameter box is not finite or has lower > upper")
@@ -200,17 +251,13 @@ impl fmt::Display for ConfigError {
     }
 }
 
-fn range(name: &'static str, value: f32, min: f32, max: f32) -> Result<(), ConfigError> {
-    // Open interval; NaN fails every comparison.
-    if value > min && value < max {
+/// A finite value > 0.
+fn positive(name: &'static str, value: f32) -> Result<(), ConfigError> {
+    // NaN fails the comparison; +∞ is not finite.
+    if value.is_finite() && value > 0.0 {
         Ok(())
     } else {
-        Err(ConfigError::OutOfRange {
-            name,
-            value,
-            min,
-            max,
-        })
+        Err(ConfigError::NotPositive { name, value })
     }
 }
 
@@ -219,7 +266,7 @@ impl ControllerConfig {
     /// [`crate::controller::Controller::new`]).
     pub(crate) fn check_scalars(&self) -> Result<(), ConfigError> {
         for &axis in CONTROLLED.iter() {
-            for (name, k) in [("K1", self.k1[axis]), ("K2", self.k2[axis])] {
+            for (name, k) in [("k1", self.k1[axis]), ("k2", self.k2[axis])] {
                 if !(k.is_finite() && k > 0.0) {
                     return Err(ConfigError::Gain {
                         name,
@@ -235,20 +282,28 @@ impl ControllerConfig {
                 k2: self.k2[ROLL],
             });
         }
-        let [q1, q2] = self.q;
-        if !(q1.is_finite() && q2.is_finite() && q1 > 0.0 && q2 > 0.0) {
-            return Err(ConfigError::LyapunovWeight { q1, q2 });
+        for (index, &value) in self.q.iter().enumerate() {
+            if !(value.is_finite() && value > 0.0) {
+                return Err(ConfigError::LyapunovWeight { index, value });
+            }
         }
-        range("beta", self.beta, 0.0, 1.0)?;
-        range("mu", self.mu, 0.0, f32::MAX)?;
-        range("delta_max", self.delta_max, 0.0, f32::MAX)?;
-        range(
-            "pitch_limit",
-            self.pitch_limit,
-            0.0,
-            core::f32::consts::FRAC_PI_2,
-        )?;
-        range("voltage_limit", self.voltage_limit, 0.0, f32::MAX)?;
+        // Open intervals; NaN fails every comparison.
+        if !(self.beta > 0.0 && self.beta < 1.0) {
+            return Err(ConfigError::OutOfRange {
+                name: "beta",
+                value: self.beta,
+                min: 0.0,
+                max: 1.0,
+            });
+        }
+        positive("mu", self.mu)?;
+        positive("delta_max", self.delta_max)?;
+        if !(self.pitch_limit > 0.0 && self.pitch_limit < core::f32::consts::FRAC_PI_2) {
+            return Err(ConfigError::PitchLimit {
+                value: self.pitch_limit,
+            });
+        }
+        positive("voltage_limit", self.voltage_limit)?;
         if self.rate_hz == 0 {
             return Err(ConfigError::ZeroRate);
         }

@@ -30,16 +30,21 @@ pub const MAX_LINEAR_SPEED: f32 = 50.0;
 pub const MAX_ANGULAR_RATE: f32 = 50.0;
 
 /// Why the output is the fail-safe one.
+///
+/// The discriminant is the fault's **code** ([`Fault::code`]), the byte the board reports in
+/// its telemetry (`auv_link::Telemetry::controller_fault`; 0 means no fault). The codes are
+/// part of the link protocol: never renumber them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
 pub enum Fault {
     /// η or ν contains NaN or ±∞.
-    NonFiniteInput,
+    NonFiniteInput = 1,
     /// η or ν is finite but outside the plausible range (see the `MAX_*` constants).
-    InputOutOfRange,
+    InputOutOfRange = 2,
     /// |θ| beyond the configured pitch limit (J is singular at ±90°, AUV150.md §8).
-    PitchLimit,
+    PitchLimit = 3,
     /// An intermediate result was not finite (overflow on extreme but accepted inputs).
-    NonFiniteResult,
+    NonFiniteResult = 4,
 }
 
 /// Outcome of one `update`.
@@ -49,6 +54,70 @@ pub enum Status {
     Ok,
     /// Fail-safe: every thruster off.
     Fault(Fault),
+}
+
+/// The names of the faults, once: [`Fault::as_str`] and, with the `fault:` prefix,
+/// [`Status::as_str`] (the simulator's CSV `status` column) both come from this list.
+macro_rules! fault_names {
+    ($($variant:ident => $name:literal),+ $(,)?) => {
+        impl Fault {
+            /// Every fault, in code order.
+            pub const ALL: [Fault; [$(Fault::$variant),+].len()] = [$(Fault::$variant),+];
+
+            /// Stable kebab-case name, e.g. `"pitch-limit"`.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    $(Fault::$variant => $name,)+
+                }
+            }
+
+            /// The fault from its [`code`](Self::code); `None` for 0 (no fault) and unknown
+            /// codes.
+            pub const fn from_code(code: u8) -> Option<Fault> {
+                $(if code == Fault::$variant as u8 {
+                    return Some(Fault::$variant);
+                })+
+                None
+            }
+        }
+
+        impl Status {
+            /// `"ok"` or `"fault:"` and the fault's name, e.g. `"fault:pitch-limit"`.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    Status::Ok => "ok",
+                    $(Status::Fault(Fault::$variant) => concat!("fault:", $name),)+
+                }
+            }
+        }
+    };
+}
+
+fault_names! {
+    NonFiniteInput => "non-finite-input",
+    InputOutOfRange => "input-out-of-range",
+    PitchLimit => "pitch-limit",
+    NonFiniteResult => "non-finite-result",
+}
+
+impl Fault {
+    /// The fault's code on the link (its discriminant, 1…): what the board puts in
+    /// `Telemetry::controller_fault`.
+    pub const fn code(self) -> u8 {
+        self as u8
+    }
+}
+
+impl core::fmt::Display for Fault {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl core::fmt::Display for Status {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }
 
 /// Everything one step produces. All fields are finite, always.

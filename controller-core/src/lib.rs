@@ -14,6 +14,7 @@ pub mod thruster;
 pub mod trajectory;
 pub mod uncertainty;
 
+pub use allocation::DEFAULT_V_LIMIT;
 pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Status};
 pub use law::RobustLaw;

@@ -133,6 +133,16 @@ impl<T: RealField + Copy> VehicleParams<T> {
     }
 }
 
+/// Number of varied parameters (Table 3): m, x_G, y_G, z_G, I_x, I_y, I_z, −X_u̇, −Y_v̇.
+pub const VARIED_PARAMETERS: usize = 9;
+
+/// The names of the nine Δ of a [`ParamVariation`], in the order of
+/// [`ParamVariation::to_array`]: Δm, Δx_G, Δy_G, Δz_G, ΔI_x, ΔI_y, ΔI_z, Δ(−X_u̇), Δ(−Y_v̇). They
+/// are the keys of a scenario's `[variation]` table and of each `[[variation.steps]]`.
+pub const VARIED_PARAMETER_NAMES: [&str; VARIED_PARAMETERS] = [
+    "mass", "x_g", "y_g", "z_g", "ix", "iy", "iz", "x_udot", "y_vdot",
+];
+
 /// A Table-3 parameter variation Δp, added to the nominal parameters of the plant.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct ParamVariation<T> {
@@ -146,6 +156,34 @@ pub struct ParamVariation<T> {
     pub x_udot: T,
     /// Δ(−Y_v̇) (kg), applied to −Z_ẇ as well.
     pub y_vdot: T,
+}
+
+impl<T: Copy> ParamVariation<T> {
+    /// The nine Δ in the order of [`VARIED_PARAMETER_NAMES`].
+    pub fn to_array(&self) -> [T; VARIED_PARAMETERS] {
+        [
+            self.mass,
+            self.r_g[0],
+            self.r_g[1],
+            self.r_g[2],
+            self.inertia[0],
+            self.inertia[1],
+            self.inertia[2],
+            self.x_udot,
+            self.y_vdot,
+        ]
+    }
+
+    /// The variation whose nine Δ are `a`, in the order of [`VARIED_PARAMETER_NAMES`].
+    pub fn from_array(a: [T; VARIED_PARAMETERS]) -> Self {
+        ParamVariation {
+            mass: a[0],
+            r_g: [a[1], a[2], a[3]],
+            inertia: [a[4], a[5], a[6]],
+            x_udot: a[7],
+            y_vdot: a[8],
+        }
+    }
 }
 
 impl<T: RealField + Copy> ParamVariation<T> {

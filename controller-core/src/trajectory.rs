@@ -66,7 +66,19 @@ pub struct Desired {
 /// Shape and parameters of a mission (the paper's "Simulation Results"; AUV150.md §6).
 ///
 /// All frequencies ω are in rad/s and must be positive; sizes in metres; z is positive down (NED).
+///
+/// With the `serde` feature it is a table tagged by `kind` (`"circle"`, `"figure-eight"`,
+/// `"lawn-mower"`, `"helix"`) with the fields by name; unknown fields are refused, and `omega`
+/// and `depth` default to the paper's values ([`Trajectory::PAPER_OMEGA`], for the lawn-mower
+/// [`Trajectory::PAPER_LAWN_MOWER_OMEGA`]; [`Trajectory::PAPER_DEPTH`]). This is the
+/// `[trajectory]` table of host-sim's scenario files. Values are not validated there: build the
+/// mission with [`Trajectory::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)
+)]
 pub enum TrajectoryKind {
     /// x = R sin ωt, y = R cos ωt, z = depth, ψ = ωt (paper: ω = 0.1; "10 sin(0.1)t" read as
     /// R sin 0.1t).
@@ -74,8 +86,10 @@ pub enum TrajectoryKind {
         /// R (m).
         radius: f32,
         /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_omega"))]
         omega: f32,
         /// z_d (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
         depth: f32,
     },
     /// x = A sin ωt, y = A cos(ωt/2), z = depth,
@@ -85,8 +99,10 @@ pub enum TrajectoryKind {
         /// A (m): x and y each span 2A.
         amplitude: f32,
         /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_omega"))]
         omega: f32,
         /// z_d (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
         depth: f32,
     },
     /// x = s(0.25 t + 2.5 sin 2ωt), y = 15 s cos ωt, z = depth,
@@ -96,8 +112,10 @@ pub enum TrajectoryKind {
         /// s (dimensionless): loop height 30 s m, loop width ≈ 15.7 s m.
         scale: f32,
         /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_lawn_mower_omega"))]
         omega: f32,
         /// z_d (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
         depth: f32,
     },
     /// A circle whose depth changes linearly: z = depth + depth_rate·t (not in the paper).
@@ -105,12 +123,28 @@ pub enum TrajectoryKind {
         /// R (m).
         radius: f32,
         /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_omega"))]
         omega: f32,
         /// z_d at t = 0 (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
         depth: f32,
         /// ż_d (m/s, positive = descending).
         depth_rate: f32,
     },
+}
+
+// The serde defaults of `TrajectoryKind` (the paper's values).
+#[cfg(feature = "serde")]
+fn default_omega() -> f32 {
+    Trajectory::PAPER_OMEGA
+}
+#[cfg(feature = "serde")]
+fn default_lawn_mower_omega() -> f32 {
+    Trajectory::PAPER_LAWN_MOWER_OMEGA
+}
+#[cfg(feature = "serde")]
+fn default_depth() -> f32 {
+    Trajectory::PAPER_DEPTH
 }
 
 /// Why a [`TrajectoryKind`] was rejected by [`Trajectory::new`].
@@ -140,6 +174,18 @@ pub enum TrajectoryError {
         /// Upper limit.
         max: f32,
     },
+}
+
+impl TrajectoryError {
+    /// The rejected field of [`TrajectoryKind`], e.g. `"radius"` (a scenario's
+    /// `trajectory.radius`).
+    pub fn parameter(&self) -> &'static str {
+        match *self {
+            Self::NonFinite { parameter }
+            | Self::NotPositive { parameter, .. }
+            | Self::OutOfRange { parameter, .. } => parameter,
+        }
+    }
 }
 
 impl fmt::Display for TrajectoryError {

@@ -11,8 +11,7 @@ use nalgebra::{Matrix6, RealField, SymmetricEigen, Vector6};
 
 use crate::model::{self, ParamVariation, VehicleParams};
 
-/// Number of varied parameters (Table 3): m, x_G, y_G, z_G, I_x, I_y, I_z, −X_u̇, −Y_v̇.
-pub const VARIED_PARAMETERS: usize = 9;
+pub use crate::model::VARIED_PARAMETERS;
 
 /// A box of parameter variations: every Δ lies in [lower, upper], component by component.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,52 +40,28 @@ impl<T: RealField + Copy> ParamBox<T> {
         }
     }
 
-    fn flat(v: &ParamVariation<T>) -> [T; VARIED_PARAMETERS] {
-        [
-            v.mass,
-            v.r_g[0],
-            v.r_g[1],
-            v.r_g[2],
-            v.inertia[0],
-            v.inertia[1],
-            v.inertia[2],
-            v.x_udot,
-            v.y_vdot,
-        ]
-    }
-
-    fn unflat(a: &[T; VARIED_PARAMETERS]) -> ParamVariation<T> {
-        ParamVariation {
-            mass: a[0],
-            r_g: [a[1], a[2], a[3]],
-            inertia: [a[4], a[5], a[6]],
-            x_udot: a[7],
-            y_vdot: a[8],
-        }
-    }
-
     /// Corner `index` (0 ≤ index < 2⁹): bit i of `index` puts parameter i at its upper end.
     pub fn corner(&self, index: u32) -> ParamVariation<T> {
-        let lo = Self::flat(&self.lower);
-        let hi = Self::flat(&self.upper);
+        let lo = self.lower.to_array();
+        let hi = self.upper.to_array();
         let mut c = lo;
         for i in 0..VARIED_PARAMETERS {
             if index & (1 << i) != 0 {
                 c[i] = hi[i];
             }
         }
-        Self::unflat(&c)
+        ParamVariation::from_array(c)
     }
 
     /// The point at fractions `f` ∈ \[0, 1\]⁹ of the way from lower to upper.
     pub fn lerp(&self, f: &[T; VARIED_PARAMETERS]) -> ParamVariation<T> {
-        let lo = Self::flat(&self.lower);
-        let hi = Self::flat(&self.upper);
+        let lo = self.lower.to_array();
+        let hi = self.upper.to_array();
         let mut c = lo;
         for i in 0..VARIED_PARAMETERS {
             c[i] = lo[i] + (hi[i] - lo[i]) * f[i];
         }
-        Self::unflat(&c)
+        ParamVariation::from_array(c)
     }
 
     /// Number of corners, 2⁹.
@@ -94,8 +69,8 @@ impl<T: RealField + Copy> ParamBox<T> {
 
     /// Finite, and lower ≤ upper component by component.
     pub fn is_valid(&self) -> bool {
-        let lo = Self::flat(&self.lower);
-        let hi = Self::flat(&self.upper);
+        let lo = self.lower.to_array();
+        let hi = self.upper.to_array();
         lo.iter()
             .zip(hi.iter())
             .all(|(l, h)| l.is_finite() && h.is_finite() && l <= h)

@@ -3,7 +3,7 @@
 // Tests change one field of the defaults at a time; that reads best as an assignment.
 #![allow(clippy::field_reassign_with_default)]
 
-use controller_core::config::{BBound, ConfigError, ControllerConfig};
+use controller_core::config::{BBound, ConfigError, ConfigField, ControllerConfig};
 use controller_core::controller::Controller;
 use controller_core::law::RobustLaw;
 
@@ -30,13 +30,13 @@ fn paper_defaults_are_accepted() {
 fn gains_must_be_positive_on_controlled_axes_and_zero_on_roll() {
     let mut c = ControllerConfig::default();
     c.k1[4] = -1.0;
-    assert!(matches!(err(c), ConfigError::Gain { name: "K1", axis: 4, value } if value == -1.0));
+    assert!(matches!(err(c), ConfigError::Gain { name: "k1", axis: 4, value } if value == -1.0));
     let mut c = ControllerConfig::default();
     c.k2[0] = f32::NAN;
     assert!(matches!(
         err(c),
         ConfigError::Gain {
-            name: "K2",
+            name: "k2",
             axis: 0,
             ..
         }
@@ -49,34 +49,68 @@ fn gains_must_be_positive_on_controlled_axes_and_zero_on_roll() {
 #[test]
 fn scalar_ranges_are_checked_by_name() {
     type Setter = fn(&mut ControllerConfig);
-    let cases: [(&str, Setter); 6] = [
+    let cases: [(&str, Setter); 8] = [
         ("beta", |c| c.beta = 1.0),
         ("beta", |c| c.beta = 0.0),
         ("mu", |c| c.mu = 0.0),
+        ("mu", |c| c.mu = f32::NAN),
         ("delta_max", |c| c.delta_max = -3.0),
         ("pitch_limit", |c| c.pitch_limit = 95f32.to_radians()),
+        ("pitch_limit", |c| c.pitch_limit = 90f32.to_radians()),
         ("voltage_limit", |c| c.voltage_limit = f32::INFINITY),
     ];
     for (name, set) in cases {
         let mut c = ControllerConfig::default();
         set(&mut c);
-        match err(c) {
-            ConfigError::OutOfRange { name: n, .. } => assert_eq!(n, name),
-            other => panic!("{name}: got {other:?}"),
+        let e = err(c);
+        match e {
+            ConfigError::OutOfRange { name: n, .. } | ConfigError::NotPositive { name: n, .. } => {
+                assert_eq!(n, name)
+            }
+            ConfigError::PitchLimit { .. } => assert_eq!("pitch_limit", name),
+            ref other => panic!("{name}: got {other:?}"),
         }
+        // The error names its field, and says so in its text.
+        assert_eq!(e.field(), Some(ConfigField { name, index: None }));
+        assert!(e.to_string().starts_with(name), "{e}");
     }
     let mut c = ControllerConfig::default();
     c.rate_hz = 0;
     assert_eq!(err(c), ConfigError::ZeroRate);
+    assert_eq!(err(c).field().map(|f| f.name), Some("rate_hz"));
     let mut c = ControllerConfig::default();
     c.q = [1.0, 0.0];
-    assert!(matches!(err(c), ConfigError::LyapunovWeight { .. }));
+    assert!(matches!(
+        err(c),
+        ConfigError::LyapunovWeight { index: 1, .. }
+    ));
     let mut c = ControllerConfig::default();
     c.params.mass = f32::NAN;
     assert_eq!(err(c), ConfigError::NonFiniteParams);
     let mut c = ControllerConfig::default();
     c.uncertainty.lower.mass = 40.0; // above the upper end (30)
     assert_eq!(err(c), ConfigError::InvalidBox);
+}
+
+#[test]
+fn errors_of_one_setting_name_the_field_and_element() {
+    type Setter = fn(&mut ControllerConfig);
+    let cases: [(&str, Option<usize>, Setter); 5] = [
+        ("k1", Some(4), |c| c.k1[4] = -1.0),
+        ("k2", Some(0), |c| c.k2[0] = f32::INFINITY),
+        ("k1", Some(3), |c| c.k1[3] = 1.0),
+        ("k2", Some(3), |c| c.k2[3] = 1.0),
+        ("q", Some(0), |c| c.q[0] = -2.0),
+    ];
+    for (name, index, set) in cases {
+        let mut c = ControllerConfig::default();
+        set(&mut c);
+        assert_eq!(err(c).field(), Some(ConfigField { name, index }), "{name}");
+    }
+    // Checks of the whole configuration name no single field.
+    let mut c = ControllerConfig::default();
+    c.rate_hz = 10;
+    assert_eq!(err(c).field(), None);
 }
 
 #[test]

@@ -27,7 +27,7 @@ mod rt {
     use cortex_m_rt::{entry, exception, ExceptionFrame};
     use defmt::{error, info};
     use firmware::board::{period, Board, LinkBuffers};
-    use firmware::supervisor::{status_name, Supervisor};
+    use firmware::supervisor::Supervisor;
 
     #[cfg(feature = "stm32f405")]
     use defmt_rtt as _;
@@ -101,7 +101,7 @@ mod rt {
                 info!(
                     "tick {}: {}",
                     step.telemetry.tick,
-                    status_name(step.telemetry.status)
+                    step.telemetry.status.as_str()
                 );
                 last = Some(step.telemetry.status);
             }

@@ -24,7 +24,7 @@ pub const CORE_HZ: u32 = 25_000_000;
 #[cfg_attr(not(feature = "selftest"), allow(dead_code))]
 pub const INSTRUCTIONS_PER_TICK: u32 = 40;
 /// Nominal H-bridge supply (V).
-pub const SUPPLY_VOLTAGE: f32 = 24.0;
+pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
 
 const UART0: usize = 0x4000_4000;
 const DATA: usize = 0x00;

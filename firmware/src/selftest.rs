@@ -11,7 +11,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use defmt::{error, info};
 use firmware::pwm;
-use firmware::supervisor::{status_name, Supervisor};
+use firmware::supervisor::Supervisor;
 
 use crate::qemu::INSTRUCTIONS_PER_TICK;
 use crate::stack;
@@ -188,9 +188,9 @@ fn fail_safe_exercise() -> bool {
         let s = sup.step(overrun, &now);
         let off = s.voltages.iter().all(|v| *v == 0.0);
         let good = s.telemetry.status == want && (want == BoardStatus::Running || off);
-        info!("{}: {}", what, status_name(s.telemetry.status));
+        info!("{}: {}", what, s.telemetry.status.as_str());
         if !good {
-            error!("expected {}", status_name(want));
+            error!("expected {}", want.as_str());
         }
         ok &= good;
     };

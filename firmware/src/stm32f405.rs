@@ -101,7 +101,7 @@ pub const PWM_HZ: u32 = 20_000;
 pub const LINK_BAUD: u32 = 460_800;
 /// H-bridge supply voltage V_s (V): nominal, not measured. The duty for a commanded voltage
 /// is computed against it ([`firmware::pwm::duty_fraction`]).
-pub const SUPPLY_VOLTAGE: f32 = 24.0;
+pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
 /// Control rate set up by [`Stm32Board::init`] (Hz), the controller's default; call
 /// [`Board::set_rate`] for another.
 pub const DEFAULT_RATE_HZ: u32 = 100;

@@ -4,7 +4,8 @@
 //! Fail-safe (all thrusters neutral, 0 V) whenever:
 //! - the board is disarmed ([`BoardStatus::Disarmed`]);
 //! - armed but no mission is running ([`BoardStatus::Armed`]);
-//! - no valid state frame arrived for more than `stale_periods` control periods (default 2);
+//! - no valid state frame arrived for more than `stale_periods` control periods
+//!   ([`DEFAULT_STALE_PERIODS`] unless configured);
 //! - the controller reports a fault (non-finite/implausible input, pitch limit, …);
 //! - the previous control period overran its deadline.
 //!
@@ -13,13 +14,10 @@
 //! dropped, never acted on.
 
 use auv_link::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, StateFrame,
-    Telemetry,
+    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Msg, StateFrame, Telemetry,
+    DEFAULT_STALE_PERIODS,
 };
-use controller_core::{Controller, ControllerConfig, Fault, Status, Trajectory, TrajectoryKind};
-
-/// Default number of control periods a state frame stays valid.
-pub const DEFAULT_STALE_PERIODS: u8 = 2;
+use controller_core::{Controller, ControllerConfig, Status, Trajectory, TrajectoryKind};
 
 /// What one control period commands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,74 +25,6 @@ pub struct Step {
     /// Voltage per thruster (0 V = neutral duty in fail-safe).
     pub voltages: [f32; 5],
     pub telemetry: Telemetry,
-}
-
-/// Converts the link's mission description to the core's trajectory (validated).
-pub fn trajectory_of(spec: &MissionSpec) -> Option<Trajectory> {
-    let kind = match *spec {
-        MissionSpec::Circle {
-            radius,
-            omega,
-            depth,
-        } => TrajectoryKind::Circle {
-            radius,
-            omega,
-            depth,
-        },
-        MissionSpec::FigureEight {
-            amplitude,
-            omega,
-            depth,
-        } => TrajectoryKind::FigureEight {
-            amplitude,
-            omega,
-            depth,
-        },
-        MissionSpec::LawnMower {
-            scale,
-            omega,
-            depth,
-        } => TrajectoryKind::LawnMower {
-            scale,
-            omega,
-            depth,
-        },
-        MissionSpec::Helix {
-            radius,
-            omega,
-            depth,
-            depth_rate,
-        } => TrajectoryKind::Helix {
-            radius,
-            omega,
-            depth,
-            depth_rate,
-        },
-    };
-    Trajectory::new(kind).ok()
-}
-
-/// A short name of a board status, for logs.
-pub fn status_name(s: BoardStatus) -> &'static str {
-    match s {
-        BoardStatus::Disarmed => "disarmed",
-        BoardStatus::Armed => "armed",
-        BoardStatus::Running => "running",
-        BoardStatus::FailSafe(FailSafeReason::StaleState) => "fail-safe: stale state",
-        BoardStatus::FailSafe(FailSafeReason::ControllerFault) => "fail-safe: controller fault",
-        BoardStatus::FailSafe(FailSafeReason::Overrun) => "fail-safe: overrun",
-        BoardStatus::FailSafe(FailSafeReason::Disarmed) => "fail-safe: disarmed",
-        BoardStatus::FailSafe(FailSafeReason::NoMission) => "fail-safe: no mission",
-    }
-}
-
-fn fault_code(f: Fault) -> u8 {
-    match f {
-        Fault::NonFiniteInput => 1,
-        Fault::InputOutOfRange => 2,
-        Fault::PitchLimit => 3,
-        Fault::NonFiniteResult => 4,
-    }
 }
 
 /// Board state around the controller.
@@ -197,9 +127,10 @@ impl Supervisor {
                 self.latched = None;
             }
             Command::Disarm => self.armed = false,
-            Command::StartMission(spec) => match trajectory_of(spec) {
-                Some(t) => self.mission = Some((t, self.tick)),
-                None => self.rejected_commands = self.rejected_commands.saturating_add(1),
+            // The link's one conversion (auv_link::mission), validated by the core.
+            Command::StartMission(spec) => match Trajectory::new(TrajectoryKind::from(*spec)) {
+                Ok(t) => self.mission = Some((t, self.tick)),
+                Err(_) => self.rejected_commands = self.rejected_commands.saturating_add(1),
             },
             Command::StopMission => self.mission = None,
             Command::SetConfig(patch) => {
@@ -298,7 +229,7 @@ impl Supervisor {
                         BoardStatus::Running
                     }
                     Status::Fault(f) => {
-                        fault = fault_code(f);
+                        fault = f.code();
                         self.latch(FailSafeReason::ControllerFault)
                     }
                 }

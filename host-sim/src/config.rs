@@ -1,10 +1,11 @@
 //! What one simulation run is: mission, plant, disturbances, actuators and controller.
 //!
-//! [`SimConfig`] is plain data; `scenario.rs` reads it from TOML, `table1.rs` builds the
-//! paper's six cases.
+//! [`SimConfig`] is plain data. [`crate::scenario`] reads it from TOML and validates it into a
+//! runnable [`Scenario`](crate::scenario::Scenario); [`crate::paper`] builds the paper's six
+//! cases.
 
 use controller_core::model::ParamVariation;
-use controller_core::{ControllerConfig, TrajectoryKind};
+use controller_core::{ControllerConfig, Table1Case, TrajectoryKind};
 
 /// How the plant's parameters vary with time (Table 3, AUV150.md §2). Δp is added to the
 /// nominal parameters of the **plant only**; the controller keeps the nominal model.
@@ -40,25 +41,6 @@ impl VariationProfile {
                 steps.last().map(|s| s.1).unwrap_or_default()
             }
         }
-    }
-
-    /// The paper's lawn-mower staircase (Table 3).
-    pub fn table3_staircase() -> Self {
-        let row = |mass, xg, yg, zg, ix, iy, iz, xu, yv| ParamVariation {
-            mass,
-            r_g: [xg, yg, zg],
-            inertia: [ix, iy, iz],
-            x_udot: xu,
-            y_vdot: yv,
-        };
-        VariationProfile::Staircase(vec![
-            (25.0, row(30.0, 0.05, 0.02, 0.02, 2.0, 5.0, 10.0, 3.0, 50.0)),
-            (50.0, row(20.0, 0.03, 0.01, 0.018, 1.5, 3.5, 7.0, 2.0, 35.0)),
-            (
-                f64::INFINITY,
-                row(10.0, 0.02, 0.005, 0.015, 1.0, 2.5, 5.0, 1.5, 25.0),
-            ),
-        ])
     }
 }
 
@@ -119,7 +101,7 @@ impl TickRange {
 
 /// Faults injected on the board link, by control tick (processor in the loop only; a SIL run
 /// has no link and ignores them).
-#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct LinkFaults {
     /// State frames not sent.
     pub drop: Vec<TickRange>,
@@ -127,12 +109,30 @@ pub struct LinkFaults {
     pub corrupt: Vec<TickRange>,
     /// State frames replaced by the frame from `delay_ticks` earlier (stale data).
     pub delay: Vec<TickRange>,
+    /// How old a delayed state frame is (ticks). Default [`LinkFaults::DEFAULT_DELAY_TICKS`].
     pub delay_ticks: u64,
     /// Nothing is sent at all (no state, no commands).
     pub silent: Vec<TickRange>,
 }
 
+impl Default for LinkFaults {
+    /// No faults.
+    fn default() -> Self {
+        LinkFaults {
+            drop: Vec::new(),
+            corrupt: Vec::new(),
+            delay: Vec::new(),
+            delay_ticks: Self::DEFAULT_DELAY_TICKS,
+            silent: Vec::new(),
+        }
+    }
+}
+
 impl LinkFaults {
+    /// Default age of a delayed state frame (ticks): 5 periods, more than the board's
+    /// stale-state limit would allow if the frames stopped.
+    pub const DEFAULT_DELAY_TICKS: u64 = 5;
+
     pub fn any(v: &[TickRange], k: u64) -> bool {
         v.iter().any(|r| r.contains(k))
     }
@@ -149,6 +149,9 @@ impl LinkFaults {
 pub struct SimConfig {
     /// Case name, used for file names and reports.
     pub name: String,
+    /// The paper's Table-1 case this run reproduces, if any: the reports print the paper's
+    /// numbers beside it ([`crate::paper`]).
+    pub case: Option<Table1Case>,
     pub trajectory: TrajectoryKind,
     /// Simulated time (s). Paper: 70.
     pub duration: f64,
@@ -174,10 +177,12 @@ pub struct SimConfig {
 
 impl SimConfig {
     /// Defaults around a mission: 70 s, 1 ms plant step, the paper's controller at 100 Hz,
-    /// no variation, no current, no noise, ideal actuators, starting on the reference.
+    /// no variation, no current, no noise, ideal actuators, starting on the reference, no
+    /// Table-1 case.
     pub fn new(name: impl Into<String>, trajectory: TrajectoryKind) -> Self {
         SimConfig {
             name: name.into(),
+            case: None,
             trajectory,
             duration: 70.0,
             plant_step: 0.001,

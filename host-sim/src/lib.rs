@@ -4,25 +4,27 @@
 //! | module | owns |
 //! |---|---|
 //! | [`config`] | what a run is ([`config::SimConfig`]) |
+//! | [`scenario`] | TOML scenario files, and the one validation of a run ([`scenario::Scenario`]) |
 //! | [`plant`] | the 6-DOF plant with varying parameters, current and RK4 |
 //! | [`sil`] | the sampled-data loop: ZOH, actuator chain, noise, divergence |
 //! | [`metrics`] | the paper's Table-1 metrics from a run |
 //! | [`link`] | what the simulator sends the board over `auv-link` |
-//! | [`record`] | samples, outcome, metrics of a run |
-//! | `scenario` | TOML scenario files |
-//! | [`table1`] | the paper's six missions with and without Δu |
-//! | [`pil`] | processor in the loop: the firmware in QEMU flies the plant |
+//! | [`record`] | samples, outcome, metrics and JSON summary of a run |
+//! | [`paper`] | the paper's Table 1: cases, profiles, its numbers, notes, the twelve runs |
+//! | [`pil`] | processor in the loop: the firmware in QEMU flies the plant; PIL vs SIL |
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box |
-//! | `output` | CSV, plots, report |
+//! | [`output`] | CSV, plots, report |
+//! | [`cli`] | the `host-sim` commands |
 
+pub mod cli;
 pub mod config;
 pub mod link;
 pub mod metrics;
 pub mod montecarlo;
 pub mod output;
+pub mod paper;
 pub mod pil;
 pub mod plant;
 pub mod record;
 pub mod scenario;
 pub mod sil;
-pub mod table1;

@@ -9,9 +9,10 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
 
-use crate::config::{CurrentModel, SimConfig, VariationProfile};
-use crate::record::{Metrics, Outcome};
-use crate::sil::{self, SimError};
+use crate::config::{CurrentModel, VariationProfile};
+use crate::record::Metrics;
+use crate::scenario::{Scenario, ScenarioError};
+use crate::sil;
 
 #[derive(Clone, Copy, Debug)]
 pub struct MonteCarloOptions {
@@ -88,24 +89,27 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[rank.min(sorted.len()) - 1]
 }
 
+/// Runs `opts.runs` draws around `base` in parallel (the controller is `base`'s, built once).
 pub fn run(
-    base: &SimConfig,
+    base: &Scenario,
     opts: &MonteCarloOptions,
     on_done: impl Fn() + Sync,
-) -> Result<Summary, SimError> {
-    let results: Result<Vec<(Draw, Metrics, bool)>, SimError> = (0..opts.runs)
+) -> Result<Summary, ScenarioError> {
+    let name = &base.config().name;
+    let results: Result<Vec<(Draw, Metrics, bool)>, ScenarioError> = (0..opts.runs)
         .into_par_iter()
         .map(|i| {
             let d = draw(opts, i);
-            let mut cfg = base.clone();
-            cfg.name = format!("{}-mc{i}", base.name);
-            cfg.variation = VariationProfile::Constant(variation(&d));
-            if opts.max_current.is_some() {
-                cfg.current = CurrentModel::Constant(d.current);
-            }
-            let r = sil::run(&cfg)?;
+            let scenario = base.with(|cfg| {
+                cfg.name = format!("{name}-mc{i}");
+                cfg.variation = VariationProfile::Constant(variation(&d));
+                if opts.max_current.is_some() {
+                    cfg.current = CurrentModel::Constant(d.current);
+                }
+            })?;
+            let r = sil::run(&scenario);
             on_done();
-            let diverged = matches!(r.outcome, Outcome::Diverged { .. });
+            let diverged = r.diverged();
             Ok((d, r.metrics, diverged))
         })
         .collect();
@@ -145,7 +149,7 @@ pub fn run(
         .max_by(|a, b| a.1.max_path.total_cmp(&b.1.max_path))
         .map(|(d, m, _)| (d.clone(), *m));
     Ok(Summary {
-        base: base.name.clone(),
+        base: name.clone(),
         runs: opts.runs,
         seed: opts.seed,
         diverged: results.iter().filter(|r| r.2).count(),

@@ -22,30 +22,47 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use auv_link::{
-    encode, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, Msg, StateFrame, Telemetry, MAX_FRAME, PROTOCOL_VERSION,
+    encode, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope, FrameDecoder, Msg,
+    StateFrame, Telemetry, DEFAULT_STALE_PERIODS, MAX_FRAME, PROTOCOL_VERSION,
 };
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::config::{LinkFaults, SimConfig};
-use crate::link::mission_spec;
+use crate::record::{ControlStatus, RunResult, RunSummary};
 use crate::sil::{ControlOut, ControlSource};
 
 /// QEMU mps2-an386 SysTick counts per instruction ratio (`-icount shift=0`, 25 MHz).
 pub const INSTRUCTIONS_PER_TICK: u32 = 40;
 
+/// Largest |PIL − SIL| of the max path error (m) that a fault-free PIL run may show: 1 mm.
+/// PIL equals SIL bit for bit today (the same f32 core, the same state frames); this is the
+/// margin the `pil` command (exit 1 beyond it) and CI hold it to.
+pub const PIL_SIL_TOLERANCE: f64 = 1e-3;
+
+/// Whether the board entered or left fail-safe.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FailSafeEventKind {
+    Enter,
+    Exit,
+}
+
 /// A change of the board's fail-safe state, as reported by its telemetry.
-#[derive(Clone, Debug, PartialEq, Serialize)]
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct FailSafeEvent {
+    /// Control tick (the simulator's period) of the change.
     pub tick: u64,
+    /// Its time (s).
     pub t: f64,
     /// "enter" or "exit".
-    pub kind: &'static str,
+    pub kind: FailSafeEventKind,
+    /// Enter: the reason's name ([`auv_link::FailSafeReason::as_str`], e.g. `"stale state"`); exit: the
+    /// status the board left fail-safe for, as its Rust name (e.g. `"Running"`).
     pub reason: String,
 }
 
 /// Link and board figures of one PIL run.
-#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct PilStats {
     pub state_frames_sent: u64,
     pub telemetry_frames: u64,
@@ -58,6 +75,59 @@ pub struct PilStats {
     pub board_loop_overruns: u32,
     pub rearms: u32,
     pub failsafe_events: Vec<FailSafeEvent>,
+}
+
+impl FailSafeEventKind {
+    /// `"enter"` or `"exit"` (as in the JSON).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FailSafeEventKind::Enter => "enter",
+            FailSafeEventKind::Exit => "exit",
+        }
+    }
+}
+
+/// What a comparison is of: always `"pil"` (processor in the loop against SIL).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Mode {
+    Pil,
+}
+
+/// One PIL run compared with SIL: an entry of `host-sim pil --json`'s `cases` (read it back
+/// with `serde_json::from_str::<Cases<PilComparison>>`). The PIL run's summary, its SIL twin's
+/// max path error and the difference, and the board and link figures.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PilComparison {
+    /// The PIL run (`case`, `robust`, metrics, `diverged`).
+    #[serde(flatten)]
+    pub run: RunSummary,
+    pub mode: Mode,
+    /// Max path error of the same scenario in SIL (m).
+    pub sil_max_path: f64,
+    /// PIL − SIL max path error (m).
+    pub pil_minus_sil_max_path: f64,
+    /// The board's and the link's figures.
+    pub pil: PilStats,
+}
+
+impl PilComparison {
+    /// The comparison of a PIL run with the SIL run of the same scenario.
+    pub fn new(pil_run: &RunResult, sil_run: &RunResult, stats: PilStats) -> Self {
+        PilComparison {
+            run: pil_run.summary(),
+            mode: Mode::Pil,
+            sil_max_path: sil_run.metrics.max_path,
+            pil_minus_sil_max_path: pil_run.metrics.max_path - sil_run.metrics.max_path,
+            pil: stats,
+        }
+    }
+
+    /// PIL and SIL agree: |PIL − SIL| of the max path error within [`PIL_SIL_TOLERANCE`] (a NaN
+    /// difference does not agree).
+    pub fn agrees(&self) -> bool {
+        self.pil_minus_sil_max_path.abs() <= PIL_SIL_TOLERANCE
+    }
 }
 
 /// The firmware in QEMU, on a socket.
@@ -78,17 +148,6 @@ pub struct BoardInTheLoop {
     t0: Instant,
     pub stats: PilStats,
     log_path: PathBuf,
-}
-
-fn reason_name(s: BoardStatus) -> String {
-    match s {
-        BoardStatus::FailSafe(FailSafeReason::StaleState) => "stale state".into(),
-        BoardStatus::FailSafe(FailSafeReason::ControllerFault) => "controller fault".into(),
-        BoardStatus::FailSafe(FailSafeReason::Overrun) => "loop overrun".into(),
-        BoardStatus::FailSafe(FailSafeReason::Disarmed) => "disarmed".into(),
-        BoardStatus::FailSafe(FailSafeReason::NoMission) => "no mission".into(),
-        other => format!("{other:?}"),
-    }
 }
 
 impl BoardInTheLoop {
@@ -156,7 +215,7 @@ impl BoardInTheLoop {
             seq: 0,
             rate_hz: cfg.controller.rate_hz,
             faults,
-            mission: mission_spec(&cfg.trajectory),
+            mission: auv_link::MissionSpec::from(cfg.trajectory),
             started: false,
             history: Vec::new(),
             pending: std::collections::VecDeque::new(),
@@ -173,7 +232,7 @@ impl BoardInTheLoop {
             robust: Some(c.robust),
             delta_max: Some(c.delta_max),
             voltage_limit: Some(c.voltage_limit),
-            stale_periods: Some(2),
+            stale_periods: Some(DEFAULT_STALE_PERIODS),
             lockstep: Some(true),
         })))?;
         b.send(Msg::Command(LinkCommand::Arm))?;
@@ -264,19 +323,19 @@ impl BoardInTheLoop {
         let was_fail = matches!(self.last_status, Some(BoardStatus::FailSafe(_)));
         let is_fail = matches!(t.status, BoardStatus::FailSafe(_));
         let time = k as f64 / self.rate_hz as f64;
-        if is_fail && !was_fail {
+        if let (BoardStatus::FailSafe(reason), false) = (t.status, was_fail) {
             self.stats.failsafe_events.push(FailSafeEvent {
                 tick: k,
                 t: time,
-                kind: "enter",
-                reason: reason_name(t.status),
+                kind: FailSafeEventKind::Enter,
+                reason: reason.as_str().to_string(),
             });
             self.needs_rearm = true;
         } else if was_fail && !is_fail {
             self.stats.failsafe_events.push(FailSafeEvent {
                 tick: k,
                 t: time,
-                kind: "exit",
+                kind: FailSafeEventKind::Exit,
                 reason: format!("{:?}", t.status),
             });
         }
@@ -388,18 +447,7 @@ impl ControlSource for BoardInTheLoop {
         };
         self.note_status(&t, k);
         Ok(ControlOut {
-            ok: t.status == BoardStatus::Running,
-            status: match t.status {
-                BoardStatus::Running => "ok",
-                BoardStatus::Armed => "board:armed",
-                BoardStatus::Disarmed => "board:disarmed",
-                BoardStatus::FailSafe(FailSafeReason::StaleState) => "board:fail-safe:stale-state",
-                BoardStatus::FailSafe(FailSafeReason::ControllerFault) => {
-                    "board:fail-safe:controller-fault"
-                }
-                BoardStatus::FailSafe(FailSafeReason::Overrun) => "board:fail-safe:overrun",
-                BoardStatus::FailSafe(_) => "board:fail-safe",
-            },
+            status: ControlStatus::Board(t.status),
             tau: t.tau,
             voltage: t.voltages,
             saturated: t.saturated,

@@ -1,6 +1,54 @@
 //! What a run leaves behind: one [`Sample`] per control period, the outcome, and the metrics.
 
-use serde::Serialize;
+use std::fmt;
+
+use auv_link::BoardStatus;
+use controller_core::{Status, Table1Case};
+use serde::{Deserialize, Serialize};
+
+/// What produced a control period's output, and its state: the core's own [`Status`] when the
+/// law runs on the host (SIL), the board's [`BoardStatus`] when it runs on the board (PIL).
+///
+/// `Display` is the CSV `status` column: `ok` when the law ran (the core's [`Status::Ok`], the
+/// board's [`BoardStatus::Running`]); the core's name otherwise (`fault:pitch-limit`); for the
+/// board `board:` and its name with `": "` → `":"` and spaces → `-`
+/// (`board:fail-safe:stale-state`), so that the column holds one token.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControlStatus {
+    /// The core on the host.
+    Law(Status),
+    /// The firmware on the board.
+    Board(BoardStatus),
+}
+
+impl ControlStatus {
+    /// True when the law ran this period (thrusters are driven); false: fail-safe, all off.
+    pub fn is_ok(&self) -> bool {
+        matches!(
+            self,
+            ControlStatus::Law(Status::Ok) | ControlStatus::Board(BoardStatus::Running)
+        )
+    }
+}
+
+impl fmt::Display for ControlStatus {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            _ if self.is_ok() => f.write_str("ok"),
+            ControlStatus::Law(s) => f.write_str(s.as_str()),
+            ControlStatus::Board(s) => {
+                let token = s.as_str().replace(": ", ":").replace(' ', "-");
+                write!(f, "board:{token}")
+            }
+        }
+    }
+}
+
+impl Serialize for ControlStatus {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
 
 /// One control period, as the controller saw and commanded it and as the plant was.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -32,8 +80,8 @@ pub struct Sample {
     pub w_norm: f64,
     /// Payload mass variation Δm (kg) at this time.
     pub payload: f64,
-    /// Controller status ("ok" or the fault).
-    pub status: &'static str,
+    /// Controller status: ok, or why the thrusters are off.
+    pub status: ControlStatus,
 }
 
 /// How a run ended.
@@ -48,8 +96,21 @@ pub enum Outcome {
     },
 }
 
+impl fmt::Display for Outcome {
+    /// "completed" or "DIVERGED at t = … s: reason" (the reason on one line).
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Outcome::Completed => f.write_str("completed"),
+            Outcome::Diverged { t, reason } => {
+                let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
+                write!(f, "DIVERGED at t = {t:.2} s: {reason}")
+            }
+        }
+    }
+}
+
 /// The paper's Table-1 metrics (AUV150.md §7) and the actuator figures.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     pub max_x: f64,
     pub max_y: f64,
@@ -71,10 +132,63 @@ pub struct Metrics {
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct RunResult {
     pub name: String,
+    /// The paper's Table-1 case the run reproduces ([`crate::config::SimConfig::case`]).
+    #[serde(skip)]
+    pub case: Option<Table1Case>,
     /// Whether Δu was on.
     pub robust: bool,
     pub outcome: Outcome,
     pub metrics: Metrics,
     #[serde(skip)]
     pub samples: Vec<Sample>,
+}
+
+/// A run as the commands report it in JSON (`--json`): `{"case": name, "robust", the
+/// [`Metrics`] fields, "diverged": {"t", "reason"} if it stopped early}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// The run's name ([`RunResult::name`]).
+    #[serde(rename = "case")]
+    pub name: String,
+    pub robust: bool,
+    #[serde(flatten)]
+    pub metrics: Metrics,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diverged: Option<Divergence>,
+}
+
+/// When and why a run stopped early ([`Outcome::Diverged`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Divergence {
+    pub t: f64,
+    pub reason: String,
+}
+
+/// The JSON object a command prints: `{"cases": [...]}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Cases<T> {
+    pub cases: Vec<T>,
+}
+
+impl RunResult {
+    /// The run's [`RunSummary`].
+    pub fn summary(&self) -> RunSummary {
+        RunSummary {
+            name: self.name.clone(),
+            robust: self.robust,
+            metrics: self.metrics,
+            diverged: match &self.outcome {
+                Outcome::Completed => None,
+                Outcome::Diverged { t, reason } => Some(Divergence {
+                    t: *t,
+                    reason: reason.clone(),
+                }),
+            },
+        }
+    }
+
+    /// True if the run stopped early.
+    pub fn diverged(&self) -> bool {
+        matches!(self.outcome, Outcome::Diverged { .. })
+    }
 }

@@ -15,45 +15,16 @@
 use controller_core::allocation::{self, THRUSTERS};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
-use controller_core::{ConfigError, Controller, Status, Trajectory};
+use controller_core::{Controller, Trajectory};
 use nalgebra::{Vector3, Vector6};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::config::{CurrentModel, SimConfig};
+use crate::config::CurrentModel;
 use crate::metrics;
 use crate::plant::{Plant, PlantState, PlantTerms};
-use crate::record::{Outcome, RunResult, Sample};
-
-/// A run could not start.
-#[derive(Debug, Clone, PartialEq)]
-pub enum SimError {
-    Controller(ConfigError),
-    Trajectory(controller_core::trajectory::TrajectoryError),
-    /// The plant step must divide the control period into a whole number of steps.
-    PlantStep {
-        plant_step: f64,
-        period: f64,
-    },
-    /// Duration not finite or not positive.
-    Duration(f64),
-}
-
-impl std::fmt::Display for SimError {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        match self {
-            SimError::Controller(e) => write!(f, "controller configuration: {e}"),
-            SimError::Trajectory(e) => write!(f, "trajectory: {e}"),
-            SimError::PlantStep { plant_step, period } => write!(
-                f,
-                "plant_step {plant_step} s does not divide the control period {period} s into whole steps"
-            ),
-            SimError::Duration(d) => write!(f, "duration {d} s must be finite and > 0"),
-        }
-    }
-}
-
-impl std::error::Error for SimError {}
+use crate::record::{ControlStatus, Outcome, RunResult, Sample};
+use crate::scenario::Scenario;
 
 /// Ocean current state (Gauss–Markov is a random process, stepped with the plant).
 struct Current {
@@ -107,10 +78,8 @@ fn to_f64<const N: usize>(a: &[f32; N]) -> [f64; N] {
 /// What one control period returns, whether the law ran here (SIL) or on the board (PIL).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ControlOut {
-    /// False: the controller is in fail-safe (thrusters off).
-    pub ok: bool,
-    /// "ok" or why not.
-    pub status: &'static str,
+    /// Whether the law ran ([`ControlStatus::is_ok`]); if not, the thrusters are off.
+    pub status: ControlStatus,
     /// Commanded body force (used by ideal actuators).
     pub tau: [f32; 6],
     /// Voltages (used by the real actuator chain).
@@ -128,27 +97,27 @@ pub trait ControlSource {
     fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String>;
 }
 
-/// The f32 core on the host, as the firmware runs it (software in the loop).
-pub struct LocalController {
-    controller: Controller,
-    trajectory: Trajectory,
+/// The f32 core on the host, as the firmware runs it (software in the loop): the scenario's
+/// controller and trajectory.
+pub struct LocalController<'a> {
+    controller: &'a Controller,
+    trajectory: &'a Trajectory,
 }
 
-impl LocalController {
-    pub fn new(cfg: &SimConfig) -> Result<Self, SimError> {
-        Ok(LocalController {
-            controller: Controller::new(cfg.controller).map_err(SimError::Controller)?,
-            trajectory: Trajectory::new(cfg.trajectory).map_err(SimError::Trajectory)?,
-        })
+impl<'a> LocalController<'a> {
+    pub fn new(scenario: &'a Scenario) -> Self {
+        LocalController {
+            controller: scenario.controller(),
+            trajectory: scenario.trajectory(),
+        }
     }
 }
 
-impl ControlSource for LocalController {
+impl ControlSource for LocalController<'_> {
     fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
-        let out = self.controller.update(k, eta, nu, &self.trajectory);
+        let out = self.controller.update(k, eta, nu, self.trajectory);
         Ok(ControlOut {
-            ok: out.status == Status::Ok,
-            status: status_name(out.status),
+            status: ControlStatus::Law(out.status),
             tau: out.tau,
             voltage: out.voltage,
             saturated: out.saturated,
@@ -160,31 +129,21 @@ impl ControlSource for LocalController {
 }
 
 /// Runs one simulation with the law on the host (software in the loop).
-pub fn run(cfg: &SimConfig) -> Result<RunResult, SimError> {
-    let mut local = LocalController::new(cfg)?;
-    run_with(cfg, &mut local)
+pub fn run(scenario: &Scenario) -> RunResult {
+    run_with(scenario, &mut LocalController::new(scenario))
 }
 
-/// Runs one simulation with the law wherever `source` runs it.
-pub fn run_with(cfg: &SimConfig, source: &mut dyn ControlSource) -> Result<RunResult, SimError> {
-    // Validates the configuration and gives the allocation the plant's thrusters use.
-    let controller = Controller::new(cfg.controller).map_err(SimError::Controller)?;
-    let trajectory = Trajectory::new(cfg.trajectory).map_err(SimError::Trajectory)?;
-    if !(cfg.duration.is_finite() && cfg.duration > 0.0) {
-        return Err(SimError::Duration(cfg.duration));
-    }
+/// Runs one simulation with the law wherever `source` runs it. The scenario's controller gives
+/// the allocation the plant's thrusters use.
+pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResult {
+    let cfg = scenario.config();
+    let controller = scenario.controller();
+    let trajectory = scenario.trajectory();
     let rate = cfg.controller.rate_hz;
-    let period = 1.0 / rate as f64;
-    let substeps = (period / cfg.plant_step).round();
-    if !(substeps >= 1.0 && (substeps * cfg.plant_step - period).abs() < 1e-9 * period) {
-        return Err(SimError::PlantStep {
-            plant_step: cfg.plant_step,
-            period,
-        });
-    }
-    let substeps = substeps as usize;
+    let period = scenario.period();
+    let substeps = scenario.substeps();
     let h = period / substeps as f64;
-    let steps = (cfg.duration * rate as f64).round() as u64;
+    let steps = scenario.steps();
 
     let nominal = VehicleParams::auv150();
     let alloc_b = controller.allocation().matrix().cast::<f64>();
@@ -253,7 +212,7 @@ pub fn run_with(cfg: &SimConfig, source: &mut dyn ControlSource) -> Result<RunRe
         };
 
         // 2. Actuation.
-        let target: [f64; THRUSTERS] = match out.ok {
+        let target: [f64; THRUSTERS] = match out.status.is_ok() {
             false => [0.0; THRUSTERS],
             true if cfg.ideal_actuators => {
                 to_f64(&controller.allocation().thrusts(&Vector6::from(out.tau)))
@@ -330,21 +289,12 @@ pub fn run_with(cfg: &SimConfig, source: &mut dyn ControlSource) -> Result<RunRe
         }
     }
 
-    Ok(RunResult {
+    RunResult {
         name: cfg.name.clone(),
+        case: cfg.case,
         robust: cfg.controller.robust,
         metrics: metrics::compute(&samples),
         outcome,
         samples,
-    })
-}
-
-fn status_name(s: Status) -> &'static str {
-    match s {
-        Status::Ok => "ok",
-        Status::Fault(controller_core::Fault::NonFiniteInput) => "fault:non-finite-input",
-        Status::Fault(controller_core::Fault::InputOutOfRange) => "fault:input-out-of-range",
-        Status::Fault(controller_core::Fault::PitchLimit) => "fault:pitch-limit",
-        Status::Fault(controller_core::Fault::NonFiniteResult) => "fault:non-finite-result",
     }
 }

@@ -203,3 +203,59 @@ fn tempdir(tag: &str) -> std::path::PathBuf {
     std::fs::create_dir_all(&d).unwrap();
     d
 }
+
+/// The commands are library functions: run one in-process and read what it printed and wrote.
+#[test]
+fn the_run_command_runs_in_process() {
+    use host_sim::cli::{self, Exit, RunArgs};
+    use host_sim::record::{Cases, RunSummary};
+
+    let dir = tempdir("in-process");
+    let path = dir.join("short.toml");
+    std::fs::write(
+        &path,
+        "name = \"short\"\ntable1_case = \"figure-eight-30x30\"\nduration = 3\n\
+         [trajectory]\nkind = \"figure-eight\"\namplitude = 15\n\
+         [variation]\nprofile = \"constant\"\n",
+    )
+    .unwrap();
+    let args = RunArgs {
+        scenario: path.clone(),
+        json: true,
+        out: Some(dir.join("out")),
+    };
+    let mut stdout = Vec::new();
+    assert_eq!(cli::run(&args, &mut stdout).unwrap(), Exit::Success);
+    let printed: Cases<RunSummary> = serde_json::from_slice(&stdout).unwrap();
+    // With Δu, then its companion without.
+    assert_eq!(printed.cases.len(), 2);
+    assert_eq!(printed.cases[0].name, "short");
+    assert!(printed.cases[0].robust && !printed.cases[1].robust);
+    assert!(printed.cases.iter().all(|c| c.diverged.is_none()));
+    let m = &printed.cases[0].metrics;
+    assert!(
+        (m.max_path - (m.max_x.powi(2) + m.max_y.powi(2) + m.max_z.powi(2)).sqrt()).abs() < 1e-12
+    );
+    // The report knows the case: the paper's numbers for the figure-eight 30x30.
+    let report = std::fs::read_to_string(dir.join("out/report.md")).unwrap();
+    assert!(
+        report.contains("(1.738)") && report.contains("(0.031)"),
+        "{report}"
+    );
+    for f in ["short-with.csv", "short-without.csv", "short-xy.png"] {
+        assert!(dir.join("out").join(f).exists(), "{f}");
+    }
+
+    // A bad value is an Err naming the file and the key (the binary exits 2 on it).
+    std::fs::write(
+        &path,
+        "[trajectory]\nkind = \"circle\"\nradius = 10\n[controller]\nbeta = 2\n",
+    )
+    .unwrap();
+    let e = cli::run(&args, &mut Vec::new()).unwrap_err();
+    let text = format!("{e:#}");
+    assert!(
+        text.contains("short.toml") && text.contains("controller.beta"),
+        "{text}"
+    );
+}

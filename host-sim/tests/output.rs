@@ -2,11 +2,15 @@
 
 use std::path::{Path, PathBuf};
 
+use auv_link::{BoardStatus, FailSafeReason};
+use controller_core::Table1Case;
+use controller_core::{Fault, Status};
 use host_sim::output::{
-    paper_table1, plot_case, plot_case_with_limit, table_markdown, table_text, write_csv,
-    write_report, PaperRow, ReportRow, CSV_COLUMNS,
+    plot_case, plot_case_with_limit, table_markdown, table_text, write_csv, write_report,
+    ReportRow, CSV_COLUMNS,
 };
-use host_sim::record::{Metrics, Outcome, RunResult, Sample};
+use host_sim::paper::{table1_row, PaperRow};
+use host_sim::record::{ControlStatus, Metrics, Outcome, RunResult, Sample};
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0D, 0x0A, 0x1A, 0x0A];
 
@@ -73,16 +77,18 @@ fn synthetic(name: &str, robust: bool, n: usize, gain: f64) -> RunResult {
                 delta_clamped: (0.2 * t).sin() > 0.95,
                 w_norm: 1.0e-3 * t,
                 payload: if t < 25.0 { 0.0 } else { 30.0 },
-                status: if k % 50 == 49 {
-                    "fault: pitch, limit"
-                } else {
-                    "ok"
+                status: match k % 50 {
+                    49 => ControlStatus::Law(Status::Fault(Fault::PitchLimit)),
+                    24 => ControlStatus::Board(BoardStatus::FailSafe(FailSafeReason::StaleState)),
+                    23 => ControlStatus::Board(BoardStatus::Running),
+                    _ => ControlStatus::Law(Status::Ok),
                 },
             }
         })
         .collect();
     RunResult {
         name: name.to_string(),
+        case: None,
         robust,
         outcome: Outcome::Completed,
         metrics: Metrics {
@@ -173,7 +179,7 @@ fn csv_header_rows_and_values_round_trip() {
                 assert_eq!(got.to_bits(), w.to_bits());
             }
         }
-        assert_eq!(&rec[status_col], s.status);
+        assert_eq!(rec[status_col], s.status.to_string());
     }
     // Spot checks by name.
     let col = |name: &str| header.iter().position(|h| h == name).unwrap();
@@ -184,7 +190,11 @@ fn csv_header_rows_and_values_round_trip() {
     let clamped = run.samples.iter().position(|s| s.delta_clamped).unwrap();
     assert_eq!(&records[clamped][col("delta_clamped")], "1");
     assert_eq!(&records[0][col("delta_clamped")], "0");
-    assert_eq!(&records[49][col("status")], "fault: pitch, limit");
+    // The status column's names (the core's and the board's, one token each).
+    assert_eq!(&records[49][col("status")], "fault:pitch-limit");
+    assert_eq!(&records[24][col("status")], "board:fail-safe:stale-state");
+    assert_eq!(&records[23][col("status")], "ok");
+    assert_eq!(&records[0][col("status")], "ok");
     let y: f64 = records[10][col("y")].parse().unwrap();
     assert_eq!(y, run.samples[10].eta[1]);
 }
@@ -324,6 +334,7 @@ fn paper_table1_matches_the_spec() {
             [1.092, 0.001, 3.205, 0.011, 0.452, 0.121, 3.420, 0.162],
         ),
     ];
+    assert_eq!(table.len(), Table1Case::ALL.len());
     for (case, v) in table {
         let want = PaperRow {
             x: [v[0], v[1]],
@@ -331,16 +342,14 @@ fn paper_table1_matches_the_spec() {
             z: [v[4], v[5]],
             path: [v[6], v[7]],
         };
-        assert_eq!(paper_table1(case), Some(want), "{case}");
+        let case = Table1Case::from_name(case).unwrap();
+        assert_eq!(table1_row(case), want, "{}", case.name());
     }
-    let c10 = paper_table1("circular-10R").unwrap();
+    let c10 = table1_row(Table1Case::Circular10R);
     assert_eq!(c10.x, [0.485, 0.020]);
     assert_eq!(c10.y, [0.145, 0.002]);
     assert_eq!(c10.z, [0.015, 0.001]);
     assert_eq!(c10.path, [0.506, 0.022]);
-    assert_eq!(paper_table1("circular-30R"), None);
-    assert_eq!(paper_table1(""), None);
-    assert_eq!(paper_table1("Circular-10R"), None);
 }
 
 #[test]
@@ -357,17 +366,17 @@ fn tables_name_every_case_and_never_hide_a_divergence() {
         ReportRow {
             with: &a_with,
             without: Some(&a_without),
-            paper: paper_table1("circular-10R"),
+            case: Some(Table1Case::Circular10R),
         },
         ReportRow {
             with: &b_with,
             without: None,
-            paper: paper_table1("lawn-mower-30x15"),
+            case: Some(Table1Case::LawnMower30x15),
         },
         ReportRow {
             with: &c_with,
             without: None,
-            paper: None,
+            case: None,
         },
     ];
 
@@ -427,7 +436,7 @@ fn write_report_embeds_the_plots_and_keeps_the_notes() {
     let rows = [ReportRow {
         with: &with,
         without: Some(&without),
-        paper: paper_table1("circular-20R"),
+        case: Some(Table1Case::Circular20R),
     }];
     let notes = "Ideal actuators.\n\n- a *note* | verbatim";
     let report = write_report(&dir, "Table 1 reproduction", &rows, &plots, notes).unwrap();
@@ -450,7 +459,7 @@ fn write_report_embeds_the_plots_and_keeps_the_notes() {
     let rows = [ReportRow {
         with: &with,
         without: Some(&bad),
-        paper: None,
+        case: None,
     }];
     let elsewhere = PathBuf::from("/elsewhere/fig.png");
     let report = write_report(&dir.join("sub"), "t", &rows, &[elsewhere], "").unwrap();
@@ -459,4 +468,19 @@ fn write_report_embeds_the_plots_and_keeps_the_notes() {
     assert!(md.contains("DIVERGED at t = 3.00 s: runaway"), "{md}");
     assert!(md.contains("](/elsewhere/fig.png)"), "{md}");
     assert!(!md.contains("## Notes"));
+}
+
+#[test]
+fn the_paper_column_follows_the_case_not_the_name() {
+    // A run named like a paper case but not made as one gets no paper numbers; a run of the
+    // case under another name gets them (ReportRow::new takes the run's case).
+    let lookalike = synthetic("circular-10R", true, 10, 0.05);
+    let mut renamed = synthetic("my-circle", true, 10, 0.05);
+    renamed.case = Some(Table1Case::Circular10R);
+    let md = table_markdown(&[ReportRow::new(&lookalike, None)]);
+    assert!(!md.contains("(0.506)") && !md.contains("not run"), "{md}");
+    let md = table_markdown(&[ReportRow::new(&renamed, None)]);
+    assert!(md.contains("my-circle") && md.contains("(0.022)"), "{md}");
+    // …and the missing run without Δu is listed with the paper's number for it.
+    assert!(md.contains("not run") && md.contains("(0.506)"), "{md}");
 }

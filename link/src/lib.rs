@@ -42,7 +42,9 @@
 //! η, ν at a control tick) and [`Msg::Command`] (arm / disarm, start a [`MissionSpec`] /
 //! stop, or change settings with a [`ConfigPatch`]); the board answers with
 //! [`Msg::Telemetry`], whose [`Telemetry::last_state_seq`] echoes the `seq` of the last State
-//! frame it accepted.
+//! frame it accepted. A [`MissionSpec`] is the wire form of `controller_core::TrajectoryKind`:
+//! both ends convert with the `From` impls of [`mission`], the only place that maps one to the
+//! other.
 //!
 //! postcard lays a message out as follows (worst-case sizes in the `MAX_SIZE` constants of each
 //! type): fields in declaration order, no padding, no field names; `u8` and `bool` as one byte;
@@ -77,10 +79,11 @@
 
 mod cobs;
 mod frame;
+pub mod mission;
 mod msg;
 
 pub use frame::{decode_frame, encode, FrameDecoder, LinkError, CRC_LEN, MAX_BODY, MAX_FRAME};
 pub use msg::{
     BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, StateFrame,
-    Telemetry, PROTOCOL_VERSION,
+    Telemetry, DEFAULT_STALE_PERIODS, PROTOCOL_VERSION,
 };

@@ -121,8 +121,9 @@ impl Command {
     pub const MAX_SIZE: usize = TAG + max(MissionSpec::MAX_SIZE, ConfigPatch::MAX_SIZE);
 }
 
-/// A mission trajectory and its parameters. Mirrors `controller_core::TrajectoryKind` field
-/// for field (this crate does not depend on controller-core; the firmware and host-sim convert).
+/// A mission trajectory and its parameters: the wire form of
+/// [`controller_core::TrajectoryKind`], field for field. Convert with `From` both ways
+/// ([`crate::mission`]); the receiver validates with `controller_core::Trajectory::new`.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum MissionSpec {
@@ -171,6 +172,11 @@ impl MissionSpec {
     pub const MAX_SIZE: usize = TAG + 4 * F32;
 }
 
+/// Control periods a state frame stays valid on a board that was not told otherwise
+/// ([`ConfigPatch::stale_periods`]): the third period without a fresh [`Msg::State`] fails
+/// safe ([`FailSafeReason::StaleState`]).
+pub const DEFAULT_STALE_PERIODS: u8 = 2;
+
 /// A partial configuration change: `None` leaves a setting as it is.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -184,7 +190,7 @@ pub struct ConfigPatch {
     /// Thruster voltages are clamped to ±`voltage_limit` (V).
     pub voltage_limit: Option<f32>,
     /// Control periods without a fresh [`Msg::State`] before the board fails safe
-    /// ([`FailSafeReason::StaleState`]).
+    /// ([`FailSafeReason::StaleState`]); [`DEFAULT_STALE_PERIODS`] until set.
     pub stale_periods: Option<u8>,
     /// Lockstep: the board runs one control step per received [`Msg::State`] (simulation),
     /// instead of on its own timer.
@@ -230,7 +236,8 @@ pub struct Telemetry {
     pub delta_clamped: bool,
     /// ‖w‖ = ‖BᵀPe‖.
     pub w_norm: f32,
-    /// 0: no controller fault; otherwise a firmware-defined fault code.
+    /// 0: no controller fault; otherwise the fault's code, [`controller_core::Fault::code`]
+    /// (read it back with [`Telemetry::fault`]).
     pub controller_fault: u8,
     /// Control steps that missed their deadline since boot.
     pub loop_overruns: u32,
@@ -258,9 +265,16 @@ impl Telemetry {
         + U8
         + 4 * U32
         + U16;
+
+    /// The controller fault this report carries (`None`: no fault, or a code this crate does
+    /// not know).
+    pub fn fault(&self) -> Option<controller_core::Fault> {
+        controller_core::Fault::from_code(self.controller_fault)
+    }
 }
 
-/// What the board is doing.
+/// What the board is doing. [`as_str`](Self::as_str) / `Display` name it for logs and
+/// reports, e.g. `"running"`, `"fail-safe: stale state"`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
 pub enum BoardStatus {
@@ -279,23 +293,76 @@ impl BoardStatus {
     pub const MAX_SIZE: usize = TAG + FailSafeReason::MAX_SIZE;
 }
 
-/// Why the board failed safe.
+/// Why the board failed safe. The discriminant is the reason's byte on the wire (postcard's
+/// variant index, declaration order); a test holds the two equal.
+///
+/// Disarming or stopping the mission is not a fail-safe (the board reports
+/// [`BoardStatus::Disarmed`] / [`BoardStatus::Armed`]), so those have no reason here.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
+#[repr(u8)]
 pub enum FailSafeReason {
     /// No fresh [`Msg::State`] within `stale_periods` control periods.
-    StaleState,
+    StaleState = 0,
     /// The controller reported a fault (see [`Telemetry::controller_fault`]).
-    ControllerFault,
+    ControllerFault = 1,
     /// The control loop overran its deadline.
-    Overrun,
-    /// The board was disarmed while a mission ran.
-    Disarmed,
-    /// Running was requested without a mission.
-    NoMission,
+    Overrun = 2,
 }
 
 impl FailSafeReason {
     /// Worst-case postcard size of a `FailSafeReason` (bytes).
     pub const MAX_SIZE: usize = TAG;
+}
+
+/// The names of the board's states, once: [`FailSafeReason::as_str`] and
+/// [`BoardStatus::as_str`] (`"fail-safe: "` and the reason) both come from this list.
+macro_rules! status_names {
+    ($($reason:ident => $name:literal),+ $(,)?) => {
+        impl FailSafeReason {
+            /// Every reason, in wire order.
+            pub const ALL: [FailSafeReason; [$(FailSafeReason::$reason),+].len()] =
+                [$(FailSafeReason::$reason),+];
+
+            /// Short name for logs and reports, e.g. `"stale state"`.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    $(FailSafeReason::$reason => $name,)+
+                }
+            }
+        }
+
+        impl BoardStatus {
+            /// Short name for logs and reports: `"disarmed"`, `"armed"`, `"running"`, or
+            /// `"fail-safe: "` and the reason, e.g. `"fail-safe: stale state"`.
+            pub const fn as_str(self) -> &'static str {
+                match self {
+                    BoardStatus::Disarmed => "disarmed",
+                    BoardStatus::Armed => "armed",
+                    BoardStatus::Running => "running",
+                    $(BoardStatus::FailSafe(FailSafeReason::$reason) => {
+                        concat!("fail-safe: ", $name)
+                    })+
+                }
+            }
+        }
+    };
+}
+
+status_names! {
+    StaleState => "stale state",
+    ControllerFault => "controller fault",
+    Overrun => "overrun",
+}
+
+impl core::fmt::Display for FailSafeReason {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+impl core::fmt::Display for BoardStatus {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
 }

@@ -124,13 +124,7 @@ fn every_kind() -> Vec<Envelope> {
         Msg::Telemetry(telemetry(BoardStatus::Armed)),
         Msg::Telemetry(telemetry(BoardStatus::Running)),
     ];
-    for reason in [
-        FailSafeReason::StaleState,
-        FailSafeReason::ControllerFault,
-        FailSafeReason::Overrun,
-        FailSafeReason::Disarmed,
-        FailSafeReason::NoMission,
-    ] {
+    for reason in FailSafeReason::ALL {
         msgs.push(Msg::Telemetry(telemetry(BoardStatus::FailSafe(reason))));
     }
     msgs.into_iter()
@@ -145,7 +139,7 @@ fn largest() -> Envelope {
         u16::MAX,
         Msg::Telemetry(Telemetry {
             tick: u64::MAX,
-            status: BoardStatus::FailSafe(FailSafeReason::NoMission),
+            status: BoardStatus::FailSafe(FailSafeReason::Overrun),
             voltages: [f32::MAX; 5],
             thrusts: [f32::MIN; 5],
             tau: [f32::MAX; 6],
@@ -235,7 +229,7 @@ fn max_sizes_are_exact() {
     assert_eq!(postcard_len(&t), Telemetry::MAX_SIZE);
     assert_eq!(postcard_len(&t.status), BoardStatus::MAX_SIZE);
     assert_eq!(
-        postcard_len(&FailSafeReason::NoMission),
+        postcard_len(&FailSafeReason::Overrun),
         FailSafeReason::MAX_SIZE
     );
     let s = StateFrame {
@@ -446,14 +440,7 @@ fn any_f32() -> BoxedStrategy<f32> {
 }
 
 fn any_reason() -> BoxedStrategy<FailSafeReason> {
-    prop_oneof![
-        Just(FailSafeReason::StaleState),
-        Just(FailSafeReason::ControllerFault),
-        Just(FailSafeReason::Overrun),
-        Just(FailSafeReason::Disarmed),
-        Just(FailSafeReason::NoMission),
-    ]
-    .boxed()
+    proptest::sample::select(FailSafeReason::ALL.to_vec()).boxed()
 }
 
 fn any_status() -> BoxedStrategy<BoardStatus> {

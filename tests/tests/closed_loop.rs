@@ -3,17 +3,22 @@
 
 use controller_core::{Table1Case, TrajectoryKind};
 use host_sim::config::{CurrentModel, SimConfig};
+use host_sim::paper;
 use host_sim::record::Outcome;
-use host_sim::scenario::table1_scenario;
+use host_sim::scenario::Scenario;
 use host_sim::sil;
+
+fn run(config: SimConfig) -> host_sim::record::RunResult {
+    sil::run(&Scenario::new(config).expect("valid scenario"))
+}
 
 /// Each Table-1 mission with Δu at the paper's defaults stays under 0.05 m max path error, and
 /// without Δu it is worse.
 #[test]
 fn table1_missions_track_within_5_cm_with_delta_u_and_worse_without() {
     for case in Table1Case::ALL {
-        let with = sil::run(&table1_scenario(case, true)).expect("valid scenario");
-        let without = sil::run(&table1_scenario(case, false)).expect("valid scenario");
+        let with = run(paper::config(case, true));
+        let without = run(paper::config(case, false));
         assert_eq!(with.outcome, Outcome::Completed, "{}", case.name());
         assert!(
             with.metrics.max_path < 0.05,
@@ -35,9 +40,9 @@ fn table1_missions_track_within_5_cm_with_delta_u_and_worse_without() {
 /// term: the error converges.
 #[test]
 fn a_mission_in_a_current_still_converges() {
-    let mut cfg = table1_scenario(Table1Case::Circular10R, true);
+    let mut cfg = paper::config(Table1Case::Circular10R, true);
     cfg.current = CurrentModel::Constant([0.2, 0.0, 0.0]);
-    let r = sil::run(&cfg).unwrap();
+    let r = run(cfg);
     assert_eq!(r.outcome, Outcome::Completed);
     let late = r.samples.iter().filter(|s| s.t > 40.0);
     let worst_late = late
@@ -62,7 +67,7 @@ fn helix_mission_tracks_depth() {
         },
     );
     cfg.duration = 60.0;
-    let r = sil::run(&cfg).unwrap();
+    let r = run(cfg);
     assert_eq!(r.outcome, Outcome::Completed);
     let last = r.samples.last().unwrap();
     // z_d(60) = 5 + 0.2·60 = 17 m, and the vehicle is there.
@@ -77,10 +82,10 @@ fn helix_mission_tracks_depth() {
 /// Starting 1 m off the path, δ is clamped at first (AUV150.md §8) and the error converges.
 #[test]
 fn off_path_start_clamps_delta_then_converges() {
-    let mut cfg = table1_scenario(Table1Case::FigureEight30x30, true);
+    let mut cfg = paper::config(Table1Case::FigureEight30x30, true);
     cfg.initial_offset = [1.0, 0.0, 0.0, 0.0, 0.0, 0.0];
     cfg.duration = 20.0;
-    let r = sil::run(&cfg).unwrap();
+    let r = run(cfg);
     assert!(r.samples[0].delta_clamped || r.samples[0].delta > 10.0);
     let end = r.samples.last().unwrap();
     assert!(

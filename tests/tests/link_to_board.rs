@@ -1,13 +1,37 @@
 //! The simulator and the board share the link types: what host-sim sends, the firmware's
 //! supervisor (built for the host) receives through real frames, and it flies exactly the law
-//! the simulator runs — bit for bit.
+//! the simulator runs — bit for bit. Every mission kind crosses the link, the helix included.
 
-use auv_link::{encode, Command, Envelope, FrameDecoder, Msg, MAX_FRAME, PROTOCOL_VERSION};
+use auv_link::{
+    encode, Command, Envelope, FrameDecoder, MissionSpec, Msg, MAX_FRAME, PROTOCOL_VERSION,
+};
 use controller_core::kinematics::{self, Attitude};
-use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
-use firmware::supervisor::{trajectory_of, Supervisor};
-use host_sim::link::{mission_spec, state_frame};
+use controller_core::{
+    Controller, ControllerConfig, Status, Table1Case, Trajectory, TrajectoryKind,
+};
+use firmware::supervisor::Supervisor;
+use host_sim::link::state_frame;
 use nalgebra::Vector6;
+
+/// The six Table-1 missions and a descending helix (not in the paper; the one kind no
+/// Table-1 case uses).
+fn missions() -> Vec<(String, Trajectory)> {
+    let mut m: Vec<(String, Trajectory)> = Table1Case::ALL
+        .iter()
+        .map(|&c| (c.name().to_string(), Trajectory::table1(c)))
+        .collect();
+    let helix = TrajectoryKind::Helix {
+        radius: 12.0,
+        omega: 0.08,
+        depth: 4.0,
+        depth_rate: 0.15,
+    };
+    m.push((
+        "helix".into(),
+        Trajectory::new(helix).expect("a valid helix"),
+    ));
+    m
+}
 
 fn deliver(sup: &mut Supervisor, dec: &mut FrameDecoder, seq: u16, msg: Msg) {
     let mut buf = [0u8; MAX_FRAME];
@@ -31,16 +55,12 @@ fn deliver(sup: &mut Supervisor, dec: &mut FrameDecoder, seq: u16, msg: Msg) {
 
 #[test]
 fn the_board_builds_the_same_mission_from_the_link() {
-    for case in Table1Case::ALL {
-        let tr = Trajectory::table1(case);
-        let on_board = trajectory_of(&mission_spec(&tr.kind())).expect("valid mission");
+    for (name, tr) in missions() {
+        let spec = MissionSpec::from(tr.kind());
+        let on_board = Trajectory::new(TrajectoryKind::from(spec)).expect("valid mission");
+        assert_eq!(on_board, tr, "{name}");
         for k in [0u64, 777, 6999, 1 << 40] {
-            assert_eq!(
-                tr.sample(k, 100),
-                on_board.sample(k, 100),
-                "{}",
-                case.name()
-            );
+            assert_eq!(tr.sample(k, 100), on_board.sample(k, 100), "{name}");
         }
     }
 }
@@ -48,8 +68,7 @@ fn the_board_builds_the_same_mission_from_the_link() {
 #[test]
 fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
     let ctl = Controller::new(ControllerConfig::default()).unwrap();
-    for case in Table1Case::ALL {
-        let tr = Trajectory::table1(case);
+    for (name, tr) in missions() {
         let mut sup = Supervisor::new(Controller::new(ControllerConfig::default()).unwrap());
         let mut dec = FrameDecoder::new();
         deliver(&mut sup, &mut dec, 0, Msg::Command(Command::Arm));
@@ -57,7 +76,7 @@ fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
             &mut sup,
             &mut dec,
             1,
-            Msg::Command(Command::StartMission(mission_spec(&tr.kind()))),
+            Msg::Command(Command::StartMission(tr.kind().into())),
         );
         for k in 0..50u64 {
             // A plant state near the reference, in f64 as the simulator holds it.
@@ -71,7 +90,12 @@ fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
             let step = sup.step(false, &|| 0);
             let direct = ctl.update(k, &frame.eta, &frame.nu, &tr);
             assert_eq!(direct.status, Status::Ok);
-            assert_eq!(step.voltages, direct.voltage, "{} at tick {k}", case.name());
+            assert_eq!(
+                step.telemetry.status,
+                auv_link::BoardStatus::Running,
+                "{name}"
+            );
+            assert_eq!(step.voltages, direct.voltage, "{name} at tick {k}");
             assert_eq!(step.telemetry.thrusts, direct.thrust);
             assert_eq!(step.telemetry.delta, direct.delta);
         }

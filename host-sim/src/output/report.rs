@@ -1,0 +1,287 @@
+//! The Table-1 style report: the table (Markdown and terminal text) of each case's runs with
+//! and without Δu beside the paper's numbers, and `report.md` with the plots and notes.
+
+use std::fmt::Write as _;
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use anyhow::{Context, Result};
+use controller_core::Table1Case;
+
+use crate::paper;
+use crate::record::{Metrics, Outcome, RunResult};
+
+/// One row of a report table: a case, its run with Δu, optionally its run without Δu, and
+/// the paper's Table-1 case it reproduces, if any (its numbers are printed beside ours).
+#[derive(Clone, Copy, Debug)]
+pub struct ReportRow<'a> {
+    pub with: &'a RunResult,
+    pub without: Option<&'a RunResult>,
+    pub case: Option<Table1Case>,
+}
+
+impl<'a> ReportRow<'a> {
+    /// The row of a run and its companion without Δu, for the case the run names
+    /// ([`RunResult::case`]).
+    pub fn new(with: &'a RunResult, without: Option<&'a RunResult>) -> Self {
+        ReportRow {
+            with,
+            without,
+            case: with.case,
+        }
+    }
+}
+
+/// A length or angle: 3 decimals as in the paper, scientific when that would hide it.
+fn fmt_err(v: f64) -> String {
+    if !v.is_finite() {
+        format!("{v}")
+    } else if v == 0.0 || (v.abs() >= 1e-3 && v.abs() < 1e6) {
+        format!("{v:.3}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+fn fmt_fixed(v: f64, decimals: usize) -> String {
+    if v.is_finite() {
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v}")
+    }
+}
+
+const TABLE_HEADER: [&str; 13] = [
+    "case",
+    "Δu",
+    "max x (m)",
+    "max y (m)",
+    "max z (m)",
+    "path (m)",
+    "rms path (m)",
+    "max roll (rad)",
+    "max pitch (rad)",
+    "max yaw (rad)",
+    "peak |V| (V)",
+    "saturated",
+    "outcome",
+];
+
+/// The table's cells: per case the run without Δu (if run or if the paper has numbers), then
+/// the run with Δu. Max errors read "ours (paper)".
+fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
+    let mut out = Vec::new();
+    for row in rows {
+        let runs = [(row.without, 0usize, false), (Some(row.with), 1usize, true)];
+        for (run, col, robust) in runs {
+            if run.is_none() && row.case.is_none() {
+                continue;
+            }
+            let mut du = if robust { "with" } else { "without" }.to_string();
+            if run.is_some_and(|r| r.robust != robust) {
+                let _ = write!(du, " (run.robust = {}!)", !robust);
+            }
+            let name = run.map_or(row.with.name.as_str(), |r| r.name.as_str());
+            let m = run.map(|r| r.metrics);
+            let ours_vs = |ours: Option<f64>, paper: Option<f64>| -> String {
+                let ours = ours.map_or("—".to_string(), fmt_err);
+                match paper {
+                    Some(p) => format!("{ours} ({})", fmt_err(p)),
+                    None => ours,
+                }
+            };
+            let p = row.case.map(paper::table1_row);
+            let ours = |f: fn(&Metrics) -> f64| m.as_ref().map(f);
+            let other = |f: fn(&Metrics) -> f64, fmt: &dyn Fn(f64) -> String| {
+                m.as_ref().map_or("—".to_string(), |m| fmt(f(m)))
+            };
+            out.push(vec![
+                name.to_string(),
+                du,
+                ours_vs(ours(|m| m.max_x), p.map(|p| p.x[col])),
+                ours_vs(ours(|m| m.max_y), p.map(|p| p.y[col])),
+                ours_vs(ours(|m| m.max_z), p.map(|p| p.z[col])),
+                ours_vs(ours(|m| m.max_path), p.map(|p| p.path[col])),
+                other(|m| m.rms_path, &fmt_err),
+                other(|m| m.max_roll, &fmt_err),
+                other(|m| m.max_pitch, &fmt_err),
+                other(|m| m.max_yaw, &fmt_err),
+                other(|m| m.peak_voltage, &|v| fmt_fixed(v, 1)),
+                other(|m| m.saturated_fraction, &|v| {
+                    format!("{} %", fmt_fixed(100.0 * v, 1))
+                }),
+                run.map_or("not run".to_string(), |r| r.outcome.to_string()),
+            ]);
+        }
+    }
+    out
+}
+
+fn md_escape(s: &str) -> String {
+    s.replace('\\', "\\\\").replace('|', "\\|")
+}
+
+/// Markdown table: per case one row without Δu and one with, each giving x, y, z and path max
+/// errors as "ours (paper)" (the paper's value only where [`ReportRow::case`] is given), rms
+/// path, max roll/pitch/yaw error, peak voltage, saturated fraction, and the outcome (a
+/// diverged run says "DIVERGED at t = … s: reason"). A missing `without` run with paper
+/// numbers gets a row with "—" and "not run".
+pub fn table_markdown(rows: &[ReportRow]) -> String {
+    let mut s = String::new();
+    let line = |cells: &mut dyn Iterator<Item = String>| {
+        let mut l = String::from("|");
+        for c in cells {
+            l.push(' ');
+            l.push_str(&c);
+            l.push_str(" |");
+        }
+        l.push('\n');
+        l
+    };
+    s.push_str(&line(&mut TABLE_HEADER.iter().map(|h| md_escape(h))));
+    s.push_str(&line(&mut TABLE_HEADER.iter().enumerate().map(|(i, _)| {
+        if i < 2 || i == TABLE_HEADER.len() - 1 {
+            "---".to_string()
+        } else {
+            "---:".to_string()
+        }
+    })));
+    for row in table_cells(rows) {
+        s.push_str(&line(&mut row.iter().map(|c| md_escape(c))));
+    }
+    s
+}
+
+/// The same table as [`table_markdown`] for the terminal: plain text, columns aligned (by
+/// characters), numbers right-aligned, and a line saying what the parentheses hold when any
+/// row has the paper's numbers.
+pub fn table_text(rows: &[ReportRow]) -> String {
+    let header: Vec<String> = TABLE_HEADER.iter().map(|h| h.to_string()).collect();
+    let body = table_cells(rows);
+    let n = header.len();
+    let width = |i: usize| {
+        std::iter::once(&header)
+            .chain(&body)
+            .map(|r| r[i].chars().count())
+            .max()
+            .unwrap_or(0)
+    };
+    let widths: Vec<usize> = (0..n).map(width).collect();
+    let fmt_row = |r: &[String]| {
+        let mut l = String::new();
+        for (i, c) in r.iter().enumerate() {
+            if i > 0 {
+                l.push_str("  ");
+            }
+            let pad = widths[i].saturating_sub(c.chars().count());
+            let numeric = (2..n - 1).contains(&i);
+            if numeric {
+                l.extend(std::iter::repeat_n(' ', pad));
+                l.push_str(c);
+            } else {
+                l.push_str(c);
+                l.extend(std::iter::repeat_n(' ', pad));
+            }
+        }
+        l.truncate(l.trim_end().len());
+        l.push('\n');
+        l
+    };
+    let mut s = fmt_row(&header);
+    let rule: Vec<String> = widths.iter().map(|w| "-".repeat(*w)).collect();
+    s.push_str(&fmt_row(&rule));
+    for r in &body {
+        s.push_str(&fmt_row(r));
+    }
+    if rows.iter().any(|r| r.case.is_some()) {
+        s.push_str("max errors as ours (paper's Table 1, AUV150.md §7)\n");
+    }
+    s
+}
+
+/// A Markdown link target for `plot`: relative to `dir` when it lies inside it (compared as
+/// given, then canonicalised), else the path as given.
+fn link_target(dir: &Path, plot: &Path) -> String {
+    let canonical = || {
+        let (d, p) = (dir.canonicalize().ok()?, plot.canonicalize().ok()?);
+        p.strip_prefix(d).ok().map(Path::to_path_buf)
+    };
+    let rel = match plot.strip_prefix(dir) {
+        Ok(r) => r.to_path_buf(),
+        Err(_) => canonical().unwrap_or_else(|| plot.to_path_buf()),
+    };
+    let s = rel.to_string_lossy().replace('\\', "/");
+    if s.contains([' ', '(', ')', '<', '>']) {
+        format!("<{s}>")
+    } else {
+        s
+    }
+}
+
+/// Writes `dir/report.md` (creating `dir`): `# title`, a line on how to read the table,
+/// a warning if any run diverged, [`table_markdown`], each plot embedded as
+/// `![file](path)` (relative to `dir` when inside it) under its file name, and `notes`
+/// verbatim under "## Notes" (omitted if empty). Returns the report's path.
+pub fn write_report(
+    dir: &Path,
+    title: &str,
+    rows: &[ReportRow],
+    plots: &[PathBuf],
+    notes: &str,
+) -> Result<PathBuf> {
+    let path = dir.join("report.md");
+    let mut s = String::new();
+    let _ = writeln!(s, "# {title}\n");
+    s.push_str(
+        "Maximum errors over each run in metres as **ours (paper)**, the paper's numbers from \
+         its Table 1 (AUV150.md §7) where the case is one of its six; path = \
+         √(max|e_x|² + max|e_y|² + max|e_z|²), rms path = √mean(e_x² + e_y² + e_z²). Angles in \
+         rad. Peak |V| is the largest thruster voltage commanded; saturated is the fraction of \
+         control periods with at least one thruster at the supply limit.\n\n",
+    );
+    let diverged: Vec<String> = rows
+        .iter()
+        .flat_map(|r| std::iter::once(r.with).chain(r.without))
+        .filter_map(|r| match &r.outcome {
+            Outcome::Diverged { .. } => Some(format!(
+                "{} ({} Δu): {}",
+                r.name,
+                if r.robust { "with" } else { "without" },
+                r.outcome
+            )),
+            Outcome::Completed => None,
+        })
+        .collect();
+    if !diverged.is_empty() {
+        let _ = writeln!(
+            s,
+            "**Warning: {} run(s) diverged** — their metrics cover only the time before \
+             they stopped:\n",
+            diverged.len()
+        );
+        for d in &diverged {
+            let _ = writeln!(s, "- {}", md_escape(d));
+        }
+        s.push('\n');
+    }
+    s.push_str(&table_markdown(rows));
+    if !plots.is_empty() {
+        s.push_str("\n## Plots\n");
+        for p in plots {
+            let name = p.file_name().map_or_else(
+                || p.display().to_string(),
+                |n| n.to_string_lossy().into_owned(),
+            );
+            let _ = write!(s, "\n### {name}\n\n![{name}]({})\n", link_target(dir, p));
+        }
+    }
+    if !notes.is_empty() {
+        let _ = write!(s, "\n## Notes\n\n{notes}");
+        if !notes.ends_with('\n') {
+            s.push('\n');
+        }
+    }
+    fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    fs::write(&path, s).with_context(|| format!("writing {}", path.display()))?;
+    Ok(path)
+}

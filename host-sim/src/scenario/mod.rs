@@ -1,0 +1,282 @@
+//! Scenarios: one TOML file describes one run, a [`SimConfig`]; [`Scenario::new`] validates it
+//! into a [`Scenario`], which holds what the run needs built (the [`Controller`], the
+//! [`Trajectory`]) and its step counts.
+//!
+//! Two stages, each written once:
+//! - **Parsing** ([`parse_scenario`], [`load_scenario`]; `parse.rs`) is about the file's shape.
+//!   Every table denies unknown keys (the error names the key and its line), a key that the
+//!   chosen `kind`, `profile` or `model` does not use is an error, not silently ignored, and a
+//!   required one must be there. The `[trajectory]` table is the core's own
+//!   [`TrajectoryKind`](controller_core::TrajectoryKind) (its `serde` form, with the paper's ω
+//!   and depth as defaults).
+//! - **Validation** ([`Scenario::new`]; `check.rs`) is about the values, for any
+//!   [`SimConfig`], from a file or built in code. An out-of-range value is a
+//!   [`ScenarioError::Invalid`] that names the dotted key, e.g.
+//!   `controller.mu: mu must be a finite number > 0, got -1`. The controller's and the
+//!   trajectory's ranges are checked by the core once ([`Controller::new`],
+//!   [`Trajectory::new`]): their errors name their field, which is mapped to the key. So an
+//!   infeasible configuration (loop rate too low for the boundary-layer gain, Assumption 2,
+//!   Theorem 2, …) is refused at load time, not half-way through a run.
+//!
+//! # Schema
+//!
+//! Every table is optional except `[trajectory]`. Anything left out takes the default of
+//! [`SimConfig::new`] and [`ControllerConfig::default`](controller_core::ControllerConfig) (the
+//! paper's values). Integers are accepted where a number is expected (`duration = 70`).
+//!
+//! ```toml
+//! name = "circular-10R"       # file-name safe; default: the file stem (load_scenario) or "scenario"
+//! table1_case = "circular-10R" # this run is that case of the paper's Table 1: reports print
+//!                             # the paper's numbers beside ours; default: none
+//! duration = 70.0             # s, (0, 86400]
+//! plant_step = 0.001          # s, (0, 0.1] and ≤ the control period 1/rate_hz
+//! ideal_actuators = true      # thrusters deliver the allocated thrust whatever the voltage limit
+//! initial_offset = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # added to η(0) = η_d(0), m and rad
+//! divergence_limit = 50.0     # m, > 0
+//! thruster_lag = 0.1          # s, > 0; leave out for no lag
+//!
+//! [trajectory]                # required
+//! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix"
+//! radius = 10.0               # circle, helix (required)
+//! amplitude = 15.0            # figure-eight (required)
+//! scale = 1.0                 # lawn-mower (required)
+//! depth_rate = 0.05           # helix (required), m/s, positive descends
+//! omega = 0.1                 # rad/s; default 0.1, lawn-mower 0.05
+//! depth = 5.0                 # m, positive down; default 5
+//!
+//! [variation]                 # Table-3 parameter variation of the plant (not the controller)
+//! profile = "abs-sin"         # "none" | "constant" | "abs-sin" | "staircase" | "table3-staircase"
+//! omega = 0.1                 # abs-sin only, rad/s, default 0.1
+//! mass = 30.0                 # constant / abs-sin: Δ (abs-sin: the maximum); see below
+//! x_g = 0.05
+//! y_g = 0.02
+//! z_g = 0.02
+//! ix = 2.0
+//! iy = 5.0
+//! iz = 10.0
+//! x_udot = 3.0
+//! y_vdot = 50.0
+//! # staircase only: one table per step, Δ holds while t ≤ until; the last step's `until` may
+//! # be left out (holds for ever).
+//! # [[variation.steps]]
+//! # until = 25.0
+//! # mass = 30.0 ...
+//!
+//! [current]                   # ocean current, earth frame (NED)
+//! model = "constant"          # "none" | "constant" | "gauss-markov"
+//! velocity = [0.2, 0.1, 0.0]  # constant (required), m/s
+//! mean = [0.0, 0.0, 0.0]      # gauss-markov, m/s, default zeros
+//! sigma = [0.05, 0.05, 0.0]   # gauss-markov (required), m/s, ≥ 0
+//! tau = 30.0                  # gauss-markov (required), s, > 0
+//! seed = 1                    # gauss-markov, default 1
+//!
+//! [noise]                     # present = measurement noise on; absent = off
+//! eta_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # default zeros, ≥ 0
+//! nu_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]   # default zeros, ≥ 0
+//! seed = 1                                    # default 1
+//!
+//! [controller]
+//! robust = true               # false: u = ū only (the paper's "without Δu")
+//! law = "boundary-layer"      # "boundary-layer" (Theorem 4) | "discontinuous" (Theorem 3)
+//! k1 = [4.0, 4.0, 4.0, 0.0, 4.0, 4.0]  # controlled axes > 0, roll (index 3) = 0
+//! k2 = [4.0, 4.0, 4.0, 0.0, 4.0, 4.0]
+//! q = [1.0, 1.0]              # > 0
+//! beta = 0.605                # (0, 1)
+//! mu = 0.1                    # > 0
+//! delta_max = 25.0            # > 0
+//! rate_hz = 100               # integer ≥ 1
+//! pitch_limit_deg = 80.0      # (0, 90)
+//! voltage_limit = 24.0        # V, > 0
+//! b_bound = "controlled-rows" # "controlled-rows" | "literal"
+//!
+//! [link_faults]               # processor in the loop only: tick ranges "A..B" (A included)
+//! drop = ["100..101"]         # state frames not sent
+//! corrupt = ["150..152"]      # state frames with a byte flipped
+//! delay = ["200..210"]        # the state from delay_ticks earlier is sent instead
+//! delay_ticks = 5             # default 5
+//! silent = ["300..310"]       # nothing sent at all
+//! ```
+//!
+//! **Δ fields of `constant` and `abs-sin`** (their names:
+//! [`VARIED_PARAMETER_NAMES`](controller_core::model::VARIED_PARAMETER_NAMES)): with none of
+//! the nine given, Δ is Table 3's maximum
+//! ([`ParamVariation::TABLE3_MAX`](controller_core::model::ParamVariation::TABLE3_MAX): the
+//! paper's circle and figure-eight); as soon as one is given, the ones left out are 0. The
+//! fields of a staircase step left out are 0. Δ may lie outside Table 3's box (the
+//! controller's bounds then no longer cover the plant), but the varied plant's inertia matrix
+//! M must stay positive definite.
+//!
+//! The six files `scenarios/<case>.toml` are the paper's Table-1 runs; [`crate::paper::config`]
+//! builds the same [`SimConfig`] in code.
+
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+use controller_core::{Controller, Trajectory};
+
+use crate::config::SimConfig;
+
+mod check;
+mod parse;
+
+pub use check::{MAX_DURATION, MAX_PLANT_STEP};
+pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
+
+/// Why a scenario could not be loaded or validated.
+#[derive(Debug)]
+pub enum ScenarioError {
+    /// The file could not be read.
+    Io {
+        path: PathBuf,
+        source: std::io::Error,
+    },
+    /// Not valid TOML, an unknown key, a missing required key or a value of the wrong type.
+    /// The message is the `toml` crate's: it names the line, column and key.
+    Toml(String),
+    /// A value out of its range, or a key that does not belong. `key` is the dotted path,
+    /// e.g. `controller.mu`, `variation.steps[1].until`, or `controller` for a check of the
+    /// controller as a whole made by [`Controller::new`].
+    Invalid { key: String, message: String },
+}
+
+impl fmt::Display for ScenarioError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            ScenarioError::Io { path, source } => {
+                write!(f, "cannot read scenario file {}: {source}", path.display())
+            }
+            ScenarioError::Toml(message) => write!(f, "invalid scenario: {}", message.trim_end()),
+            ScenarioError::Invalid { key, message } => {
+                write!(f, "invalid scenario value `{key}`: {message}")
+            }
+        }
+    }
+}
+
+impl std::error::Error for ScenarioError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ScenarioError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
+
+/// A validated run: its [`SimConfig`], the [`Controller`] and [`Trajectory`] built from it
+/// (once), and its step counts. Only [`Scenario::new`] makes one, so a `Scenario` always runs.
+#[derive(Clone, Debug)]
+pub struct Scenario {
+    config: SimConfig,
+    controller: Controller,
+    trajectory: Trajectory,
+    steps: u64,
+    substeps: usize,
+}
+
+impl PartialEq for Scenario {
+    /// Equal configurations (everything else is built from the configuration).
+    fn eq(&self, other: &Self) -> bool {
+        self.config == other.config
+    }
+}
+
+impl Scenario {
+    /// Validates `config` (every check, see the module doc) and builds its controller and
+    /// trajectory.
+    pub fn new(config: SimConfig) -> Result<Self, ScenarioError> {
+        let controller = check::controller(&config)?;
+        let trajectory = check::trajectory(&config.trajectory)?;
+        Self::assemble(config, controller, trajectory)
+    }
+
+    /// This scenario with `change` applied to its configuration, validated again. The built
+    /// controller and trajectory are kept when `change` leaves their settings as they were
+    /// (a Monte Carlo draw, a shorter duration), so only what changed is rebuilt.
+    pub fn with(&self, change: impl FnOnce(&mut SimConfig)) -> Result<Self, ScenarioError> {
+        let mut config = self.config.clone();
+        change(&mut config);
+        let controller = if config.controller == self.config.controller {
+            self.controller.clone()
+        } else {
+            check::controller(&config)?
+        };
+        let trajectory = if config.trajectory == self.config.trajectory {
+            self.trajectory
+        } else {
+            check::trajectory(&config.trajectory)?
+        };
+        Self::assemble(config, controller, trajectory)
+    }
+
+    fn assemble(
+        config: SimConfig,
+        controller: Controller,
+        trajectory: Trajectory,
+    ) -> Result<Self, ScenarioError> {
+        let (steps, substeps) = check::run(&config)?;
+        Ok(Scenario {
+            config,
+            controller,
+            trajectory,
+            steps,
+            substeps,
+        })
+    }
+
+    /// The configuration (read only: change it with [`Scenario::with`]).
+    pub fn config(&self) -> &SimConfig {
+        &self.config
+    }
+
+    /// The configuration, for building another scenario from it.
+    pub fn into_config(self) -> SimConfig {
+        self.config
+    }
+
+    /// The controller of [`SimConfig::controller`], built.
+    pub fn controller(&self) -> &Controller {
+        &self.controller
+    }
+
+    /// The mission of [`SimConfig::trajectory`], built.
+    pub fn trajectory(&self) -> &Trajectory {
+        &self.trajectory
+    }
+
+    /// The last control tick: the run samples ticks 0..=steps, steps = duration · rate_hz
+    /// rounded.
+    pub fn steps(&self) -> u64 {
+        self.steps
+    }
+
+    /// Plant steps per control period (the plant step divides the period).
+    pub fn substeps(&self) -> usize {
+        self.substeps
+    }
+
+    /// The control period 1/rate_hz (s).
+    pub fn period(&self) -> f64 {
+        1.0 / f64::from(self.config.controller.rate_hz)
+    }
+}
+
+/// Parses and validates a scenario from TOML text. A scenario without `name` is called
+/// [`DEFAULT_NAME`].
+pub fn parse_scenario(text: &str) -> Result<Scenario, ScenarioError> {
+    Scenario::new(parse::parse(text, DEFAULT_NAME)?)
+}
+
+/// Reads, parses and validates a scenario file. A scenario without `name` takes the file stem.
+/// A read error carries the path.
+pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
+    let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .unwrap_or(DEFAULT_NAME);
+    Scenario::new(parse::parse(&text, stem)?)
+}
