@@ -25,13 +25,7 @@ use core::fmt;
 
 use nalgebra::{Matrix5, Matrix6x5, Vector5, Vector6};
 
-use crate::effectiveness::{GeometryError, ThrusterGeometry};
-
-// host-sim (`sil.rs`, `output.rs`) names these through `allocation::` today; the re-exports keep
-// those paths working across the issue-8 merge. New code names the owning modules,
-// [`crate::effectiveness`] and [`crate::thruster`].
-pub use crate::effectiveness::THRUSTERS;
-pub use crate::thruster::{default_maps, DEFAULT_V_LIMIT};
+use crate::effectiveness::{GeometryError, ThrusterGeometry, THRUSTERS};
 
 /// Largest accepted ∞-norm condition number κ∞(B₅) = ‖B₅‖∞·‖B₅⁻¹‖∞ of the 5×5 allocation
 /// matrix (f32 has ≈ 7 digits; κ = 10⁴ leaves ≈ 3). The AUV-150 default has κ∞ = 3.6.

@@ -14,8 +14,8 @@ pub mod thruster;
 pub mod trajectory;
 pub mod uncertainty;
 
-pub use allocation::DEFAULT_V_LIMIT;
 pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Status};
 pub use law::RobustLaw;
+pub use thruster::DEFAULT_V_LIMIT;
 pub use trajectory::{Desired, Table1Case, Trajectory, TrajectoryKind};

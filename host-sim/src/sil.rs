@@ -12,9 +12,10 @@
 //! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
 //! run with a reason; every sample recorded until then is kept.
 
-use controller_core::allocation::{self, THRUSTERS};
+use controller_core::effectiveness::THRUSTERS;
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
+use controller_core::thruster;
 use controller_core::{Controller, Trajectory};
 use nalgebra::{Vector3, Vector6};
 use rand::SeedableRng;
@@ -147,7 +148,7 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
 
     let nominal = VehicleParams::auv150();
     let alloc_b = controller.allocation().matrix().cast::<f64>();
-    let maps = allocation::default_maps();
+    let maps = thruster::default_maps();
 
     // Start on the reference (AUV150.md §6), plus the configured offset.
     let d0 = trajectory.sample(0, rate);
