@@ -7,7 +7,7 @@
 set -uo pipefail
 cd "$(dirname "$0")/.."
 target=thumbv7em-none-eabihf
-elf=target/$target/release/firmware
+elf=target/$target/release/firmware-qemu-selftest
 snap=firmware/snapshots
 flash_budget=$((128 * 1024))
 ram_budget=$((32 * 1024))
@@ -20,10 +20,10 @@ bad() { say "FIRMWARE CI FAILURE: $*"; fail=1; }
 normalise() { sed -E '/instructions|stack high-water/ s/[0-9]+/#/g' "$1"; }
 
 for backend in libm micromath; do
-  feats=selftest
-  [ "$backend" = micromath ] && feats=selftest,micromath
+  feats=qemu
+  [ "$backend" = micromath ] && feats=qemu,micromath
   say "== self-test image, $backend backend"
-  cargo build --release -p firmware --target $target --features "$feats" || { bad "build ($backend)"; continue; }
+  cargo build --release -p firmware --target $target --features "$feats" --bin firmware-qemu-selftest || { bad "build ($backend)"; continue; }
   log=$(mktemp)
   QEMU_TIMEOUT=120 bash scripts/qemu-run.sh "$elf" >"$log" 2>&1
   status=$?
@@ -63,11 +63,10 @@ for backend in libm micromath; do
 done
 
 say "== flying image (QEMU board) and the STM32F405 board"
-cargo build --release -p firmware --target $target || bad "QEMU board build"
-say "QEMU board sizes: $(bash scripts/firmware-size.sh "$elf")"
-# Its own target dir, so target/$target/release/firmware stays the QEMU image (host-sim pil).
-stm32=target/stm32/$target/release/firmware
-cargo build --release -p firmware --target $target --target-dir target/stm32 --no-default-features --features stm32f405 || bad "STM32F405 build"
+cargo build --release -p firmware --target $target --features qemu --bins || bad "QEMU board build"
+say "QEMU board sizes: $(bash scripts/firmware-size.sh target/$target/release/firmware-qemu)"
+stm32=target/$target/release/firmware-stm32f405
+cargo build --release -p firmware --target $target --features stm32f405 --bin firmware-stm32f405 || bad "STM32F405 build"
 say "STM32F405 sizes: $(bash scripts/firmware-size.sh "$stm32")"
 # The STM32 image must be linked with its own memory map (flash at 0x0800_0000, 128 KiB RAM).
 reset=$(readelf -s "$stm32" | awk '$8 == "__RESET_VECTOR" { print $2 }')

@@ -1,9 +1,11 @@
-//! Board: QEMU `mps2-an386` (ARM MPS2 with a Cortex-M4F, 25 MHz).
+//! Board: QEMU `mps2-an386` (ARM MPS2 with a Cortex-M4F, 25 MHz), for the QEMU images
+//! (feature `qemu`, target only).
 //!
 //! - Navigation link: CMSDK APB UART0 at 0x4000_4000 (`-serial` of QEMU).
-//! - Period timer: SysTick on the 25 MHz core clock. Under `-icount shift=0` one instruction
-//!   takes 1 ns of virtual time, so one SysTick count is 40 instructions — the unit of
-//!   [`Board::now`] here, which makes update timings deterministic instruction counts.
+//! - Period timer: SysTick on the 25 MHz core clock. Its count is the unit of [`Board::now`]
+//!   here: [`INSTRUCTIONS_PER_TICK`](crate::qemu_clock::INSTRUCTIONS_PER_TICK) instructions
+//!   under the runner's `-icount`, which makes update timings deterministic instruction counts
+//!   (see [`crate::qemu_clock`]).
 //! - Thrusters: the board has no PWM; [`MemPwm`] channels keep the commanded duty in RAM (they
 //!   implement `SetDutyCycle` like a real timer channel would).
 //! - No watchdog.
@@ -16,15 +18,24 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
 use embedded_io::{ErrorType, Read, ReadReady, Write};
-use firmware::board::Board;
 
-/// Core clock of mps2-an386 (Hz).
-pub const CORE_HZ: u32 = 25_000_000;
-/// Instructions per SysTick count under `-icount shift=0` (1 GHz virtual / 25 MHz).
-#[cfg_attr(not(feature = "selftest"), allow(dead_code))]
-pub const INSTRUCTIONS_PER_TICK: u32 = 40;
+use crate::board::Board;
+use crate::qemu_clock::CORE_HZ;
+
 /// Nominal H-bridge supply (V).
 pub const SUPPLY_VOLTAGE: f32 = 24.0;
+
+/// Ends the program: QEMU exits with `code` (0 = success) through semihosting. Without a
+/// semihosting host (a real board), the core resets instead.
+pub fn halt(code: i32) -> ! {
+    let status = if code == 0 {
+        cortex_m_semihosting::debug::EXIT_SUCCESS
+    } else {
+        cortex_m_semihosting::debug::EXIT_FAILURE
+    };
+    cortex_m_semihosting::debug::exit(status);
+    cortex_m::peripheral::SCB::sys_reset()
+}
 
 const UART0: usize = 0x4000_4000;
 const DATA: usize = 0x00;

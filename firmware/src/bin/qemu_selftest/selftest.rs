@@ -1,7 +1,6 @@
-//! QEMU self-test image (`--features selftest`): checks the core on the target against the
-//! host, counts the instructions of `update`, exercises the link and the fail-safe, and
-//! reports the stack high-water mark. Exits through semihosting: 0 on success, 1 on any
-//! failure. Its decoded defmt log is compared with `firmware/snapshots/selftest.log` in CI.
+//! The self-test's checks: golden vectors against the host core, instruction counts of
+//! `update`, the link and fail-safe exercise, the PWM mapping, and the failure injection that
+//! proves each kind of failure is visible.
 
 use auv_link::{encode, Command, Envelope, FrameDecoder, MissionSpec, Msg, StateFrame, MAX_FRAME};
 use auv_link::{BoardStatus, FailSafeReason};
@@ -11,9 +10,9 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use defmt::{error, info};
 use firmware::pwm;
+use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 use firmware::supervisor::{status_name, Supervisor};
 
-use crate::qemu::INSTRUCTIONS_PER_TICK;
 use crate::stack;
 
 include!(concat!(env!("OUT_DIR"), "/golden.rs"));
@@ -32,10 +31,9 @@ pub struct Golden {
     pub status: u8,
 }
 
-/// Instruction budget of one `update` (max over the golden vectors), set from the measured
-/// maximum with ≈ 13–15 % headroom; the counts are deterministic under `-icount shift=0`.
-/// Measured (Rust 1.95, release): libm max 35 280 / mean 26 200; micromath max 10 440 /
-/// mean 9 880.
+/// Instruction budget of one `update` (max over the golden vectors): the measured maximum,
+/// which the self-test logs and `firmware/snapshots/selftest-<backend>.log` records, plus
+/// ≈ 13–15 % headroom. The counts are deterministic under the runner's `-icount`.
 #[cfg(not(feature = "micromath"))]
 pub const UPDATE_INSTRUCTION_BUDGET: u32 = 40_000;
 #[cfg(feature = "micromath")]
