@@ -63,7 +63,8 @@ enum Command {
         json: bool,
         #[arg(long, default_value = "runs/pil")]
         out: PathBuf,
-        /// Firmware ELF (the QEMU flying image).
+        /// Firmware ELF: the QEMU flying image [default:
+        /// target/thumbv7em-none-eabihf/release/firmware-qemu].
         #[arg(long)]
         elf: Option<PathBuf>,
         /// Override the scenario's duration (s).
@@ -415,7 +416,7 @@ fn cmd_pil(
         }
     }
     let root = workspace_root();
-    let elf = elf.unwrap_or_else(|| root.join("target/thumbv7em-none-eabihf/release/firmware"));
+    let elf = elf.unwrap_or_else(|| host_sim::pil::default_elf(&root));
     let runner = root.join("scripts/qemu-run.sh");
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let pb = progress(configs.len(), "PIL", json);
