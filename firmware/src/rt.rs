@@ -7,6 +7,7 @@ use cortex_m_rt::ExceptionFrame;
 use defmt::{error, info};
 
 use crate::board::{period, Board, LinkBuffers};
+use crate::image::Image;
 use crate::supervisor::{status_name, Supervisor};
 
 /// Ends the program with an exit code (0 = success); never returns.
@@ -75,4 +76,37 @@ pub fn report_panic(info: &core::panic::PanicInfo) {
 /// Logs a HardFault; the image's `HardFault` handler then halts.
 pub fn report_hard_fault(ef: &ExceptionFrame) {
     error!("HardFault at pc = {:#010x}", ef.pc());
+}
+
+/// What a flying image's `main` does: marks the image, takes the core peripherals, builds the
+/// controller, brings the board up with them at the controller's rate (`init`), and flies.
+pub fn fly_image<B: Board>(
+    image: Image,
+    halt: Halt,
+    init: impl FnOnce(cortex_m::Peripherals, u32) -> B,
+) -> ! {
+    image.embed();
+    let cp = core_peripherals(halt);
+    let controller = controller(halt);
+    let mut board = init(cp, controller.config().rate_hz);
+    fly(&mut board, Supervisor::new(controller))
+}
+
+/// Defines an image's `#[panic_handler]` and `HardFault` handler: report, then `$halt(1)`.
+/// Each image's binary invokes it once with its board's `halt`.
+#[macro_export]
+macro_rules! fault_handlers {
+    ($halt:path) => {
+        #[panic_handler]
+        fn panic(info: &core::panic::PanicInfo) -> ! {
+            $crate::rt::report_panic(info);
+            $halt(1)
+        }
+
+        #[cortex_m_rt::exception]
+        unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+            $crate::rt::report_hard_fault(ef);
+            $halt(1)
+        }
+    };
 }

@@ -3,30 +3,16 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::image::Image;
 use firmware::qemu::{halt, QemuBoard};
-use firmware::rt;
-use firmware::supervisor::Supervisor;
 
 #[entry]
 fn main() -> ! {
-    Image::Qemu.embed();
-    let cp = rt::core_peripherals(halt);
-    let controller = rt::controller(halt);
-    let mut board = QemuBoard::init(cp.SYST, controller.config().rate_hz);
-    rt::fly(&mut board, Supervisor::new(controller))
+    firmware::rt::fly_image(Image::Qemu, halt, |cp, rate_hz| {
+        QemuBoard::init(cp.SYST, rate_hz)
+    })
 }
 
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    rt::report_panic(info);
-    halt(1)
-}
-
-#[exception]
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    rt::report_hard_fault(ef);
-    halt(1)
-}
+firmware::fault_handlers!(halt);

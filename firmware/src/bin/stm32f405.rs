@@ -3,21 +3,16 @@
 #![no_std]
 #![no_main]
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::entry;
 use defmt_rtt as _;
 use firmware::image::Image;
-use firmware::rt;
 use firmware::stm32f405::{self, halt, Stm32Board};
-use firmware::supervisor::Supervisor;
 use stm32f4xx_hal::pac::interrupt;
 
 #[entry]
 fn main() -> ! {
-    Image::Stm32f405.embed();
-    let cp = rt::core_peripherals(halt);
-    let controller = rt::controller(halt);
-    let mut board = Stm32Board::init(cp);
-    rt::fly(&mut board, Supervisor::new(controller))
+    // The board starts at its DEFAULT_RATE_HZ; the loop sets the controller's rate.
+    firmware::rt::fly_image(Image::Stm32f405, halt, |cp, _rate_hz| Stm32Board::init(cp))
 }
 
 #[interrupt]
@@ -25,14 +20,4 @@ fn USART2() {
     stm32f405::on_usart2_interrupt();
 }
 
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    rt::report_panic(info);
-    halt(1)
-}
-
-#[exception]
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    rt::report_hard_fault(ef);
-    halt(1)
-}
+firmware::fault_handlers!(halt);

@@ -8,7 +8,7 @@
 mod selftest;
 mod stack;
 
-use cortex_m_rt::{entry, exception, ExceptionFrame};
+use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::image::Image;
 use firmware::qemu::halt;
@@ -23,14 +23,4 @@ fn main() -> ! {
     halt(if ok { 0 } else { 1 })
 }
 
-#[panic_handler]
-fn panic(info: &core::panic::PanicInfo) -> ! {
-    rt::report_panic(info);
-    halt(1)
-}
-
-#[exception]
-unsafe fn HardFault(ef: &ExceptionFrame) -> ! {
-    rt::report_hard_fault(ef);
-    halt(1)
-}
+firmware::fault_handlers!(halt);
