@@ -115,6 +115,10 @@ pub struct MemPwm {
     pub duty: u16,
 }
 
+/// Cycles between two reads of SysTick's flag while waiting for a period (40 µs at 25 MHz, 0.4 %
+/// of a 10 ms period).
+pub const WAIT_POLL_CYCLES: u32 = 1000;
+
 /// Counts of full duty: 10-bit resolution, like a 24 kHz timer channel at 25 MHz.
 pub const MAX_DUTY: u16 = 1000;
 
@@ -191,6 +195,21 @@ impl Board for QemuBoard {
     fn period_elapsed(&mut self) -> bool {
         // COUNTFLAG is set at each wrap and cleared by reading it.
         self.syst.has_wrapped()
+    }
+    /// As the default, but reads SysTick's flag only every [`WAIT_POLL_CYCLES`] cycles: under
+    /// `-icount` every device-register read leaves QEMU's translated code, so a tight polling
+    /// loop makes an idle 10 ms period cost seconds of wall time and keeps QEMU's I/O thread,
+    /// which feeds UART0's bytes, waiting for its lock (PIL's arming handshake, which runs on
+    /// these periods, then timed out on an idle host). The boundary is seen at most that many
+    /// cycles late; what the loop does with it does not change.
+    fn wait_period(&mut self) -> bool {
+        let overrun = self.period_elapsed();
+        if !overrun {
+            while !self.period_elapsed() {
+                cortex_m::asm::delay(WAIT_POLL_CYCLES);
+            }
+        }
+        overrun
     }
     fn now(&self) -> u32 {
         // Down-counter: elapsed = last − current, modulo the period.
