@@ -234,8 +234,7 @@ pub struct Usart2Link {
     _serial: Serial<pac::USART2, u8>,
 }
 
-// Diagnostics for the binary's logs; the control loop itself does not need them.
-#[allow(dead_code)]
+// Diagnostics (for logs or a debugger); the control loop itself does not need them.
 impl Usart2Link {
     /// Receive line errors so far (overrun, framing, noise, parity).
     pub fn rx_line_errors(&self) -> u32 {
