@@ -1,5 +1,11 @@
-//! Puts the board's memory map on the linker path as `memory.x`, and computes the self-test's
-//! golden vectors with the same `controller-core`, built for the host.
+//! Gives each image (binary) its board's memory map, and computes the self-test's golden
+//! vectors with the same `controller-core`, built for the host.
+//!
+//! Memory maps: cortex-m-rt's `link.x` includes `memory.x` from the linker's search path. Each
+//! image gets its own directory holding a copy of its map as `memory.x`, on its own link line
+//! only (`cargo:rustc-link-arg-bin`), so one `cargo build` of several images links each with
+//! its own map. No `memory.x` may sit at the workspace root: the linker searches the working
+//! directory first, and a root copy would shadow every image's choice.
 
 use std::env;
 use std::fmt::Write as _;
@@ -9,19 +15,24 @@ use std::path::PathBuf;
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
 
+// The images' table, shared with the library (bin names, memory maps).
+#[allow(dead_code)]
+#[path = "src/image.rs"]
+mod image;
+
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
     let root = PathBuf::from(env::var_os("CARGO_MANIFEST_DIR").expect("cargo sets it")).join("..");
-    let map = if env::var_os("CARGO_FEATURE_STM32F405").is_some() {
-        "memory-stm32f405.x"
-    } else {
-        "memory-qemu.x"
-    };
-    let src = root.join(map);
-    fs::copy(&src, out.join("memory.x"))
-        .unwrap_or_else(|e| panic!("copying {}: {e}", src.display()));
-    println!("cargo:rustc-link-search={}", out.display());
-    println!("cargo:rerun-if-changed={}", src.display());
+    for img in image::Image::ALL {
+        let dir = out.join("memory").join(img.bin());
+        fs::create_dir_all(&dir).unwrap_or_else(|e| panic!("creating {}: {e}", dir.display()));
+        let src = root.join(img.memory_map());
+        fs::copy(&src, dir.join("memory.x"))
+            .unwrap_or_else(|e| panic!("copying {}: {e}", src.display()));
+        println!("cargo:rustc-link-arg-bin={}=-L{}", img.bin(), dir.display());
+        println!("cargo:rerun-if-changed={}", src.display());
+    }
+    println!("cargo:rerun-if-changed=src/image.rs");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=../controller-core/src");
 

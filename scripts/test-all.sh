@@ -1,13 +1,14 @@
 #!/usr/bin/env bash
 # Every test of the workspace, set-up included (safe on a fresh machine):
 # host tests with both math backends of the core, the simulator and the closed loop, the
-# firmware's host tests, and the firmware on the target: both boards built, the QEMU
-# self-test (golden vectors, instruction counts, fail-safe, snapshots, failure injection).
+# firmware's host tests, and the firmware on the target (`cargo xtask firmware`, xtask/): every
+# image built, its memory map and sizes checked, the QEMU self-test (golden vectors,
+# instruction counts, fail-safe, snapshots, failure injection) and processor in the loop.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
 
-echo "== host tests (libm backend): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic"
+echo "== host tests (libm backend): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic, xtask"
 cargo test --workspace --release
 
 echo "== controller-core tests with the micromath backend"
@@ -17,7 +18,7 @@ echo "== controller-core cross-build for thumbv7em-none-eabihf"
 cargo build -p controller-core --release --target thumbv7em-none-eabihf
 cargo build -p controller-core --release --target thumbv7em-none-eabihf --features micromath
 
-echo "== firmware on the target (QEMU mps2-an386) and the STM32F405 build"
-bash scripts/firmware-ci.sh
+echo "== firmware on the target: images, QEMU self-test, snapshots, failure injection, PIL"
+cargo xtask firmware
 
 echo "all tests passed"

@@ -63,6 +63,11 @@ impl Default for LinkBuffers {
 }
 
 /// Reads whatever bytes are waiting (without blocking) into the supervisor.
+///
+/// A read error means the byte stream is broken at that point (a UART line error: overrun,
+/// framing, noise, or bytes dropped on a full queue, see [`crate::serial`]): the frame in
+/// progress has lost bytes, so the decoder is resynchronised (it drops everything up to the
+/// next delimiter) and the loss is counted as one receive error.
 pub fn pump<L: Read + ReadReady>(link: &mut L, sup: &mut Supervisor, bufs: &mut LinkBuffers) {
     let mut chunk = [0u8; 64];
     // Bounded: at most 16 chunks per period, so a flooding link cannot stall the loop.
@@ -72,8 +77,13 @@ pub fn pump<L: Read + ReadReady>(link: &mut L, sup: &mut Supervisor, bufs: &mut 
             _ => return,
         }
         let n = match link.read(&mut chunk) {
-            Ok(n) if n > 0 => n,
-            _ => return,
+            Ok(0) => return,
+            Ok(n) => n,
+            Err(_) => {
+                bufs.decoder.resync();
+                sup.on_rx_error();
+                continue;
+            }
         };
         for &b in &chunk[..n] {
             match bufs.decoder.push(b) {

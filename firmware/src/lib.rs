@@ -1,11 +1,29 @@
 //! AUV-150 thruster-board firmware: a thin fixed-rate shell around `controller-core`.
 //!
-//! Hardware-free parts live here so they are tested on the host: [`supervisor`] (arming,
-//! missions, fail-safe), [`pwm`] (voltage → H-bridge duty) and [`board`] (the board trait and
-//! one control period). The target binary (`src/main.rs`) adds a board: `qemu` (mps2-an386)
-//! or `stm32f405`.
+//! Hardware-free parts, tested on the host: [`supervisor`] (arming, missions, fail-safe),
+//! [`pwm`] (voltage → H-bridge duty), [`board`] (the board trait and one control period),
+//! [`serial`] (the UART's byte queues between interrupt and loop), [`image`] (which images
+//! exist and how to tell their ELFs apart) and [`qemu_clock`] (QEMU's instruction counts).
+//!
+//! Target only (`thumbv7em-none-eabihf`): `rt` (boot, the flying loop, fault reports) and one
+//! module per board, each behind its feature — `qemu` (mps2-an386) and `stm32f405`. The
+//! features only add a board (and its crates); they can be combined. The images themselves are
+//! the binaries in `src/bin/`: `firmware-qemu`, `firmware-qemu-selftest`,
+//! `firmware-stm32f405` (see firmware/README.md).
 #![cfg_attr(not(test), no_std)]
 
 pub mod board;
+pub mod image;
 pub mod pwm;
+pub mod qemu_clock;
+pub mod serial;
 pub mod supervisor;
+
+#[cfg(target_os = "none")]
+pub mod rt;
+
+#[cfg(all(target_os = "none", feature = "qemu"))]
+pub mod qemu;
+
+#[cfg(all(target_os = "none", feature = "stm32f405"))]
+pub mod stm32f405;

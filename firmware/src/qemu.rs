@@ -1,9 +1,11 @@
-//! Board: QEMU `mps2-an386` (ARM MPS2 with a Cortex-M4F, 25 MHz).
+//! Board: QEMU `mps2-an386` (ARM MPS2 with a Cortex-M4F, 25 MHz), for the QEMU images
+//! (feature `qemu`, target only).
 //!
 //! - Navigation link: CMSDK APB UART0 at 0x4000_4000 (`-serial` of QEMU).
-//! - Period timer: SysTick on the 25 MHz core clock. Under `-icount shift=0` one instruction
-//!   takes 1 ns of virtual time, so one SysTick count is 40 instructions — the unit of
-//!   [`Board::now`] here, which makes update timings deterministic instruction counts.
+//! - Period timer: SysTick on the 25 MHz core clock. Its count is the unit of [`Board::now`]
+//!   here: [`INSTRUCTIONS_PER_TICK`](crate::qemu_clock::INSTRUCTIONS_PER_TICK) instructions
+//!   under the runner's `-icount`, which makes update timings deterministic instruction counts
+//!   (see [`crate::qemu_clock`]).
 //! - Thrusters: the board has no PWM; [`MemPwm`] channels keep the commanded duty in RAM (they
 //!   implement `SetDutyCycle` like a real timer channel would).
 //! - No watchdog.
@@ -16,15 +18,24 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
 use embedded_io::{ErrorType, Read, ReadReady, Write};
-use firmware::board::Board;
 
-/// Core clock of mps2-an386 (Hz).
-pub const CORE_HZ: u32 = 25_000_000;
-/// Instructions per SysTick count under `-icount shift=0` (1 GHz virtual / 25 MHz).
-#[cfg_attr(not(feature = "selftest"), allow(dead_code))]
-pub const INSTRUCTIONS_PER_TICK: u32 = 40;
+use crate::board::Board;
+use crate::qemu_clock::CORE_HZ;
+
 /// Nominal H-bridge supply (V).
 pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
+
+/// Ends the program: QEMU exits with `code` (0 = success) through semihosting. Without a
+/// semihosting host (a real board), the core resets instead.
+pub fn halt(code: i32) -> ! {
+    let status = if code == 0 {
+        cortex_m_semihosting::debug::EXIT_SUCCESS
+    } else {
+        cortex_m_semihosting::debug::EXIT_FAILURE
+    };
+    cortex_m_semihosting::debug::exit(status);
+    cortex_m::peripheral::SCB::sys_reset()
+}
 
 const UART0: usize = 0x4000_4000;
 const DATA: usize = 0x00;
@@ -104,6 +115,10 @@ pub struct MemPwm {
     pub duty: u16,
 }
 
+/// Cycles between two reads of SysTick's flag while waiting for a period (40 µs at 25 MHz, 0.4 %
+/// of a 10 ms period).
+pub const WAIT_POLL_CYCLES: u32 = 1000;
+
 /// Counts of full duty: 10-bit resolution, like a 24 kHz timer channel at 25 MHz.
 pub const MAX_DUTY: u16 = 1000;
 
@@ -180,6 +195,21 @@ impl Board for QemuBoard {
     fn period_elapsed(&mut self) -> bool {
         // COUNTFLAG is set at each wrap and cleared by reading it.
         self.syst.has_wrapped()
+    }
+    /// As the default, but reads SysTick's flag only every [`WAIT_POLL_CYCLES`] cycles: under
+    /// `-icount` every device-register read leaves QEMU's translated code, so a tight polling
+    /// loop makes an idle 10 ms period cost seconds of wall time and keeps QEMU's I/O thread,
+    /// which feeds UART0's bytes, waiting for its lock (PIL's arming handshake, which runs on
+    /// these periods, then timed out on an idle host). The boundary is seen at most that many
+    /// cycles late; what the loop does with it does not change.
+    fn wait_period(&mut self) -> bool {
+        let overrun = self.period_elapsed();
+        if !overrun {
+            while !self.period_elapsed() {
+                cortex_m::asm::delay(WAIT_POLL_CYCLES);
+            }
+        }
+        overrun
     }
     fn now(&self) -> u32 {
         // Down-counter: elapsed = last − current, modulo the period.

@@ -1,6 +1,7 @@
 //! Board: STM32F405 (Cortex-M4F at 168 MHz), e.g. STM32F405RGT6, with stm32f4xx-hal 0.23.
 //!
-//! Built only for `target_os = "none"` with `--features stm32f405`.
+//! Built only for `target_os = "none"` with `--features stm32f405`; the image is the
+//! `firmware-stm32f405` binary.
 //!
 //! # Clocks
 //!
@@ -28,11 +29,13 @@
 //! - **PWM**: [`PWM_HZ`] = 20 kHz, edge-aligned PWM mode 1 on the two advanced timers (168 MHz
 //!   timer clock, no prescaler: 8400 counts per period, [`Thruster::max_duty_cycle`] = 8400).
 //!   Duty d gives a mean H-bridge voltage (2d − 1)·V_s (locked anti-phase, see
-//!   [`firmware::pwm`]); **neutral is 50 %**. `init` sets all five channels to neutral and
+//!   [`crate::pwm`]); **neutral is 50 %**. `init` sets all five channels to neutral and
 //!   lets the timers load it before it enables any output.
 //! - **Navigation link**: USART2 at 460800 baud, 8 data bits, no parity, 1 stop bit (8N1), no
 //!   flow control. [`Usart2Link`] is interrupt driven: the `USART2` interrupt moves bytes
-//!   between the data register and two RAM rings ([`RX_RING`] / [`TX_RING`] bytes), so
+//!   between the data register and two `heapless` queues ([`crate::serial`]:
+//!   [`RX_CAPACITY`](crate::serial::RX_CAPACITY) / [`TX_CAPACITY`](crate::serial::TX_CAPACITY)
+//!   bytes), so
 //!   nothing is lost while the loop computes or waits for the period (the USART has a
 //!   one-byte receive register: a polled receiver would drop almost every byte of a frame that
 //!   arrives during `wait_period`), and telemetry goes out in the background instead of
@@ -68,24 +71,24 @@
 //! way at full line rate); it can land inside a timed `Controller::update` and lengthen the
 //! measured ticks by that much.
 
-#![cfg(all(target_os = "none", feature = "stm32f405"))]
-
-use core::cell::UnsafeCell;
+use core::cell::RefCell;
 use core::convert::Infallible;
-use core::sync::atomic::{AtomicU32, AtomicUsize, Ordering};
 
+use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::{DWT, NVIC, SYST};
 use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
 use embedded_io::{ErrorType, Read, ReadReady, Write};
-use firmware::board::Board;
-use firmware::pwm;
-use stm32f4xx_hal::pac::{self, interrupt};
+use stm32f4xx_hal::pac;
 use stm32f4xx_hal::prelude::*;
 use stm32f4xx_hal::rcc::Config as ClockConfig;
 use stm32f4xx_hal::serial::config::StopBits;
 use stm32f4xx_hal::serial::{Config as SerialConfig, Event as SerialEvent, Serial};
 use stm32f4xx_hal::timer::{ErasedChannel, PwmHzManager};
+
+use crate::board::Board;
+use crate::pwm;
+use crate::serial::{self, IrqSide, LineError, LoopSide, RxFlags, RxQueue, TxQueue};
 
 /// HSE crystal frequency (Hz). **Assumption: an 8 MHz crystal.**
 pub const HSE_HZ: u32 = 8_000_000;
@@ -100,22 +103,25 @@ pub const PWM_HZ: u32 = 20_000;
 /// Navigation-link baud rate (8N1).
 pub const LINK_BAUD: u32 = 460_800;
 /// H-bridge supply voltage V_s (V): nominal, not measured. The duty for a commanded voltage
-/// is computed against it ([`firmware::pwm::duty_fraction`]).
+/// is computed against it ([`crate::pwm::duty_fraction`]).
 pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
 /// Control rate set up by [`Stm32Board::init`] (Hz), the controller's default; call
 /// [`Board::set_rate`] for another.
 pub const DEFAULT_RATE_HZ: u32 = 100;
 /// Shortest watchdog timeout (ms, nominal at a 32 kHz LSI).
 pub const WATCHDOG_MIN_MS: u32 = 50;
-/// Receive ring (bytes): 11 ms of line at 460800 baud.
-pub const RX_RING: usize = 512;
-/// Transmit ring (bytes): more than one telemetry frame.
-pub const TX_RING: usize = 512;
 
 /// Nominal LSI frequency (Hz) clocking the IWDG.
 const LSI_HZ: u32 = 32_000;
 /// IWDG prescaler /32: one watchdog count per ms at the nominal LSI.
 const IWDG_DIV: u32 = 32;
+
+/// Ends the program (the image's panic and fault handlers): a system reset — the exit code has
+/// nowhere to go. Reset returns every pin to a floating input, so the H-bridge pull-downs
+/// disable the thrusters (see *Safe state*).
+pub fn halt(_code: i32) -> ! {
+    cortex_m::peripheral::SCB::sys_reset()
+}
 
 // ---------------------------------------------------------------------------------------------
 // Thrusters
@@ -159,111 +165,51 @@ impl SetDutyCycle for Thruster {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Navigation link: USART2, interrupt driven through two single-producer/single-consumer rings
+// Navigation link: USART2, interrupt driven through the two queues of `crate::serial`
 // ---------------------------------------------------------------------------------------------
 
-/// A byte ring with one producer and one consumer on the same core (main loop and the
-/// `USART2` interrupt). `head`/`tail` count bytes pushed/popped (wrapping); N is a power of
-/// two. Each index is written by one side only, and a byte is written before `head` is
-/// published (Release) and read after it is observed (Acquire).
-struct Ring<const N: usize> {
-    buf: UnsafeCell<[u8; N]>,
-    head: AtomicUsize,
-    tail: AtomicUsize,
-}
-
-// SAFETY: the producer only writes slots in [head, tail + N) and the consumer only reads slots
-// in [tail, head); the atomics order those accesses (see `push`/`pop`).
-unsafe impl<const N: usize> Sync for Ring<N> {}
-
-impl<const N: usize> Ring<N> {
-    const fn new() -> Self {
-        const { assert!(N.is_power_of_two()) };
-        Ring {
-            buf: UnsafeCell::new([0; N]),
-            head: AtomicUsize::new(0),
-            tail: AtomicUsize::new(0),
-        }
-    }
-
-    fn len(&self) -> usize {
-        let tail = self.tail.load(Ordering::Acquire);
-        self.head.load(Ordering::Acquire).wrapping_sub(tail)
-    }
-
-    fn is_empty(&self) -> bool {
-        self.len() == 0
-    }
-
-    fn is_full(&self) -> bool {
-        self.len() >= N
-    }
-
-    /// Appends `b`; false if full. Call from the producer side only.
-    fn push(&self, b: u8) -> bool {
-        let head = self.head.load(Ordering::Relaxed);
-        if head.wrapping_sub(self.tail.load(Ordering::Acquire)) >= N {
-            return false;
-        }
-        // SAFETY: the slot is outside [tail, head), so the consumer does not read it, and only
-        // this (single) producer writes; no reference to the array is formed.
-        unsafe { self.buf.get().cast::<u8>().add(head % N).write_volatile(b) };
-        self.head.store(head.wrapping_add(1), Ordering::Release);
-        true
-    }
-
-    /// Removes the oldest byte. Call from the consumer side only.
-    fn pop(&self) -> Option<u8> {
-        let tail = self.tail.load(Ordering::Relaxed);
-        if self.head.load(Ordering::Acquire) == tail {
-            return None;
-        }
-        // SAFETY: the slot is in [tail, head): written and published by the producer, which
-        // does not touch it again until `tail` moves past it.
-        let b = unsafe { self.buf.get().cast::<u8>().add(tail % N).read_volatile() };
-        self.tail.store(tail.wrapping_add(1), Ordering::Release);
-        Some(b)
-    }
-}
-
-/// Received bytes: produced by the interrupt, consumed by [`Usart2Link::read`].
-static RX: Ring<RX_RING> = Ring::new();
-/// Bytes to send: produced by [`Usart2Link::write`], consumed by the interrupt.
-static TX: Ring<TX_RING> = Ring::new();
-/// Received bytes dropped because the receive ring was full.
-static RX_DROPPED: AtomicU32 = AtomicU32::new(0);
-/// Receive line errors seen by the USART (overrun, framing, noise, parity).
-static RX_LINE_ERRORS: AtomicU32 = AtomicU32::new(0);
+/// The interrupt's end of the queues, put here by [`Stm32Board::init`] before it unmasks the
+/// interrupt. Only [`on_usart2_interrupt`] and the diagnostics use it, each in a critical
+/// section.
+static IRQ_SIDE: Mutex<RefCell<Option<IrqSide<'static>>>> = Mutex::new(RefCell::new(None));
 
 fn usart2() -> &'static pac::usart1::RegisterBlock {
     // SAFETY: USART2's register block is always mapped. `Usart2Link` owns the peripheral; the
     // interrupt only reads SR/DR, writes DR and clears TXEIE, the main side only sets TXEIE
-    // (in a critical section) and reads SR — see `USART2` and `Usart2Link::write`.
+    // (in a critical section) and reads SR — see `on_usart2_interrupt` and `Usart2Link::write`.
     unsafe { &*pac::USART2::ptr() }
 }
 
-#[interrupt]
-fn USART2() {
+/// The body of the `USART2` interrupt handler (the STM32 image binds it: `#[interrupt] fn
+/// USART2()`): moves a received byte, with its status flags, into the receive queue, and the
+/// next queued byte into the data register.
+pub fn on_usart2_interrupt() {
     let u = usart2();
     let sr = u.sr().read();
-    let errors = sr.ore().bit_is_set()
-        || sr.fe().bit_is_set()
-        || sr.nf().bit_is_set()
-        || sr.pe().bit_is_set();
-    if sr.rxne().bit_is_set() || errors {
-        // Reading DR after SR clears RXNE and the error flags (ORE would otherwise keep the
-        // interrupt pending). A byte with a framing/noise/parity error is kept: the frame's
-        // CRC rejects it.
-        let b = u.dr().read().dr().bits() as u8;
-        if errors {
-            RX_LINE_ERRORS.fetch_add(1, Ordering::Relaxed);
+    let flags = RxFlags {
+        byte: sr.rxne().bit_is_set(),
+        damaged: sr.fe().bit_is_set() || sr.nf().bit_is_set() || sr.pe().bit_is_set(),
+        overrun: sr.ore().bit_is_set(),
+    };
+    // Reading DR after SR clears RXNE and the error flags (ORE would otherwise keep the
+    // interrupt pending).
+    let received =
+        (flags.byte || flags.damaged || flags.overrun).then(|| u.dr().read().dr().bits() as u8);
+    let send = sr.txe().bit_is_set() && u.cr1().read().txeie().bit_is_set();
+    let next = cortex_m::interrupt::free(|cs| {
+        let mut guard = IRQ_SIDE.borrow(cs).try_borrow_mut().ok()?;
+        let side = guard.as_mut()?;
+        if let Some(b) = received {
+            side.received(flags, b);
         }
-        if sr.rxne().bit_is_set() && !RX.push(b) {
-            RX_DROPPED.fetch_add(1, Ordering::Relaxed);
+        if send {
+            side.next_tx()
+        } else {
+            None
         }
-    }
-    if sr.txe().bit_is_set() && u.cr1().read().txeie().bit_is_set() {
-        match TX.pop() {
+    });
+    if send {
+        match next {
             Some(b) => {
                 u.dr().write(|w| w.dr().set(b as u16));
             }
@@ -275,88 +221,71 @@ fn USART2() {
     }
 }
 
-/// The navigation link on USART2 (PA2 TX, PA3 RX), 460800 8N1, as an `embedded_io` port.
+/// The navigation link on USART2 (PA2 TX, PA3 RX), 460800 8N1, as an `embedded_io` port: the
+/// loop's end of the [`crate::serial`] queues (see [`LoopSide`] for how reads and writes
+/// behave).
 ///
-/// - [`Read::read`] never waits when a byte is waiting: it returns every buffered byte that
-///   fits (at least one). With nothing buffered it waits for the first byte, as `embedded_io`
-///   requires; the control loop only reads after [`ReadReady::read_ready`] says true.
-/// - [`ReadReady::read_ready`]: a received byte is waiting (the buffered equivalent of RXNE).
-/// - [`Write::write`] queues bytes for the interrupt and returns at once; it waits only while
-///   the transmit ring is full. [`Write::flush`] waits until the last bit is on the line.
-///
-/// Line errors are never returned (the error type is `Infallible`): damaged bytes are passed
-/// on and the frame's CRC rejects them; they are counted in [`Usart2Link::rx_line_errors`],
-/// and bytes lost to a full ring in [`Usart2Link::rx_dropped`].
+/// A line error (overrun, framing, noise, parity) or a byte dropped on a full queue comes out of
+/// [`Read::read`] as a [`LineError`] at the place in the stream where it happened; the control
+/// loop then resynchronises the frame decoder ([`crate::board::pump`]). The counts are in
+/// [`Usart2Link::rx_line_errors`] and [`Usart2Link::rx_dropped`].
 pub struct Usart2Link {
+    queues: LoopSide<'static>,
     _serial: Serial<pac::USART2, u8>,
 }
 
-// Diagnostics for the binary's logs; the control loop itself does not need them.
-#[allow(dead_code)]
+// Diagnostics (for logs or a debugger); the control loop itself does not need them.
 impl Usart2Link {
     /// Receive line errors so far (overrun, framing, noise, parity).
     pub fn rx_line_errors(&self) -> u32 {
-        RX_LINE_ERRORS.load(Ordering::Relaxed)
+        irq_side(|s| s.line_errors())
     }
 
-    /// Received bytes dropped because the receive ring was full (the loop stalled > 44 ms).
+    /// Received bytes dropped because the receive queue was full (the loop stalled > 11 ms).
     pub fn rx_dropped(&self) -> u32 {
-        RX_DROPPED.load(Ordering::Relaxed)
+        irq_side(|s| s.dropped())
     }
+}
+
+fn irq_side(f: impl FnOnce(&IrqSide<'static>) -> u32) -> u32 {
+    cortex_m::interrupt::free(|cs| {
+        IRQ_SIDE
+            .borrow(cs)
+            .try_borrow()
+            .ok()
+            .and_then(|s| s.as_ref().map(f))
+            .unwrap_or(0)
+    })
 }
 
 impl ErrorType for Usart2Link {
-    type Error = Infallible;
+    type Error = LineError;
 }
 
 impl ReadReady for Usart2Link {
-    fn read_ready(&mut self) -> Result<bool, Infallible> {
-        Ok(!RX.is_empty())
+    fn read_ready(&mut self) -> Result<bool, LineError> {
+        self.queues.read_ready()
     }
 }
 
 impl Read for Usart2Link {
-    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
-        if buf.is_empty() {
-            return Ok(0);
-        }
-        while RX.is_empty() {}
-        let mut n = 0;
-        for slot in buf.iter_mut() {
-            match RX.pop() {
-                Some(b) => {
-                    *slot = b;
-                    n += 1;
-                }
-                None => break,
-            }
-        }
-        Ok(n)
+    fn read(&mut self, buf: &mut [u8]) -> Result<usize, LineError> {
+        self.queues.read(buf)
     }
 }
 
 impl Write for Usart2Link {
-    fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
-        if buf.is_empty() {
-            return Ok(0);
-        }
-        // The interrupt drains the ring (TXEIE is on whenever it holds bytes).
-        while TX.is_full() {}
-        let mut n = 0;
-        for &b in buf {
-            if !TX.push(b) {
-                break;
-            }
-            n += 1;
-        }
+    fn write(&mut self, buf: &[u8]) -> Result<usize, LineError> {
+        // The interrupt drains the queue (TXEIE is on whenever it holds bytes).
+        let n = self.queues.write(buf)?;
         // The interrupt clears TXEIE (read-modify-write of CR1): set it where it cannot
         // interleave.
         cortex_m::interrupt::free(|_| usart2().cr1().modify(|_, w| w.txeie().set_bit()));
         Ok(n)
     }
 
-    fn flush(&mut self) -> Result<(), Infallible> {
-        while !TX.is_empty() {}
+    fn flush(&mut self) -> Result<(), LineError> {
+        self.queues.flush()?;
         while usart2().sr().read().tc().bit_is_clear() {}
         Ok(())
     }
@@ -454,11 +383,20 @@ impl Stm32Board {
             &mut rcc,
         )
         .expect("USART2 460800 8N1 from PCLK1");
+        // The queues live for the rest of the program; `init` runs once (a second call would
+        // already have failed to take the peripherals above).
+        let rx = cortex_m::singleton!(: RxQueue = RxQueue::new()).expect("init runs once");
+        let tx = cortex_m::singleton!(: TxQueue = TxQueue::new()).expect("init runs once");
+        let (irq_side, loop_side) = serial::split(rx, tx);
+        cortex_m::interrupt::free(|cs| IRQ_SIDE.borrow(cs).replace(Some(irq_side)));
         serial.listen(SerialEvent::RxNotEmpty);
-        // SAFETY: the handler above only touches USART2 and the rings; unmasking it cannot break
-        // a critical section (none is active here).
+        // SAFETY: the handler only touches USART2 and its end of the queues; unmasking it
+        // cannot break a critical section (none is active here).
         unsafe { NVIC::unmask(pac::Interrupt::USART2) };
-        let link = Usart2Link { _serial: serial };
+        let link = Usart2Link {
+            queues: loop_side,
+            _serial: serial,
+        };
 
         // Cycle counter for `now()`.
         cp.DCB.enable_trace();

@@ -109,7 +109,8 @@ pub struct PilArgs {
     pub json: bool,
     #[arg(long, default_value = "runs/pil")]
     pub out: PathBuf,
-    /// Firmware ELF (the QEMU flying image).
+    /// Firmware ELF: the QEMU flying image [default:
+    /// target/thumbv7em-none-eabihf/release/firmware-qemu].
     #[arg(long)]
     pub elf: Option<PathBuf>,
     /// Override the scenario's duration (s).
@@ -333,7 +334,7 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let elf = args
         .elf
         .clone()
-        .unwrap_or_else(|| root.join("target/thumbv7em-none-eabihf/release/firmware"));
+        .unwrap_or_else(|| crate::pil::default_elf(&root));
     let runner = root.join("scripts/qemu-run.sh");
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;

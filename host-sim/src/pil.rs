@@ -27,12 +27,11 @@ use auv_link::{
 };
 use serde::{Deserialize, Serialize};
 
+use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+
 use crate::config::{LinkFaults, SimConfig};
 use crate::record::{ControlStatus, RunResult, RunSummary};
 use crate::sil::{ControlOut, ControlSource};
-
-/// QEMU mps2-an386 SysTick counts per instruction ratio (`-icount shift=0`, 25 MHz).
-pub const INSTRUCTIONS_PER_TICK: u32 = 40;
 
 /// Largest |PIL − SIL| of the max path error (m) that a fault-free PIL run may show: 1 mm.
 /// PIL equals SIL bit for bit today (the same f32 core, the same state frames); this is the
@@ -161,12 +160,7 @@ impl BoardInTheLoop {
         faults: LinkFaults,
         log_path: &Path,
     ) -> Result<Self, String> {
-        if !elf.exists() {
-            return Err(format!(
-                "firmware ELF {} not found: build it with `cargo build -p firmware --release --target thumbv7em-none-eabihf`",
-                elf.display()
-            ));
-        }
+        check_flying_image(elf)?;
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
@@ -455,5 +449,44 @@ impl ControlSource for BoardInTheLoop {
             delta_clamped: t.delta_clamped,
             w_norm: t.w_norm,
         })
+    }
+}
+
+/// The QEMU flying image as `cargo build -p firmware --release --target thumbv7em-none-eabihf
+/// --features qemu --bin firmware-qemu` (or `cargo xtask firmware`) leaves it under `root`.
+pub fn default_elf(root: &Path) -> PathBuf {
+    use firmware::image::{Image, TARGET};
+    root.join("target")
+        .join(TARGET)
+        .join("release")
+        .join(Image::Qemu.bin())
+}
+
+/// Refuses an ELF that is not the QEMU flying image: the self-test image would run its checks
+/// and exit, the STM32 image would wait for clocks QEMU does not have. The image says which it
+/// is by the marker in its flash ([`firmware::image::Image::of_elf`]).
+pub fn check_flying_image(elf: &Path) -> Result<(), String> {
+    use firmware::image::{Image, TARGET};
+    let bytes = std::fs::read(elf).map_err(|e| {
+        format!(
+            "firmware ELF {}: {e}; build it with `cargo build -p firmware --release --target {} --features qemu --bin {}`",
+            elf.display(),
+            TARGET,
+            Image::Qemu.bin()
+        )
+    })?;
+    match Image::of_elf(&bytes) {
+        Some(Image::Qemu) => Ok(()),
+        Some(other) => Err(format!(
+            "{} is the `{}` image, not the QEMU flying image `{}` that PIL flies (see --elf)",
+            elf.display(),
+            other.bin(),
+            Image::Qemu.bin()
+        )),
+        None => Err(format!(
+            "{} is not an AUV-150 firmware image (no image marker; built before the images were binaries?); PIL flies `{}`",
+            elf.display(),
+            Image::Qemu.bin()
+        )),
     }
 }

@@ -1,6 +1,8 @@
 //! Frames: encoding, one-shot decoding and the streaming [`FrameDecoder`].
+//!
+//! COBS (Cheshire & Baker, 1999) is the [`cobs`] crate's; this module decides what it is applied
+//! to (postcard ‖ CRC), what a frame may contain, and how errors are reported.
 
-use crate::cobs;
 use crate::msg::{Envelope, PROTOCOL_VERSION};
 use core::fmt;
 
@@ -17,7 +19,12 @@ pub const MAX_BODY: usize = Envelope::MAX_SIZE + CRC_LEN;
 /// Worst-case length of a complete frame on the wire: COBS of the body plus the `0x00`
 /// delimiter. An `out` buffer of this size makes [`encode`] infallible, and a receiver never
 /// needs more.
-pub const MAX_FRAME: usize = cobs::max_encoded_len(MAX_BODY) + 1;
+pub const MAX_FRAME: usize = cobs::max_encoding_length(MAX_BODY) + 1;
+
+// COBS implementations differ only for data that ends in a run of 254 non-zero bytes (some
+// append a final code byte 0x01, some do not). A body shorter than that never has such a run,
+// so the wire form of every frame is the one COBS form, whatever the crate's choice.
+const _: () = assert!(MAX_BODY < 254);
 
 /// Why a frame was not encoded or not accepted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -26,7 +33,8 @@ pub enum LinkError {
     /// More than `MAX_FRAME − 1` bytes without a delimiter: the bytes up to the next `0x00`
     /// are dropped.
     Overflow,
-    /// Not a valid COBS encoding (a code byte runs past the end of the frame).
+    /// Not a valid COBS encoding (a code byte runs past the end of the frame, or the frame
+    /// holds a `0x00`).
     Cobs,
     /// The CRC does not match (or the frame is too short to hold one).
     Crc,
@@ -73,7 +81,7 @@ pub fn encode(env: &Envelope, out: &mut [u8]) -> Result<usize, LinkError> {
         .len();
     let crc = CRC.checksum(&body[..n]).to_le_bytes();
     body[n..n + CRC_LEN].copy_from_slice(&crc);
-    let len = cobs::encode(&body[..n + CRC_LEN], out).ok_or(LinkError::BufferTooSmall)?;
+    let len = cobs::try_encode(&body[..n + CRC_LEN], out).map_err(|_| LinkError::BufferTooSmall)?;
     *out.get_mut(len).ok_or(LinkError::BufferTooSmall)? = 0;
     Ok(len + 1)
 }
@@ -84,6 +92,15 @@ pub fn encode(env: &Envelope, out: &mut [u8]) -> Result<usize, LinkError> {
 pub fn decode_frame(frame: &mut [u8]) -> Result<Envelope, LinkError> {
     if frame.len() > MAX_FRAME - 1 {
         return Err(LinkError::Overflow);
+    }
+    // An empty frame has no room for a CRC. A 0x00 can only come from a caller that did not
+    // split at the delimiters: it is not COBS (the crate would stop at it and decode the rest
+    // as the next frame's).
+    if frame.is_empty() {
+        return Err(LinkError::Crc);
+    }
+    if frame.contains(&0) {
+        return Err(LinkError::Cobs);
     }
     let n = cobs::decode_in_place(frame).map_err(|_| LinkError::Cobs)?;
     let body = frame.get(..n).ok_or(LinkError::Cobs)?;
@@ -220,25 +237,6 @@ mod tests {
     }
 
     #[test]
-    fn frame_layout() {
-        let env = Envelope::new(0x0102, Msg::Command(Command::Arm));
-        let mut out = [0u8; MAX_FRAME];
-        let n = encode(&env, &mut out).unwrap();
-        // postcard: version 01, seq varint 0x0102 = 82 02, Msg::Command = 01, Command::Arm = 00.
-        let body = [0x01, 0x82, 0x02, 0x01, 0x00];
-        let crc = CRC.checksum(&body).to_le_bytes();
-        let mut raw = [0u8; 7];
-        raw[..5].copy_from_slice(&body);
-        raw[5..].copy_from_slice(&crc);
-        let mut want = [0u8; 16];
-        let m = cobs::encode(&raw, &mut want).unwrap();
-        want[m] = 0;
-        assert_eq!(&out[..n], &want[..m + 1]);
-        assert_eq!(out[n - 1], 0);
-        assert!(!out[..n - 1].contains(&0));
-    }
-
-    #[test]
     fn short_frames_are_errors_not_panics() {
         for frame in [&[][..], &[0x01], &[0x02, 0x05], &[0x01, 0x01, 0x01]] {
             let mut buf = [0u8; 4];
@@ -248,8 +246,23 @@ mod tests {
         // A valid CRC over an empty payload: no version byte.
         let crc = CRC.checksum(&[]).to_le_bytes();
         let mut buf = [0u8; 4];
-        let n = cobs::encode(&crc, &mut buf).unwrap();
+        let n = cobs::try_encode(&crc, &mut buf).unwrap();
         assert_eq!(decode_frame(&mut buf[..n]), Err(LinkError::Deserialize));
+    }
+
+    #[test]
+    fn a_zero_inside_a_frame_is_not_cobs() {
+        // A valid frame followed by a 0x00 and more bytes, given as one frame: the COBS crate
+        // alone would decode up to the 0x00 and accept it.
+        let env = Envelope::new(9, Msg::Command(Command::Arm));
+        let mut out = [0u8; MAX_FRAME + 2];
+        let n = encode(&env, &mut out).unwrap();
+        let mut copy = out;
+        assert_eq!(decode_frame(&mut copy[..n - 1]), Ok(env));
+        out[n] = 0x01;
+        assert_eq!(decode_frame(&mut out[..n + 1]), Err(LinkError::Cobs));
+        // Empty: no room for a CRC (as before the COBS crate).
+        assert_eq!(decode_frame(&mut []), Err(LinkError::Crc));
     }
 
     #[test]
@@ -261,7 +274,7 @@ mod tests {
         let crc = CRC.checksum(&body[..n + 1]).to_le_bytes();
         body[n + 1..n + 3].copy_from_slice(&crc);
         let mut frame = [0u8; MAX_FRAME + 1];
-        let m = cobs::encode(&body[..n + 3], &mut frame).unwrap();
+        let m = cobs::try_encode(&body[..n + 3], &mut frame).unwrap();
         assert_eq!(decode_frame(&mut frame[..m]), Err(LinkError::Deserialize));
     }
 

@@ -15,11 +15,12 @@
 //!   reflected, no final XOR; check value 0x29B1), over the postcard bytes only, appended
 //!   little-endian. It detects every error of up to 3 bits and every burst of up to 16 bits
 //!   in the body.
-//! - **Framing:** Consistent Overhead Byte Stuffing of the body, with this crate's own COBS
-//!   (not postcard's helpers, which would stuff the postcard bytes without the CRC): code byte
-//!   `c` = 1..=255 followed by `c − 1` non-zero bytes, `c < 0xFF` implying a zero after them.
-//!   The stuffed frame contains no `0x00`; a single `0x00` ends each frame. A sender may also
-//!   send a `0x00` before a frame (e.g. after reset): empty frames are ignored.
+//! - **Framing:** Consistent Overhead Byte Stuffing of the body, by the
+//!   [`cobs`](https://docs.rs/cobs) crate (not postcard's COBS helpers, which would stuff the
+//!   postcard bytes without the CRC): code byte `c` = 1..=255 followed by `c − 1` non-zero
+//!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
+//!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
+//!   reset): empty frames are ignored.
 //! - **Size:** at most [`MAX_FRAME`] = 119 bytes on the wire, delimiter included
 //!   ([`Envelope::MAX_SIZE`] = 115 postcard bytes + 2 CRC bytes + 1 COBS code byte + 1
 //!   delimiter). At 460 800 baud (46 080 bytes/s, the STM32 board's link) that is 2.6 ms, so a
@@ -77,7 +78,6 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
-mod cobs;
 mod frame;
 pub mod mission;
 mod msg;

@@ -162,6 +162,13 @@ fn postcard_len<T: serde::Serialize>(value: &T) -> usize {
     postcard::to_slice(value, &mut buf).unwrap().len()
 }
 
+/// What `encode` must put on the wire for `env`, built with the reference CRC and COBS: the
+/// postcard bytes, their CRC-16, stuffed, delimited.
+fn reference_frame(env: &Envelope) -> Vec<u8> {
+    let mut buf = [0u8; 256];
+    frame_from_body(postcard::to_slice(env, &mut buf).unwrap())
+}
+
 // ---------------------------------------------------------------------------------------------
 // Round trips
 
@@ -169,6 +176,11 @@ fn postcard_len<T: serde::Serialize>(value: &T) -> usize {
 fn every_kind_round_trips_byte_by_byte() {
     for env in every_kind() {
         let wire = frame(&env);
+        assert_eq!(
+            wire,
+            reference_frame(&env),
+            "{env:?}: wire bytes differ from the reference"
+        );
         assert_eq!(*wire.last().unwrap(), 0, "{env:?}");
         assert!(!wire[..wire.len() - 1].contains(&0), "{env:?}");
         let mut dec = FrameDecoder::new();
@@ -617,6 +629,7 @@ proptest! {
     #[test]
     fn arbitrary_envelopes_round_trip(env in any_envelope()) {
         let wire = frame(&env);
+        prop_assert_eq!(&wire, &reference_frame(&env));
         prop_assert!(wire.len() <= MAX_FRAME);
         prop_assert!(!wire[..wire.len() - 1].contains(&0));
         prop_assert_eq!(*wire.last().unwrap(), 0);

@@ -1,0 +1,26 @@
+//! The QEMU self-test image (`cargo fw-test`): checks the core on the target against the host,
+//! counts the instructions of `update`, exercises the link and the fail-safe, reports the stack
+//! high-water mark, and exits through semihosting (0 = every check passed). `cargo xtask
+//! firmware` compares its decoded log with `firmware/snapshots/selftest-*.log`.
+#![no_std]
+#![no_main]
+
+mod selftest;
+mod stack;
+
+use cortex_m_rt::entry;
+use defmt_semihosting as _;
+use firmware::image::Image;
+use firmware::qemu::halt;
+use firmware::rt;
+
+#[entry]
+fn main() -> ! {
+    stack::paint();
+    Image::QemuSelftest.embed();
+    let cp = rt::core_peripherals(halt);
+    let ok = selftest::run(cp.SYST);
+    halt(if ok { 0 } else { 1 })
+}
+
+firmware::fault_handlers!(halt);

@@ -1,0 +1,112 @@
+//! What every image does at boot, in flight and on a fault (target only). Each image's `main`
+//! (`src/bin/…`) picks its board and its way to end the program (`halt`: QEMU exits through
+//! semihosting, the STM32 resets) and hands them to these functions.
+
+use controller_core::{Controller, ControllerConfig};
+use cortex_m_rt::ExceptionFrame;
+use defmt::{error, info};
+
+use crate::board::{period, Board, LinkBuffers};
+use crate::image::Image;
+use crate::supervisor::Supervisor;
+
+/// Ends the program with an exit code (0 = success); never returns.
+pub type Halt = fn(i32) -> !;
+
+/// The core peripherals, taken once at boot (a second take is a bug: logged, then `halt(1)`).
+pub fn core_peripherals(halt: Halt) -> cortex_m::Peripherals {
+    match cortex_m::Peripherals::take() {
+        Some(cp) => cp,
+        None => {
+            error!("core peripherals already taken");
+            halt(1)
+        }
+    }
+}
+
+/// The controller with the default configuration, and the boot line that names the loop rate
+/// and the math backend (`halt(1)` if the defaults were rejected, which the host tests rule
+/// out).
+pub fn controller(halt: Halt) -> Controller {
+    let controller = match Controller::new(ControllerConfig::default()) {
+        Ok(c) => c,
+        Err(_) => {
+            error!("default controller configuration rejected");
+            halt(1)
+        }
+    };
+    info!(
+        "AUV-150 thruster board: {} Hz loop, controller-core {} backend",
+        controller.config().rate_hz,
+        controller_core::math::BACKEND
+    );
+    controller
+}
+
+/// The flying loop: one [`period`] after another, forever, logging every status change and
+/// following rate changes the supervisor accepts.
+pub fn fly<B: Board>(board: &mut B, mut sup: Supervisor) -> ! {
+    let mut bufs = LinkBuffers::new();
+    let mut rate = sup.rate_hz();
+    board.set_rate(rate);
+    let mut last = None;
+    loop {
+        let step = period(board, &mut sup, &mut bufs);
+        if last != Some(step.telemetry.status) {
+            info!(
+                "tick {}: {}",
+                step.telemetry.tick,
+                step.telemetry.status.as_str()
+            );
+            last = Some(step.telemetry.status);
+        }
+        if sup.rate_hz() != rate {
+            rate = sup.rate_hz();
+            board.set_rate(rate);
+            info!("loop rate now {} Hz", rate);
+        }
+    }
+}
+
+/// Logs a panic; the image's `#[panic_handler]` then halts.
+pub fn report_panic(info: &core::panic::PanicInfo) {
+    error!("panic: {}", defmt::Display2Format(info));
+}
+
+/// Logs a HardFault; the image's `HardFault` handler then halts.
+pub fn report_hard_fault(ef: &ExceptionFrame) {
+    error!("HardFault at pc = {:#010x}", ef.pc());
+}
+
+/// What a flying image's `main` does: marks the image, takes the core peripherals, builds the
+/// controller, brings the board up with them at the controller's rate (`init`), and flies.
+pub fn fly_image<B: Board>(
+    image: Image,
+    halt: Halt,
+    init: impl FnOnce(cortex_m::Peripherals, u32) -> B,
+) -> ! {
+    image.embed();
+    let cp = core_peripherals(halt);
+    let controller = controller(halt);
+    let mut board = init(cp, controller.config().rate_hz);
+    fly(&mut board, Supervisor::new(controller))
+}
+
+/// Defines an image's `#[panic_handler]` and `HardFault` handler: report, then `$halt(1)`.
+/// Each image's binary invokes it once with its board's `halt`.
+#[macro_export]
+macro_rules! fault_handlers {
+    ($halt:path) => {
+        #[panic_handler]
+        fn panic(info: &core::panic::PanicInfo) -> ! {
+            $crate::rt::report_panic(info);
+            $halt(1)
+        }
+
+        #[cortex_m_rt::exception]
+        unsafe fn HardFault(ef: &cortex_m_rt::ExceptionFrame) -> ! {
+            $crate::rt::report_hard_fault(ef);
+            $halt(1)
+        }
+    };
+}

@@ -1,0 +1,311 @@
+//! Building the images and checking what their ELF files say: which image each is (its
+//! marker), where it links (reset vector, stack top), and its flash and static RAM against the
+//! budgets and `firmware/snapshots/sizes.txt`.
+
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+
+use firmware::image::{Image, TARGET};
+use object::{Object, ObjectSection, ObjectSymbol};
+
+use crate::ci::Ci;
+use crate::snapshot::{self, SizeKey, Sizes};
+
+/// Flash budget of every image (bytes): well inside the STM32F405's 1 MiB, so that the board
+/// keeps room for a bootloader and a second image.
+pub const FLASH_BUDGET: u64 = 128 * 1024;
+/// Static RAM budget of every image (bytes): a quarter of the STM32F405's 128 KiB SRAM, the
+/// rest is stack (the self-test measures its high-water mark).
+pub const RAM_BUDGET: u64 = 32 * 1024;
+
+/// The controller-core math backend an image is built with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
+pub enum Backend {
+    /// libm (the boards' default).
+    Libm,
+    /// micromath's fast approximations (`--features micromath`).
+    Micromath,
+}
+
+impl Backend {
+    pub fn name(self) -> &'static str {
+        match self {
+            Backend::Libm => "libm",
+            Backend::Micromath => "micromath",
+        }
+    }
+}
+
+/// One ELF the CI builds: an image with a math backend.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Variant {
+    pub image: Image,
+    pub backend: Backend,
+}
+
+impl Variant {
+    pub const QEMU: Variant = Variant::libm(Image::Qemu);
+    pub const SELFTEST: [Variant; 2] = [
+        Variant::libm(Image::QemuSelftest),
+        Variant {
+            image: Image::QemuSelftest,
+            backend: Backend::Micromath,
+        },
+    ];
+    /// Every image with the board default (libm), and the self-test with micromath too.
+    pub const ALL: [Variant; 4] = [
+        Variant::libm(Image::Qemu),
+        Variant::SELFTEST[0],
+        Variant::SELFTEST[1],
+        Variant::libm(Image::Stm32f405),
+    ];
+
+    const fn libm(image: Image) -> Variant {
+        Variant {
+            image,
+            backend: Backend::Libm,
+        }
+    }
+
+    pub fn label(self) -> String {
+        format!("{} ({})", self.image.bin(), self.backend.name())
+    }
+}
+
+/// The ELFs that built, by variant.
+pub struct Built {
+    elfs: Vec<(Variant, PathBuf)>,
+}
+
+impl Built {
+    pub fn elf(&self, v: Variant) -> Option<&Path> {
+        self.elfs
+            .iter()
+            .find(|(w, _)| *w == v)
+            .map(|(_, p)| p.as_path())
+    }
+}
+
+/// Builds `variants`: one `cargo build` per board feature and backend, with a `--bin` for each
+/// image. The libm images stay where cargo puts them (`target/thumbv7em-none-eabihf/release/`,
+/// what `cargo fw` and `host-sim pil` use); the micromath self-test is built first and copied
+/// to `target/xtask/` so that the libm build after it leaves the default ELFs in place.
+pub fn build(ci: &mut Ci, variants: &[Variant]) -> Built {
+    ci.step("building the images");
+    let mut groups: BTreeMap<(Backend, &str), Vec<Image>> = BTreeMap::new();
+    for v in variants {
+        groups
+            .entry((v.backend, v.image.board_feature()))
+            .or_default()
+            .push(v.image);
+    }
+    let mut elfs = Vec::new();
+    // Micromath first (see above): reverse order of the backends.
+    for ((backend, board), images) in groups.into_iter().rev() {
+        let mut features = board.to_string();
+        if backend == Backend::Micromath {
+            features.push_str(",micromath");
+        }
+        let mut cmd = ci.cargo();
+        cmd.args(["build", "--release", "-p", "firmware", "--target", TARGET])
+            .args(["--features", &features]);
+        for image in &images {
+            cmd.args(["--bin", image.bin()]);
+        }
+        let what = format!(
+            "cargo build --release -p firmware --target {TARGET} --features {features} {}",
+            images
+                .iter()
+                .map(|i| format!("--bin {}", i.bin()))
+                .collect::<Vec<_>>()
+                .join(" ")
+        );
+        println!("{what}");
+        match cmd.status() {
+            Ok(s) if s.success() => {}
+            Ok(s) => {
+                ci.fail(format!(
+                    "{what} failed ({s}); the compiler's errors are above"
+                ));
+                continue;
+            }
+            Err(e) => {
+                ci.fail(format!("{what}: could not run cargo: {e}"));
+                continue;
+            }
+        }
+        for image in images {
+            let elf = ci.target_dir.join(TARGET).join("release").join(image.bin());
+            let variant = Variant { image, backend };
+            if backend == Backend::Libm {
+                elfs.push((variant, elf));
+                continue;
+            }
+            let copy = ci
+                .scratch()
+                .join(format!("{}-{}", image.bin(), backend.name()));
+            match std::fs::copy(&elf, &copy) {
+                Ok(_) => elfs.push((variant, copy)),
+                Err(e) => ci.fail(format!(
+                    "copying {} to {}: {e}",
+                    elf.display(),
+                    copy.display()
+                )),
+            }
+        }
+    }
+    Built { elfs }
+}
+
+/// Reset vector and initial stack pointer an image must link to, from its board's memory
+/// (independently of the linker scripts they check).
+fn expected_map(image: Image) -> (u64, u64) {
+    match image {
+        // mps2-an386: code at 0x0000_0000, 4 MiB of SRAM at 0x2000_0000.
+        Image::Qemu | Image::QemuSelftest => (0x0000_0004, 0x2040_0000),
+        // STM32F405 (RM0090): flash at 0x0800_0000, 128 KiB of SRAM1+SRAM2 at 0x2000_0000.
+        Image::Stm32f405 => (0x0800_0004, 0x2002_0000),
+    }
+}
+
+/// What one ELF says about itself.
+struct ElfFacts {
+    image: Option<Image>,
+    sizes: Sizes,
+    reset_vector: Option<u64>,
+    stack_top: Option<u64>,
+}
+
+fn read_elf(path: &Path) -> Result<ElfFacts, String> {
+    let bytes = std::fs::read(path).map_err(|e| format!("reading {}: {e}", path.display()))?;
+    let file = object::File::parse(&*bytes)
+        .map_err(|e| format!("{} is not an ELF file: {e}", path.display()))?;
+    // flash = what is loaded into it (vector table, code, constants, .data's initial values);
+    // static RAM = .data + .bss + .uninit.
+    let mut sizes = Sizes { flash: 0, ram: 0 };
+    for section in file.sections() {
+        let size = section.size();
+        match section.name().unwrap_or("") {
+            ".vector_table" | ".text" | ".rodata" => sizes.flash += size,
+            ".data" => {
+                sizes.flash += size;
+                sizes.ram += size;
+            }
+            ".bss" | ".uninit" => sizes.ram += size,
+            _ => {}
+        }
+    }
+    let symbol = |name: &str| {
+        file.symbols()
+            .find(|s| s.name() == Ok(name))
+            .map(|s| s.address())
+    };
+    Ok(ElfFacts {
+        image: Image::of_elf(&bytes),
+        sizes,
+        reset_vector: symbol("__RESET_VECTOR"),
+        stack_top: symbol("_stack_start"),
+    })
+}
+
+/// Checks every ELF that built: its marker names its image, it links to its board's memory,
+/// it fits the budgets and stays within 10 % of its size snapshot (or, with `--bless`, becomes
+/// the snapshot).
+pub fn check(ci: &mut Ci, built: &Built) {
+    ci.step("images: marker, memory map, flash and static RAM");
+    let snapshot_path = ci.root.join(snapshot::SIZES);
+    let snapshot = if ci.bless {
+        BTreeMap::new()
+    } else {
+        match snapshot::read_sizes(&snapshot_path) {
+            Ok(s) => s,
+            Err(e) => {
+                ci.fail(format!("{e} (cargo xtask images --bless writes it)"));
+                BTreeMap::new()
+            }
+        }
+    };
+    let mut measured = BTreeMap::new();
+    for v in Variant::ALL {
+        let Some(elf) = built.elf(v) else { continue };
+        let facts = match read_elf(elf) {
+            Ok(f) => f,
+            Err(e) => {
+                ci.fail(e);
+                continue;
+            }
+        };
+        let label = v.label();
+        println!(
+            "{label}: flash {} B, static RAM {} B, reset vector {}, stack top {}  [{}]",
+            facts.sizes.flash,
+            facts.sizes.ram,
+            hex(facts.reset_vector),
+            hex(facts.stack_top),
+            ci.rel(elf)
+        );
+        if facts.image != Some(v.image) {
+            ci.fail(format!(
+                "{label}: the ELF's image marker says {:?}, not {:?} (firmware::image; does its main call Image::embed?)",
+                facts.image, v.image
+            ));
+        }
+        let (reset, stack) = expected_map(v.image);
+        if facts.reset_vector != Some(reset) || facts.stack_top != Some(stack) {
+            ci.fail(format!(
+                "{label} is linked with the wrong memory map: reset vector {} and stack top {}, expected {reset:#010x} and {stack:#010x} from {} (firmware/build.rs gives each bin its map)",
+                hex(facts.reset_vector),
+                hex(facts.stack_top),
+                v.image.memory_map()
+            ));
+        }
+        if facts.sizes.flash > FLASH_BUDGET {
+            ci.fail(format!(
+                "{label}: flash {} B exceeds the budget of {FLASH_BUDGET} B",
+                facts.sizes.flash
+            ));
+        }
+        if facts.sizes.ram > RAM_BUDGET {
+            ci.fail(format!(
+                "{label}: static RAM {} B exceeds the budget of {RAM_BUDGET} B",
+                facts.sizes.ram
+            ));
+        }
+        let key = SizeKey {
+            bin: v.image.bin().to_string(),
+            backend: v.backend.name().to_string(),
+        };
+        if !ci.bless {
+            match snapshot.get(&key) {
+                None => ci.fail(format!(
+                    "{label}: no entry in {} (cargo xtask images --bless adds it)",
+                    snapshot::SIZES
+                )),
+                Some(snap) => {
+                    for (what, now, then) in [
+                        ("flash", facts.sizes.flash, snap.flash),
+                        ("static RAM", facts.sizes.ram, snap.ram),
+                    ] {
+                        if !snapshot::size_close(now, then) {
+                            ci.fail(format!(
+                                "{label}: {what} {now} B is more than 10 % from the snapshot's {then} B in {} (a size jump is a review item; if it is intended: cargo xtask images --bless)",
+                                snapshot::SIZES
+                            ));
+                        }
+                    }
+                }
+            }
+        }
+        measured.insert(key, facts.sizes);
+    }
+    if ci.bless {
+        match snapshot::write_sizes(&snapshot_path, &measured) {
+            Ok(()) => println!("blessed {}", snapshot::SIZES),
+            Err(e) => ci.fail(e),
+        }
+    }
+}
+
+fn hex(a: Option<u64>) -> String {
+    a.map_or_else(|| "missing".into(), |a| format!("{a:#010x}"))
+}

@@ -1,0 +1,103 @@
+//! The firmware's CI as code, in the manner of defmt's and RTIC's xtasks (`cargo xtask …`; the
+//! alias is in `.cargo/config.toml`). `scripts/test-all.sh` runs `cargo xtask firmware`.
+//!
+//! ```text
+//! cargo xtask firmware [--bless]   everything below, in this order
+//! cargo xtask images   [--bless]   build every image; its marker, memory map, flash and RAM
+//!                                  against the budgets and firmware/snapshots/sizes.txt
+//! cargo xtask selftest [--bless]   the QEMU self-test with each math backend against
+//!                                  firmware/snapshots/selftest-<backend>.log, and the failure
+//!                                  injection (a wrong answer, a panic, a HardFault, a hang)
+//! cargo xtask pil                  processor in the loop: a short mission must equal SIL bit
+//!                                  for bit; the link-fault case must enter and leave fail-safe
+//!                                  at its exact ticks
+//! ```
+//!
+//! `--bless` rewrites the snapshots from this run instead of comparing (review the diff, then
+//! commit it). Every check runs even after one failed; the end lists each failure with what to
+//! do about it, and the exit status is 1.
+//!
+//! QEMU runs through `scripts/qemu-run.sh` (the cargo runner, kept in shell with
+//! `scripts/setup.sh`); everything else is here. The images, their features and ELF names come
+//! from `firmware::image`.
+
+mod ci;
+mod images;
+mod pil;
+mod qemu;
+mod selftest;
+mod snapshot;
+
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand};
+
+use crate::ci::Ci;
+use crate::images::Variant;
+
+#[derive(Parser)]
+#[command(about = "AUV-150 firmware CI: images, QEMU self-test, snapshots, PIL")]
+struct Cli {
+    #[command(subcommand)]
+    command: Task,
+}
+
+#[derive(Subcommand)]
+enum Task {
+    /// Every firmware check: images, self-test, failure injection, PIL.
+    Firmware {
+        /// Rewrite firmware/snapshots/ from this run instead of comparing.
+        #[arg(long)]
+        bless: bool,
+    },
+    /// Build every image; check its marker, memory map, flash and RAM.
+    Images {
+        /// Rewrite firmware/snapshots/sizes.txt from this run instead of comparing.
+        #[arg(long)]
+        bless: bool,
+    },
+    /// Run the QEMU self-test (both math backends) and the failure injection.
+    Selftest {
+        /// Rewrite firmware/snapshots/selftest-*.log from this run instead of comparing.
+        #[arg(long)]
+        bless: bool,
+    },
+    /// Processor in the loop: PIL = SIL, and the link-fault case.
+    Pil,
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let bless = match cli.command {
+        Task::Firmware { bless } | Task::Images { bless } | Task::Selftest { bless } => bless,
+        Task::Pil => false,
+    };
+    let mut ci = match Ci::new(bless) {
+        Ok(ci) => ci,
+        Err(e) => {
+            eprintln!("xtask: {e:#}");
+            return ExitCode::from(2);
+        }
+    };
+    match cli.command {
+        Task::Firmware { .. } => {
+            let built = images::build(&mut ci, &Variant::ALL);
+            images::check(&mut ci, &built);
+            selftest::run(&mut ci, &built);
+            pil::run(&mut ci, &built);
+        }
+        Task::Images { .. } => {
+            let built = images::build(&mut ci, &Variant::ALL);
+            images::check(&mut ci, &built);
+        }
+        Task::Selftest { .. } => {
+            let built = images::build(&mut ci, &Variant::SELFTEST);
+            selftest::run(&mut ci, &built);
+        }
+        Task::Pil => {
+            let built = images::build(&mut ci, &[Variant::QEMU]);
+            pil::run(&mut ci, &built);
+        }
+    }
+    ci.finish()
+}

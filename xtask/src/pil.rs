@@ -1,0 +1,188 @@
+//! Processor in the loop: the QEMU flying image flies the simulated vehicle through
+//! `host-sim pil`. Two checks: a short lawn-mower mission must equal SIL bit for bit, and a
+//! link-fault case must enter and leave fail-safe at its exact ticks.
+
+use std::path::Path;
+use std::process::Command;
+
+use auv_link::FailSafeReason;
+use auv_link::DEFAULT_STALE_PERIODS;
+use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+use host_sim::pil::{FailSafeEventKind, PilComparison};
+use host_sim::record::Cases;
+
+use crate::ci::Ci;
+use crate::images::{Built, Variant};
+
+pub fn run(ci: &mut Ci, built: &Built) {
+    ci.step("processor in the loop: a short mission (PIL must equal SIL) and a link-fault case");
+    let Some(elf) = built.elf(Variant::QEMU) else {
+        ci.fail("PIL: no QEMU flying image (its build failed, see above)");
+        return;
+    };
+    let what = "cargo build --release -p host-sim";
+    println!("{what}");
+    match ci
+        .cargo()
+        .args(["build", "--release", "-p", "host-sim"])
+        .status()
+    {
+        Ok(s) if s.success() => {}
+        other => {
+            ci.fail(format!(
+                "{what} failed ({other:?}); the compiler's errors are above"
+            ));
+            return;
+        }
+    }
+    let host_sim = ci.target_dir.join("release").join("host-sim");
+    let elf = elf.to_path_buf();
+    pil_checks(ci, &host_sim, &elf);
+}
+
+/// Both PIL checks. Runs the release `host-sim` binary with `--json` and reads its report into
+/// host-sim's own types ([`Cases`]`<`[`PilComparison`]`>`), so the check and the report cannot
+/// disagree on a field.
+fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
+    type Case = PilComparison;
+    let scratch = ci.scratch();
+    let run = |ci: &mut Ci, name: &str, args: &[&str]| -> Option<(bool, Case)> {
+        let out = scratch.join(format!("pil-{name}"));
+        let mut cmd = Command::new(host_sim);
+        cmd.current_dir(&ci.root)
+            .arg("pil")
+            .args(args)
+            .arg("--elf")
+            .arg(elf)
+            .arg("--json")
+            .arg("--out")
+            .arg(&out);
+        let shown = format!("{} pil {}", ci.rel(host_sim), args.join(" "));
+        println!("{shown}");
+        let output = match cmd.output() {
+            Ok(o) => o,
+            Err(e) => {
+                ci.fail(format!("PIL {name}: running {shown}: {e}"));
+                return None;
+            }
+        };
+        // host-sim prints its report even when it exits 1 (PIL ≠ SIL, or diverged).
+        match serde_json::from_slice::<Cases<PilComparison>>(&output.stdout) {
+            Ok(r) if r.cases.len() == 1 => {
+                let case = r.cases.into_iter().next()?;
+                Some((output.status.success(), case))
+            }
+            Ok(r) => {
+                ci.fail(format!(
+                    "PIL {name}: expected one case, got {}",
+                    r.cases.len()
+                ));
+                None
+            }
+            Err(e) => {
+                ci.fail(format!(
+                    "PIL {name}: {shown} exited {} without a JSON report ({e}); its messages:\n{}",
+                    output.status,
+                    String::from_utf8_lossy(&output.stderr)
+                ));
+                None
+            }
+        }
+    };
+    let whole_counts = |ci: &mut Ci, name: &str, c: &Case| {
+        if !c
+            .pil
+            .worst_update_instructions
+            .is_multiple_of(u64::from(INSTRUCTIONS_PER_TICK))
+        {
+            ci.fail(format!(
+                "PIL {name}: worst update {} instructions is not a whole number of SysTick counts ({INSTRUCTIONS_PER_TICK} each)",
+                c.pil.worst_update_instructions
+            ));
+        }
+    };
+
+    // 1. PIL = SIL: the same f32 core on the same inputs, bit for bit.
+    if let Some((ok, c)) = run(
+        ci,
+        "short",
+        &[
+            "--scenario",
+            "host-sim/scenarios/lawn-mower-20x10.toml",
+            "--duration",
+            "10",
+        ],
+    ) {
+        println!(
+            "PIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s, worst update {} instructions",
+            c.run.metrics.max_path,
+            c.sil_max_path,
+            c.pil.frames_per_second,
+            c.pil.worst_update_instructions
+        );
+        whole_counts(ci, "short mission", &c);
+        if !ok || c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits() {
+            ci.fail(format!(
+                "PIL short mission: PIL max path {} m is not SIL's {} m bit for bit (host-sim {}); the board and SIL run the same f32 core on the same state frames, so look for a change in what crosses the link or in the firmware's period",
+                c.run.metrics.max_path,
+                c.sil_max_path,
+                if ok { "passed its 1 mm check" } else { "failed" }
+            ));
+        }
+    }
+
+    // 2. Link faults: drop, corruption and a short delay stay within the stale limit; silence
+    //    from tick SILENT.0 is fail-safe (stale state) once DEFAULT_STALE_PERIODS periods have
+    //    passed without a frame, and the re-arm on the first healthy frame (SILENT.1) ends it.
+    const SILENT: (u64, u64) = (300, 310);
+    let silent = format!("{}..{}", SILENT.0, SILENT.1);
+    if let Some((ok, c)) = run(
+        ci,
+        "faults",
+        &[
+            "--scenario",
+            "host-sim/scenarios/circular-10R.toml",
+            "--duration",
+            "8",
+            "--drop",
+            "100..101",
+            "--corrupt",
+            "150..152",
+            "--delay",
+            "200..210",
+            "--silent",
+            &silent,
+        ],
+    ) {
+        let ev = &c.pil.failsafe_events;
+        println!(
+            "fail-safe events: {:?}, board rx_errors {}",
+            ev.iter()
+                .map(|e| (e.kind.as_str(), e.tick, e.reason.as_str()))
+                .collect::<Vec<_>>(),
+            c.pil.board_rx_errors
+        );
+        whole_counts(ci, "link-fault case", &c);
+        let enter = SILENT.0 + u64::from(DEFAULT_STALE_PERIODS);
+        let as_expected = matches!(
+            &ev[..],
+            [a, b] if a.kind == FailSafeEventKind::Enter && a.tick == enter
+                && a.reason == FailSafeReason::StaleState.as_str()
+                && b.kind == FailSafeEventKind::Exit && b.tick == SILENT.1
+        );
+        if !ok || !as_expected {
+            ci.fail(format!(
+                "PIL link-fault case: expected fail-safe (stale state) entered at tick {enter} (silent from {}, stale after {DEFAULT_STALE_PERIODS} periods) and left at {} (re-armed on the first healthy frame), nothing else; got {ev:?}{}",
+                SILENT.0,
+                SILENT.1,
+                if ok { "" } else { " and host-sim failed" }
+            ));
+        }
+        if c.pil.board_rx_errors < 2 {
+            ci.fail(format!(
+                "PIL link-fault case: the board counted {} receive errors; the two corrupted frames must be counted",
+                c.pil.board_rx_errors
+            ));
+        }
+    }
+}

@@ -1,0 +1,175 @@
+//! The QEMU self-test with each math backend, compared with its log snapshot, and the failure
+//! injection that proves each kind of failure is visible.
+
+use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+
+use crate::ci::Ci;
+use crate::images::{Backend, Built, Variant};
+use crate::qemu::{self, TIMED_OUT};
+use crate::snapshot;
+
+/// Seconds a self-test run may take (it needs about one on an idle machine).
+const SELFTEST_TIMEOUT_S: u32 = 120;
+/// Seconds before a failure-injection run counts as hung: the injections act before the
+/// self-test's work, so this only bounds the `hang` case.
+const INJECTION_TIMEOUT_S: u32 = 15;
+/// Seconds the `hang` injection is given before the runner stops it (its timeout is the
+/// expected outcome, so a short one suffices).
+const HANG_TIMEOUT_S: u32 = 5;
+
+/// `-append inject=<kind>` and the line (substring) that shows that failure in the log.
+const INJECTIONS: [(&str, &str); 4] = [
+    ("wrong", "ERROR injected wrong answer"),
+    ("panic", "ERROR panic: "),
+    ("hardfault", "ERROR HardFault at pc"),
+    ("hang", "TIMEOUT"),
+];
+
+pub fn run(ci: &mut Ci, built: &Built) {
+    for v in Variant::SELFTEST {
+        let Some(elf) = built.elf(v) else { continue };
+        let backend = v.backend.name();
+        ci.step(&format!("self-test in QEMU, {backend} backend"));
+        let run = match qemu::run(
+            ci,
+            elf,
+            &[],
+            SELFTEST_TIMEOUT_S,
+            &format!("selftest-{backend}"),
+        ) {
+            Ok(r) => r,
+            Err(e) => {
+                ci.fail(e);
+                continue;
+            }
+        };
+        print!("{}", run.log);
+        if run.status != Some(0) {
+            ci.fail(format!(
+                "self-test ({backend}) exited {:?}, not 0 (its log: {})",
+                run.status,
+                ci.rel(&run.log_path)
+            ));
+        }
+        check_instruction_counts(ci, backend, &run.log);
+        compare_log(ci, backend, &run.log);
+        if v.backend == Backend::Libm {
+            inject_failures(ci, elf);
+        }
+    }
+}
+
+/// The instruction counts are SysTick counts × `INSTRUCTIONS_PER_TICK`: each must be a whole
+/// number of counts, and the `update` line must be there (the budget is checked on the target).
+fn check_instruction_counts(ci: &mut Ci, backend: &str, log: &str) {
+    if !log.contains("update instructions: max=") {
+        ci.fail(format!(
+            "self-test ({backend}): no `update instructions: max=` line in its log"
+        ));
+        return;
+    }
+    let counts: Vec<u64> = log
+        .lines()
+        .filter(|l| l.contains("instructions"))
+        // The counts: `~N` and `max=N mean=N` (not the `2^9` of the box corners).
+        .flat_map(|l| l.split_whitespace())
+        .filter_map(|t| {
+            t.trim_start_matches(|c: char| !c.is_ascii_digit())
+                .parse::<u64>()
+                .ok()
+        })
+        .collect();
+    if let Some(n) = counts
+        .iter()
+        .find(|&&n| !n.is_multiple_of(u64::from(INSTRUCTIONS_PER_TICK)))
+    {
+        ci.fail(format!(
+            "self-test ({backend}): {n} instructions is not a whole number of SysTick counts ({INSTRUCTIONS_PER_TICK} instructions each, firmware::qemu_clock): is the runner's -icount shift the one the firmware assumes?"
+        ));
+    }
+    let show = |f: &dyn Fn(u64) -> u64| {
+        counts
+            .iter()
+            .map(|&n| f(n).to_string())
+            .collect::<Vec<_>>()
+            .join(" / ")
+    };
+    println!(
+        "{backend}: instructions of Controller::new / update max / update mean: {} = {} SysTick counts of {INSTRUCTIONS_PER_TICK}",
+        show(&|n| n),
+        show(&|n| n / u64::from(INSTRUCTIONS_PER_TICK))
+    );
+}
+
+fn compare_log(ci: &mut Ci, backend: &str, log: &str) {
+    let rel = snapshot::selftest_log(backend);
+    let path = ci.root.join(&rel);
+    if ci.bless {
+        match std::fs::write(&path, log) {
+            Ok(()) => println!("blessed {rel}"),
+            Err(e) => ci.fail(format!("writing {rel}: {e}")),
+        }
+        return;
+    }
+    let snap = match std::fs::read_to_string(&path) {
+        Ok(s) => s,
+        Err(e) => {
+            ci.fail(format!(
+                "reading {rel}: {e} (cargo xtask selftest --bless writes it)"
+            ));
+            return;
+        }
+    };
+    let d = snapshot::diff(&snapshot::normalise(&snap), &snapshot::normalise(log));
+    if !d.is_empty() {
+        ci.fail(format!(
+            "self-test log ({backend}) differs from {rel} (- snapshot, + this run; numbers on instruction and stack lines are not compared):\n      {}\n    if the change is intended: cargo xtask selftest --bless, then review and commit the snapshot",
+            d.join("\n      ")
+        ));
+    }
+}
+
+/// Each injected failure must make the self-test fail, visibly: a non-zero exit and its line
+/// in the log.
+fn inject_failures(ci: &mut Ci, elf: &std::path::Path) {
+    ci.step("failure injection: each must fail visibly");
+    for (kind, evidence) in INJECTIONS {
+        let timeout = if kind == "hang" {
+            HANG_TIMEOUT_S
+        } else {
+            INJECTION_TIMEOUT_S
+        };
+        let arg = format!("inject={kind}");
+        let run = match qemu::run(
+            ci,
+            elf,
+            &["-append", &arg],
+            timeout,
+            &format!("inject-{kind}"),
+        ) {
+            Ok(r) => r,
+            Err(e) => {
+                ci.fail(e);
+                continue;
+            }
+        };
+        let shown = run.log.lines().find(|l| l.contains(evidence));
+        println!(
+            "inject={kind} → exit {:?}: {}",
+            run.status,
+            shown.unwrap_or("(no evidence line)")
+        );
+        let failed = match kind {
+            "hang" => run.status == Some(TIMED_OUT),
+            _ => matches!(run.status, Some(s) if s != 0 && s != TIMED_OUT),
+        };
+        if !failed || shown.is_none() {
+            ci.fail(format!(
+                "inject={kind} did not fail visibly: exit {:?}, expected {} and a line with `{evidence}` (log: {})",
+                run.status,
+                if kind == "hang" { "the runner's timeout (124)" } else { "a failure exit" },
+                ci.rel(&run.log_path)
+            ));
+        }
+    }
+}
