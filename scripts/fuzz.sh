@@ -27,7 +27,7 @@ if ! cargo +nightly fuzz --version >/dev/null 2>&1; then
 fi
 
 # Longest input worth generating: controller_update reads 75 bytes; frame_decoder needs room
-# for a few frames of up to 95 bytes and for oversize ones.
+# for a few frames of up to auv_link::MAX_FRAME bytes and for oversize ones.
 max_len() {
     case "$1" in
         controller_update) echo 128 ;;

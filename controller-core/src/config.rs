@@ -2,7 +2,7 @@
 //! [`Controller`](crate::controller::Controller).
 //!
 //! Validation is where every configuration-time number is computed (P, ‖K‖, the bounds over the
-//! Table-3 box, the allocation inverse) and every check of the paper and of AUV150.md §4 and §8
+//! Table-3 box, the allocation inverse) and every check of the paper and of docs/design.md §4 and §8
 //! is made. A failed check is a [`ConfigError`] that names the check and its numbers; a
 //! configuration is never run silently out of its assumptions.
 
@@ -14,11 +14,12 @@ use crate::law::{RobustLaw, CONTROLLED, ROLL};
 use crate::model::VehicleParams;
 use crate::uncertainty::{BoundsError, ParamBox};
 
-/// Which bound on ‖b‖ = ‖M̄⁻¹‖ enters δ(e,t) (AUV150.md §4 **Choice**).
+/// Which bound on ‖b‖ = ‖M̄⁻¹‖ enters δ(e,t) (docs/design.md §4 **Choice**).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BBound {
     /// c_b · max(1, 1/|cos θ|) with c_b = sup‖S₀ M(p)⁻¹‖₂ over the controlled rows u, v, w, q, r.
-    /// δ ≈ 4–7 on the paper's missions; the default.
+    /// δ stays in single digits on the paper's missions (`cargo run -p controller-core
+    /// --example track` prints it); the default.
     ControlledRows,
     /// The literal ‖M̄⁻¹‖ ≤ sup‖M(p)⁻¹‖₂ · max(1, 1/cos²θ): dominated by the unactuated roll
     /// inertia (17.1 kg m²), it gives δ ≈ 200, far more thrust demand and chattering, and needs a
@@ -45,13 +46,13 @@ pub struct ControllerConfig {
     pub robust: bool,
     /// Which ‖b‖ bound enters δ.
     pub b_bound: BBound,
-    /// Clamp on δ (AUV150.md §8): δ grows with ‖e‖, so an off-path start would ask for tens of
+    /// Clamp on δ (docs/design.md §8): δ grows with ‖e‖, so an off-path start would ask for tens of
     /// kN. The output reports when the clamp is active. Default 25.
     pub delta_max: f32,
     /// Control-loop rate (Hz). Time is `ticks / rate_hz`. Default 100.
     pub rate_hz: u32,
     /// |θ| beyond which the law faults instead of computing through the singularity of J
-    /// (AUV150.md §8), radians. Default 80°.
+    /// (docs/design.md §8), radians. Default 80°.
     pub pitch_limit: f32,
     /// Thruster supply limit: voltages are clamped to ±`voltage_limit` (V). Default
     /// [`DEFAULT_V_LIMIT`](crate::DEFAULT_V_LIMIT), the board's 24 V supply.
@@ -60,7 +61,7 @@ pub struct ControllerConfig {
     pub params: VehicleParams<f32>,
     /// Parameter box the bounds are taken over (Table 3).
     pub uncertainty: ParamBox<f32>,
-    /// Thruster positions and directions (AUV150.md §5 **Choice**).
+    /// Thruster positions and directions (docs/design.md §5 **Choice**).
     pub geometry: ThrusterGeometry,
 }
 
@@ -127,7 +128,7 @@ pub enum ConfigError {
     Assumption2 { beta_hat: f32, beta: f32 },
     /// Theorem 2 (Eq 25) as printed: λmaxλmin/(λmin − λmax) < λmin + λmin(ΔM).
     Theorem2 { lhs: f32, rhs: f32 },
-    /// AUV150.md §8: inside the boundary layer Δu is a gain δ/μ; the sampled loop needs
+    /// docs/design.md §8: inside the boundary layer Δu is a gain δ/μ; the sampled loop needs
     /// T·(k₂ + p₂₂ δ_max/μ) < 2 on every controlled axis.
     LoopRate {
         axis: usize,
@@ -244,7 +245,7 @@ impl fmt::Display for ConfigError {
                 mu,
             } => write!(
                 f,
-                "loop period {period} s is too long for axis {axis}: with δ_max = {delta_max} and μ = {mu} the boundary-layer gain needs T < {max_period} s (AUV150.md §8)"
+                "loop period {period} s is too long for axis {axis}: with δ_max = {delta_max} and μ = {mu} the boundary-layer gain needs T < {max_period} s (docs/design.md §8)"
             ),
             ConfigError::Allocation(e) => write!(f, "thruster allocation: {e:?}"),
         }

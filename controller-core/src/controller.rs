@@ -19,7 +19,7 @@ use crate::trajectory::Trajectory;
 use crate::uncertainty::UncertaintyBounds;
 
 /// Largest |position| accepted (m). Positions are relative to a mission origin near the
-/// vehicle (AUV150.md §8): f32 keeps ≈ 1 mm at 10 km.
+/// vehicle (docs/design.md §8): f32 keeps ≈ 1 mm at 10 km.
 pub const MAX_POSITION: f32 = 10_000.0;
 /// Largest |Euler angle| accepted (rad). Angles are wrapped internally; this only rejects
 /// absurd values.
@@ -41,7 +41,7 @@ pub enum Fault {
     NonFiniteInput = 1,
     /// η or ν is finite but outside the plausible range (see the `MAX_*` constants).
     InputOutOfRange = 2,
-    /// |θ| beyond the configured pitch limit (J is singular at ±90°, AUV150.md §8).
+    /// |θ| beyond the configured pitch limit (J is singular at ±90°, docs/design.md §8).
     PitchLimit = 3,
     /// An intermediate result was not finite (overflow on extreme but accepted inputs).
     NonFiniteResult = 4,
@@ -136,7 +136,7 @@ pub struct Output {
     pub saturated: u8,
     /// δ(e,t) after the clamp, Eq (29). Computed (and reported) also when Δu is off.
     pub delta: f32,
-    /// True when the δ clamp (AUV150.md §8) limited Δu this step (never when Δu is off).
+    /// True when the δ clamp (docs/design.md §8) limited Δu this step (never when Δu is off).
     pub delta_clamped: bool,
     /// ‖w‖ = ‖BᵀPe‖.
     pub w_norm: f32,
@@ -193,7 +193,7 @@ pub struct Controller {
 }
 
 impl Controller {
-    /// Validates `config` and precomputes the law's constants. Every check of AUV150.md §4
+    /// Validates `config` and precomputes the law's constants. Every check of docs/design.md §4
     /// and §8 is made here; see [`ConfigError`] for the list.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
         config.check_scalars()?;
@@ -223,7 +223,7 @@ impl Controller {
             k_norm = k_norm.max(libm::sqrtf(k1 * k1 + k2 * k2));
         }
 
-        // AUV150.md §8: Δu inside the boundary layer is the gain δ/μ on w, a closed-loop pole
+        // docs/design.md §8: Δu inside the boundary layer is the gain δ/μ on w, a closed-loop pole
         // near −(k₂ + p₂₂ δ/μ); forward-Euler sampling of it is stable for T·(…) < 2. The
         // discontinuous law has no such pole (it chatters, bounded by δ), so only the
         // nominal gain is checked for it.

@@ -1,6 +1,6 @@
 //! Kinematics of Eq (2): η̇ = J(η) ν, J = diag(R(φ,θ,ψ), T(φ,θ)), and the terms of Eq (3).
 //!
-//! Fossen's zyx convention (AUV150.md §1): R = R_z(ψ) R_y(θ) R_x(φ) and
+//! Fossen's zyx convention (docs/design.md §1): R = R_z(ψ) R_y(θ) R_x(φ) and
 //! T = [[1, sφ tθ, cφ tθ], [0, cφ, −sφ], [0, sφ/cθ, cφ/cθ]]. J is singular at θ = ±90°: every
 //! function that divides by cos θ returns [`GimbalLock`] there instead of a non-finite number.
 //! J⁻¹ = diag(Rᵀ, T⁻¹) needs no division and is always defined.
@@ -47,7 +47,7 @@ impl<T: RealField + Copy> Attitude<T> {
     }
 
     /// |cos θ| below which T(φ, θ) is treated as singular: ≈ 0.006° from ±90°, far beyond the
-    /// controller's pitch fault (80° by default, AUV150.md §8).
+    /// controller's pitch fault (80° by default, docs/design.md §8).
     pub fn gimbal_threshold() -> T {
         nalgebra::convert(1e-4)
     }
@@ -200,7 +200,7 @@ pub fn jacobian_dot<T: RealField + Copy>(
     Ok(jd)
 }
 
-/// J⁻¹ J̇ ν in closed form (AUV150.md §4): [ω × v; T⁻¹ Ṫ ω]. This is the term of Eq (3)
+/// J⁻¹ J̇ ν in closed form (docs/design.md §4): [ω × v; T⁻¹ Ṫ ω]. This is the term of Eq (3)
 /// (ν̇ = J⁻¹(η̈ − J̇ν)) that the inversion-free law needs.
 pub fn jinv_jdot_nu<T: RealField + Copy>(
     a: &Attitude<T>,

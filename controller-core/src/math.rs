@@ -86,7 +86,7 @@ pub fn norm<const N: usize>(v: &[f32; N]) -> f32 {
 
 /// Wraps an angle to (−π, π] with a fixed amount of work (no loop).
 ///
-/// Used for the yaw component of e₁ (AUV150.md §4, **Choice**) and for trajectory phases.
+/// Used for the yaw component of e₁ (docs/design.md §4, **Choice**) and for trajectory phases.
 /// Non-finite input gives NaN (the caller checks finiteness). Fossen's `ssa` (smallest signed
 /// angle, which returns [−π, π) where this returns (−π, π]) and MATLAB's `wrapToPi`.
 #[doc(alias("ssa", "wrapToPi"))]
@@ -105,7 +105,7 @@ pub fn wrap_pi(x: f32) -> f32 {
 
 /// Reduces the phase ω·t, with t = `ticks` / `rate_hz` seconds, to [0, 2π] (up to one rounding
 /// either side; callers wrap before sin/cos) in f64 before it
-/// becomes f32 (AUV150.md §8, "Time"): an f32 `t` would lose a millisecond per tick after a few
+/// becomes f32 (docs/design.md §8, "Time"): an f32 `t` would lose a millisecond per tick after a few
 /// hours, and ω·t in f32 loses the phase itself. Fixed work (one floor, no loop).
 #[inline]
 pub fn phase(omega: f32, ticks: u64, rate_hz: u32) -> f32 {

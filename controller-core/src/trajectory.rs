@@ -3,7 +3,7 @@
 //! This module owns the desired state fed to the control law (ū = η̈_d − K₁e₁ − K₂e₂, Eq 17, with
 //! e₁ = η − η_d and e₂ = η̇ − η̇_d, Eqs 12–13) and the bound K_d ≥ ‖η̈_d(t)‖ of Assumption 1
 //! (Eq 19) that enters δ (Eq 29). The missions are the paper's "Simulation Results" section, as
-//! cleaned up in AUV150.md §6; all have φ_d = θ_d = 0 (and zero roll/pitch rates):
+//! cleaned up in docs/design.md §6; all have φ_d = θ_d = 0 (and zero roll/pitch rates):
 //!
 //! | kind | x_d | y_d | z_d | ψ_d |
 //! |---|---|---|---|---|
@@ -15,7 +15,7 @@
 //! The paper's values are ω = 0.1 (circle, figure-eight) and ω = 0.05 (lawn-mower, so that
 //! 2ω = 0.1 in x_d), depth 5 m. The helix is ours (a circle that changes depth).
 //!
-//! **Choices** (AUV150.md §6):
+//! **Choices** (docs/design.md §6):
 //! * The circle's printed "x_d = 10 sin(0.1)t" is read as R sin(0.1t) (a misplaced parenthesis:
 //!   y_d = 10 cos(0.1t) beside it and the circular plot fix it).
 //! * Both heading series use the prefactor 8/π (it makes the triangle and the trapezoid reach
@@ -25,7 +25,7 @@
 //!   even n), so only n = 1, 3, 5, 7, 9 are evaluated.
 //! * All derivatives are analytic (term-by-term derivatives of the truncated series).
 //!
-//! **Time and precision** (AUV150.md §8): time is the integer tick count; no f32 `t` is ever
+//! **Time and precision** (docs/design.md §8): time is the integer tick count; no f32 `t` is ever
 //! formed. For each base frequency one phase θ = ω·t is reduced modulo 2π in f64
 //! ([`math::phase`]); harmonics use n·θ (n an integer, so n·θ ≡ nωt mod 2π), wrapped to (−π, π]
 //! before the f32 `sin`/`cos`. Terms linear in t (lawn-mower surge advance, helix depth rate)
@@ -37,7 +37,7 @@
 //! without bound and wraps once per revolution. The truncated lawn-mower series overshoots π
 //! on its plateau (its maximum is ≈ 3.198 rad), so there too ψ_d jumps by 2π while the
 //! heading itself is continuous; ψ̇_d and ψ̈_d are continuous everywhere. Consumers compare
-//! headings modulo 2π (AUV150.md §4 wraps the yaw error).
+//! headings modulo 2π (docs/design.md §4 wraps the yaw error).
 //!
 //! Every [`Trajectory::sample`] does a fixed amount of work (a `match` on the kind and, for the
 //! series, a loop over a constant five harmonics), never allocates and never panics.
@@ -63,7 +63,7 @@ pub struct Desired {
     pub eta_ddot: Vector6<f32>,
 }
 
-/// Shape and parameters of a mission (the paper's "Simulation Results"; AUV150.md §6).
+/// Shape and parameters of a mission (the paper's "Simulation Results"; docs/design.md §6).
 ///
 /// All frequencies ω are in rad/s and must be positive; sizes in metres; z is positive down (NED).
 ///
@@ -208,7 +208,7 @@ impl fmt::Display for TrajectoryError {
     }
 }
 
-/// The six missions of the paper's Table 1 (AUV150.md §6–7).
+/// The six missions of the paper's Table 1 (docs/design.md §6–7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Table1Case {
     /// Circle, R = 10 m.
@@ -337,7 +337,7 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
-    /// N, the last harmonic of the heading series (AUV150.md §6 **Choice**: truncate at N = 9).
+    /// N, the last harmonic of the heading series (docs/design.md §6 **Choice**: truncate at N = 9).
     pub const SERIES_TERMS: u32 = 9;
     /// The paper's ω for the circle and the figure-eight (rad/s).
     pub const PAPER_OMEGA: f32 = 0.1;

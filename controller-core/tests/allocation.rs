@@ -21,7 +21,7 @@ fn wrench() -> impl Strategy<Value = [f32; 6]> {
     proptest::array::uniform6(-1.0e4f32..1.0e4)
 }
 
-/// AUV150.md §5 closed form, in f64.
+/// docs/design.md §5 closed form, in f64.
 fn closed_form(tau: &[f32; 6]) -> [f64; 5] {
     let [x, y, z, _k, m, n] = tau.map(|v| v as f64);
     [

@@ -39,7 +39,7 @@ fn on_the_reference_the_errors_and_w_vanish_and_delta_is_the_model_bound() {
             assert_eq!(out.status, Status::Ok);
             assert!(out.w_norm < tol, "{case:?}: ‖w‖ = {}", out.w_norm);
             assert!(out.e1.iter().all(|e| e.abs() < tol));
-            // δ ≈ 4–7 on the paper's missions with the controlled-rows bound (AUV150.md §4).
+            // δ stays in single digits on the paper's missions with the controlled-rows bound (docs/design.md §4).
             assert!(
                 out.delta > 1.0 && out.delta < 10.0,
                 "{case:?}: δ = {}",
@@ -121,7 +121,7 @@ fn voltages_respect_the_supply_limit_and_report_saturation() {
     let tr = Trajectory::table1(Table1Case::Circular20R);
     let (eta, nu) = on_reference(&tr, 0);
     let out = c.update(0, &eta, &nu, &tr);
-    // The paper's missions need far more than ±24 V gives (AUV150.md §5).
+    // The paper's missions need far more than ±24 V gives (docs/design.md §5).
     assert!(out.saturated != 0);
     assert!(out.voltage.iter().all(|v| v.abs() <= 24.0));
     // What is reported as achieved is what B gives for the achieved thrusts, and it is

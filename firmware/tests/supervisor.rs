@@ -145,7 +145,7 @@ fn config_changes_only_while_disarmed_and_only_if_valid() {
     s.on_envelope(&env(Msg::Command(Command::Disarm)));
     s.on_envelope(&patch(50));
     assert_eq!(s.rate_hz(), 50);
-    s.on_envelope(&patch(5)); // violates the loop-rate check of AUV150.md §8
+    s.on_envelope(&patch(5)); // violates the loop-rate check of docs/design.md §8
     assert_eq!(s.rate_hz(), 50);
     assert_eq!(s.rejected_commands(), 2);
 }

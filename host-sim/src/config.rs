@@ -7,7 +7,7 @@
 use controller_core::model::ParamVariation;
 use controller_core::{ControllerConfig, Table1Case, TrajectoryKind};
 
-/// How the plant's parameters vary with time (Table 3, AUV150.md §2). Δp is added to the
+/// How the plant's parameters vary with time (Table 3, docs/design.md §2). Δp is added to the
 /// nominal parameters of the **plant only**; the controller keeps the nominal model.
 #[derive(Clone, Debug, PartialEq)]
 pub enum VariationProfile {
@@ -44,7 +44,7 @@ impl VariationProfile {
     }
 }
 
-/// Earth-fixed ocean current (AUV150.md §2): the plant sees ν_r = ν − [Rᵀ v_c; 0] in C_A and D.
+/// Earth-fixed ocean current (docs/design.md §2): the plant sees ν_r = ν − [Rᵀ v_c; 0] in C_A and D.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CurrentModel {
     None,
@@ -165,7 +165,7 @@ pub struct SimConfig {
     /// First-order thruster lag time constant (s), if any.
     pub thruster_lag: Option<f64>,
     /// Ideal actuators: the thrusters deliver the allocated thrust whatever the voltage limit
-    /// (the Table-1 reproduction; AUV150.md §5). Voltages are still computed and reported.
+    /// (the Table-1 reproduction; docs/design.md §5). Voltages are still computed and reported.
     pub ideal_actuators: bool,
     /// Added to η(0) = η_d(0) (m, rad).
     pub initial_offset: [f64; 6],

@@ -1,4 +1,4 @@
-//! The paper's Table-1 metrics (AUV150.md §7) from a run's samples.
+//! The paper's Table-1 metrics (docs/design.md §7) from a run's samples.
 
 use crate::record::{Metrics, Sample};
 

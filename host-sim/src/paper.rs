@@ -1,4 +1,4 @@
-//! Everything about the paper's Table 1, keyed by [`Table1Case`] (AUV150.md §6–7): each case's
+//! Everything about the paper's Table 1, keyed by [`Table1Case`] (docs/design.md §6–7): each case's
 //! run ([`config`]: its mission, its Table-3 variation profile, the paper's controller), the
 //! lawn-mowers' Table-3 staircase, the paper's printed numbers ([`table1_row`]), the report's
 //! notes on how our runs were made, and the twelve runs themselves ([`run_all`]).
@@ -83,7 +83,7 @@ pub struct PaperRow {
     pub path: [f64; 2],
 }
 
-/// The paper's Table 1 (AUV150.md §7): its row for `case`.
+/// The paper's Table 1 (docs/design.md §7): its row for `case`.
 pub fn table1_row(case: Table1Case) -> PaperRow {
     let row = |x: [f64; 2], y: [f64; 2], z: [f64; 2], path: [f64; 2]| PaperRow { x, y, z, path };
     match case {
@@ -137,9 +137,9 @@ pub const NOTES: &str = "\
   zero-order hold; paper gains K₁ = K₂ = diag(4,4,4,0,4,4), β = 0.605, μ = 0.1, Theorem 4.
 - Actuators: ideal (the allocated thrusts are delivered). The voltages in the table are what
   the controller commanded at the board's ±24 V supply limit: the paper's missions need far
-  more thrust than Eqs 31–32 give at 24 V, so a real board would saturate (AUV150.md §5).
+  more thrust than Eqs 31–32 give at 24 V, so a real board would saturate (docs/design.md §5).
 - The paper does not state its step size, integrator or loop rate; differences in the
-  \"without Δu\" column come mostly from that and from the choices listed in AUV150.md.
+  \"without Δu\" column come mostly from that and from the choices listed in docs/design.md.
 ";
 
 /// Runs all six cases with and without Δu in parallel; returns (with, without) per case in

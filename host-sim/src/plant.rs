@@ -2,7 +2,7 @@
 //!
 //! M_RB ν̇ + C_RB(ν) ν + M_A ν̇_r + C_A(ν_r) ν_r + D(ν_r) ν_r + g(η) = τ,  η̇ = J(η) ν,
 //!
-//! with ν_r = ν − ν_c, ν_c = [Rᵀ v_c; 0] for an earth-fixed current v_c (AUV150.md §2). The
+//! with ν_r = ν − ν_c, ν_c = [Rᵀ v_c; 0] for an earth-fixed current v_c (docs/design.md §2). The
 //! matrices come from `controller_core::model` with the plant's (varying) parameters, so the
 //! plant and the controller share one implementation of Eq (1) and differ only in parameters.
 //!

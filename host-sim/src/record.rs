@@ -109,7 +109,7 @@ impl fmt::Display for Outcome {
     }
 }
 
-/// The paper's Table-1 metrics (AUV150.md §7) and the actuator figures.
+/// The paper's Table-1 metrics (docs/design.md §7) and the actuator figures.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
     pub max_x: f64,

@@ -150,7 +150,7 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
     let alloc_b = controller.allocation().matrix().cast::<f64>();
     let maps = thruster::default_maps();
 
-    // Start on the reference (AUV150.md §6), plus the configured offset.
+    // Start on the reference (docs/design.md §6), plus the configured offset.
     let d0 = trajectory.sample(0, rate);
     let mut state = PlantState {
         eta: d0.eta.cast::<f64>() + Vector6::from(cfg.initial_offset),

@@ -307,7 +307,7 @@ fn plot_case_survives_empty_single_and_nan_runs() {
 
 #[test]
 fn paper_table1_matches_the_spec() {
-    // AUV150.md §7, [without, with] Δu.
+    // docs/design.md §7, [without, with] Δu.
     let table: [(&str, [f64; 8]); 6] = [
         (
             "circular-10R",

@@ -194,7 +194,7 @@ pub fn table_text(rows: &[ReportRow]) -> String {
         s.push_str(&fmt_row(r));
     }
     if rows.iter().any(|r| r.case.is_some()) {
-        s.push_str("max errors as ours (paper's Table 1, AUV150.md §7)\n");
+        s.push_str("max errors as ours (paper's Table 1, docs/design.md §7)\n");
     }
     s
 }
@@ -234,7 +234,7 @@ pub fn write_report(
     let _ = writeln!(s, "# {title}\n");
     s.push_str(
         "Maximum errors over each run in metres as **ours (paper)**, the paper's numbers from \
-         its Table 1 (AUV150.md §7) where the case is one of its six; path = \
+         its Table 1 (docs/design.md §7) where the case is one of its six; path = \
          √(max|e_x|² + max|e_y|² + max|e_z|²), rms path = √mean(e_x² + e_y² + e_z²). Angles in \
          rad. Peak |V| is the largest thruster voltage commanded; saturated is the fraction of \
          control periods with at least one thruster at the supply limit.\n\n",
