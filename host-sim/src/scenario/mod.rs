@@ -117,9 +117,12 @@ use controller_core::{Controller, Trajectory};
 use crate::config::SimConfig;
 
 mod check;
+mod exact;
 mod parse;
 
-pub use check::{MAX_DURATION, MAX_PLANT_STEP};
+pub use check::{
+    MAX_CONTROL_PERIODS, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS, MAX_VARIATION_OMEGA_STEP,
+};
 pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
 
 /// Why a scenario could not be loaded or validated.
@@ -186,7 +189,7 @@ impl Scenario {
     pub fn new(config: SimConfig) -> Result<Self, ScenarioError> {
         let controller = check::controller(&config)?;
         let trajectory = check::trajectory(&config.trajectory)?;
-        Self::assemble(config, controller, trajectory)
+        Self::assemble(config, controller, trajectory, true)
     }
 
     /// This scenario with `change` applied to its configuration, validated again. The built
@@ -205,15 +208,23 @@ impl Scenario {
         } else {
             check::trajectory(&config.trajectory)?
         };
-        Self::assemble(config, controller, trajectory)
+        // The mission's reference depends only on these (a Monte Carlo draw keeps them all).
+        let same_mission = config.controller == self.config.controller
+            && config.trajectory == self.config.trajectory
+            && config.duration == self.config.duration;
+        Self::assemble(config, controller, trajectory, !same_mission)
     }
 
     fn assemble(
         config: SimConfig,
         controller: Controller,
         trajectory: Trajectory,
+        check_mission: bool,
     ) -> Result<Self, ScenarioError> {
         let (steps, substeps) = check::run(&config)?;
+        if check_mission {
+            check::mission(&config, &controller, &trajectory, steps)?;
+        }
         Ok(Scenario {
             config,
             controller,
@@ -269,6 +280,13 @@ pub fn parse_scenario(text: &str) -> Result<Scenario, ScenarioError> {
 /// Reads, parses and validates a scenario file. A scenario without `name` takes the file stem.
 /// A read error carries the path.
 pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
+    Scenario::new(load_config(path)?)
+}
+
+/// Reads and parses a scenario file into its [`SimConfig`], not yet validated (for a caller
+/// that sets what a file cannot, e.g. [`SimConfig::allow_long_run`], before
+/// [`Scenario::new`]). A scenario without `name` takes the file stem.
+pub fn load_config(path: &Path) -> Result<SimConfig, ScenarioError> {
     let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
         path: path.to_path_buf(),
         source,
@@ -278,5 +296,5 @@ pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
         .and_then(|s| s.to_str())
         .filter(|s| !s.is_empty())
         .unwrap_or(DEFAULT_NAME);
-    Scenario::new(parse::parse(&text, stem)?)
+    parse::parse(&text, stem)
 }
