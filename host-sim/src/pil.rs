@@ -139,7 +139,8 @@ pub struct BoardInTheLoop {
     faults: LinkFaults,
     mission: auv_link::MissionSpec,
     started: bool,
-    history: Vec<StateFrame>,
+    /// The last `delay_ticks + 1` state frames (what a delayed frame is taken from).
+    history: std::collections::VecDeque<StateFrame>,
     pending: std::collections::VecDeque<Telemetry>,
     last_tick: Option<u64>,
     last_status: Option<BoardStatus>,
@@ -152,20 +153,20 @@ pub struct BoardInTheLoop {
 impl BoardInTheLoop {
     /// Starts QEMU with `elf` (the QEMU flying image), waits for its UART to connect, and
     /// configures and arms the board. `runner` is `scripts/qemu-run.sh`; QEMU's decoded log
-    /// goes to `log_path`.
+    /// goes to `log` (opened by the caller, who decides where and how it is written), which
+    /// messages call `log_path`.
     pub fn start(
         elf: &Path,
         runner: &Path,
         cfg: &SimConfig,
         faults: LinkFaults,
+        log: std::fs::File,
         log_path: &Path,
     ) -> Result<Self, String> {
         check_flying_image(elf)?;
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
-        let log = std::fs::File::create(log_path)
-            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
         let log_err = log.try_clone().map_err(|e| e.to_string())?;
         let child = Command::new("bash")
             // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
@@ -211,7 +212,7 @@ impl BoardInTheLoop {
             faults,
             mission: auv_link::MissionSpec::from(cfg.trajectory),
             started: false,
-            history: Vec::new(),
+            history: std::collections::VecDeque::new(),
             pending: std::collections::VecDeque::new(),
             last_tick: None,
             last_status: None,
@@ -378,7 +379,10 @@ impl ControlSource for BoardInTheLoop {
             eta: *eta,
             nu: *nu,
         };
-        self.history.push(frame);
+        self.history.push_back(frame);
+        if self.history.len() > (self.faults.delay_ticks as usize).saturating_add(1) {
+            self.history.pop_front();
+        }
         let silent = LinkFaults::any(&self.faults.silent, k);
         let dropped = LinkFaults::any(&self.faults.drop, k);
         let corrupt = LinkFaults::any(&self.faults.corrupt, k);

@@ -48,6 +48,8 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     let scratch = ci.scratch();
     let run = |ci: &mut Ci, name: &str, args: &[&str]| -> Option<(bool, Case)> {
         let out = scratch.join(format!("pil-{name}"));
+        // host-sim refuses an output folder it did not write (no manifest): start afresh.
+        let _ = std::fs::remove_dir_all(&out);
         let mut cmd = Command::new(host_sim);
         cmd.current_dir(&ci.root)
             .arg("pil")
