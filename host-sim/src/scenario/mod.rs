@@ -28,12 +28,14 @@
 //! name = "circular-10R"       # file-name safe; default: the file stem (load_scenario) or "scenario"
 //! table1_case = "circular-10R" # this run is that case of the paper's Table 1: reports print
 //!                             # the paper's numbers beside ours; default: none
-//! duration = 70.0             # s, (0, 86400]
+//! duration = 70.0             # s, (0, 86400]; and the step cap below
 //! plant_step = 0.001          # s, (0, 0.1] and ≤ the control period 1/rate_hz
 //! ideal_actuators = true      # thrusters deliver the allocated thrust whatever the voltage limit
 //! initial_offset = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # added to η(0) = η_d(0), m and rad
 //! divergence_limit = 50.0     # m, > 0
 //! thruster_lag = 0.1          # s, > 0; leave out for no lag
+//! expect_faults = false       # true: periods with the controller in fail-safe are reported but
+//!                             # do not fail the command (else exit 3); default false
 //!
 //! [trajectory]                # required
 //! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix"
@@ -96,6 +98,24 @@
 //! delay_ticks = 5             # default 5
 //! silent = ["300..310"]       # nothing sent at all
 //! ```
+//!
+//! **Arrays** have exactly the length shown (`k1` six numbers, `q` two, `velocity` three…):
+//! more or fewer entries, or an entry that is not a number, is an error at the key.
+//!
+//! **Limits checked with the run as a whole** (each refusal names its key and says why):
+//! - the step cap: at most [`MAX_CONTROL_PERIODS`] control periods (duration × rate_hz) and
+//!   [`MAX_PLANT_STEPS`] plant steps (one day at 100 Hz and 1 ms), unless
+//!   [`SimConfig::allow_long_run`] (the CLI's `--allow-long-run`); never beyond 2⁵³;
+//! - `current.tau` ≥ `plant_step` (Euler–Maruyama of the Gauss–Markov current is unstable
+//!   below half the step, and its variance is σ²/(1 − h/2τ));
+//! - `variation.omega` · `plant_step` ≤ [`MAX_VARIATION_OMEGA_STEP`] (the plant resolves the
+//!   variation; 1e308 used to give NaN parameters);
+//! - the reference stays inside what the controller accepts as input
+//!   (`controller_core::controller::MAX_POSITION`, `MAX_LINEAR_SPEED`, `MAX_ANGULAR_RATE`;
+//!   checked at every tick up to 10⁵ ticks, else at 10⁵ evenly spaced ones): a faster or
+//!   longer mission would be flown in fail-safe;
+//! - the law does not overflow f32 on the reference itself (gains like k1 = 1e30, which the
+//!   loop-rate rule on k2 does not catch, made every update a fail-safe).
 //!
 //! **Δ fields of `constant` and `abs-sin`** (their names:
 //! [`VARIED_PARAMETER_NAMES`](controller_core::model::VARIED_PARAMETER_NAMES)): with none of
