@@ -7,7 +7,7 @@
 //! host-sim                                   # = host-sim table1
 //! host-sim table1 [--json] [--out DIR]
 //! host-sim run --scenario FILE.toml [--json] [--out DIR]
-//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--json] [--out DIR]
+//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! ```
 //!
@@ -113,6 +113,11 @@ pub struct PilArgs {
     /// target/thumbv7em-none-eabihf/release/firmware-qemu].
     #[arg(long)]
     pub elf: Option<PathBuf>,
+    /// Sign the link with this key file (`#` comment lines, then 64 hex digits; e.g.
+    /// firmware/ci-test-link-key.hex): the board is started with it, and both ends refuse
+    /// unsigned frames. Without it the link is unsigned.
+    #[arg(long)]
+    pub link_key_file: Option<PathBuf>,
     /// Override the scenario's duration (s).
     #[arg(long)]
     pub duration: Option<f64>,
@@ -336,6 +341,17 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .clone()
         .unwrap_or_else(|| crate::pil::default_elf(&root));
     let runner = root.join("scripts/qemu-run.sh");
+    let key = match &args.link_key_file {
+        None => None,
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("reading the link key file {}", p.display()))?;
+            Some(
+                auv_link::sign::LinkKey::from_key_file(&text)
+                    .map_err(|e| anyhow!("{}: {e}", p.display()))?,
+            )
+        }
+    };
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let pb = progress(scenarios.len(), "PIL", args.json);
@@ -346,8 +362,15 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         let cfg = s.config();
         let sil_run = sil::run(s);
         let log = args.out.join(format!("{}-qemu.log", cfg.name));
-        let mut board = BoardInTheLoop::start(&elf, &runner, cfg, cfg.link_faults.clone(), &log)
-            .map_err(|e| anyhow!("{}: {e}", cfg.name))?;
+        let mut board = BoardInTheLoop::start(
+            &elf,
+            &runner,
+            cfg,
+            cfg.link_faults.clone(),
+            &log,
+            key.as_ref(),
+        )
+        .map_err(|e| anyhow!("{}: {e}", cfg.name))?;
         let pil_run = sil::run_with(s, &mut board);
         let stats = board.finish();
         pb.inc(1);
@@ -393,11 +416,12 @@ fn pil_notes(cases: &[PilComparison]) -> String {
     let mut notes = String::from(
         "## Processor in the loop vs software in the loop\n\n\
          | case | PIL max path (m) | SIL max path (m) | PIL − SIL (m) | frames/s | worst update \
-         (instructions) | fail-safe events | re-arms |\n|---|---|---|---|---|---|---|---|\n",
+         (instructions) | fail-safe events | re-arms | signed | board drops (old / auth) | \
+         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cases {
         notes += &format!(
-            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} |\n",
+            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
             c.run.name,
             c.run.metrics.max_path,
             c.sil_max_path,
@@ -406,6 +430,13 @@ fn pil_notes(cases: &[PilComparison]) -> String {
             c.pil.worst_update_instructions,
             c.pil.failsafe_events.len(),
             c.pil.rearms,
+            if c.pil.signed { "yes" } else { "no" },
+            c.pil.board_rx_stale,
+            c.pil.board_rx_auth_errors,
+            match &c.pil.board_last_refusal {
+                Some(r) => format!("{} (last: {r})", c.pil.board_refused_commands),
+                None => c.pil.board_refused_commands.to_string(),
+            },
         );
     }
     notes
