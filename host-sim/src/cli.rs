@@ -7,7 +7,7 @@
 //! host-sim                                   # = host-sim table1
 //! host-sim table1 [--json] [--out DIR]
 //! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
-//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--json] [--out DIR]
+//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! ```
 //!
@@ -157,6 +157,11 @@ pub struct PilArgs {
     /// target/thumbv7em-none-eabihf/release/firmware-qemu].
     #[arg(long)]
     pub elf: Option<PathBuf>,
+    /// Sign the link with this key file (`#` comment lines, then 64 hex digits; e.g.
+    /// firmware/ci-test-link-key.hex): the board is started with it, and both ends refuse
+    /// unsigned frames. Without it the link is unsigned.
+    #[arg(long)]
+    pub link_key_file: Option<PathBuf>,
     /// Override the scenario's duration (s); the scenario's limits apply to it.
     #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
@@ -525,6 +530,17 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .unwrap_or_else(|| crate::pil::default_elf(&root));
     crate::pil::check_flying_image(&elf).map_err(|e| anyhow!(e))?;
     let runner = root.join("scripts/qemu-run.sh");
+    let key = match &args.link_key_file {
+        None => None,
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("reading the link key file {}", p.display()))?;
+            Some(
+                auv_link::sign::LinkKey::from_key_file(&text)
+                    .map_err(|e| anyhow!("{}: {e}", p.display()))?,
+            )
+        }
+    };
     let dir = OutputDir::prepare(&args.out)?;
     // Each scenario runs twice: SIL, then PIL.
     let progress = Progress::start("PIL", 2 * periods(&scenarios), !args.json);
@@ -548,6 +564,7 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
             cfg.link_faults.clone(),
             log_file,
             &log_path,
+            key.as_ref(),
         );
         let mut board = match started {
             Ok(b) => b,
@@ -609,11 +626,12 @@ fn pil_notes(cases: &[PilComparison]) -> String {
     let mut notes = String::from(
         "## Processor in the loop vs software in the loop\n\n\
          | case | PIL max path (m) | SIL max path (m) | PIL − SIL (m) | frames/s | worst update \
-         (instructions) | fail-safe events | re-arms |\n|---|---|---|---|---|---|---|---|\n",
+         (instructions) | fail-safe events | re-arms | signed | board drops (old / auth) | \
+         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cases {
         notes += &format!(
-            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} |\n",
+            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
             c.run.name,
             c.run.metrics.max_path,
             c.sil_max_path,
@@ -622,6 +640,13 @@ fn pil_notes(cases: &[PilComparison]) -> String {
             c.pil.worst_update_instructions,
             c.pil.failsafe_events.len(),
             c.pil.rearms,
+            if c.pil.signed { "yes" } else { "no" },
+            c.pil.board_rx_stale,
+            c.pil.board_rx_auth_errors,
+            match &c.pil.board_last_refusal {
+                Some(r) => format!("{} (last: {r})", c.pil.board_refused_commands),
+                None => c.pil.board_refused_commands.to_string(),
+            },
         );
     }
     notes
