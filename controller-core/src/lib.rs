@@ -19,4 +19,4 @@ pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Status};
 pub use law::RobustLaw;
 pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};
-pub use trajectory::{Desired, Table1Case, Trajectory, TrajectoryKind};
+pub use trajectory::{Desired, HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
