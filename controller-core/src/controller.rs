@@ -9,12 +9,13 @@
 use nalgebra::{Matrix6, Vector6};
 
 use crate::allocation::Allocation;
+use crate::allocator::Allocator;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
 use crate::kinematics::{self, Attitude};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
 use crate::model::{self, VehicleParams};
-use crate::thruster::{self, Actuation, ThrusterMap};
+use crate::thruster::{self, Actuation, Envelope, ThrusterMap};
 use crate::trajectory::Trajectory;
 use crate::uncertainty::UncertaintyBounds;
 
@@ -128,11 +129,16 @@ pub struct Output {
     pub tau: [f32; 6],
     /// Body force the thrusters actually give (B · achieved thrusts).
     pub tau_achieved: [f32; 6],
+    /// The part of τ the saturation-aware allocator could not give inside the thrusters'
+    /// envelopes (τ − B·T over the axes of each block that was not met; zero when every block
+    /// was met, and on the unactuated roll row). docs/design.md §9, §15.
+    pub tau_unallocated: [f32; 6],
     /// Achieved thrust per thruster (N), order [main, vert fore, vert aft, horz fore, horz aft].
     pub thrust: [f32; THRUSTERS],
     /// Voltage per thruster (V), within ±voltage_limit.
     pub voltage: [f32; THRUSTERS],
-    /// Bit i set: thruster i saturated.
+    /// Bit i set: thruster i saturated — it is on a bound of its envelope for a block the
+    /// allocator could not meet, or the voltage chain clipped it ([`thruster::actuate`]).
     pub saturated: u8,
     /// δ(e,t) after the clamp, Eq (29). Computed (and reported) also when Δu is off.
     pub delta: f32,
@@ -153,6 +159,7 @@ impl Output {
             status: Status::Fault(fault),
             tau: [0.0; 6],
             tau_achieved: [0.0; 6],
+            tau_unallocated: [0.0; 6],
             thrust: Actuation::OFF.thrusts,
             voltage: Actuation::OFF.voltages,
             saturated: 0,
@@ -168,6 +175,7 @@ impl Output {
         self.tau
             .iter()
             .chain(self.tau_achieved.iter())
+            .chain(self.tau_unallocated.iter())
             .chain(self.thrust.iter())
             .chain(self.voltage.iter())
             .chain(self.eta_d.iter())
@@ -187,7 +195,7 @@ pub struct Controller {
     lyapunov: [AxisLyapunov<f32>; 6],
     delta_constants: DeltaConstants,
     bounds: UncertaintyBounds<f32>,
-    allocation: Allocation,
+    allocator: Allocator,
     maps: [ThrusterMap; THRUSTERS],
     cos_pitch_limit: f32,
 }
@@ -198,6 +206,9 @@ impl Controller {
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
         config.check_scalars()?;
         let allocation = Allocation::new(&config.geometry)?;
+        let maps = thruster::default_maps();
+        let envelope = Envelope::new(&maps, config.thrust_unit, config.voltage_limit);
+        let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
         let bounds = UncertaintyBounds::compute(&config.params, &config.uncertainty)?;
         let beta_hat = bounds.beta_hat;
@@ -265,8 +276,8 @@ impl Controller {
             lyapunov,
             delta_constants,
             bounds,
-            allocation,
-            maps: thruster::default_maps(),
+            allocator,
+            maps,
             cos_pitch_limit: libm::cosf(config.pitch_limit),
             config,
         })
@@ -292,9 +303,20 @@ impl Controller {
         &self.lyapunov
     }
 
-    /// The thrust allocation.
+    /// The exact (unconstrained) thrust allocation B₅⁻¹.
     pub fn allocation(&self) -> &Allocation {
-        &self.allocation
+        self.allocator.allocation()
+    }
+
+    /// The saturation-aware allocator `update` flies (docs/design.md §9).
+    pub fn allocator(&self) -> &Allocator {
+        &self.allocator
+    }
+
+    /// Each thruster's envelope [T_min, T_max] (N) at the supply limit, in the configured
+    /// thrust unit's reading of Eqs 31–32.
+    pub fn envelope(&self) -> &Envelope {
+        self.allocator.envelope()
     }
 
     /// Nominal M̂.
@@ -384,20 +406,23 @@ impl Controller {
         if !tau.iter().all(|x| x.is_finite()) {
             return Err(Fault::NonFiniteResult);
         }
+        let alloc = self.allocator.allocate(&tau);
         let act = thruster::actuate(
             &self.maps,
-            &self.allocation.thrusts(&tau),
+            self.config.thrust_unit,
+            &alloc.thrusts,
             self.config.voltage_limit,
         );
-        let tau_achieved = self.allocation.wrench(&act.thrusts);
+        let tau_achieved = self.allocator.allocation().wrench(&act.thrusts);
 
         Ok(Output {
             status: Status::Ok,
             tau: tau.into(),
             tau_achieved: tau_achieved.into(),
+            tau_unallocated: alloc.unallocated,
             thrust: act.thrusts,
             voltage: act.voltages,
-            saturated: act.saturated,
+            saturated: alloc.saturated | act.saturated,
             delta,
             delta_clamped: self.config.robust && delta_clamped,
             w_norm,

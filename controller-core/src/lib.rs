@@ -3,6 +3,7 @@
 #![forbid(unsafe_code)]
 
 pub mod allocation;
+pub mod allocator;
 pub mod config;
 pub mod controller;
 pub mod effectiveness;
@@ -17,5 +18,5 @@ pub mod uncertainty;
 pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Status};
 pub use law::RobustLaw;
-pub use thruster::DEFAULT_V_LIMIT;
-pub use trajectory::{Desired, Table1Case, Trajectory, TrajectoryKind};
+pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};
+pub use trajectory::{Desired, HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
