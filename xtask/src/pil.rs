@@ -19,6 +19,10 @@ use crate::images::{Built, Variant};
 /// The key the signed PIL run uses (workspace-relative): public, for tests only.
 const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
 
+/// The workspace's host test profile (`[profile.host]` in Cargo.toml), whose `host-sim` the
+/// PIL checks run.
+const HOST_PROFILE: &str = "host";
+
 pub fn run(ci: &mut Ci, built: &Built) {
     ci.step(
         "processor in the loop: a short mission unsigned and signed (PIL must equal SIL) and a link-fault case",
@@ -27,13 +31,13 @@ pub fn run(ci: &mut Ci, built: &Built) {
         ci.fail("PIL: no QEMU flying image (its build failed, see above)");
         return;
     };
-    let what = "cargo build --release -p host-sim";
+    // The very build of the README's test command (scripts/test-all.sh), so that host-sim is
+    // built once: `cargo build -p host-sim` alone resolves features differently (no
+    // dev-dependencies) and would build host-sim a second time.
+    let args = ["test", "--workspace", "--profile", HOST_PROFILE, "--no-run"];
+    let what = format!("cargo {}", args.join(" "));
     println!("{what}");
-    match ci
-        .cargo()
-        .args(["build", "--release", "-p", "host-sim"])
-        .status()
-    {
+    match ci.cargo().args(args).status() {
         Ok(s) if s.success() => {}
         other => {
             ci.fail(format!(
@@ -42,7 +46,7 @@ pub fn run(ci: &mut Ci, built: &Built) {
             return;
         }
     }
-    let host_sim = ci.target_dir.join("release").join("host-sim");
+    let host_sim = ci.target_dir.join(HOST_PROFILE).join("host-sim");
     let elf = elf.to_path_buf();
     pil_checks(ci, &host_sim, &elf);
 }
