@@ -147,6 +147,9 @@ enum Auth {
     Forged,
 }
 
+/// A frame the harness built: its envelope and how it was signed.
+type Known = Option<(Envelope, Auth)>;
+
 /// What the board may have done: learnt only from the frames sent and the supervisor's public
 /// counters and telemetry.
 #[derive(Clone, Copy, Debug)]
@@ -216,7 +219,7 @@ struct Harness {
     forger: Signer,
     reflector: Signer,
     /// The last frames sent, and what each is (for replays).
-    history: Vec<(Vec<u8>, Option<(Envelope, Auth)>)>,
+    history: Vec<(Vec<u8>, Known)>,
     model: Model,
     stats: Stats,
 }
@@ -476,7 +479,7 @@ impl Harness {
         self.remember(frame, Some((env, auth)));
     }
 
-    fn remember(&mut self, frame: Vec<u8>, known: Option<(Envelope, Auth)>) {
+    fn remember(&mut self, frame: Vec<u8>, known: Known) {
         if self.history.len() == 8 {
             self.history.remove(0);
         }
@@ -510,7 +513,7 @@ impl Harness {
 
     /// Feeds `frame` to the board's end of the link and checks the supervisor's reaction
     /// against the model. `known`: the envelope and how it was signed, if it is a frame.
-    fn deliver(&mut self, frame: &[u8], known: Option<(Envelope, Auth)>) {
+    fn deliver(&mut self, frame: &[u8], known: Known) {
         let before = self.counters();
         let settings_before = settings(&self.sup);
         board::receive(&mut self.sup, &mut self.link, frame);
