@@ -120,6 +120,31 @@ fn replays_forgeries_and_the_wrong_signing_never_fly() {
     }
 }
 
+/// Found by the fuzz target: a peer holding the key that stamps a frame at 2⁴⁸ − 1 leaves the
+/// board no timestamp to sign its telemetry with (until it resets). The harness first asserted
+/// that telemetry always encodes; now the exhaustion is allowed only in exactly that case, and
+/// the board still fails safe (its peer's later frames are replays).
+#[test]
+fn a_peer_stamping_the_last_timestamp_exhausts_the_boards_stamps_and_it_fails_safe() {
+    let mut v = vec![1];
+    v.extend(arm());
+    v.extend(start());
+    // A restarted signer advanced to 2⁴⁸ − 2 (the harness reads a u64 and shifts it by 16).
+    v.extend([OP_STATE, 0, 0, SIGN_RESTARTED]);
+    v.extend(((auv_link::sign::MAX_TIMESTAMP - 1) << 16).to_le_bytes());
+    for _ in 0..6 {
+        v.extend(state(SIGN_AS_EXPECTED));
+        v.extend(period(false));
+    }
+    let s = run(&v);
+    assert_eq!(
+        s.periods_on,
+        1 + u32::from(auv_link::DEFAULT_STALE_PERIODS),
+        "{s:?}"
+    );
+    assert_eq!(s.latches, 1, "{s:?}");
+}
+
 /// One piece of the grammar: mostly what a navigation computer sends, sometimes not.
 fn piece() -> impl Strategy<Value = Vec<u8>> {
     let how = prop_oneof![
