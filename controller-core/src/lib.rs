@@ -15,7 +15,7 @@ pub mod trajectory;
 pub mod uncertainty;
 
 pub use config::{BBound, ConfigError, ControllerConfig};
-pub use controller::{Controller, Fault, Output, Status};
+pub use controller::{Controller, Fault, Output, Stage, Status};
 pub use law::RobustLaw;
 pub use thruster::DEFAULT_V_LIMIT;
 pub use trajectory::{Desired, Table1Case, Trajectory, TrajectoryKind};
