@@ -1,6 +1,8 @@
 #![no_std]
 #![doc = include_str!("../README.md")]
-#![forbid(unsafe_code)]
+// One `unsafe` block in the crate: the FPU's square-root instruction on the target
+// (`math::kernels::sqrt`), which core has no stable function for.
+#![deny(unsafe_code)]
 
 pub mod allocation;
 pub mod config;
