@@ -7,6 +7,7 @@
 #![no_main]
 
 mod cost;
+mod kernels;
 mod selftest;
 mod stack;
 
