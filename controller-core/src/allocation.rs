@@ -7,19 +7,11 @@
 //! and checks its condition number. Per tick it is one 5×5 matrix–vector product
 //! ([`Allocation::thrusts`]) and, for the report, one 6×5 product ([`Allocation::wrench`]).
 //!
-//! # The seam for saturation-aware allocation
-//!
-//! Today the allocation is exact and unconstrained: [`Allocation::thrusts`] returns B₅⁻¹τ
-//! whatever the thrusters can give, and [`crate::thruster::actuate`] then clips each
-//! thruster on its own, so a saturated step distorts the wrench (depth and pitch are lost
-//! together with surge). A saturation-aware allocator replaces exactly the one call
-//! `allocation.thrusts(&tau)` in [`crate::controller::Controller`]'s step: it takes the same
-//! [`Allocation`] (B and its block structure) and the per-thruster envelopes
-//! [`ThrusterMap::thrust_range`](crate::thruster::ThrusterMap::thrust_range) at the supply
-//! limit (asymmetric: a tunnel thruster gives −9.2 … +20.1 N at ±24 V) and returns thrusts
-//! inside them, after which [`actuate`](crate::thruster::actuate) clips nothing. For the
-//! default geometry B₅ is block diagonal — X ← main; (Z, M) ← the vertical pair; (Y, N) ← the
-//! horizontal pair — so each block can be solved within its box on its own.
+//! This is the exact, unconstrained allocation. The board flies the saturation-aware
+//! [`crate::allocator::Allocator`], which starts from these thrusts, keeps them where they fit
+//! the thrusters' envelopes and solves each block of B₅ within its box where they do not
+//! (docs/design.md §9, §15). The simulator's ideal actuators deliver exactly these
+//! unconstrained thrusts (the paper's experiment, §7).
 
 use core::fmt;
 
@@ -32,7 +24,7 @@ use crate::effectiveness::{GeometryError, ThrusterGeometry, THRUSTERS};
 pub const MAX_CONDITION: f32 = 1.0e4;
 
 /// Rows of τ = [X Y Z K M N] that are actuated (K, roll, is not).
-const ACTUATED_ROWS: [usize; 5] = [0, 1, 2, 4, 5];
+pub const ACTUATED_ROWS: [usize; 5] = [0, 1, 2, 4, 5];
 
 /// Why a thruster geometry was rejected by [`Allocation::new`].
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -49,6 +41,32 @@ pub enum AllocationError {
         condition: f32,
         /// The limit, [`MAX_CONDITION`].
         limit: f32,
+    },
+    /// The saturation-aware allocator ([`crate::allocator`]) solves blocks of one or two
+    /// thrusters: this geometry couples `thrusters` thrusters through `axes` actuated axes
+    /// (docs/design.md §9 **Choice**: non-block geometries are refused, no fallback).
+    NotBlockDiagonal {
+        /// Thrusters in the offending block.
+        thrusters: usize,
+        /// Actuated axes they touch.
+        axes: usize,
+    },
+    /// A thruster's envelope is not finite with T_min < T_max (e.g. a supply limit so low
+    /// that no thrust range is left).
+    Envelope {
+        /// Thruster index.
+        thruster: usize,
+        /// T_min (N).
+        min: f32,
+        /// T_max (N).
+        max: f32,
+    },
+    /// An axis priority weight of an actuated axis is not finite and > 0.
+    Weight {
+        /// Row of τ = [X Y Z K M N].
+        axis: usize,
+        /// The weight.
+        weight: f32,
     },
 }
 
@@ -69,6 +87,19 @@ impl fmt::Display for AllocationError {
             AllocationError::IllConditioned { condition, limit } => write!(
                 f,
                 "allocation check failed: condition number (inf-norm) of the 5x5 matrix over (X, Y, Z, M, N) is {condition}, limit {limit}"
+            ),
+            AllocationError::NotBlockDiagonal { thrusters, axes } => write!(
+                f,
+                "allocation check failed: {thrusters} thrusters share {axes} actuated axes; the saturation-aware allocator needs a block-diagonal allocation with blocks of one or two thrusters (docs/design.md §9)"
+            ),
+            AllocationError::Envelope { thruster, min, max } => write!(
+                f,
+                "allocation check failed: thruster {thruster} has the envelope [{min}, {max}] N at the supply limit; it needs finite bounds with min < max"
+            ),
+            AllocationError::Weight { axis, weight } => write!(
+                f,
+                "allocation check failed: the priority weight of axis {} ({axis}) must be a finite number > 0, got {weight}",
+                crate::allocator::AXIS_NAMES.get(axis).unwrap_or(&"?")
             ),
         }
     }
@@ -122,8 +153,8 @@ impl Allocation {
     }
 
     /// Thrusts T (N, thruster order) = B₅⁻¹·[X Y Z M N]ᵀ for the wrench `tau` = [X Y Z K M N]
-    /// (N, N·m). τ_K is ignored (roll is not actuated). Exact and unconstrained (see the module
-    /// docs for the saturation-aware replacement). Fixed work; a non-finite τ gives non-finite
+    /// (N, N·m). τ_K is ignored (roll is not actuated). Exact and unconstrained (the
+    /// saturation-aware allocation is [`crate::allocator`]). Fixed work; a non-finite τ gives non-finite
     /// thrusts, which [`actuate`](crate::thruster::actuate) turns into 0 V with the bits set.
     #[inline]
     pub fn thrusts(&self, tau: &Vector6<f32>) -> [f32; THRUSTERS] {

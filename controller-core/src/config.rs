@@ -9,9 +9,11 @@
 use core::fmt;
 
 use crate::allocation::AllocationError;
+use crate::allocator::AxisPriority;
 use crate::effectiveness::ThrusterGeometry;
 use crate::law::{RobustLaw, CONTROLLED, ROLL};
 use crate::model::VehicleParams;
+use crate::thruster::ThrustUnit;
 use crate::uncertainty::{BoundsError, ParamBox};
 
 /// Which bound on ‖b‖ = ‖M̄⁻¹‖ enters δ(e,t) (docs/design.md §4 **Choice**).
@@ -61,8 +63,15 @@ pub struct ControllerConfig {
     pub params: VehicleParams<f32>,
     /// Parameter box the bounds are taken over (Table 3).
     pub uncertainty: ParamBox<f32>,
-    /// Thruster positions and directions (docs/design.md §5 **Choice**).
+    /// Thruster positions and directions, the direction carrying each thruster's mounting
+    /// sign (docs/design.md §5, §9 **Choice**: the real AUV-150's, with the tunnel pairs'
+    /// strong side pushing up and to port).
     pub geometry: ThrusterGeometry,
+    /// The thrust unit of Eqs 31–32 (docs/design.md §9 **Choice**: kgf by default).
+    pub thrust_unit: ThrustUnit,
+    /// Which forces the saturation-aware allocator gives up first (docs/design.md §9
+    /// **Choice**: pitch, depth, yaw, sway, surge, highest first).
+    pub priority: AxisPriority,
 }
 
 impl Default for ControllerConfig {
@@ -83,6 +92,8 @@ impl Default for ControllerConfig {
             params: VehicleParams::auv150().cast(|x| x as f32),
             uncertainty: ParamBox::table3().cast(|x| x as f32),
             geometry: ThrusterGeometry::default(),
+            thrust_unit: ThrustUnit::Kgf,
+            priority: AxisPriority::default(),
         }
     }
 }
@@ -164,6 +175,10 @@ impl ConfigError {
             ConfigError::ZeroRate => ("rate_hz", None),
             ConfigError::NonFiniteParams => ("params", None),
             ConfigError::InvalidBox | ConfigError::Bounds(_) => ("uncertainty", None),
+            ConfigError::Allocation(AllocationError::Weight { axis, .. }) => {
+                ("priority", Some(axis))
+            }
+            ConfigError::Allocation(AllocationError::Envelope { .. }) => ("voltage_limit", None),
             ConfigError::Allocation(_) => ("geometry", None),
             ConfigError::Assumption2 { .. }
             | ConfigError::Theorem2 { .. }
@@ -247,7 +262,7 @@ impl fmt::Display for ConfigError {
                 f,
                 "loop period {period} s is too long for axis {axis}: with δ_max = {delta_max} and μ = {mu} the boundary-layer gain needs T < {max_period} s (docs/design.md §8)"
             ),
-            ConfigError::Allocation(e) => write!(f, "thruster allocation: {e:?}"),
+            ConfigError::Allocation(e) => write!(f, "thruster allocation: {e}"),
         }
     }
 }

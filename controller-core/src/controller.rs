@@ -9,12 +9,14 @@
 use nalgebra::{Matrix6, Vector6};
 
 use crate::allocation::Allocation;
+use crate::allocator::Allocated;
+use crate::allocator::Allocator;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
 use crate::kinematics::{self, Attitude};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
 use crate::model::{self, VehicleParams};
-use crate::thruster::{self, Actuation, ThrusterMap};
+use crate::thruster::{self, Actuation, Envelope, ThrusterMap};
 use crate::trajectory::{Desired, Trajectory};
 use crate::uncertainty::UncertaintyBounds;
 
@@ -128,11 +130,16 @@ pub struct Output {
     pub tau: [f32; 6],
     /// Body force the thrusters actually give (B · achieved thrusts).
     pub tau_achieved: [f32; 6],
+    /// The part of τ the saturation-aware allocator could not give inside the thrusters'
+    /// envelopes (τ − B·T over the axes of each block that was not met; zero when every block
+    /// was met, and on the unactuated roll row). docs/design.md §9, §15.
+    pub tau_unallocated: [f32; 6],
     /// Achieved thrust per thruster (N), order [main, vert fore, vert aft, horz fore, horz aft].
     pub thrust: [f32; THRUSTERS],
     /// Voltage per thruster (V), within ±voltage_limit.
     pub voltage: [f32; THRUSTERS],
-    /// Bit i set: thruster i saturated.
+    /// Bit i set: thruster i saturated — it is on a bound of its envelope for a block the
+    /// allocator could not meet, or the voltage chain clipped it ([`thruster::actuate`]).
     pub saturated: u8,
     /// δ(e,t) after the clamp, Eq (29). Computed (and reported) also when Δu is off.
     pub delta: f32,
@@ -153,6 +160,7 @@ impl Output {
             status: Status::Fault(fault),
             tau: [0.0; 6],
             tau_achieved: [0.0; 6],
+            tau_unallocated: [0.0; 6],
             thrust: Actuation::OFF.thrusts,
             voltage: Actuation::OFF.voltages,
             saturated: 0,
@@ -168,6 +176,7 @@ impl Output {
         self.tau
             .iter()
             .chain(self.tau_achieved.iter())
+            .chain(self.tau_unallocated.iter())
             .chain(self.thrust.iter())
             .chain(self.voltage.iter())
             .chain(self.eta_d.iter())
@@ -187,7 +196,7 @@ pub struct Controller {
     lyapunov: [AxisLyapunov<f32>; 6],
     delta_constants: DeltaConstants,
     bounds: UncertaintyBounds<f32>,
-    allocation: Allocation,
+    allocator: Allocator,
     maps: [ThrusterMap; THRUSTERS],
     cos_pitch_limit: f32,
 }
@@ -198,6 +207,9 @@ impl Controller {
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
         config.check_scalars()?;
         let allocation = Allocation::new(&config.geometry)?;
+        let maps = thruster::default_maps();
+        let envelope = Envelope::new(&maps, config.thrust_unit, config.voltage_limit);
+        let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
         let bounds = UncertaintyBounds::compute(&config.params, &config.uncertainty)?;
         let beta_hat = bounds.beta_hat;
@@ -265,8 +277,8 @@ impl Controller {
             lyapunov,
             delta_constants,
             bounds,
-            allocation,
-            maps: thruster::default_maps(),
+            allocator,
+            maps,
             cos_pitch_limit: libm::cosf(config.pitch_limit),
             config,
         })
@@ -292,9 +304,20 @@ impl Controller {
         &self.lyapunov
     }
 
-    /// The thrust allocation.
+    /// The exact (unconstrained) thrust allocation B₅⁻¹.
     pub fn allocation(&self) -> &Allocation {
-        &self.allocation
+        self.allocator.allocation()
+    }
+
+    /// The saturation-aware allocator `update` flies (docs/design.md §9).
+    pub fn allocator(&self) -> &Allocator {
+        &self.allocator
+    }
+
+    /// Each thruster's envelope [T_min, T_max] (N) at the supply limit, in the configured
+    /// thrust unit's reading of Eqs 31–32.
+    pub fn envelope(&self) -> &Envelope {
+        self.allocator.envelope()
     }
 
     /// Nominal M̂.
@@ -340,15 +363,16 @@ impl Controller {
         let kin = self.kinematics_stage(eta, nu)?;
         let desired = self.trajectory_stage(ticks, trajectory);
         let law = self.law_stage(&kin, &desired, trajectory)?;
-        let demand = self.allocation_stage(&law.tau);
-        let (act, tau_achieved) = self.maps_stage(&demand);
+        let alloc = self.allocation_stage(&law.tau);
+        let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
         Ok(Output {
             status: Status::Ok,
             tau: law.tau.into(),
             tau_achieved: tau_achieved.into(),
+            tau_unallocated: alloc.unallocated,
             thrust: act.thrusts,
             voltage: act.voltages,
-            saturated: act.saturated,
+            saturated: alloc.saturated | act.saturated,
             delta: law.delta,
             delta_clamped: self.config.robust && law.delta_clamped,
             w_norm: law.w_norm,
@@ -456,20 +480,26 @@ impl Controller {
         })
     }
 
-    /// Stage [`Stage::Allocation`]: the thrust each thruster is asked for, B₅⁻¹τ.
+    /// Stage [`Stage::Allocation`]: the thrust each thruster is asked for, by the
+    /// saturation-aware allocator (B₅⁻¹τ when it fits the envelopes; docs/design.md §9).
     #[doc(hidden)]
     #[inline]
-    pub fn allocation_stage(&self, tau: &Vector6<f32>) -> [f32; THRUSTERS] {
-        self.allocation.thrusts(tau)
+    pub fn allocation_stage(&self, tau: &Vector6<f32>) -> Allocated {
+        self.allocator.allocate(tau)
     }
 
-    /// Stage [`Stage::Maps`]: the voltages (Eqs 31–32, clamped to the supply), the thrusts
-    /// they give, and the wrench B·T those give.
+    /// Stage [`Stage::Maps`]: the voltages (Eqs 31–32 in the configured thrust unit, clamped
+    /// to the supply), the thrusts they give, and the wrench B·T those give.
     #[doc(hidden)]
     #[inline]
     pub fn maps_stage(&self, demand: &[f32; THRUSTERS]) -> (Actuation, Vector6<f32>) {
-        let act = thruster::actuate(&self.maps, demand, self.config.voltage_limit);
-        let tau_achieved = self.allocation.wrench(&act.thrusts);
+        let act = thruster::actuate(
+            &self.maps,
+            self.config.thrust_unit,
+            demand,
+            self.config.voltage_limit,
+        );
+        let tau_achieved = self.allocator.allocation().wrench(&act.thrusts);
         (act, tau_achieved)
     }
 }
@@ -486,7 +516,7 @@ pub enum Stage {
     Trajectory,
     /// e₁, e₂, ū, δ, w, Δu and τ.
     Law,
-    /// Thrust demand B₅⁻¹τ.
+    /// Thrust demand: the saturation-aware allocator ([`crate::allocator::Allocator`]).
     Allocation,
     /// Voltages (Eqs 31–32), achieved thrusts and achieved wrench.
     Maps,

@@ -3,7 +3,7 @@
 //! This module says where the five thrusters sit and which way they push, and turns that into
 //! the 6×5 matrix B whose column i is the wrench [dᵢ; rᵢ × dᵢ] of one newton on thruster i
 //! (rows X Y Z K M N). In PX4's terms it is the *actuator effectiveness*; solving B·T = τ for
-//! T is the *control allocation* of [`crate::allocation`], and what a thruster does with a
+//! T is the *control allocation* of [`crate::allocation`] and [`crate::allocator`], and what a thruster does with a
 //! voltage is [`crate::thruster`].
 //!
 //! Thruster order everywhere: `[main, vertical fore, vertical aft, horizontal fore,
@@ -11,7 +11,8 @@
 //! [`HORZ_AFT`]).
 //!
 //! The geometry is **not in the paper**. [`ThrusterGeometry::default`] is the **Choice** of
-//! docs/design.md §5; any other geometry is configuration and is checked here.
+//! docs/design.md §5 (positions) and §9 (mounting signs, [`AUV150_REVERSED`]); any other
+//! geometry is configuration and is checked here.
 
 use core::fmt;
 
@@ -21,25 +22,69 @@ use nalgebra::Matrix6x5;
 pub const THRUSTERS: usize = 5;
 /// Index of the stern main thruster (along +x).
 pub const MAIN: usize = 0;
-/// Index of the fore vertical tunnel thruster (along +z).
+/// Index of the fore vertical tunnel thruster (reference axis +z).
 pub const VERT_FORE: usize = 1;
-/// Index of the aft vertical tunnel thruster (along +z).
+/// Index of the aft vertical tunnel thruster (reference axis +z).
 pub const VERT_AFT: usize = 2;
-/// Index of the fore horizontal tunnel thruster (along +y).
+/// Index of the fore horizontal tunnel thruster (reference axis +y).
 pub const HORZ_FORE: usize = 3;
-/// Index of the aft horizontal tunnel thruster (along +y).
+/// Index of the aft horizontal tunnel thruster (reference axis +y).
 pub const HORZ_AFT: usize = 4;
 
 /// Allowed deviation of a direction's norm from 1: |‖d‖ − 1| ≤ this.
 pub const UNIT_TOLERANCE: f32 = 1.0e-3;
 
-/// Thruster positions (m) and unit thrust directions, body frame (origin CO, x forward,
-/// y starboard, z down), in thruster order.
+/// Where the AUV-150's thrusters sit, body frame (m), thruster order (docs/design.md §5
+/// **Choice**: all on the centre line; the main thruster at the stern, the tunnels at ±1.8 m).
+pub const AUV150_POSITIONS: [[f32; 3]; THRUSTERS] = [
+    [-2.43, 0.0, 0.0],
+    [1.8, 0.0, 0.0],
+    [-1.8, 0.0, 0.0],
+    [1.8, 0.0, 0.0],
+    [-1.8, 0.0, 0.0],
+];
+
+/// The reference axis of each AUV-150 thruster, thruster order: +x for the main thruster, +z
+/// (down) for the vertical tunnels, +y (starboard) for the horizontal tunnels. A thruster's
+/// direction is its reference axis or, if it is mounted the other way round, the axis
+/// negated ([`ThrusterGeometry::auv150`]).
+pub const AUV150_AXES: [[f32; 3]; THRUSTERS] = [
+    [1.0, 0.0, 0.0],
+    [0.0, 0.0, 1.0],
+    [0.0, 0.0, 1.0],
+    [0.0, 1.0, 0.0],
+    [0.0, 1.0, 0.0],
+];
+
+/// The real vehicle's mounting (docs/design.md §9 **Choice**), as a reversed-thruster mask
+/// for [`ThrusterGeometry::auv150`]: bit i set ⇔ thruster i's positive (strong) thrust pushes
+/// against its reference axis [`AUV150_AXES`].
 ///
-/// [`Default`] is docs/design.md §5 **Choice** — main at x = −2.43 m along +x; vertical
-/// tunnels at x = +1.8 m (fore) and −1.8 m (aft) along +z; horizontal tunnels at x = +1.8 m
-/// (fore) and −1.8 m (aft) along +y; all on the centre line. It is configuration:
-/// [`effectiveness`](Self::effectiveness) accepts any geometry that passes its checks.
+/// * Vertical pair reversed: its strong direction pushes **up** (−z). The vehicle's standing
+///   vertical demand is upward — a forward CG shift or an untrimmed payload is held by an
+///   upward push fore (and the pair's weak side, −9.2 polynomial units against +20.1, then
+///   only has to pull the other end) — and a tunnel thruster is more than twice as strong
+///   in its positive direction (§5).
+/// * Horizontal pair reversed: its strong direction pushes to **port** (−y). With the
+///   tangent heading the sway demand is the centripetal force of the turn, ≈ (m − X_u̇)·u·r;
+///   both Table-1 circles turn to port all the time (ψ̇_d = −ω), so that is their standing
+///   demand, while the figure-eights and lawn-mowers turn both ways equally and do not
+///   prefer a side.
+/// * Main thruster as it is: positive thrust forward (+x).
+pub const AUV150_REVERSED: u8 =
+    (1 << VERT_FORE) | (1 << VERT_AFT) | (1 << HORZ_FORE) | (1 << HORZ_AFT);
+
+/// Thruster positions (m) and unit thrust directions, body frame (origin CO, x forward,
+/// y starboard, z down), in thruster order. The direction carries the **mounting sign**:
+/// positive thrust pushes the vehicle along it.
+///
+/// [`Default`] is the real AUV-150 of docs/design.md §5 and §9 (**Choice**):
+/// [`auv150`](Self::auv150)([`AUV150_REVERSED`]) — the main thruster at x = −2.43 m along +x;
+/// the vertical tunnels at x = +1.8 m (fore) and −1.8 m (aft) along −z (pushing up); the
+/// horizontal tunnels at x = ±1.8 m along −y (pushing to port); all on the centre line. It is
+/// configuration: [`effectiveness`](Self::effectiveness) accepts any geometry that passes its
+/// checks, and the allocator any whose 5×5 allocation is block diagonal
+/// ([`crate::allocator`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ThrusterGeometry {
     /// Position rᵢ of thruster i, m.
@@ -49,24 +94,47 @@ pub struct ThrusterGeometry {
 }
 
 impl Default for ThrusterGeometry {
-    /// The docs/design.md §5 **Choice** layout (see the type's docs).
+    /// The real AUV-150: [`ThrusterGeometry::auv150`]`(`[`AUV150_REVERSED`]`)` (see the
+    /// type's docs).
     fn default() -> Self {
-        ThrusterGeometry {
-            position: [
-                [-2.43, 0.0, 0.0],
-                [1.8, 0.0, 0.0],
-                [-1.8, 0.0, 0.0],
-                [1.8, 0.0, 0.0],
-                [-1.8, 0.0, 0.0],
-            ],
-            direction: [
-                [1.0, 0.0, 0.0],
-                [0.0, 0.0, 1.0],
-                [0.0, 0.0, 1.0],
-                [0.0, 1.0, 0.0],
-                [0.0, 1.0, 0.0],
-            ],
+        ThrusterGeometry::auv150(AUV150_REVERSED)
+    }
+}
+
+impl ThrusterGeometry {
+    /// The AUV-150 layout ([`AUV150_POSITIONS`]) with each thruster along its reference axis
+    /// ([`AUV150_AXES`]), or against it where bit i of `reversed` is set (bits above the
+    /// fifth are ignored). `auv150(0)` is every thruster along +x, +z, +z, +y, +y.
+    pub const fn auv150(reversed: u8) -> Self {
+        let mut direction = AUV150_AXES;
+        let mut i = 0;
+        while i < THRUSTERS {
+            if reversed & (1 << i) != 0 {
+                let mut k = 0;
+                while k < 3 {
+                    direction[i][k] = -direction[i][k];
+                    k += 1;
+                }
+            }
+            i += 1;
         }
+        ThrusterGeometry {
+            position: AUV150_POSITIONS,
+            direction,
+        }
+    }
+
+    /// The reversed-thruster mask `m` with `self == auv150(m)`, if this is the AUV-150 layout
+    /// with some thrusters reversed; `None` for any other geometry. The board's link carries
+    /// the geometry as this mask (`SetConfig`).
+    pub fn auv150_reversed(&self) -> Option<u8> {
+        let mut mask = 0u8;
+        for (i, axis) in AUV150_AXES.iter().enumerate() {
+            if self.direction[i] != *axis {
+                mask |= 1 << i;
+            }
+        }
+        (*self == ThrusterGeometry::auv150(mask)).then_some(mask)
     }
 }
 
@@ -115,9 +183,10 @@ impl ThrusterGeometry {
     /// direction with |‖d‖ − 1| > [`UNIT_TOLERANCE`]. Whether B can be inverted is the
     /// allocation's question ([`crate::allocation::Allocation::new`]).
     ///
-    /// For the default geometry, with r = (x, 0, 0): r × d = (0, −x d_z, x d_y), so a downward
+    /// For the AUV-150 layout, with r = (x, 0, 0): r × d = (0, −x d_z, x d_y), so a downward
     /// (+z) tunnel thrust at x = +1.8 m gives M = −1.8·T and a starboard (+y) one N = +1.8·T;
-    /// the K row is zero (every thruster on the centre line).
+    /// the default mounting reverses both (an upward push fore gives M = +1.8·T, a push to
+    /// port fore N = −1.8·T). The K row is zero (every thruster on the centre line).
     pub fn effectiveness(&self) -> Result<Matrix6x5<f32>, GeometryError> {
         let lo = (1.0 - UNIT_TOLERANCE) * (1.0 - UNIT_TOLERANCE);
         let hi = (1.0 + UNIT_TOLERANCE) * (1.0 + UNIT_TOLERANCE);

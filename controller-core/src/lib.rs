@@ -5,6 +5,7 @@
 #![deny(unsafe_code)]
 
 pub mod allocation;
+pub mod allocator;
 pub mod config;
 pub mod controller;
 pub mod effectiveness;
@@ -19,5 +20,5 @@ pub mod uncertainty;
 pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Stage, Status};
 pub use law::RobustLaw;
-pub use thruster::DEFAULT_V_LIMIT;
-pub use trajectory::{Desired, Table1Case, Trajectory, TrajectoryKind};
+pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};
+pub use trajectory::{Desired, HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};

@@ -82,7 +82,8 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
     }
 }
 
-/// atan2(y, x), the angle of the point (x, y) in [−π, π].
+/// atan2(y, x), the angle of the point (x, y) in [−π, π] (the tangent heading's course,
+/// docs/design.md §6).
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
     #[cfg(feature = "micromath")]
@@ -164,8 +165,15 @@ pub fn wrap_pi(x: f32) -> f32 {
 /// hours, and ω·t in f32 loses the phase itself. Fixed work (one floor, no loop).
 #[inline]
 pub fn phase(omega: f32, ticks: u64, rate_hz: u32) -> f32 {
+    phase_f64(omega as f64, ticks, rate_hz)
+}
+
+/// [`phase`] for a frequency given in f64 (a mission's ω/k, docs/design.md §6: the time scale
+/// divides the frequency once, at configuration time, not the time on every tick).
+#[inline]
+pub fn phase_f64(omega: f64, ticks: u64, rate_hz: u32) -> f32 {
     let t = ticks as f64 / rate_hz as f64;
-    let p = omega as f64 * t;
+    let p = omega * t;
     let r = p - core::f64::consts::TAU * libm::floor(p / core::f64::consts::TAU);
     r as f32
 }

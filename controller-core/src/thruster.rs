@@ -11,8 +11,18 @@
 //! * [`actuate`]: the supply clamp, the main thruster's fold, and the thrust the clamped voltage
 //!   actually gives ([`Actuation`]) — the saturation-honesty signal of docs/design.md §5.
 //!
-//! Thrust is in newtons, voltage in volts. The paper does not state the unit of Eqs 31–32; this
-//! crate reads newtons (docs/design.md §9 discusses the kgf reading).
+//! # Units
+//!
+//! The paper does not state the thrust unit of Eqs 31–32. [`ThrusterMap::voltage`] and
+//! [`ThrusterMap::thrust`] are the polynomials as printed, in *polynomial units*; which unit
+//! that is, is configuration: [`ThrustUnit`], default [`ThrustUnit::Kgf`] (docs/design.md §9
+//! **Choice**: under the paper's own damping only the kgf reading reaches the vehicle's
+//! published 2–4 kn, and a wrong kgf guess under-drives the thrusters instead of over-driving
+//! them 9.81×). Everything else in the workspace is newtons: [`ThrusterMap::voltage_of_newtons`],
+//! [`ThrusterMap::newtons_of_voltage`], [`Envelope`] and [`actuate`] convert at this one seam.
+//! 1 kgf = [`KGF_IN_NEWTONS`] = 9.80665 N, the standard kilogram-force (docs/design.md §9
+//! **Choice**: the paper gives no sign that its fits use its model's g = 9.81; the two differ by
+//! 0.03 %). Voltage is in volts.
 //!
 //! Everything here is fixed work: no loops that depend on data, no iteration to convergence,
 //! no heap, no panics.
@@ -34,6 +44,62 @@ use crate::math;
 
 /// Default supply limit of the board, V (docs/design.md §5: ±24 V).
 pub const DEFAULT_V_LIMIT: f32 = 24.0;
+
+/// One kilogram-force in newtons: the standard value, 9.80665 N (docs/design.md §9 **Choice**).
+pub const KGF_IN_NEWTONS: f32 = 9.806_65;
+
+/// The thrust unit of the polynomials of Eqs 31–32 (docs/design.md §9 **Choice**: kgf by
+/// default, newtons one setting away). It is part of the controller's validated configuration
+/// ([`ControllerConfig::thrust_unit`](crate::ControllerConfig::thrust_unit)), crosses the link
+/// in `SetConfig` and is reported in every telemetry frame.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum ThrustUnit {
+    /// Eqs 31–32 take and give kilogram-force (1 kgf = [`KGF_IN_NEWTONS`] N). The default.
+    #[default]
+    Kgf,
+    /// Eqs 31–32 take and give newtons.
+    Newton,
+}
+
+impl ThrustUnit {
+    /// Both units, [`ThrustUnit::Kgf`] first.
+    pub const ALL: [ThrustUnit; 2] = [ThrustUnit::Kgf, ThrustUnit::Newton];
+
+    /// Newtons per polynomial unit: 9.80665 for kgf, 1 for newtons.
+    pub const fn newtons(self) -> f32 {
+        match self {
+            ThrustUnit::Kgf => KGF_IN_NEWTONS,
+            ThrustUnit::Newton => 1.0,
+        }
+    }
+
+    /// Polynomial units per newton, 1/[`newtons`](Self::newtons) (exactly 1 for newtons).
+    pub const fn per_newton(self) -> f32 {
+        match self {
+            ThrustUnit::Kgf => 1.0 / KGF_IN_NEWTONS,
+            ThrustUnit::Newton => 1.0,
+        }
+    }
+
+    /// `"kgf"` or `"newton"`: the scenario files' `controller.thrust_unit` and the reports.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            ThrustUnit::Kgf => "kgf",
+            ThrustUnit::Newton => "newton",
+        }
+    }
+
+    /// The unit whose [`as_str`](Self::as_str) is `name`.
+    pub fn from_name(name: &str) -> Option<ThrustUnit> {
+        Self::ALL.into_iter().find(|u| u.as_str() == name)
+    }
+}
+
+impl core::fmt::Display for ThrustUnit {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
 
 // Eq 31, tunnel: V = A T³ + B T² + C T + D.
 const TUN_A: f64 = 0.0005;
@@ -128,18 +194,81 @@ impl ThrusterMap {
         }
     }
 
-    /// The thrust envelope at a supply limit: the range of thrust (N) reachable with voltages
-    /// in [−`v_limit`, +`v_limit`], as (lowest, highest).
+    /// The thrust envelope at a supply limit in polynomial units: the range of thrust
+    /// reachable with voltages in [−`v_limit`, +`v_limit`], as (lowest, highest). In newtons:
+    /// [`Envelope::new`].
     ///
-    /// The envelope is asymmetric: at ±24 V a tunnel thruster gives −9.165 … +20.102 N, the
-    /// main thruster −17.467 (the fold of Eq 32) … +73.306 N (docs/design.md §5).
-    #[doc(alias = "envelope")]
+    /// In closed form: the tunnel map is increasing, so (T(−V), T(+V)); the main map is
+    /// decreasing on its branch and folds, so (T_fold, T(−V)) once V ≥ V_fold = 0.719 V (the
+    /// fold of Eq 32), T(+V) below that. The envelope is asymmetric: at ±24 V a tunnel thruster
+    /// gives −9.165 … +20.102, the main thruster −17.467 … +73.306 (docs/design.md §5).
     #[inline]
     pub fn thrust_range(self, v_limit: f32) -> (f32, f32) {
         match self {
             ThrusterMap::Tunnel => (self.thrust(-v_limit), self.thrust(v_limit)),
             ThrusterMap::Main => (self.thrust(v_limit), self.thrust(-v_limit)),
         }
+    }
+
+    /// Voltage (V) for a thrust of `newtons` (N) when the polynomial reads `unit`:
+    /// [`voltage`](Self::voltage)(`newtons` · [`ThrustUnit::per_newton`]).
+    #[inline]
+    pub fn voltage_of_newtons(self, unit: ThrustUnit, newtons: f32) -> f32 {
+        self.voltage(newtons * unit.per_newton())
+    }
+
+    /// Thrust (N) that voltage `v` gives when the polynomial reads `unit`:
+    /// [`thrust`](Self::thrust)(`v`) · [`ThrustUnit::newtons`].
+    #[inline]
+    pub fn newtons_of_voltage(self, unit: ThrustUnit, v: f32) -> f32 {
+        self.thrust(v) * unit.newtons()
+    }
+}
+
+/// The per-thruster thrust envelope [T_min, T_max] in **newtons** at a supply limit
+/// (docs/design.md §5, §9): what each thruster can give with voltages in ±V_limit, in closed
+/// form from the maps ([`ThrusterMap::thrust_range`]; the main thruster's lower end is the
+/// fold of Eq 32) times the unit. Computed once at configuration time
+/// ([`Controller::new`](crate::Controller::new)); the allocator keeps every thrust inside it.
+///
+/// At ±24 V, kgf (the default): main −171.29 … +718.89 N, tunnels −89.88 … +197.13 N;
+/// newtons: main −17.47 … +73.31 N, tunnels −9.17 … +20.10 N.
+#[doc(alias = "thrust_envelope")]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Envelope {
+    /// T_min per thruster (N), thruster order.
+    pub min: [f32; THRUSTERS],
+    /// T_max per thruster (N), thruster order.
+    pub max: [f32; THRUSTERS],
+}
+
+impl Envelope {
+    /// The envelope of `maps` (thruster order) read in `unit` at ±`v_limit`.
+    pub fn new(maps: &[ThrusterMap; THRUSTERS], unit: ThrustUnit, v_limit: f32) -> Envelope {
+        let mut e = Envelope {
+            min: [0.0; THRUSTERS],
+            max: [0.0; THRUSTERS],
+        };
+        for (i, map) in maps.iter().enumerate() {
+            let (lo, hi) = map.thrust_range(v_limit);
+            e.min[i] = lo * unit.newtons();
+            e.max[i] = hi * unit.newtons();
+        }
+        e
+    }
+
+    /// This envelope shrunk to `fraction` of itself about 0 N (each bound times `fraction`;
+    /// every default envelope contains 0 N): the preflight check's margin (docs/design.md §9).
+    pub fn scaled(&self, fraction: f32) -> Envelope {
+        Envelope {
+            min: self.min.map(|x| x * fraction),
+            max: self.max.map(|x| x * fraction),
+        }
+    }
+
+    /// True if every thrust lies in [min, max] (false for NaN).
+    pub fn contains(&self, thrusts: &[f32; THRUSTERS]) -> bool {
+        (0..THRUSTERS).all(|i| thrusts[i] >= self.min[i] && thrusts[i] <= self.max[i])
     }
 }
 
@@ -234,27 +363,32 @@ impl Actuation {
 /// Mask with every thruster's saturation bit set.
 pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
 
-/// Turns thrust commands (N) into voltages (V) within ±`v_limit` and reports the thrust those
-/// voltages actually give (docs/design.md §5, "Saturation").
+/// Turns thrust commands (N) into voltages (V) within ±`v_limit` and reports the thrust (N)
+/// those voltages actually give (docs/design.md §5, "Saturation"), with Eqs 31–32 read in
+/// `unit`.
 ///
-/// Per thruster i, with map `maps[i]`:
+/// Per thruster i, with map `maps[i]` and c = cmd · [`ThrustUnit::per_newton`] (polynomial
+/// units):
 /// 1. a non-finite command → 0 V (power off), 0 N reported, bit i set;
 /// 2. main thruster commanded below [`MAIN_T_FOLD`] → voltage [`MAIN_V_FOLD`] (the closest
 ///    thrust Eq 32 can give), bit i set;
-/// 3. otherwise V = `maps[i].voltage(cmd)` (Eq 31/32);
+/// 3. otherwise V = `maps[i].voltage(c)` (Eq 31/32);
 /// 4. V clamped to [−`v_limit`, +`v_limit`], bit i set if the clamp acted;
-/// 5. reported thrust = `maps[i].thrust(V)` of the clamped voltage — also when nothing
-///    saturated, so the report is always what the applied voltage gives (within the inverse
-///    map's f32 round trip, ~1e-5 N).
+/// 5. reported thrust = `maps[i].thrust(V)` · [`ThrustUnit::newtons`] of the clamped voltage —
+///    also when nothing saturated, so the report is always what the applied voltage gives
+///    (within the inverse map's f32 round trip, ~1e-5 polynomial units).
 ///
-/// Each thruster is clipped on its own, so a saturated step distorts the wrench: see
-/// [`crate::allocation`] for where a saturation-aware allocator takes over.
+/// The controller's commands come from the saturation-aware allocator
+/// ([`crate::allocator`]), which keeps them inside the [`Envelope`]: then nothing is clipped
+/// here beyond the f32 rounding of a thrust that sits exactly on its envelope. Called with
+/// arbitrary commands it clips each thruster on its own.
 ///
 /// `v_limit` must be finite and > 0; otherwise every thruster is switched off (0 V, 0 N) with
 /// every bit set. Fixed work, never panics; for finite `v_limit` > 0 every output is finite
 /// and |V| ≤ `v_limit`.
 pub fn actuate(
     maps: &[ThrusterMap; THRUSTERS],
+    unit: ThrustUnit,
     thrust_cmd: &[f32; THRUSTERS],
     v_limit: f32,
 ) -> Actuation {
@@ -266,9 +400,9 @@ pub fn actuate(
     }
     let mut out = Actuation::OFF;
     for i in 0..THRUSTERS {
-        let (v, t, sat) = actuate_one(maps[i], thrust_cmd[i], v_limit);
+        let (v, t, sat) = actuate_one(maps[i], thrust_cmd[i] * unit.per_newton(), v_limit);
         out.voltages[i] = v;
-        out.thrusts[i] = t;
+        out.thrusts[i] = t * unit.newtons();
         if sat {
             out.saturated |= 1 << i;
         }
@@ -276,7 +410,7 @@ pub fn actuate(
     out
 }
 
-/// One thruster of [`actuate`]; `v_limit` is finite and > 0.
+/// One thruster of [`actuate`], in polynomial units; `v_limit` is finite and > 0.
 #[inline]
 fn actuate_one(map: ThrusterMap, cmd: f32, v_limit: f32) -> (f32, f32, bool) {
     if !cmd.is_finite() {

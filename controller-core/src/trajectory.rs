@@ -174,16 +174,25 @@ pub enum TrajectoryError {
         /// Upper limit.
         max: f32,
     },
+    /// A tangent-heading mission whose horizontal speed falls below
+    /// [`Trajectory::MIN_TANGENT_SPEED`] somewhere (the course is undefined at zero speed).
+    TooSlowForTangent {
+        /// The path's minimum horizontal speed at its time scale (m/s).
+        min_speed: f32,
+        /// [`Trajectory::MIN_TANGENT_SPEED`].
+        threshold: f32,
+    },
 }
 
 impl TrajectoryError {
-    /// The rejected field of [`TrajectoryKind`], e.g. `"radius"` (a scenario's
-    /// `trajectory.radius`).
+    /// The rejected field of [`TrajectoryKind`] or [`Mission`], e.g. `"radius"` (a scenario's
+    /// `trajectory.radius`), `"time_scale"` or `"heading"`.
     pub fn parameter(&self) -> &'static str {
         match *self {
             Self::NonFinite { parameter }
             | Self::NotPositive { parameter, .. }
             | Self::OutOfRange { parameter, .. } => parameter,
+            Self::TooSlowForTangent { .. } => "heading",
         }
     }
 }
@@ -203,6 +212,13 @@ impl fmt::Display for TrajectoryError {
             } => write!(
                 f,
                 "trajectory {parameter} = {value} is outside [{min}, {max}]"
+            ),
+            Self::TooSlowForTangent {
+                min_speed,
+                threshold,
+            } => write!(
+                f,
+                "tangent heading needs a horizontal speed of at least {threshold} m/s everywhere; this path slows to {min_speed} m/s (lower the time scale, or fly the paper's heading)"
             ),
         }
     }
@@ -326,15 +342,123 @@ const fn series_coefficients(series: Series, omega: f32) -> [[f32; 3]; ODD_TERMS
     out
 }
 
+/// How a mission's desired heading ψ_d is formed (docs/design.md §6, §9).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
+pub enum HeadingMode {
+    /// The paper's headings: ψ_d = ωt on the circle and the helix, the triangle and trapezoid
+    /// series on the figure-eight and the lawn-mower. They make a torpedo vehicle crab.
+    #[default]
+    Paper,
+    /// ψ_d follows the path's course χ_d = atan2(ẏ_d, ẋ_d), with ψ̇_d and ψ̈_d from the
+    /// path's curvature (docs/design.md §9): ψ̇_d = N/D, ψ̈_d = (Ṅ − ψ̇_d Ḋ)/D with
+    /// N = ẋ_d ÿ_d − ẏ_d ẍ_d, D = ẋ_d² + ẏ_d², Ṅ = ẋ_d y⃛_d − ẏ_d x⃛_d,
+    /// Ḋ = 2(ẋ_d ẍ_d + ẏ_d ÿ_d). Defined where the horizontal speed √D is not zero:
+    /// [`Trajectory::new`] refuses a tangent mission whose minimum speed is below
+    /// [`Trajectory::MIN_TANGENT_SPEED`].
+    Tangent,
+}
+
+impl HeadingMode {
+    /// Both modes, the paper's first.
+    pub const ALL: [HeadingMode; 2] = [HeadingMode::Paper, HeadingMode::Tangent];
+
+    /// `"paper"` or `"tangent"`: the scenario files' `trajectory.heading`.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            HeadingMode::Paper => "paper",
+            HeadingMode::Tangent => "tangent",
+        }
+    }
+
+    /// The mode whose [`as_str`](Self::as_str) is `name`.
+    pub fn from_name(name: &str) -> Option<HeadingMode> {
+        Self::ALL.into_iter().find(|m| m.as_str() == name)
+    }
+}
+
+impl fmt::Display for HeadingMode {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.as_str())
+    }
+}
+
+/// A mission as the board flies it: a path ([`TrajectoryKind`]), how its heading is formed
+/// ([`HeadingMode`]) and how slowly it is flown (`time_scale` k ≥ 1: the desired state is
+/// η_d(t/k), so velocities are divided by k and accelerations by k²). Validated by
+/// [`Trajectory::new`]; crosses the link in `StartMission`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Mission {
+    /// The path's shape and parameters.
+    pub path: TrajectoryKind,
+    /// ψ_d: the paper's or the path's course.
+    pub heading: HeadingMode,
+    /// k ≥ 1 (1: the paper's speed).
+    pub time_scale: f32,
+}
+
+impl Mission {
+    /// `path` as the paper flies it: its own heading, k = 1.
+    pub const fn paper(path: TrajectoryKind) -> Mission {
+        Mission {
+            path,
+            heading: HeadingMode::Paper,
+            time_scale: 1.0,
+        }
+    }
+}
+
+impl From<TrajectoryKind> for Mission {
+    /// [`Mission::paper`].
+    fn from(path: TrajectoryKind) -> Mission {
+        Mission::paper(path)
+    }
+}
+
 /// A validated mission with its precomputed constants; sample it with [`Trajectory::sample`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Trajectory {
-    kind: TrajectoryKind,
+    mission: Mission,
+    /// ω/k (rad/s), for the amplitudes.
+    omega: f32,
+    /// ω/k in f64, for the phases (docs/design.md §16).
+    omega_f64: f64,
+    /// The linear rate over k: the lawn-mower's advance 0.25/k (per unit scale, m/s) or the
+    /// helix's depth rate ż/k (m/s); zero otherwise.
+    rate: f32,
+    /// `rate` in f64, for the positions that grow with t.
+    rate_f64: f64,
     /// `[a_n, a_n nω, a_n n²ω²]` for the odd harmonics (zero for circle/helix).
     psi: [[f32; 3]; ODD_TERMS],
     /// K_d of Assumption 1.
     accel_bound: f32,
+    /// The smallest horizontal speed along the path (m/s), in closed form.
+    min_speed: f32,
 }
+
+/// The phases a sample needs: θ = (ω/k)·t and, for the figure-eight, the half phase, both
+/// reduced in f64; t (s) for the terms linear in time.
+#[derive(Clone, Copy)]
+struct Phases {
+    theta: f32,
+    half: f32,
+    t: f64,
+}
+
+/// The horizontal path and its first three derivatives, and z_d, ż_d.
+#[derive(Clone, Copy)]
+struct Planar {
+    x: f32,
+    y: f32,
+    z: f32,
+    z_dot: f32,
+    /// (ẋ, ẏ), (ẍ, ÿ), (x⃛, y⃛).
+    d: [[f32; 2]; 3],
+}
+
+/// Samples per period of the path in the sampled bound on the tangent heading's |ψ̈_d|.
+const TANGENT_BOUND_SAMPLES: u32 = 1024;
+/// Margin on the sampled maximum of the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**).
+const TANGENT_BOUND_MARGIN: f32 = 1.1;
 
 impl Trajectory {
     /// N, the last harmonic of the heading series (docs/design.md §6 **Choice**: truncate at N = 9).
@@ -354,19 +478,33 @@ impl Trajectory {
     pub const MAX_OMEGA: f32 = 10.0;
     /// Largest |depth_rate| of a helix (m/s).
     pub const MAX_DEPTH_RATE: f32 = 10.0;
+    /// Largest time scale k (a mission flown 100 times slower than its path says).
+    pub const MAX_TIME_SCALE: f32 = 100.0;
+    /// Smallest horizontal speed (m/s) a tangent-heading mission may reach anywhere on its
+    /// path (docs/design.md §6 **Choice**): the course atan2(ẏ_d, ẋ_d) is undefined at zero
+    /// speed and its derivatives grow as 1/speed², so [`Trajectory::new`] refuses a tangent
+    /// mission whose closed-form minimum speed is lower, instead of holding a heading (which
+    /// would need state in a stateless `update`). The shipped paths never stop.
+    pub const MIN_TANGENT_SPEED: f32 = 0.02;
 
-    /// Validates `kind` and precomputes the series coefficients and K_d.
+    /// Validates `mission` and precomputes the series coefficients, K_d and the minimum speed.
+    /// A [`TrajectoryKind`] is the paper's mission ([`Mission::paper`]).
     ///
     /// Checks, in field order: every parameter finite; radius/amplitude in (0, [`MAX_SIZE`]],
     /// lawn-mower scale in (0, [`MAX_SIZE`]/15]; omega in (0, [`MAX_OMEGA`]];
-    /// |depth| ≤ [`MAX_DEPTH`]; |depth_rate| ≤ [`MAX_DEPTH_RATE`]. The error names the field.
+    /// |depth| ≤ [`MAX_DEPTH`]; |depth_rate| ≤ [`MAX_DEPTH_RATE`]; then time_scale in
+    /// [1, [`MAX_TIME_SCALE`]]; then, for the tangent heading, a minimum horizontal speed
+    /// ≥ [`MIN_TANGENT_SPEED`]. The error names the field.
     ///
     /// [`MAX_SIZE`]: Self::MAX_SIZE
     /// [`MAX_OMEGA`]: Self::MAX_OMEGA
     /// [`MAX_DEPTH`]: Self::MAX_DEPTH
     /// [`MAX_DEPTH_RATE`]: Self::MAX_DEPTH_RATE
-    pub fn new(kind: TrajectoryKind) -> Result<Self, TrajectoryError> {
-        match kind {
+    /// [`MAX_TIME_SCALE`]: Self::MAX_TIME_SCALE
+    /// [`MIN_TANGENT_SPEED`]: Self::MIN_TANGENT_SPEED
+    pub fn new(mission: impl Into<Mission>) -> Result<Self, TrajectoryError> {
+        let mission = mission.into();
+        match mission.path {
             TrajectoryKind::Circle {
                 radius,
                 omega,
@@ -406,49 +544,160 @@ impl Trajectory {
                 symmetric("depth_rate", depth_rate, Self::MAX_DEPTH_RATE)?;
             }
         }
-        Ok(Self::build(kind))
+        let k = mission.time_scale;
+        if !k.is_finite() {
+            return Err(TrajectoryError::NonFinite {
+                parameter: "time_scale",
+            });
+        }
+        if !(1.0..=Self::MAX_TIME_SCALE).contains(&k) {
+            return Err(TrajectoryError::OutOfRange {
+                parameter: "time_scale",
+                value: k,
+                min: 1.0,
+                max: Self::MAX_TIME_SCALE,
+            });
+        }
+        let t = Self::build(mission);
+        if mission.heading == HeadingMode::Tangent
+            && (t.min_speed.is_nan() || t.min_speed < Self::MIN_TANGENT_SPEED)
+        {
+            return Err(TrajectoryError::TooSlowForTangent {
+                min_speed: t.min_speed,
+                threshold: Self::MIN_TANGENT_SPEED,
+            });
+        }
+        Ok(t)
     }
 
-    /// Precomputes the constants of an already validated kind.
-    fn build(kind: TrajectoryKind) -> Self {
-        let psi = match kind {
-            TrajectoryKind::FigureEight { omega, .. } => {
-                series_coefficients(Series::Triangle, omega)
+    /// Precomputes the constants of an already validated mission.
+    fn build(mission: Mission) -> Self {
+        let k = mission.time_scale as f64;
+        let (omega, rate) = match mission.path {
+            TrajectoryKind::Circle { omega, .. } | TrajectoryKind::FigureEight { omega, .. } => {
+                (omega, 0.0)
             }
-            TrajectoryKind::LawnMower { omega, .. } => {
-                series_coefficients(Series::Trapezoid, omega)
-            }
+            TrajectoryKind::LawnMower { omega, .. } => (omega, LAWN_MOWER_ADVANCE),
+            TrajectoryKind::Helix {
+                omega, depth_rate, ..
+            } => (omega, depth_rate),
+        };
+        // η_d(t/k): every frequency and every linear rate over k (exact for k = 1).
+        let omega_f64 = omega as f64 / k;
+        let rate_f64 = rate as f64 / k;
+        let omega = omega_f64 as f32;
+        let psi = match mission.path {
+            TrajectoryKind::FigureEight { .. } => series_coefficients(Series::Triangle, omega),
+            TrajectoryKind::LawnMower { .. } => series_coefficients(Series::Trapezoid, omega),
             TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. } => [[0.0; 3]; ODD_TERMS],
         };
+        let mut t = Self {
+            mission,
+            omega,
+            omega_f64,
+            rate: rate_f64 as f32,
+            rate_f64,
+            psi,
+            accel_bound: 0.0,
+            min_speed: 0.0,
+        };
+        t.min_speed = t.min_horizontal_speed();
         // Assumption 1 (Eq 19): per component Σ |amplitude|·frequency² over its harmonics
         // (|sin|, |cos| ≤ 1), then the Euclidean norm over the components. Linear-in-t terms
         // (lawn-mower 0.25 s t, helix z) and the circle's ψ = ωt have no acceleration.
-        let mut series_bound = 0.0f32;
-        for c in &psi {
-            series_bound += libm::fabsf(c[2]);
-        }
-        let (x, y) = match kind {
-            TrajectoryKind::Circle { radius, omega, .. }
-            | TrajectoryKind::Helix { radius, omega, .. } => {
+        let heading_bound = match mission.heading {
+            HeadingMode::Paper => {
+                let mut series_bound = 0.0f32;
+                for c in &psi {
+                    series_bound += libm::fabsf(c[2]);
+                }
+                series_bound
+            }
+            HeadingMode::Tangent => t.tangent_accel_bound(),
+        };
+        let (x, y) = match mission.path {
+            TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => {
                 (radius * omega * omega, radius * omega * omega)
             }
-            TrajectoryKind::FigureEight {
-                amplitude, omega, ..
-            } => {
+            TrajectoryKind::FigureEight { amplitude, .. } => {
                 let half = 0.5 * omega;
                 (amplitude * omega * omega, amplitude * half * half)
             }
-            TrajectoryKind::LawnMower { scale, omega, .. } => {
+            TrajectoryKind::LawnMower { scale, .. } => {
                 let two = 2.0 * omega;
                 (2.5 * scale * two * two, 15.0 * scale * omega * omega)
             }
         };
-        let accel_bound = sqrt_upper(x * x + y * y + series_bound * series_bound);
-        Self {
-            kind,
-            psi,
-            accel_bound,
+        t.accel_bound = sqrt_upper(x * x + y * y + heading_bound * heading_bound);
+        t
+    }
+
+    /// The smallest horizontal speed √(ẋ_d² + ẏ_d²) over the path, in closed form (m/s):
+    ///
+    /// * circle, helix: Rω/k, constant;
+    /// * figure-eight: ẋ = Aω cos θ, ẏ = −(Aω/2) sin(θ/2), so with s = sin²(θ/2) the speed² is
+    ///   A²ω²[(1 − 2s)² + s/4], least at s = 15/32: Aω√31/16 ≈ 0.348 Aω;
+    /// * lawn-mower: ẋ = s(a − b u), ẏ² = s² c u with u = sin²θ ∈ [0, 1], a = 0.25/k + 5ω,
+    ///   b = 10ω, c = 225ω² (ω already over k): a convex quadratic in u, least at
+    ///   u* = (2ab − c)/(2b²) clamped to [0, 1].
+    fn min_horizontal_speed(&self) -> f32 {
+        let w = self.omega;
+        match self.mission.path {
+            TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => {
+                radius * w
+            }
+            TrajectoryKind::FigureEight { amplitude, .. } => {
+                amplitude * w * math::sqrt(31.0) / 16.0
+            }
+            TrajectoryKind::LawnMower { scale, .. } => {
+                let a = self.rate + 5.0 * w;
+                let b = 10.0 * w;
+                let c = 225.0 * w * w;
+                let u = ((2.0 * a * b - c) / (2.0 * b * b)).clamp(0.0, 1.0);
+                let f = (a - b * u) * (a - b * u) + c * u;
+                scale * math::sqrt(f)
+            }
         }
+    }
+
+    /// An upper bound on the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**). On the
+    /// circle and the helix ψ̈_d = 0 exactly (the course turns at the constant −ω/k). On the
+    /// figure-eight and the lawn-mower ψ̈_d is periodic in the path's phase: its maximum over
+    /// [`TANGENT_BOUND_SAMPLES`] phases of one period, times [`TANGENT_BOUND_MARGIN`] for
+    /// the peak between samples. Fixed work, at configuration time only; the tests check the
+    /// bound against whole missions sampled at the control rate.
+    fn tangent_accel_bound(&self) -> f32 {
+        let periodic = matches!(
+            self.mission.path,
+            TrajectoryKind::FigureEight { .. } | TrajectoryKind::LawnMower { .. }
+        );
+        if !periodic {
+            return 0.0;
+        }
+        let mut max = 0.0f32;
+        for j in 0..TANGENT_BOUND_SAMPLES {
+            // One period: the figure-eight's y has the half phase (period 4π in θ), the
+            // lawn-mower's derivatives have period 2π in θ.
+            let a = core::f32::consts::TAU * j as f32 / TANGENT_BOUND_SAMPLES as f32;
+            let ph = match self.mission.path {
+                TrajectoryKind::FigureEight { .. } => Phases {
+                    theta: math::wrap_pi(2.0 * a),
+                    half: a,
+                    t: 0.0,
+                },
+                _ => Phases {
+                    theta: a,
+                    half: 0.0,
+                    t: 0.0,
+                },
+            };
+            let (_, _, accel) = tangent(&self.planar(&ph));
+            let accel = libm::fabsf(accel);
+            if accel > max {
+                max = accel;
+            }
+        }
+        max * TANGENT_BOUND_MARGIN
     }
 
     /// Circle of radius `radius` with the paper's ω = 0.1 rad/s and depth 5 m.
@@ -480,12 +729,22 @@ impl Trajectory {
 
     /// One of the paper's Table-1 missions (always valid, so no `Result`).
     pub fn table1(case: Table1Case) -> Self {
-        Self::build(case.kind())
+        Self::build(Mission::paper(case.kind()))
     }
 
-    /// The mission's shape and parameters.
+    /// The mission's path: its shape and parameters.
     pub fn kind(&self) -> TrajectoryKind {
-        self.kind
+        self.mission.path
+    }
+
+    /// The mission: path, heading and time scale.
+    pub fn mission(&self) -> Mission {
+        self.mission
+    }
+
+    /// The smallest horizontal speed along the path at its time scale (m/s), in closed form.
+    pub fn min_speed(&self) -> f32 {
+        self.min_speed
     }
 
     /// K_d of Assumption 1 (Eq 19): an upper bound on ‖η̈_d(t)‖ for all t.
@@ -493,9 +752,10 @@ impl Trajectory {
     /// Computed from the amplitudes: for each component of η̈_d the sum of |amplitude|·(frequency)²
     /// over its harmonics, then the Euclidean norm over the components. For the circle this is
     /// √2·Rω² (the true maximum is Rω²); for the paper's figure-eight it is within 1 % of the true
-    /// maximum (all the bounds are reached together at ωt = π/2). The square root is the
-    /// backend's followed by one Newton step, which can only round up (AM–GM), so the bound holds
-    /// with micromath's ≈ 6 % `sqrt` too.
+    /// maximum (all the bounds are reached together at ωt = π/2). The tangent heading's term is
+    /// the sampled bound of docs/design.md §6. All frequencies are over the time scale k, so
+    /// K_d falls as 1/k². The square root is the backend's followed by one Newton step, which
+    /// can only round up (AM–GM), so the bound holds with micromath's ≈ 6 % `sqrt` too.
     pub fn accel_bound(&self) -> f32 {
         self.accel_bound
     }
@@ -512,86 +772,29 @@ impl Trajectory {
         } else {
             (ticks, rate_hz)
         };
+        let ph = self.phases(ticks, rate_hz);
+        let p = self.planar(&ph);
         let mut eta = Vector6::<f32>::zeros();
         let mut eta_dot = Vector6::<f32>::zeros();
         let mut eta_ddot = Vector6::<f32>::zeros();
-        match self.kind {
-            TrajectoryKind::Circle {
-                radius,
-                omega,
-                depth,
-            } => {
-                circle(
-                    radius,
-                    omega,
-                    ticks,
-                    rate_hz,
-                    &mut eta,
-                    &mut eta_dot,
-                    &mut eta_ddot,
-                );
-                eta[2] = depth;
+        eta[0] = p.x;
+        eta[1] = p.y;
+        eta[2] = p.z;
+        eta_dot[0] = p.d[0][0];
+        eta_dot[1] = p.d[0][1];
+        eta_dot[2] = p.z_dot;
+        eta_ddot[0] = p.d[1][0];
+        eta_ddot[1] = p.d[1][1];
+        let (psi, rate, accel) = match (self.mission.heading, self.mission.path) {
+            (HeadingMode::Tangent, _) => tangent(&p),
+            (HeadingMode::Paper, TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. }) => {
+                (math::wrap_pi(ph.theta), self.omega, 0.0)
             }
-            TrajectoryKind::Helix {
-                radius,
-                omega,
-                depth,
-                depth_rate,
-            } => {
-                circle(
-                    radius,
-                    omega,
-                    ticks,
-                    rate_hz,
-                    &mut eta,
-                    &mut eta_dot,
-                    &mut eta_ddot,
-                );
-                let t = math::seconds(ticks, rate_hz);
-                eta[2] = (depth as f64 + depth_rate as f64 * t) as f32;
-                eta_dot[2] = depth_rate;
-            }
-            TrajectoryKind::FigureEight {
-                amplitude,
-                omega,
-                depth,
-            } => {
-                let theta = math::phase(omega, ticks, rate_hz);
-                let half = 0.5 * omega;
-                let theta_half = math::phase(half, ticks, rate_hz);
-                let (s1, c1) = harmonic(1, theta);
-                let (sh, ch) = harmonic(1, theta_half);
-                eta[0] = amplitude * s1;
-                eta_dot[0] = amplitude * omega * c1;
-                eta_ddot[0] = -amplitude * omega * omega * s1;
-                eta[1] = amplitude * ch;
-                eta_dot[1] = -amplitude * half * sh;
-                eta_ddot[1] = -amplitude * half * half * ch;
-                eta[2] = depth;
-                self.heading_series(theta, &mut eta, &mut eta_dot, &mut eta_ddot);
-            }
-            TrajectoryKind::LawnMower {
-                scale,
-                omega,
-                depth,
-            } => {
-                let theta = math::phase(omega, ticks, rate_hz);
-                let (s1, c1) = harmonic(1, theta);
-                let (s2, c2) = harmonic(2, theta);
-                let two = 2.0 * omega;
-                let t = math::seconds(ticks, rate_hz);
-                let wave = 2.5 * scale * s2;
-                eta[0] = (0.25 * scale as f64 * t + wave as f64) as f32;
-                eta_dot[0] = scale * (0.25 + 2.5 * two * c2);
-                eta_ddot[0] = -2.5 * scale * two * two * s2;
-                let amp_y = 15.0 * scale;
-                eta[1] = amp_y * c1;
-                eta_dot[1] = -amp_y * omega * s1;
-                eta_ddot[1] = -amp_y * omega * omega * c1;
-                eta[2] = depth;
-                self.heading_series(theta, &mut eta, &mut eta_dot, &mut eta_ddot);
-            }
-        }
+            (HeadingMode::Paper, _) => self.heading_series(ph.theta),
+        };
+        eta[5] = psi;
+        eta_dot[5] = rate;
+        eta_ddot[5] = accel;
         Desired {
             eta,
             eta_dot,
@@ -599,14 +802,87 @@ impl Trajectory {
         }
     }
 
+    /// The phases of tick `ticks` (`rate_hz` ≥ 1): only those the path uses.
+    fn phases(&self, ticks: u64, rate_hz: u32) -> Phases {
+        let theta = math::phase_f64(self.omega_f64, ticks, rate_hz);
+        let (half, t) = match self.mission.path {
+            TrajectoryKind::FigureEight { .. } => {
+                (math::phase_f64(0.5 * self.omega_f64, ticks, rate_hz), 0.0)
+            }
+            TrajectoryKind::LawnMower { .. } | TrajectoryKind::Helix { .. } => {
+                (0.0, math::seconds(ticks, rate_hz))
+            }
+            TrajectoryKind::Circle { .. } => (0.0, 0.0),
+        };
+        Phases { theta, half, t }
+    }
+
+    /// The path at the given phases: x_d, y_d and three derivatives each, z_d and ż_d
+    /// (analytic; every frequency and rate is already over the time scale).
+    fn planar(&self, ph: &Phases) -> Planar {
+        let omega = self.omega;
+        match self.mission.path {
+            TrajectoryKind::Circle { radius, depth, .. } => {
+                let mut p = circle(radius, omega, ph.theta);
+                p.z = depth;
+                p
+            }
+            TrajectoryKind::Helix { radius, depth, .. } => {
+                let mut p = circle(radius, omega, ph.theta);
+                p.z = (depth as f64 + self.rate_f64 * ph.t) as f32;
+                p.z_dot = self.rate;
+                p
+            }
+            TrajectoryKind::FigureEight {
+                amplitude, depth, ..
+            } => {
+                let half = 0.5 * omega;
+                let (s1, c1) = harmonic(1, ph.theta);
+                let (sh, ch) = harmonic(1, ph.half);
+                Planar {
+                    x: amplitude * s1,
+                    y: amplitude * ch,
+                    z: depth,
+                    z_dot: 0.0,
+                    d: [
+                        [amplitude * omega * c1, -amplitude * half * sh],
+                        [
+                            -amplitude * omega * omega * s1,
+                            -amplitude * half * half * ch,
+                        ],
+                        [
+                            -amplitude * omega * omega * omega * c1,
+                            amplitude * half * half * half * sh,
+                        ],
+                    ],
+                }
+            }
+            TrajectoryKind::LawnMower { scale, depth, .. } => {
+                let (s1, c1) = harmonic(1, ph.theta);
+                let (s2, c2) = harmonic(2, ph.theta);
+                let two = 2.0 * omega;
+                let wave = 2.5 * scale * s2;
+                let amp_y = 15.0 * scale;
+                Planar {
+                    x: (self.rate_f64 * scale as f64 * ph.t + wave as f64) as f32,
+                    y: amp_y * c1,
+                    z: depth,
+                    z_dot: 0.0,
+                    d: [
+                        [scale * (self.rate + 2.5 * two * c2), -amp_y * omega * s1],
+                        [-2.5 * scale * two * two * s2, -amp_y * omega * omega * c1],
+                        [
+                            -2.5 * scale * two * two * two * c2,
+                            amp_y * omega * omega * omega * s1,
+                        ],
+                    ],
+                }
+            }
+        }
+    }
+
     /// ψ_d, ψ̇_d, ψ̈_d from the precomputed odd-harmonic coefficients (fixed five terms).
-    fn heading_series(
-        &self,
-        theta: f32,
-        eta: &mut Vector6<f32>,
-        eta_dot: &mut Vector6<f32>,
-        eta_ddot: &mut Vector6<f32>,
-    ) {
+    fn heading_series(&self, theta: f32) -> (f32, f32, f32) {
         let (mut psi, mut rate, mut accel) = (0.0f32, 0.0f32, 0.0f32);
         for (i, c) in self.psi.iter().enumerate() {
             let (s, co) = harmonic(2 * i as u32 + 1, theta);
@@ -614,32 +890,45 @@ impl Trajectory {
             rate += c[1] * co;
             accel -= c[2] * s;
         }
-        eta[5] = math::wrap_pi(psi);
-        eta_dot[5] = rate;
-        eta_ddot[5] = accel;
+        (math::wrap_pi(psi), rate, accel)
     }
 }
 
-/// Circle part shared by the circle and the helix: x, y, ψ and their derivatives.
-fn circle(
-    radius: f32,
-    omega: f32,
-    ticks: u64,
-    rate_hz: u32,
-    eta: &mut Vector6<f32>,
-    eta_dot: &mut Vector6<f32>,
-    eta_ddot: &mut Vector6<f32>,
-) {
-    let theta = math::phase(omega, ticks, rate_hz);
+/// The lawn-mower's advance, x_d = s(0.25 t + …): 0.25 m/s per unit scale.
+const LAWN_MOWER_ADVANCE: f32 = 0.25;
+
+/// The tangent heading of a path sample (see [`HeadingMode::Tangent`]): ψ_d = atan2(ẏ, ẋ),
+/// ψ̇_d = N/D, ψ̈_d = (Ṅ − ψ̇_d Ḋ)/D. One `atan2` and one division.
+#[inline]
+fn tangent(p: &Planar) -> (f32, f32, f32) {
+    let [[xd, yd], [xdd, ydd], [xddd, yddd]] = p.d;
+    let d = xd * xd + yd * yd;
+    let inv_d = 1.0 / d;
+    let n = xd * ydd - yd * xdd;
+    let n_dot = xd * yddd - yd * xddd;
+    let d_dot = 2.0 * (xd * xdd + yd * ydd);
+    let rate = n * inv_d;
+    let accel = (n_dot - rate * d_dot) * inv_d;
+    (math::atan2(yd, xd), rate, accel)
+}
+
+/// Circle part shared by the circle and the helix: x, y and their derivatives (z left 0).
+fn circle(radius: f32, omega: f32, theta: f32) -> Planar {
     let (s, c) = harmonic(1, theta);
-    eta[0] = radius * s;
-    eta_dot[0] = radius * omega * c;
-    eta_ddot[0] = -radius * omega * omega * s;
-    eta[1] = radius * c;
-    eta_dot[1] = -radius * omega * s;
-    eta_ddot[1] = -radius * omega * omega * c;
-    eta[5] = math::wrap_pi(theta);
-    eta_dot[5] = omega;
+    Planar {
+        x: radius * s,
+        y: radius * c,
+        z: 0.0,
+        z_dot: 0.0,
+        d: [
+            [radius * omega * c, -radius * omega * s],
+            [-radius * omega * omega * s, -radius * omega * omega * c],
+            [
+                -radius * omega * omega * omega * c,
+                radius * omega * omega * omega * s,
+            ],
+        ],
+    }
 }
 
 /// (sin nθ, cos nθ) with n·θ wrapped to (−π, π] first (θ is a reduced phase; n·θ ≡ nωt mod 2π

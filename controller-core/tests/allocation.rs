@@ -3,7 +3,7 @@
 //! general tilted layout, and the singular and ill-conditioned layouts it must refuse.
 
 use controller_core::allocation::{Allocation, AllocationError, MAX_CONDITION};
-use controller_core::effectiveness::{ThrusterGeometry, HORZ_AFT, HORZ_FORE};
+use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE};
 use nalgebra::Vector6;
 use proptest::prelude::*;
 
@@ -21,24 +21,45 @@ fn wrench() -> impl Strategy<Value = [f32; 6]> {
     proptest::array::uniform6(-1.0e4f32..1.0e4)
 }
 
-/// docs/design.md §5 closed form, in f64.
-fn closed_form(tau: &[f32; 6]) -> [f64; 5] {
+/// docs/design.md §5 closed form, in f64, for every thruster along its reference axis
+/// (+x, +z, +z, +y, +y); a reversed thruster (bit i of `reversed`) gives the negated thrust.
+fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; 5] {
     let [x, y, z, _k, m, n] = tau.map(|v| v as f64);
-    [
+    let t = [
         x,
         (z - m / 1.8) / 2.0,
         (z + m / 1.8) / 2.0,
         (y + n / 1.8) / 2.0,
         (y - n / 1.8) / 2.0,
-    ]
+    ];
+    std::array::from_fn(|i| {
+        if reversed & (1 << i) != 0 {
+            -t[i]
+        } else {
+            t[i]
+        }
+    })
+}
+
+#[test]
+fn default_is_the_real_vehicle_mounting() {
+    // Vertical pair pushing up, horizontal pair pushing to port (docs/design.md §9): a
+    // pure upward force is positive (strong) thrust on both vertical tunnels, a pure force to
+    // port positive thrust on both horizontal ones.
+    let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry");
+    let up = a.thrusts(&Vector6::new(0.0, 0.0, -100.0, 0.0, 0.0, 0.0));
+    assert_eq!(up, [0.0, 50.0, 50.0, 0.0, 0.0]);
+    let port = a.thrusts(&Vector6::new(0.0, -100.0, 0.0, 0.0, 0.0, 0.0));
+    assert_eq!(port, [0.0, 0.0, 0.0, 50.0, 50.0]);
+    assert_eq!(AUV150_REVERSED, 0b11110);
 }
 
 proptest! {
     #[test]
-    fn default_thrusts_equal_closed_form(tau in wrench()) {
-        let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry");
+    fn default_thrusts_equal_closed_form(tau in wrench(), reversed in 0u8..32) {
+        let a = Allocation::new(&ThrusterGeometry::auv150(reversed)).expect("AUV-150 layout");
         let t = a.thrusts(&Vector6::from(tau));
-        let want = closed_form(&tau);
+        let want = closed_form(&tau, reversed);
         let scale: f64 = tau.iter().map(|v| v.abs() as f64).sum::<f64>().max(1.0);
         for i in 0..5 {
             prop_assert!((t[i] as f64 - want[i]).abs() <= 4.0 * EPS * scale,
@@ -48,6 +69,7 @@ proptest! {
         let mut tau_k = tau;
         tau_k[3] = 1234.5;
         prop_assert_eq!(a.thrusts(&Vector6::from(tau_k)), t);
+        prop_assert_eq!(ThrusterGeometry::auv150(reversed).auv150_reversed(), Some(reversed));
     }
 
     #[test]

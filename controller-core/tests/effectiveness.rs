@@ -4,47 +4,74 @@
 
 use controller_core::allocation::{Allocation, AllocationError};
 use controller_core::effectiveness::{
-    GeometryError, ThrusterGeometry, HORZ_AFT, HORZ_FORE, MAIN, THRUSTERS, VERT_AFT, VERT_FORE,
+    GeometryError, ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE, MAIN, THRUSTERS,
+    VERT_AFT, VERT_FORE,
 };
 
 #[test]
 fn default_layout_is_the_spec_choice() {
+    // Positions docs/design.md §5; mounting §9: vertical pair pushing up (−z), horizontal
+    // pair pushing to port (−y), main forward.
     let g = ThrusterGeometry::default();
     assert_eq!(g.position[MAIN], [-2.43, 0.0, 0.0]);
     assert_eq!(g.direction[MAIN], [1.0, 0.0, 0.0]);
     assert_eq!(g.position[VERT_FORE], [1.8, 0.0, 0.0]);
     assert_eq!(g.position[VERT_AFT], [-1.8, 0.0, 0.0]);
-    assert_eq!(g.direction[VERT_FORE], [0.0, 0.0, 1.0]);
-    assert_eq!(g.direction[VERT_AFT], [0.0, 0.0, 1.0]);
+    assert_eq!(g.direction[VERT_FORE], [0.0, 0.0, -1.0]);
+    assert_eq!(g.direction[VERT_AFT], [0.0, 0.0, -1.0]);
     assert_eq!(g.position[HORZ_FORE], [1.8, 0.0, 0.0]);
     assert_eq!(g.position[HORZ_AFT], [-1.8, 0.0, 0.0]);
-    assert_eq!(g.direction[HORZ_FORE], [0.0, 1.0, 0.0]);
-    assert_eq!(g.direction[HORZ_AFT], [0.0, 1.0, 0.0]);
+    assert_eq!(g.direction[HORZ_FORE], [0.0, -1.0, 0.0]);
+    assert_eq!(g.direction[HORZ_AFT], [0.0, -1.0, 0.0]);
     assert_eq!(THRUSTERS, 5);
+    assert_eq!(g, ThrusterGeometry::auv150(AUV150_REVERSED));
+    assert_eq!(g.auv150_reversed(), Some(AUV150_REVERSED));
+    // Every thruster along its reference axis.
+    let r = ThrusterGeometry::auv150(0);
+    assert_eq!(r.direction[VERT_AFT], [0.0, 0.0, 1.0]);
+    assert_eq!(r.direction[HORZ_FORE], [0.0, 1.0, 0.0]);
+    // A geometry that is not the AUV-150 layout has no mask.
+    let mut tilted = g;
+    tilted.direction[MAIN] = [0.6, 0.8, 0.0];
+    assert_eq!(tilted.auv150_reversed(), None);
+    let mut moved = g;
+    moved.position[MAIN][0] = -2.0;
+    assert_eq!(moved.auv150_reversed(), None);
 }
 
 #[test]
-fn default_effectiveness_matrix_by_hand() {
-    let b = ThrusterGeometry::default()
-        .effectiveness()
-        .expect("default geometry accepted");
+fn effectiveness_matrix_by_hand() {
     // Columns [d; r × d] by hand, rows X Y Z K M N: r × d for r = (x, 0, 0) is
-    // (0, −x d_z, x d_y).
-    let want: [[f32; 6]; 5] = [
+    // (0, −x d_z, x d_y). Along the reference axes (+x, +z, +z, +y, +y):
+    let reference: [[f32; 6]; 5] = [
         [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],  // main: on the x axis, no moment
         [0.0, 0.0, 1.0, 0.0, -1.8, 0.0], // vertical fore: M = −1.8·T
         [0.0, 0.0, 1.0, 0.0, 1.8, 0.0],  // vertical aft: M = +1.8·T
         [0.0, 1.0, 0.0, 0.0, 0.0, 1.8],  // horizontal fore: N = +1.8·T
         [0.0, 1.0, 0.0, 0.0, 0.0, -1.8], // horizontal aft: N = −1.8·T
     ];
-    for (c, col) in want.iter().enumerate() {
-        for (r, &w) in col.iter().enumerate() {
-            assert_eq!(b[(r, c)], w, "B[{r},{c}]");
+    // The real vehicle (default): the four tunnels reversed, their columns negated.
+    let default: [[f32; 6]; 5] = [
+        [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+        [0.0, 0.0, -1.0, 0.0, 1.8, 0.0], // pushing up fore: nose up
+        [0.0, 0.0, -1.0, 0.0, -1.8, 0.0],
+        [0.0, -1.0, 0.0, 0.0, 0.0, -1.8], // pushing to port fore: nose to port
+        [0.0, -1.0, 0.0, 0.0, 0.0, 1.8],
+    ];
+    for (g, want) in [
+        (ThrusterGeometry::auv150(0), reference),
+        (ThrusterGeometry::default(), default),
+    ] {
+        let b = g.effectiveness().expect("AUV-150 layout accepted");
+        for (c, col) in want.iter().enumerate() {
+            for (r, &w) in col.iter().enumerate() {
+                assert_eq!(b[(r, c)], w, "B[{r},{c}]");
+            }
         }
+        // The allocation keeps this very matrix.
+        let a = Allocation::new(&g).expect("AUV-150 layout accepted");
+        assert_eq!(a.matrix(), b);
     }
-    // The allocation keeps this very matrix.
-    let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry accepted");
-    assert_eq!(a.matrix(), b);
 }
 
 #[test]

@@ -11,8 +11,8 @@
 
 use controller_core::effectiveness::{MAIN, THRUSTERS, VERT_FORE};
 use controller_core::thruster::{
-    actuate, default_maps, Actuation, ThrusterMap, ALL_SATURATED, DEFAULT_V_LIMIT, MAIN_T_FOLD,
-    MAIN_V_FOLD,
+    actuate, default_maps, Actuation, Envelope, ThrustUnit, ThrusterMap, ALL_SATURATED,
+    DEFAULT_V_LIMIT, MAIN_T_FOLD, MAIN_V_FOLD,
 };
 use proptest::prelude::*;
 
@@ -333,6 +333,85 @@ fn thrust_range_at_24_volts() {
     assert!((hi as f64 - 73.306).abs() < 1e-3);
 }
 
+/// The standard kilogram-force, typed here (not the crate's constant).
+const KGF: f64 = 9.806_65;
+
+#[test]
+fn envelope_in_newtons_in_both_readings() {
+    // Closed form: tunnel (T(−24), T(+24)) of the increasing cubic; main (T_fold, T(−24)) of
+    // the decreasing parabola, T_fold = −0.1048/0.006. In kgf every bound is ×9.80665 N.
+    let fold = -0.1048 / 0.006;
+    let poly = [
+        (fold, main_root(-24.0)),
+        (tunnel_root(-24.0), tunnel_root(24.0)),
+    ];
+    for (unit, newtons) in [(ThrustUnit::Newton, 1.0), (ThrustUnit::Kgf, KGF)] {
+        let e = Envelope::new(&default_maps(), unit, 24.0);
+        for i in 0..THRUSTERS {
+            let (lo, hi) = poly[usize::from(i != MAIN)];
+            let (lo, hi) = (lo * newtons, hi * newtons);
+            let tol = 4e-5 * newtons;
+            assert!(
+                (e.min[i] as f64 - lo).abs() < tol,
+                "{unit} {i}: min {} vs {lo}",
+                e.min[i]
+            );
+            assert!(
+                (e.max[i] as f64 - hi).abs() < tol,
+                "{unit} {i}: max {} vs {hi}",
+                e.max[i]
+            );
+        }
+    }
+    // The figures docs/design.md §9 quotes (kgf): main −171.29 … +718.89 N, tunnel −89.88 …
+    // +197.13 N.
+    let e = Envelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
+    assert!((e.min[MAIN] + 171.29).abs() < 0.01 && (e.max[MAIN] - 718.89).abs() < 0.01);
+    assert!((e.min[VERT_FORE] + 89.88).abs() < 0.01 && (e.max[VERT_FORE] - 197.13).abs() < 0.01);
+    assert!(e.contains(&[0.0; 5]));
+    assert!(!e.scaled(0.8).contains(&e.max));
+}
+
+#[test]
+fn kgf_reading_divides_the_thrust_before_the_polynomial() {
+    // 98.0665 N is 10 kgf: the kgf reading commands Eq 31 at 10, the newton reading at 98.07.
+    let maps = default_maps();
+    let cmd = [
+        50.0 * KGF as f32,
+        10.0 * KGF as f32,
+        -5.0 * KGF as f32,
+        0.0,
+        2.0,
+    ];
+    let kgf = actuate(&maps, ThrustUnit::Kgf, &cmd, DEFAULT_V_LIMIT);
+    for (i, &cmd_i) in cmd.iter().enumerate() {
+        let c = cmd_i as f64 / KGF;
+        let want = if i == MAIN { main_v(c) } else { tunnel_v(c) };
+        assert!(
+            (kgf.voltages[i] as f64 - want).abs() < 1e-4,
+            "{i}: {} vs {want}",
+            kgf.voltages[i]
+        );
+        // Reported back in newtons.
+        assert!(
+            (kgf.thrusts[i] as f64 - cmd_i as f64).abs() < 1e-3 * KGF,
+            "{i}"
+        );
+    }
+    assert_eq!(kgf.saturated, 0);
+    // The same newtons read as newtons: Eq 31 at 98.07 N is beyond +24 V, saturated.
+    let newton = actuate(&maps, ThrustUnit::Newton, &cmd, DEFAULT_V_LIMIT);
+    assert_eq!(newton.voltages[VERT_FORE], DEFAULT_V_LIMIT);
+    assert!(newton.is_saturated(VERT_FORE) && newton.is_saturated(MAIN));
+    assert!((newton.voltages[4] as f64 - tunnel_v(2.0)).abs() < 1e-4);
+    assert_eq!(ThrustUnit::default(), ThrustUnit::Kgf);
+    assert_eq!(ThrustUnit::from_name("newton"), Some(ThrustUnit::Newton));
+    assert_eq!(
+        ThrustUnit::from_name("kgf").map(ThrustUnit::as_str),
+        Some("kgf")
+    );
+}
+
 #[test]
 fn default_maps_follow_the_thruster_order() {
     assert_eq!(
@@ -354,7 +433,7 @@ fn default_maps_follow_the_thruster_order() {
 fn huge_commands_saturate_at_the_thrust_of_the_limit() {
     let maps = default_maps();
     let cmd = [1.0e6, 1.0e6, -1.0e6, 1.0e9, -1.0e30];
-    let a = actuate(&maps, &cmd, DEFAULT_V_LIMIT);
+    let a = actuate(&maps, ThrustUnit::Newton, &cmd, DEFAULT_V_LIMIT);
     assert_eq!(a.saturated, ALL_SATURATED);
     // Main: forward thrust needs negative voltage.
     assert_eq!(a.voltages, [-24.0, 24.0, -24.0, 24.0, -24.0]);
@@ -381,7 +460,7 @@ fn huge_commands_saturate_at_the_thrust_of_the_limit() {
 fn small_commands_pass_through_unsaturated() {
     let maps = default_maps();
     let cmd = [10.0, 2.0, -3.0, 1.5, -0.5];
-    let a = actuate(&maps, &cmd, DEFAULT_V_LIMIT);
+    let a = actuate(&maps, ThrustUnit::Newton, &cmd, DEFAULT_V_LIMIT);
     assert_eq!(a.saturated, 0);
     for (i, &c) in cmd.iter().enumerate() {
         let want_v = if i == MAIN {
@@ -397,19 +476,29 @@ fn small_commands_pass_through_unsaturated() {
 #[test]
 fn main_below_fold_is_saturated_at_the_fold() {
     let maps = default_maps();
-    let a = actuate(&maps, &[-30.0, 0.0, 0.0, 0.0, 0.0], DEFAULT_V_LIMIT);
+    let a = actuate(
+        &maps,
+        ThrustUnit::Newton,
+        &[-30.0, 0.0, 0.0, 0.0, 0.0],
+        DEFAULT_V_LIMIT,
+    );
     assert_eq!(a.saturated, 1 << MAIN);
     assert_eq!(a.voltages[MAIN], MAIN_V_FOLD);
     assert_eq!(a.thrusts[MAIN], MAIN_T_FOLD);
     // Tunnels at 0 N: −1.354 V (Eq 31 offset), not saturated.
     assert!((a.voltages[VERT_FORE] as f64 + 1.354).abs() < 1e-6);
     // A supply limit below V_fold clamps further: T = thrust(v_limit) > T_fold.
-    let a = actuate(&maps, &[-30.0, 0.0, 0.0, 0.0, 0.0], 0.5);
+    let a = actuate(&maps, ThrustUnit::Newton, &[-30.0, 0.0, 0.0, 0.0, 0.0], 0.5);
     assert_eq!(a.voltages[MAIN], 0.5);
     assert!((a.thrusts[MAIN] as f64 - main_root(0.5)).abs() < 1e-4);
     assert!(a.is_saturated(MAIN));
     // A command exactly at the fold is reachable.
-    let a = actuate(&maps, &[MAIN_T_FOLD, 0.0, 0.0, 0.0, 0.0], DEFAULT_V_LIMIT);
+    let a = actuate(
+        &maps,
+        ThrustUnit::Newton,
+        &[MAIN_T_FOLD, 0.0, 0.0, 0.0, 0.0],
+        DEFAULT_V_LIMIT,
+    );
     assert!(!a.is_saturated(MAIN));
 }
 
@@ -417,7 +506,7 @@ fn main_below_fold_is_saturated_at_the_fold() {
 fn non_finite_commands_switch_the_thruster_off() {
     let maps = default_maps();
     let cmd = [f32::NAN, f32::INFINITY, f32::NEG_INFINITY, 1.0, f32::NAN];
-    let a = actuate(&maps, &cmd, DEFAULT_V_LIMIT);
+    let a = actuate(&maps, ThrustUnit::Newton, &cmd, DEFAULT_V_LIMIT);
     assert_eq!(a.saturated, 0b10111);
     for i in [0usize, 1, 2, 4] {
         assert_eq!(a.voltages[i], 0.0);
@@ -435,7 +524,7 @@ fn non_finite_commands_switch_the_thruster_off() {
 fn invalid_supply_limit_switches_everything_off() {
     let maps = default_maps();
     for v_limit in [f32::NAN, 0.0, -24.0, f32::INFINITY] {
-        let a = actuate(&maps, &[1.0; 5], v_limit);
+        let a = actuate(&maps, ThrustUnit::Newton, &[1.0; 5], v_limit);
         assert_eq!(a.voltages, [0.0; 5]);
         assert_eq!(a.thrusts, [0.0; 5]);
         assert_eq!(a.saturated, ALL_SATURATED, "v_limit = {v_limit}");
@@ -478,7 +567,7 @@ proptest! {
     #[test]
     fn actuate_is_bounded_and_finite(cmd in proptest::array::uniform5(any_f32()), v_limit in v_limit()) {
         let maps = default_maps();
-        let a = actuate(&maps, &cmd, v_limit);
+        let a = actuate(&maps, ThrustUnit::Newton, &cmd, v_limit);
         for i in 0..THRUSTERS {
             let (v, t) = (a.voltages[i], a.thrusts[i]);
             prop_assert!(v.is_finite() && t.is_finite(), "thruster {}: V {} T {}", i, v, t);

@@ -2,17 +2,26 @@
 //! navigation link — on a loopback TCP socket; the simulator plays the vehicle and its
 //! navigation computer.
 //!
-//! Set-up: `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods }`,
-//! `Arm`, then `StartMission` with the first state frame. In lock-step the board runs one
-//! control period per state frame and takes the frame's `t_ticks` as mission time, so the
-//! result does not depend on host speed. Each period the simulator sends a state frame from
+//! Set-up: the runner waits for the board's first telemetry and numbers its own frames from the
+//! board's `last_rx_seq` on (a restarted runner is heard again: `auv_link::seq`), then sends
+//! `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods }` and `Arm`,
+//! and waits for the board to report itself armed (a refused command is reported with the
+//! board's reason); then `StartMission` with the first state frame. In lock-step the board runs
+//! one control period per state frame and takes the frame's `t_ticks` as mission time (on its
+//! mission clock), so the result does not depend on host speed.
+//!
+//! Signing ([`auv_link::sign`]): with a key, QEMU is started with `-append link-key=…` (the
+//! QEMU image's configuration; the key never crosses the link), the runner signs every frame
+//! (timestamps: 10 µs units since 2015-01-01 UTC, as MAVLink) and refuses telemetry that is not
+//! signed by the board. Telemetry frames are also checked for sequence order. Each period the simulator sends a state frame from
 //! the plant and applies the returned telemetry (voltages, or τ for ideal actuators) through
 //! the same actuator chain as SIL ([`crate::sil::run_with`]).
 //!
 //! Link faults ([`LinkFaults`]) drop, corrupt, delay or silence state frames over tick ranges.
-//! The board must go to fail-safe within its stale-state limit; once the link is healthy
-//! again the simulator re-arms it (disarm + arm) and it must resume. Every fail-safe entry and
-//! exit is recorded.
+//! The board must go to fail-safe within its stale-state limit; a delayed frame is an old state
+//! the board drops (off its mission clock). Once the link is healthy again the simulator
+//! re-arms it (disarm, arm, and start the mission again where it is, since disarming drops it)
+//! and it must resume. Every fail-safe entry and exit is recorded.
 
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
@@ -21,9 +30,12 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use auv_link::seq::SeqCheck;
+use auv_link::sign::{AuthError, Direction, LinkKey, Signer, Verifier};
 use auv_link::{
-    encode, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope, FrameDecoder, Msg,
-    StateFrame, Telemetry, DEFAULT_STALE_PERIODS, MAX_FRAME, PROTOCOL_VERSION,
+    encode, encode_signed, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope,
+    FrameDecoder, LinkError, Msg, StateFrame, Telemetry, DEFAULT_STALE_PERIODS, MAX_FRAME,
+    PROTOCOL_VERSION,
 };
 use serde::{Deserialize, Serialize};
 
@@ -74,6 +86,23 @@ pub struct PilStats {
     pub board_loop_overruns: u32,
     pub rearms: u32,
     pub failsafe_events: Vec<FailSafeEvent>,
+    /// The link was signed (both ends).
+    #[serde(default)]
+    pub signed: bool,
+    /// Frames the board dropped as repeated, old or off its mission clock (its `rx_stale`).
+    #[serde(default)]
+    pub board_rx_stale: u32,
+    /// Frames the board refused for their authentication (its `rx_auth_errors`).
+    #[serde(default)]
+    pub board_rx_auth_errors: u32,
+    /// Commands the board refused, and the last reason ([`auv_link::Refusal::as_str`]).
+    #[serde(default)]
+    pub board_refused_commands: u32,
+    #[serde(default)]
+    pub board_last_refusal: Option<String>,
+    /// Telemetry frames this end refused: undecodable, badly signed, or out of sequence.
+    #[serde(default)]
+    pub telemetry_refused: u64,
 }
 
 impl FailSafeEventKind {
@@ -134,12 +163,17 @@ pub struct BoardInTheLoop {
     child: Child,
     stream: TcpStream,
     decoder: FrameDecoder,
+    /// Signing on: signs every frame sent.
+    signer: Option<Signer>,
+    /// The board's telemetry numbers.
+    telemetry_seq: SeqCheck,
     seq: u16,
     rate_hz: u32,
     faults: LinkFaults,
     mission: auv_link::MissionSpec,
     started: bool,
-    history: Vec<StateFrame>,
+    /// The last `delay_ticks + 1` state frames (what a delayed frame is taken from).
+    history: std::collections::VecDeque<StateFrame>,
     pending: std::collections::VecDeque<Telemetry>,
     last_tick: Option<u64>,
     last_status: Option<BoardStatus>,
@@ -151,28 +185,37 @@ pub struct BoardInTheLoop {
 
 impl BoardInTheLoop {
     /// Starts QEMU with `elf` (the QEMU flying image), waits for its UART to connect, and
-    /// configures and arms the board. `runner` is `scripts/qemu-run.sh`; QEMU's decoded log
-    /// goes to `log_path`.
+    /// configures and arms the board; with `key`, the board and this end sign the link.
+    /// `runner` is `scripts/qemu-run.sh`; QEMU's decoded log goes to `log` (opened by the
+    /// caller, who decides where and how it is written), which messages call `log_path`.
     pub fn start(
         elf: &Path,
         runner: &Path,
         cfg: &SimConfig,
         faults: LinkFaults,
+        log: std::fs::File,
         log_path: &Path,
+        key: Option<&LinkKey>,
     ) -> Result<Self, String> {
         check_flying_image(elf)?;
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
-        let log = std::fs::File::create(log_path)
-            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
         let log_err = log.try_clone().map_err(|e| e.to_string())?;
-        let child = Command::new("bash")
+        let mut qemu = Command::new("bash");
+        qemu
             // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
             // under `timeout`, two processes down).
             .process_group(0)
             .arg(runner)
-            .arg(elf)
+            .arg(elf);
+        if let Some(k) = key {
+            // The QEMU image's provisioning (firmware::qemu::link_key); visible to this
+            // machine's process list, which is acceptable for a simulator's key.
+            let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
+            qemu.arg("-append").arg(format!("link-key={hex}"));
+        }
+        let child = qemu
             .env("QEMU_SERIAL", format!("tcp:127.0.0.1:{port},nodelay=on"))
             .env("QEMU_TIMEOUT", "3600")
             .stdin(Stdio::null())
@@ -205,21 +248,36 @@ impl BoardInTheLoop {
         let mut b = BoardInTheLoop {
             child,
             stream,
-            decoder: FrameDecoder::new(),
+            decoder: match key {
+                Some(k) => FrameDecoder::signed(Verifier::new(k, Direction::FromBoard)),
+                None => FrameDecoder::new(),
+            },
+            signer: key.map(|k| Signer::new(k, Direction::ToBoard)),
+            telemetry_seq: SeqCheck::new(),
             seq: 0,
             rate_hz: cfg.controller.rate_hz,
             faults,
             mission: auv_link::MissionSpec::from(cfg.trajectory),
             started: false,
-            history: Vec::new(),
+            history: std::collections::VecDeque::new(),
             pending: std::collections::VecDeque::new(),
             last_tick: None,
             last_status: None,
             needs_rearm: false,
             t0: Instant::now(),
-            stats: PilStats::default(),
+            stats: PilStats {
+                signed: key.is_some(),
+                ..PilStats::default()
+            },
             log_path: log_path.to_path_buf(),
         };
+        // Continue the board's numbering: a board that already heard a runner (this one
+        // restarted) drops frames numbered at or before its last (auv_link::seq).
+        let first = b.next_telemetry()?;
+        if first.rx_frames > 0 {
+            b.seq = first.last_rx_seq.wrapping_add(1);
+        }
+        let refused_before = first.refused_commands;
         let c = &cfg.controller;
         b.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
             rate_hz: Some(c.rate_hz),
@@ -234,6 +292,12 @@ impl BoardInTheLoop {
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
             let t = b.next_telemetry()?;
+            if t.refused_commands > refused_before {
+                return Err(format!(
+                    "the board refused the set-up: {}",
+                    t.last_refusal.map_or("(no reason)", |r| r.as_str())
+                ));
+            }
             if t.status == BoardStatus::Armed {
                 break;
             }
@@ -258,7 +322,14 @@ impl BoardInTheLoop {
             msg,
         };
         self.seq = self.seq.wrapping_add(1);
-        encode(&env, buf).map_err(|e| format!("encoding: {e}"))
+        match &mut self.signer {
+            None => encode(&env, buf),
+            Some(signer) => {
+                signer.advance_to(mavlink_time());
+                encode_signed(&env, signer, buf)
+            }
+        }
+        .map_err(|e| format!("encoding: {e}"))
     }
 
     fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
@@ -291,12 +362,25 @@ impl BoardInTheLoop {
                 ));
             }
             for &b in &chunk[..n] {
-                if let Some(Ok(Envelope {
-                    msg: Msg::Telemetry(t),
-                    ..
-                })) = self.decoder.push(b)
-                {
-                    self.pending.push_back(t);
+                match self.decoder.push(b) {
+                    None => {}
+                    Some(Ok(Envelope {
+                        seq,
+                        msg: Msg::Telemetry(t),
+                        ..
+                    })) if self.telemetry_seq.accept(seq) => self.pending.push_back(t),
+                    // The two ends disagree on signing: nothing will ever be accepted.
+                    Some(Err(LinkError::Auth(
+                        e @ (AuthError::SigningOff | AuthError::Unsigned),
+                    ))) => {
+                        return Err(format!(
+                            "the board's telemetry is {} but this end has signing {}: {e}; give the board and host-sim the same key (--link-key-file), or neither",
+                            if e == AuthError::SigningOff { "signed" } else { "unsigned" },
+                            on_off(self.signer.is_some())
+                        ));
+                    }
+                    // Undecodable, badly signed, out of sequence, or not telemetry.
+                    Some(_) => self.stats.telemetry_refused += 1,
                 }
             }
         }
@@ -335,6 +419,10 @@ impl BoardInTheLoop {
         }
         self.last_status = Some(t.status);
         self.stats.board_rx_errors = t.rx_errors;
+        self.stats.board_rx_stale = t.rx_stale;
+        self.stats.board_rx_auth_errors = t.rx_auth_errors;
+        self.stats.board_refused_commands = t.refused_commands;
+        self.stats.board_last_refusal = t.last_refusal.map(|r| r.as_str().to_string());
         self.stats.board_loop_overruns = t.loop_overruns;
         self.stats.worst_update_instructions =
             t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
@@ -378,7 +466,10 @@ impl ControlSource for BoardInTheLoop {
             eta: *eta,
             nu: *nu,
         };
-        self.history.push(frame);
+        self.history.push_back(frame);
+        if self.history.len() > (self.faults.delay_ticks as usize).saturating_add(1) {
+            self.history.pop_front();
+        }
         let silent = LinkFaults::any(&self.faults.silent, k);
         let dropped = LinkFaults::any(&self.faults.drop, k);
         let corrupt = LinkFaults::any(&self.faults.corrupt, k);
@@ -389,8 +480,14 @@ impl ControlSource for BoardInTheLoop {
         let mut buf = [0u8; MAX_FRAME];
         if !silent {
             if self.needs_rearm && healthy {
-                // Recovery: the link is good again; re-arm (the fail-safe latches until then).
-                for c in [LinkCommand::Disarm, LinkCommand::Arm] {
+                // Recovery: the link is good again; re-arm (the fail-safe latches until
+                // then) and start the mission again, since disarming dropped it. Its first
+                // state frame below sets the board's mission clock to this tick.
+                for c in [
+                    LinkCommand::Disarm,
+                    LinkCommand::Arm,
+                    LinkCommand::StartMission(self.mission),
+                ] {
                     let n = self.encode(Msg::Command(c), &mut buf)?;
                     out.extend_from_slice(&buf[..n]);
                 }
@@ -415,7 +512,9 @@ impl ControlSource for BoardInTheLoop {
                 } else {
                     frame
                 };
-                if !corrupt {
+                // A corrupted frame is refused, and a delayed one holds an old state that the
+                // board drops as off its mission clock: neither is answered.
+                if !corrupt && !delayed {
                     expect_seq = Some(self.seq);
                 }
                 let n = self.encode(Msg::State(sent), &mut buf)?;
@@ -450,6 +549,25 @@ impl ControlSource for BoardInTheLoop {
             w_norm: t.w_norm,
         })
     }
+}
+
+fn on_off(b: bool) -> &'static str {
+    if b {
+        "on"
+    } else {
+        "off"
+    }
+}
+
+/// MAVLink 2's signing time: 10 µs units since 2015-01-01 00:00 UTC (1 420 070 400 s after the
+/// Unix epoch), so that a restarted runner still counts upwards.
+pub fn mavlink_time() -> u64 {
+    const EPOCH_2015: u64 = 1_420_070_400;
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| {
+            d.as_secs().saturating_sub(EPOCH_2015) * 100_000 + u64::from(d.subsec_micros() / 10)
+        })
 }
 
 /// The QEMU flying image as `cargo build -p firmware --release --target thumbv7em-none-eabihf

@@ -7,8 +7,14 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::refusal::Refusal;
+
 /// The protocol version this crate speaks; sent as the first byte of every frame.
-pub const PROTOCOL_VERSION: u8 = 1;
+///
+/// 2: sequence numbers checked ([`crate::seq`]), optional signature trailer
+/// ([`crate::sign`]), and the telemetry's latched reason, refusals, drop counters, last
+/// accepted sequence number and signing flag.
+pub const PROTOCOL_VERSION: u8 = 2;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -42,7 +48,8 @@ pub struct Envelope {
     /// [`PROTOCOL_VERSION`] of the sender. Receivers reject any other value
     /// ([`LinkError::Version`](crate::LinkError::Version)) without looking at the rest.
     pub version: u8,
-    /// Sender's frame counter: +1 per frame sent, wrapping. Each direction has its own.
+    /// Sender's frame counter: +1 per frame sent, wrapping. Each direction has its own. A
+    /// receiver accepts only frames newer than the last it accepted ([`crate::seq`]).
     pub seq: u16,
     /// The payload.
     pub msg: Msg,
@@ -237,7 +244,8 @@ pub struct Telemetry {
     /// ‖w‖ = ‖BᵀPe‖.
     pub w_norm: f32,
     /// 0: no controller fault; otherwise the fault's code, [`controller_core::Fault::code`]
-    /// (read it back with [`Telemetry::fault`]).
+    /// (read it back with [`Telemetry::fault`]). A fault that latched the fail-safe is
+    /// reported in every frame until the board is re-armed (with [`Telemetry::latched`]).
     pub controller_fault: u8,
     /// Control steps that missed their deadline since boot.
     pub loop_overruns: u32,
@@ -249,6 +257,26 @@ pub struct Telemetry {
     pub rx_errors: u32,
     /// `seq` of the last [`Msg::State`] the board accepted.
     pub last_state_seq: u16,
+    // Protocol 2: appended fields.
+    /// The latched fail-safe reason, in every frame from the period it latched until the board
+    /// is re-armed (disarm, then arm): also while disarmed.
+    pub latched: Option<FailSafeReason>,
+    /// Commands refused since boot (each changed nothing).
+    pub refused_commands: u32,
+    /// Why the last refused command was refused (`None` before the first).
+    pub last_refusal: Option<Refusal>,
+    /// Frames dropped since boot as repeated, old or out of order: a sequence number that is
+    /// not newer ([`crate::seq`]), or a lock-step state frame off the mission clock. They
+    /// never restart the stale-state timer.
+    pub rx_stale: u32,
+    /// Frames refused since boot for their authentication ([`crate::sign`]; also counted in
+    /// `rx_errors`).
+    pub rx_auth_errors: u32,
+    /// `seq` of the last frame (any message) the board accepted; a restarted navigation
+    /// computer continues from the next number ([`crate::seq`]).
+    pub last_rx_seq: u16,
+    /// The board's link has signing on (it refuses unsigned frames).
+    pub signing: bool,
 }
 
 impl Telemetry {
@@ -264,7 +292,13 @@ impl Telemetry {
         + F32
         + U8
         + 4 * U32
-        + U16;
+        + U16
+        + option(FailSafeReason::MAX_SIZE)
+        + U32
+        + option(Refusal::MAX_SIZE)
+        + 2 * U32
+        + U16
+        + BOOL;
 
     /// The controller fault this report carries (`None`: no fault, or a code this crate does
     /// not know).

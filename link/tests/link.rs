@@ -1,9 +1,10 @@
 //! Frame round trips, corruption, resynchronisation, size bounds and fuzzing of the decoder.
 
+use auv_link::sign::{AuthError, SIGNATURE_LEN};
 use auv_link::{
     decode_frame, encode, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, LinkError, MissionSpec, Msg, StateFrame, Telemetry, MAX_BODY, MAX_FRAME,
-    PROTOCOL_VERSION,
+    FrameDecoder, LinkError, MissionSpec, Msg, Refusal, StateFrame, Telemetry, CRC_LEN, MAX_BODY,
+    MAX_FRAME, PROTOCOL_VERSION,
 };
 use proptest::prelude::*;
 
@@ -72,6 +73,13 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         rx_frames: 1_000_000,
         rx_errors: 17,
         last_state_seq: 65_000,
+        latched: Some(FailSafeReason::ControllerFault),
+        refused_commands: 4,
+        last_refusal: Some(Refusal::WhileArmed),
+        rx_stale: 300,
+        rx_auth_errors: 2,
+        last_rx_seq: 65_001,
+        signing: true,
     }
 }
 
@@ -153,6 +161,13 @@ fn largest() -> Envelope {
             rx_frames: u32::MAX,
             rx_errors: u32::MAX,
             last_state_seq: u16::MAX,
+            latched: Some(FailSafeReason::Overrun),
+            refused_commands: u32::MAX,
+            last_refusal: Some(Refusal::ControllerConfig),
+            rx_stale: u32::MAX,
+            rx_auth_errors: u32::MAX,
+            last_rx_seq: u16::MAX,
+            signing: true,
         }),
     )
 }
@@ -281,17 +296,32 @@ fn max_sizes_are_exact() {
 
 #[test]
 fn largest_message_fits_max_frame_exactly() {
-    assert_eq!(Envelope::MAX_SIZE, 115);
-    assert_eq!(MAX_BODY, 117);
-    assert_eq!(MAX_FRAME, 119);
+    assert_eq!(Envelope::MAX_SIZE, 138);
+    assert_eq!(MAX_BODY, 153);
+    assert_eq!(MAX_FRAME, 155);
+    // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
+    // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
+    let unsigned = MAX_FRAME - SIGNATURE_LEN;
     let mut out = [0u8; MAX_FRAME];
-    assert_eq!(encode(&env, &mut out), Ok(MAX_FRAME));
+    assert_eq!(encode(&env, &mut out), Ok(unsigned));
     assert_eq!(
-        encode(&env, &mut [0u8; MAX_FRAME - 1]),
+        encode(&env, &mut [0u8; MAX_FRAME - SIGNATURE_LEN - 1]),
         Err(LinkError::BufferTooSmall)
     );
-    assert_eq!(decode_stream(&out), vec![Ok(env)]);
+    assert_eq!(decode_stream(&out[..unsigned]), vec![Ok(env)]);
+}
+
+#[test]
+fn a_telemetry_frame_fits_a_100_hz_period_at_the_boards_baud() {
+    // The STM32 board's link: 460 800 baud, 8N1 (10 bits a byte). A period must carry a
+    // telemetry frame one way and a state frame the other; the UART is full duplex, so the
+    // larger of the two must fit, with the signature.
+    let bytes_per_second = 460_800 / 10;
+    let frame_us = MAX_FRAME * 1_000_000 / bytes_per_second;
+    assert!(frame_us < 10_000 / 2, "{frame_us} µs");
+    // Body arithmetic: the CRC follows the signature.
+    assert_eq!(MAX_BODY, Envelope::MAX_SIZE + SIGNATURE_LEN + CRC_LEN);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -330,7 +360,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 2, 0x7F, 0xFF] {
+    for version in [0u8, 1, 3, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -347,26 +377,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[2, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[3, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 2 })]
+        vec![Err(LinkError::Version { got: 3 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 1, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    let wire = frame_from_body(&[PROTOCOL_VERSION, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 2, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 2);
+    let wire = frame_from_body(&[2, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
-    // A body with a byte left over, or a bad variant, or cut short: Deserialize.
+    // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
+    // short: Deserialize.
     for body in [
-        &[1, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[1, 0x00, 0x03][..],
-        &[1, 0x00, 0x01, 0x05][..],
-        &[1, 0x00, 0x00, 0x01][..],
-        &[1][..],
+        &[2, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[2, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[2, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[2, 0x00, 0x03][..],
+        &[2, 0x00, 0x01, 0x05][..],
+        &[2, 0x00, 0x00, 0x01][..],
+        &[2][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -374,6 +408,12 @@ fn hand_made_frames_match_the_documented_format() {
             "{body:?}"
         );
     }
+    // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
+    let signed = [&[2, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    assert_eq!(
+        decode_stream(&frame_from_body(&signed)),
+        vec![Err(LinkError::Auth(AuthError::SigningOff))]
+    );
     // A bad CRC.
     let mut body = vec![PROTOCOL_VERSION, 0xAC, 0x02, 0x01, 0x00];
     let crc = crc16(&body);
@@ -429,6 +469,7 @@ fn errors_display() {
         LinkError::Version { got: 9 },
         LinkError::BufferTooSmall,
         LinkError::Serialize,
+        LinkError::Auth(AuthError::BadMac),
     ] {
         let s = e.to_string();
         assert!(!s.is_empty(), "{e:?}");
@@ -549,6 +590,15 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<u32>(),
             any::<u16>(),
         ),
+        (
+            prop::option::of(any_reason()),
+            any::<u32>(),
+            prop::option::of(any_refusal()),
+            any::<u32>(),
+            any::<u32>(),
+            any::<u16>(),
+            any::<bool>(),
+        ),
     )
         .prop_map(
             |(
@@ -561,6 +611,15 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     rx_frames,
                     rx_errors,
                     last_state_seq,
+                ),
+                (
+                    latched,
+                    refused_commands,
+                    last_refusal,
+                    rx_stale,
+                    rx_auth_errors,
+                    last_rx_seq,
+                    signing,
                 ),
             )| Telemetry {
                 tick,
@@ -578,9 +637,20 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 rx_frames,
                 rx_errors,
                 last_state_seq,
+                latched,
+                refused_commands,
+                last_refusal,
+                rx_stale,
+                rx_auth_errors,
+                last_rx_seq,
+                signing,
             },
         )
         .boxed()
+}
+
+fn any_refusal() -> BoxedStrategy<Refusal> {
+    prop::sample::select(Refusal::ALL.to_vec()).boxed()
 }
 
 fn any_msg() -> BoxedStrategy<Msg> {

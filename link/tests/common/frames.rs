@@ -228,6 +228,13 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         rx_frames,
         rx_errors,
         last_state_seq,
+        latched,
+        refused_commands,
+        last_refusal,
+        rx_stale,
+        rx_auth_errors,
+        last_rx_seq,
+        signing,
     } = a;
     *tick == b.tick
         && *status == b.status
@@ -244,4 +251,11 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         && *rx_frames == b.rx_frames
         && *rx_errors == b.rx_errors
         && *last_state_seq == b.last_state_seq
+        && *latched == b.latched
+        && *refused_commands == b.refused_commands
+        && *last_refusal == b.last_refusal
+        && *rx_stale == b.rx_stale
+        && *rx_auth_errors == b.rx_auth_errors
+        && *last_rx_seq == b.last_rx_seq
+        && *signing == b.signing
 }

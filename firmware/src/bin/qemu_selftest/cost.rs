@@ -92,7 +92,7 @@ fn step_counts(
     let kin = c.kinematics_stage(&g.eta, &g.nu).ok()?;
     let desired = c.trajectory_stage(g.ticks, tr);
     let law = c.law_stage(&kin, &desired, tr).ok()?;
-    let demand = c.allocation_stage(&law.tau);
+    let demand = c.allocation_stage(&law.tau).thrusts;
     let mut counts = [0u32; STAGES];
     for (slot, stage) in counts.iter_mut().zip(Stage::ALL) {
         *slot = match stage {
