@@ -38,17 +38,19 @@ pub const BUDGETS: [StepBudget; 3] = [
         backend: "libm",
         update: 40_000,
         // kinematics, trajectory, law, allocation, voltage maps
-        stages: [8_800, 22_000, 1_200, 100, 8_000],
+        stages: [8_800, 22_000, 1_200, 1_000, 8_000],
     },
+    // Allocation 100 → 1 000 and the totals with it: issue 9's saturation-aware allocator
+    // (block solves and envelope clamps, ≈ 890 instructions) replaced the bare B₅⁻¹τ.
     StepBudget {
         backend: "micromath",
-        update: 12_000,
-        stages: [700, 2_200, 900, 100, 8_000],
+        update: 13_000,
+        stages: [700, 2_200, 900, 1_000, 8_000],
     },
     StepBudget {
         backend: "kernels",
-        update: 5_200,
-        stages: [560, 2_400, 850, 100, 1_200],
+        update: 6_400,
+        stages: [560, 2_500, 850, 1_000, 1_250],
     },
 ];
 

@@ -14,6 +14,10 @@ use crate::snapshot::{self, SizeKey, Sizes};
 /// Flash budget of every image (bytes): well inside the STM32F405's 1 MiB, so that the board
 /// keeps room for a bootloader and a second image.
 pub const FLASH_BUDGET: u64 = 128 * 1024;
+/// Flash budget of the self-test image, which never flies: it runs only in QEMU's mps2-an386
+/// (4 MiB of flash) and carries what the flying images do not — the golden and kernel vectors,
+/// libm's f32 functions and the signing exercise beside the core's own, to measure them.
+pub const SELFTEST_FLASH_BUDGET: u64 = 192 * 1024;
 /// Static RAM budget of every image (bytes): a quarter of the STM32F405's 128 KiB SRAM, the
 /// rest is stack (the self-test measures its high-water mark).
 pub const RAM_BUDGET: u64 = 32 * 1024;
@@ -279,9 +283,14 @@ pub fn check(ci: &mut Ci, built: &Built) {
                 v.image.memory_map()
             ));
         }
-        if facts.sizes.flash > FLASH_BUDGET {
+        let flash_budget = if v.image == Image::QemuSelftest {
+            SELFTEST_FLASH_BUDGET
+        } else {
+            FLASH_BUDGET
+        };
+        if facts.sizes.flash > flash_budget {
             ci.fail(format!(
-                "{label}: flash {} B exceeds the budget of {FLASH_BUDGET} B",
+                "{label}: flash {} B exceeds the budget of {flash_budget} B",
                 facts.sizes.flash
             ));
         }
