@@ -70,11 +70,7 @@ impl Stat {
     }
 
     fn mean(&self) -> u32 {
-        if self.n == 0 {
-            0
-        } else {
-            self.sum / self.n
-        }
+        self.sum.checked_div(self.n).unwrap_or(0)
     }
 }
 
