@@ -44,6 +44,7 @@ fn main() {
     println!("cargo:rerun-if-changed=../controller-core/src");
 
     fs::write(out.join("golden.rs"), golden()).expect("writing golden.rs");
+    fs::write(out.join("kernel_golden.rs"), kernel_golden()).expect("writing kernel_golden.rs");
 
     println!("cargo:rerun-if-env-changed={KEY_VAR}");
     println!("cargo:rerun-if-env-changed={UNSIGNED_VAR}");
@@ -61,6 +62,137 @@ fn main() {
         println!("cargo:warning={w}");
     }
     fs::write(out.join("link_key.rs"), code).expect("writing link_key.rs");
+}
+
+/// Inputs of every range of the math kernels (`controller_core::math::kernels`) and the host's
+/// results, as bit patterns: the self-test checks that the target gives the same bits.
+fn kernel_golden() -> String {
+    use controller_core::math::kernels;
+    // xorshift64: deterministic inputs.
+    let mut state = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        state ^= state << 13;
+        state ^= state >> 7;
+        state ^= state << 17;
+        state
+    };
+    let mut s = String::new();
+    // sin_cos: no reduction, Cody–Waite, Payne–Hanek, and the special values.
+    let mut xs: Vec<f32> = Vec::new();
+    for (lo, hi) in [
+        (0.0f32, 0.78f32),
+        (0.79, 3.2),
+        (3.2, 1599.0),
+        (1600.0, 3e38),
+    ] {
+        for _ in 0..24 {
+            // Uniform on [0, π/4], log-uniform on the others.
+            let u = (next() >> 11) as f64 / (1u64 << 53) as f64;
+            let (lo, hi) = (lo as f64, hi as f64);
+            let x = if lo == 0.0 {
+                u * hi
+            } else {
+                lo * (hi / lo).powf(u)
+            } as f32;
+            xs.push(if next() & 1 == 1 { -x } else { x });
+        }
+    }
+    xs.extend([
+        0.0,
+        -0.0,
+        f32::MIN_POSITIVE,
+        1e-40,
+        f32::MAX,
+        f32::INFINITY,
+        f32::NAN,
+    ]);
+    let rows: Vec<String> = xs
+        .iter()
+        .map(|&x| {
+            let (sn, cs) = kernels::sin_cos(x);
+            format!(
+                "({:#010x}, {:#010x}, {:#010x})",
+                x.to_bits(),
+                sn.to_bits(),
+                cs.to_bits()
+            )
+        })
+        .collect();
+    writeln!(
+        s,
+        "pub const KERNEL_SIN_COS: [(u32, u32, u32); {}] = [{}];",
+        rows.len(),
+        rows.join(", ")
+    )
+    .ok();
+    let rows: Vec<String> = (0..64)
+        .map(|_| next() as u32)
+        .chain([0, 1 << 30, 1 << 31, 3 << 30, u32::MAX])
+        .map(|p| {
+            let (sn, cs) = kernels::sin_cos_turns(p);
+            format!(
+                "({p:#010x}, {:#010x}, {:#010x})",
+                sn.to_bits(),
+                cs.to_bits()
+            )
+        })
+        .collect();
+    writeln!(
+        s,
+        "pub const KERNEL_SIN_COS_TURNS: [(u32, u32, u32); {}] = [{}];",
+        rows.len(),
+        rows.join(", ")
+    )
+    .ok();
+    let wide = |next: &mut dyn FnMut() -> u64| {
+        let r = next();
+        let e = (r % 81) as i32 - 40;
+        let m = ((r >> 8) as u32) & 0x007f_ffff;
+        f32::from_bits(((((r >> 40) & 1) as u32) << 31) | (((e + 127) as u32) << 23) | m)
+    };
+    let rows: Vec<String> = (0..64)
+        .map(|_| (wide(&mut next), wide(&mut next)))
+        .chain([
+            (0.0, -0.0),
+            (-0.0, 0.0),
+            (f32::INFINITY, -f32::INFINITY),
+            (1.0, 0.0),
+        ])
+        .map(|(y, x)| {
+            let a = kernels::atan2(y, x);
+            format!(
+                "({:#010x}, {:#010x}, {:#010x})",
+                y.to_bits(),
+                x.to_bits(),
+                a.to_bits()
+            )
+        })
+        .collect();
+    writeln!(
+        s,
+        "pub const KERNEL_ATAN2: [(u32, u32, u32); {}] = [{}];",
+        rows.len(),
+        rows.join(", ")
+    )
+    .ok();
+    for (name, f) in [
+        ("CBRT", kernels::cbrt as fn(f32) -> f32),
+        ("SQRT", kernels::sqrt),
+    ] {
+        let rows: Vec<String> = (0..64)
+            .map(|_| wide(&mut next).abs())
+            .chain([0.0, -0.0, 1e-45, f32::MAX, 27.0, -8.0, f32::INFINITY])
+            .map(|x| format!("({:#010x}, {:#010x})", x.to_bits(), f(x).to_bits()))
+            .collect();
+        writeln!(
+            s,
+            "pub const KERNEL_{name}: [(u32, u32); {}] = [{}];",
+            rows.len(),
+            rows.join(", ")
+        )
+        .ok();
+    }
+    s
 }
 
 /// Deterministic inputs around each Table-1 mission (on and off the reference, with and

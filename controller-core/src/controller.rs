@@ -9,6 +9,7 @@
 use nalgebra::{Matrix6, Vector6};
 
 use crate::allocation::Allocation;
+use crate::allocator::Allocated;
 use crate::allocator::Allocator;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
@@ -16,7 +17,7 @@ use crate::kinematics::{self, Attitude};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
 use crate::model::{self, VehicleParams};
 use crate::thruster::{self, Actuation, Envelope, ThrusterMap};
-use crate::trajectory::Trajectory;
+use crate::trajectory::{Desired, Trajectory};
 use crate::uncertainty::UncertaintyBounds;
 
 /// Largest |position| accepted (m). Positions are relative to a mission origin near the
@@ -332,6 +333,11 @@ impl Controller {
     /// One control step at t = `ticks` / rate_hz seconds since mission start, with the vehicle
     /// at pose `eta` (relative to the mission origin) and body velocity `nu`, tracking
     /// `trajectory`.
+    ///
+    /// Never inlined, so that the linked firmware has an `update` symbol: the firmware CI
+    /// builds the call graph of the flying image from it (no soft-float f64 routine may be
+    /// reachable, docs/design.md §16).
+    #[inline(never)]
     pub fn update(
         &self,
         ticks: u64,
@@ -346,6 +352,7 @@ impl Controller {
         }
     }
 
+    /// The stages of [`Stage::ALL`] in order, then the output.
     fn step(
         &self,
         ticks: u64,
@@ -353,6 +360,32 @@ impl Controller {
         nu: &[f32; 6],
         trajectory: &Trajectory,
     ) -> Result<Output, Fault> {
+        let kin = self.kinematics_stage(eta, nu)?;
+        let desired = self.trajectory_stage(ticks, trajectory);
+        let law = self.law_stage(&kin, &desired, trajectory)?;
+        let alloc = self.allocation_stage(&law.tau);
+        let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
+        Ok(Output {
+            status: Status::Ok,
+            tau: law.tau.into(),
+            tau_achieved: tau_achieved.into(),
+            tau_unallocated: alloc.unallocated,
+            thrust: act.thrusts,
+            voltage: act.voltages,
+            saturated: alloc.saturated | act.saturated,
+            delta: law.delta,
+            delta_clamped: self.config.robust && law.delta_clamped,
+            w_norm: law.w_norm,
+            eta_d: desired.eta.into(),
+            e1: law.e1.into(),
+        })
+    }
+
+    /// Stage [`Stage::Kinematics`]: the input checks, the attitude's sines and cosines, the
+    /// pitch limit, η̇ = J(η)ν (Eq 2) and J⁻¹J̇ν (Eq 3).
+    #[doc(hidden)]
+    #[inline]
+    pub fn kinematics_stage(&self, eta: &[f32; 6], nu: &[f32; 6]) -> Result<StepKinematics, Fault> {
         check_inputs(eta, nu)?;
         let eta = Vector6::from(*eta);
         let nu = Vector6::from(*nu);
@@ -363,12 +396,37 @@ impl Controller {
         if cos_theta_abs < self.cos_pitch_limit {
             return Err(Fault::PitchLimit);
         }
-
-        let desired = trajectory.sample(ticks, self.config.rate_hz);
         let eta_dot = kinematics::eta_dot(&att, &nu).map_err(|_| Fault::PitchLimit)?;
-        let (e1, e2) = law::tracking_errors(&eta, &eta_dot, &desired.eta, &desired.eta_dot);
+        let jinv_jdot_nu = kinematics::jinv_jdot_nu(&att, &nu).map_err(|_| Fault::PitchLimit)?;
+        Ok(StepKinematics {
+            eta,
+            nu,
+            att,
+            cos_theta_abs,
+            eta_dot,
+            jinv_jdot_nu,
+        })
+    }
+
+    /// Stage [`Stage::Trajectory`]: η_d, η̇_d, η̈_d at t = `ticks` / rate_hz.
+    #[doc(hidden)]
+    #[inline]
+    pub fn trajectory_stage(&self, ticks: u64, trajectory: &Trajectory) -> Desired {
+        trajectory.sample(ticks, self.config.rate_hz)
+    }
+
+    /// Stage [`Stage::Law`]: e₁, e₂ (Eqs 12–13), ū (Eq 17), δ(e,t) (Eq 29) and its clamp,
+    /// w = BᵀPe, Δu (Eq 26 or 30) and the body force τ (Eq 7, inversion-free route).
+    #[doc(hidden)]
+    #[inline]
+    pub fn law_stage(
+        &self,
+        kin: &StepKinematics,
+        desired: &Desired,
+        trajectory: &Trajectory,
+    ) -> Result<StepLaw, Fault> {
+        let (e1, e2) = law::tracking_errors(&kin.eta, &kin.eta_dot, &desired.eta, &desired.eta_dot);
         let u_bar = law::nominal_input(&desired.eta_ddot, &self.k1, &self.k2, &e1, &e2);
-        let jjn = kinematics::jinv_jdot_nu(&att, &nu).map_err(|_| Fault::PitchLimit)?;
 
         let mut e_sq = 0.0f32;
         for &i in CONTROLLED.iter() {
@@ -379,9 +437,9 @@ impl Controller {
             &DeltaInputs {
                 accel_bound: trajectory.accel_bound(),
                 error_norm: crate::math::sqrt(e_sq),
-                nu_norm: crate::math::norm(&nu.into()),
-                jinv_jdot_nu_norm: crate::math::norm(&jjn.into()),
-                cos_theta_abs,
+                nu_norm: crate::math::norm(&kin.nu.into()),
+                jinv_jdot_nu_norm: crate::math::norm(&kin.jinv_jdot_nu.into()),
+                cos_theta_abs: kin.cos_theta_abs,
             },
         );
         if !delta_raw.is_finite() {
@@ -402,34 +460,112 @@ impl Controller {
             u_bar
         };
 
-        let tau = law::body_force(&self.m_hat, &self.config.params, &att, &nu, &u, &jjn);
+        let tau = law::body_force(
+            &self.m_hat,
+            &self.config.params,
+            &kin.att,
+            &kin.nu,
+            &u,
+            &kin.jinv_jdot_nu,
+        );
         if !tau.iter().all(|x| x.is_finite()) {
             return Err(Fault::NonFiniteResult);
         }
-        let alloc = self.allocator.allocate(&tau);
+        Ok(StepLaw {
+            tau,
+            delta,
+            delta_clamped,
+            w_norm,
+            e1,
+        })
+    }
+
+    /// Stage [`Stage::Allocation`]: the thrust each thruster is asked for, by the
+    /// saturation-aware allocator (B₅⁻¹τ when it fits the envelopes; docs/design.md §9).
+    #[doc(hidden)]
+    #[inline]
+    pub fn allocation_stage(&self, tau: &Vector6<f32>) -> Allocated {
+        self.allocator.allocate(tau)
+    }
+
+    /// Stage [`Stage::Maps`]: the voltages (Eqs 31–32 in the configured thrust unit, clamped
+    /// to the supply), the thrusts they give, and the wrench B·T those give.
+    #[doc(hidden)]
+    #[inline]
+    pub fn maps_stage(&self, demand: &[f32; THRUSTERS]) -> (Actuation, Vector6<f32>) {
         let act = thruster::actuate(
             &self.maps,
             self.config.thrust_unit,
-            &alloc.thrusts,
+            demand,
             self.config.voltage_limit,
         );
         let tau_achieved = self.allocator.allocation().wrench(&act.thrusts);
-
-        Ok(Output {
-            status: Status::Ok,
-            tau: tau.into(),
-            tau_achieved: tau_achieved.into(),
-            tau_unallocated: alloc.unallocated,
-            thrust: act.thrusts,
-            voltage: act.voltages,
-            saturated: alloc.saturated | act.saturated,
-            delta,
-            delta_clamped: self.config.robust && delta_clamped,
-            w_norm,
-            eta_d: desired.eta.into(),
-            e1: e1.into(),
-        })
+        (act, tau_achieved)
     }
+}
+
+/// The stages of one [`Controller::update`], in the order it runs them; each is a method of
+/// [`Controller`] (`kinematics_stage`, `trajectory_stage`, …) that `update` is built from, so
+/// the firmware self-test can count the instructions of each on the same inputs as `update`.
+/// Around them `update` only assembles the [`Output`] and checks that it is finite.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Stage {
+    /// Input checks, attitude sines and cosines, pitch limit, η̇ = Jν and J⁻¹J̇ν.
+    Kinematics,
+    /// η_d, η̇_d, η̈_d from the mission ([`Trajectory::sample`]).
+    Trajectory,
+    /// e₁, e₂, ū, δ, w, Δu and τ.
+    Law,
+    /// Thrust demand: the saturation-aware allocator ([`crate::allocator::Allocator`]).
+    Allocation,
+    /// Voltages (Eqs 31–32), achieved thrusts and achieved wrench.
+    Maps,
+}
+
+impl Stage {
+    /// Every stage, in `update`'s order.
+    pub const ALL: [Stage; 5] = [
+        Stage::Kinematics,
+        Stage::Trajectory,
+        Stage::Law,
+        Stage::Allocation,
+        Stage::Maps,
+    ];
+
+    /// Stable name for logs and budgets, e.g. `"voltage-maps"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Stage::Kinematics => "kinematics",
+            Stage::Trajectory => "trajectory",
+            Stage::Law => "law",
+            Stage::Allocation => "allocation",
+            Stage::Maps => "voltage-maps",
+        }
+    }
+}
+
+/// What [`Stage::Kinematics`] gives the later stages.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepKinematics {
+    pub eta: Vector6<f32>,
+    pub nu: Vector6<f32>,
+    pub att: Attitude<f32>,
+    pub cos_theta_abs: f32,
+    pub eta_dot: Vector6<f32>,
+    pub jinv_jdot_nu: Vector6<f32>,
+}
+
+/// What [`Stage::Law`] gives the later stages and the output.
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StepLaw {
+    pub tau: Vector6<f32>,
+    pub delta: f32,
+    /// δ was clamped (reported only when Δu is on).
+    pub delta_clamped: bool,
+    pub w_norm: f32,
+    pub e1: Vector6<f32>,
 }
 
 fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {

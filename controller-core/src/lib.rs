@@ -1,6 +1,8 @@
 #![no_std]
 #![doc = include_str!("../README.md")]
-#![forbid(unsafe_code)]
+// One `unsafe` block in the crate: the FPU's square-root instruction on the target
+// (`math::kernels::sqrt`), which core has no stable function for.
+#![deny(unsafe_code)]
 
 pub mod allocation;
 pub mod allocator;
@@ -16,7 +18,7 @@ pub mod trajectory;
 pub mod uncertainty;
 
 pub use config::{BBound, ConfigError, ControllerConfig};
-pub use controller::{Controller, Fault, Output, Status};
+pub use controller::{Controller, Fault, Output, Stage, Status};
 pub use law::RobustLaw;
 pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};
 pub use trajectory::{Desired, HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};

@@ -3,12 +3,20 @@
 //! Every transcendental call of the f32 law goes through this module so that one cargo feature
 //! decides what runs on the board:
 //!
-//! * default — [`libm`]: correctly rounded to an ulp or two;
-//! * feature `micromath` — micromath's fast approximations for `sin`, `cos` and `sqrt`
-//!   (the product design names micromath). Measured here (`tests/math_backend.rs`): sin/cos
-//!   absolute error ≈ 1e-3, `sqrt` relative error up to ≈ 6 % (√2 → 1.5).
+//! * default — [`libm`]: correctly rounded to an ulp or two; its `sinf`, `cosf` and `cbrtf`
+//!   evaluate in f64 (soft-float calls on the Cortex-M4F) and its `sqrtf` is a software loop
+//!   there;
+//! * feature `kernels` — the core's own f32-only [`kernels`]: sin/cos within 0.82 ulp over
+//!   every f32, cbrt within 0.51 ulp, atan2 within 1.5 ulp, and the FPU's `vsqrt.f32` (exact);
+//!   no f64 anywhere;
+//! * feature `micromath` — micromath's fast approximations for `sin`, `cos`, `sqrt` and
+//!   `atan2` (the product design names micromath). Measured here (`tests/math_backend.rs`):
+//!   sin/cos absolute error ≈ 1e-3, `sqrt` relative error up to ≈ 6 % (√2 → 1.5).
 //!
-//! `cbrt` and `floor` are always libm (micromath has no `cbrt`; `floor` is exact in both).
+//! If several are enabled (features add up in a workspace), micromath wins over kernels, and
+//! kernels over libm. Making the kernels the default is one line: `default = ["kernels"]` in
+//! `controller-core/Cargo.toml`. `cbrt` is the kernels' with `kernels` and libm's otherwise
+//! (micromath has no `cbrt`); `floor` is always libm (exact, integer operations).
 //!
 //! Call these functions by path (`math::sqrt(x)`), never as methods: a method call `x.sqrt()`
 //! resolves to std on the host and to a trait method on the target, which is exactly the
@@ -16,9 +24,13 @@
 
 use core::f32::consts::{PI, TAU};
 
+pub mod kernels;
+
 /// Name of the backend compiled in, for logs and benchmarks.
 pub const BACKEND: &str = if cfg!(feature = "micromath") {
     "micromath"
+} else if cfg!(feature = "kernels") {
+    "kernels"
 } else {
     "libm"
 };
@@ -30,7 +42,11 @@ pub fn sin(x: f32) -> f32 {
     {
         micromath::F32(x).sin().0
     }
-    #[cfg(not(feature = "micromath"))]
+    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    {
+        kernels::sin(x)
+    }
+    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
     {
         libm::sinf(x)
     }
@@ -43,48 +59,75 @@ pub fn cos(x: f32) -> f32 {
     {
         micromath::F32(x).cos().0
     }
-    #[cfg(not(feature = "micromath"))]
+    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    {
+        kernels::cos(x)
+    }
+    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
     {
         libm::cosf(x)
     }
 }
 
-/// (sin x, cos x).
+/// (sin x, cos x) (the kernels reduce x once for both).
 #[inline]
 pub fn sin_cos(x: f32) -> (f32, f32) {
-    (sin(x), cos(x))
-}
-
-/// √x for x ≥ 0 (NaN for x < 0 in both backends).
-#[inline]
-pub fn sqrt(x: f32) -> f32 {
-    #[cfg(feature = "micromath")]
+    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
     {
-        micromath::F32(x).sqrt().0
+        kernels::sin_cos(x)
     }
-    #[cfg(not(feature = "micromath"))]
+    #[cfg(not(all(feature = "kernels", not(feature = "micromath"))))]
     {
-        libm::sqrtf(x)
+        (sin(x), cos(x))
     }
 }
 
-/// atan2(y, x) in (−π, π] (the tangent heading's course, docs/design.md §6).
+/// atan2(y, x), the angle of the point (x, y) in [−π, π] (the tangent heading's course,
+/// docs/design.md §6).
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
     #[cfg(feature = "micromath")]
     {
         micromath::F32(y).atan2(micromath::F32(x)).0
     }
-    #[cfg(not(feature = "micromath"))]
+    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    {
+        kernels::atan2(y, x)
+    }
+    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
     {
         libm::atan2f(y, x)
     }
 }
 
-/// ∛x (always libm).
+/// √x for x ≥ 0 (NaN for x < 0 in every backend).
+#[inline]
+pub fn sqrt(x: f32) -> f32 {
+    #[cfg(feature = "micromath")]
+    {
+        micromath::F32(x).sqrt().0
+    }
+    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    {
+        kernels::sqrt(x)
+    }
+    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
+    {
+        libm::sqrtf(x)
+    }
+}
+
+/// ∛x (the kernels' with `kernels`, libm's otherwise).
 #[inline]
 pub fn cbrt(x: f32) -> f32 {
-    libm::cbrtf(x)
+    #[cfg(feature = "kernels")]
+    {
+        kernels::cbrt(x)
+    }
+    #[cfg(not(feature = "kernels"))]
+    {
+        libm::cbrtf(x)
+    }
 }
 
 /// Euclidean norm of a slice of fixed length, through the backend's `sqrt`.

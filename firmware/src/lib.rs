@@ -1,7 +1,9 @@
 //! AUV-150 thruster-board firmware: a thin fixed-rate shell around `controller-core`.
 //!
 //! Hardware-free parts, tested on the host: [`supervisor`] (arming, missions, fail-safe,
-//! refusals), [`limits`] (what the board's configuration may be), [`pwm`] (voltage → H-bridge duty), [`board`] (the board trait and one control period),
+//! refusals), [`limits`] (what the board's configuration may be), [`budget`] (the control
+//! step's instruction budgets on the target), [`pwm`] (voltage → H-bridge duty), [`board`]
+//! (the board trait and one control period),
 //! [`serial`] (the UART's byte queues between interrupt and loop), [`image`] (which images
 //! exist and how to tell their ELFs apart) and [`qemu_clock`] (QEMU's instruction counts).
 //!
@@ -13,6 +15,7 @@
 #![cfg_attr(not(test), no_std)]
 
 pub mod board;
+pub mod budget;
 pub mod image;
 pub mod limits;
 pub mod pwm;

@@ -4,9 +4,12 @@
 //! ```text
 //! cargo xtask firmware [--bless]   everything below, in this order
 //! cargo xtask images   [--bless]   build every image; its marker, memory map, flash and RAM
-//!                                  against the budgets and firmware/snapshots/sizes.txt
+//!                                  against the budgets and firmware/snapshots/sizes.txt; the
+//!                                  soft-float f64 routines reachable from Controller::update
+//!                                  in its call graph (xtask/src/no_f64.rs)
 //! cargo xtask selftest [--bless]   the QEMU self-test with each math backend against
-//!                                  firmware/snapshots/selftest-<backend>.log, and the failure
+//!                                  firmware/snapshots/selftest-<backend>.log, each stage's
+//!                                  instructions against firmware/src/budget.rs, and the failure
 //!                                  injection (a wrong answer, a panic, a HardFault, a hang)
 //! cargo xtask pil                  processor in the loop: a short mission must equal SIL bit
 //!                                  for bit; the link-fault case must enter and leave fail-safe
@@ -21,12 +24,15 @@
 //! `scripts/setup.sh`); everything else is here. The images, their features and ELF names come
 //! from `firmware::image`.
 
+mod callgraph;
 mod ci;
 mod images;
+mod no_f64;
 mod pil;
 mod qemu;
 mod selftest;
 mod snapshot;
+mod thumb;
 
 use std::process::ExitCode;
 
@@ -50,7 +56,8 @@ enum Task {
         #[arg(long)]
         bless: bool,
     },
-    /// Build every image; check its marker, memory map, flash and RAM.
+    /// Build every image; check its marker, memory map, flash and RAM, and report the f64
+    /// routines reachable from `update`.
     Images {
         /// Rewrite firmware/snapshots/sizes.txt from this run instead of comparing.
         #[arg(long)]
@@ -83,12 +90,14 @@ fn main() -> ExitCode {
         Task::Firmware { .. } => {
             let built = images::build(&mut ci, &Variant::ALL);
             images::check(&mut ci, &built);
+            no_f64::run(&mut ci, &built);
             selftest::run(&mut ci, &built);
             pil::run(&mut ci, &built);
         }
         Task::Images { .. } => {
             let built = images::build(&mut ci, &Variant::ALL);
             images::check(&mut ci, &built);
+            no_f64::run(&mut ci, &built);
         }
         Task::Selftest { .. } => {
             let built = images::build(&mut ci, &Variant::SELFTEST);

@@ -1,6 +1,9 @@
-//! The QEMU self-test with each math backend, compared with its log snapshot, and the failure
-//! injection that proves each kind of failure is visible.
+//! The QEMU self-test with each math backend, compared with its log snapshot, its per-stage
+//! instruction counts against `firmware::budget`, and the failure injection that proves each
+//! kind of failure is visible.
 
+use controller_core::Stage;
+use firmware::budget;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 
 use crate::ci::Ci;
@@ -52,12 +55,21 @@ pub fn run(ci: &mut Ci, built: &Built) {
             ));
         }
         check_instruction_counts(ci, backend, &run.log);
+        check_stage_budgets(ci, backend, &run.log);
         check_signing_budget(ci, backend, &run.log);
         compare_log(ci, backend, &run.log);
         if v.backend == Backend::Libm {
             inject_failures(ci, elf);
         }
     }
+}
+
+/// The lines whose counts are one call timed in whole SysTick counts (`INSTRUCTIONS_PER_TICK`
+/// instructions each): `Controller::new` and `update instructions: max=N mean=N`. The per-call
+/// lines of the cost module (`stage …`, `step …`, `kernel …`) average 40 calls and are exact to
+/// one instruction instead.
+fn is_systick_count(line: &str) -> bool {
+    line.contains("Controller::new") || line.contains("update instructions:")
 }
 
 /// Instructions signing adds to the largest telemetry frame the board sends (the self-test's
@@ -92,8 +104,8 @@ fn check_signing_budget(ci: &mut Ci, backend: &str, log: &str) {
     }
 }
 
-/// The instruction counts are SysTick counts × `INSTRUCTIONS_PER_TICK`: each must be a whole
-/// number of counts, and the `update` line must be there (the budget is checked on the target).
+/// The SysTick-timed counts must be whole numbers of counts, and the `update` line must be
+/// there (its budget is checked on the target).
 fn check_instruction_counts(ci: &mut Ci, backend: &str, log: &str) {
     if !log.contains("update instructions: max=") {
         ci.fail(format!(
@@ -103,7 +115,7 @@ fn check_instruction_counts(ci: &mut Ci, backend: &str, log: &str) {
     }
     let counts: Vec<u64> = log
         .lines()
-        .filter(|l| l.contains("instructions"))
+        .filter(|l| is_systick_count(l))
         // The counts: `~N` and `max=N mean=N` (not the `2^9` of the box corners).
         .flat_map(|l| l.split_whitespace())
         .filter_map(|t| {
@@ -131,6 +143,45 @@ fn check_instruction_counts(ci: &mut Ci, backend: &str, log: &str) {
         "{backend}: instructions of Controller::new / update max / update mean: {} = {} SysTick counts of {INSTRUCTIONS_PER_TICK}",
         show(&|n| n),
         show(&|n| n / u64::from(INSTRUCTIONS_PER_TICK))
+    );
+}
+
+/// `max=N` of the log line that starts (after the level) with `prefix`, e.g. `stage law:`.
+fn max_of(log: &str, prefix: &str) -> Option<u32> {
+    log.lines()
+        .filter_map(|l| l.split_once("  ").map(|(_, rest)| rest.trim_start()))
+        .find_map(|rest| rest.strip_prefix(prefix))
+        .and_then(|rest| rest.trim_start().strip_prefix("max="))
+        .and_then(|rest| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+}
+
+/// Every stage of `update` (`controller_core::Stage`) must have its `stage NAME: max=N` line,
+/// within its budget in `firmware::budget`.
+fn check_stage_budgets(ci: &mut Ci, backend: &str, log: &str) {
+    let Some(budget) = budget::for_backend(backend) else {
+        ci.fail(format!(
+            "self-test ({backend}): no budget for this backend in firmware/src/budget.rs"
+        ));
+        return;
+    };
+    let mut shown = Vec::new();
+    for stage in Stage::ALL {
+        let name = stage.name();
+        let limit = budget.stage(stage);
+        match max_of(log, &format!("stage {name}:")) {
+            None => ci.fail(format!(
+                "self-test ({backend}): no `stage {name}: max=N` line in its log"
+            )),
+            Some(n) if n > limit => ci.fail(format!(
+                "self-test ({backend}): stage {name} takes {n} instructions, over its budget of {limit} (firmware/src/budget.rs; raise it there only with the reason)"
+            )),
+            Some(n) => shown.push(format!("{name} {n}/{limit}")),
+        }
+    }
+    println!(
+        "{backend}: stage instructions / budget: {}",
+        shown.join(", ")
     );
 }
 
@@ -204,5 +255,28 @@ fn inject_failures(ci: &mut Ci, elf: &std::path::Path) {
                 ci.rel(&run.log_path)
             ));
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LOG: &str = "INFO  update instructions: max=35200 mean=26120\n\
+                       INFO  stage law: max=1004 mean=996 instructions\n\
+                       INFO    circular-10R: [7592, 3412, 1004, 66, 7072] = update 19186 instructions";
+
+    #[test]
+    fn a_stage_count_is_read_from_its_own_line_only() {
+        assert_eq!(max_of(LOG, "stage law:"), Some(1004));
+        assert_eq!(max_of(LOG, "stage trajectory:"), None);
+        assert_eq!(max_of(LOG, "update instructions:"), Some(35200));
+    }
+
+    #[test]
+    fn only_single_call_lines_are_whole_systick_counts() {
+        let lines: Vec<&str> = LOG.lines().filter(|l| is_systick_count(l)).collect();
+        assert_eq!(lines.len(), 1);
+        assert!(lines[0].contains("update instructions"));
     }
 }

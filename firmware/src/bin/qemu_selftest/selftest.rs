@@ -34,14 +34,6 @@ pub struct Golden {
     pub status: u8,
 }
 
-/// Instruction budget of one `update` (max over the golden vectors): the measured maximum,
-/// which the self-test logs and `firmware/snapshots/selftest-<backend>.log` records, plus
-/// ≈ 13–15 % headroom. The counts are deterministic under the runner's `-icount`.
-#[cfg(not(feature = "micromath"))]
-pub const UPDATE_INSTRUCTION_BUDGET: u32 = 40_000;
-#[cfg(feature = "micromath")]
-pub const UPDATE_INSTRUCTION_BUDGET: u32 = 12_000;
-
 /// Target and host agree when the difference is within a few f32 roundings of the larger
 /// magnitude: ≈ 8 ulp relative, with an absolute floor for values near zero.
 fn close(a: f32, b: f32) -> bool {
@@ -68,7 +60,7 @@ fn start_counter(syst: &mut SYST) {
     syst.enable_counter();
 }
 
-fn elapsed(t0: u32, t1: u32) -> u32 {
+pub(crate) fn elapsed(t0: u32, t1: u32) -> u32 {
     t0.wrapping_sub(t1) & 0x00FF_FFFF
 }
 
@@ -518,13 +510,7 @@ pub fn run(mut syst: SYST) -> bool {
     );
     let (golden_ok, max, mean) = golden_vectors();
     info!("update instructions: max={} mean={}", max, mean);
-    let budget_ok = max <= UPDATE_INSTRUCTION_BUDGET;
-    if !budget_ok {
-        error!(
-            "update exceeds its budget of {} instructions",
-            UPDATE_INSTRUCTION_BUDGET
-        );
-    }
+    let budget_ok = crate::cost::run(max);
     let link_ok = fail_safe_exercise() && signed_link_exercise();
     let signing_ok = signing_cost().is_some();
     let pwm_ok = pwm_mapping();

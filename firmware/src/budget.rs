@@ -1,0 +1,73 @@
+//! Instruction budgets of one control step on the target, in total and per stage, for each
+//! math backend of the core: the one place they are written.
+//!
+//! The self-test (`firmware-qemu-selftest`) counts, under QEMU's `-icount`, the instructions of
+//! `Controller::update` and of each of its stages ([`Stage`]) on the golden vectors; the counts
+//! are deterministic. It fails itself when `update` exceeds [`StepBudget::update`], and
+//! `cargo xtask firmware` fails when a stage exceeds its budget in the self-test's log. Each
+//! budget is the measured maximum (in `firmware/snapshots/selftest-<backend>.log`) plus about
+//! 10–15 % headroom, so that a change that makes a stage much slower is a reviewed decision:
+//! raise the budget here, in the same commit, with the reason.
+
+use controller_core::Stage;
+
+/// The budgets of one math backend (instructions per call, worst case over the self-test's
+/// golden vectors).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct StepBudget {
+    /// The backend's name, as `controller_core::math::BACKEND` gives it.
+    pub backend: &'static str,
+    /// One `update`, counted as one call (SysTick counts of 40 instructions).
+    pub update: u32,
+    /// Each stage, in [`Stage::ALL`]'s order, counted per call (40 calls of one SysTick count).
+    pub stages: [u32; Stage::ALL.len()],
+}
+
+impl StepBudget {
+    /// The budget of `stage`.
+    pub fn stage(&self, stage: Stage) -> u32 {
+        let i = Stage::ALL.iter().position(|s| *s == stage).unwrap_or(0);
+        self.stages[i]
+    }
+}
+
+/// Every backend's budgets: the measured maxima are the `stage …: max=` and `update
+/// instructions: max=` lines of `firmware/snapshots/selftest-<backend>.log`.
+pub const BUDGETS: [StepBudget; 3] = [
+    StepBudget {
+        backend: "libm",
+        update: 40_000,
+        // kinematics, trajectory, law, allocation, voltage maps
+        stages: [8_800, 22_000, 1_200, 1_000, 8_000],
+    },
+    // Allocation 100 → 1 000 and the totals with it: issue 9's saturation-aware allocator
+    // (block solves and envelope clamps, ≈ 890 instructions) replaced the bare B₅⁻¹τ.
+    StepBudget {
+        backend: "micromath",
+        update: 13_000,
+        stages: [700, 2_200, 900, 1_000, 8_000],
+    },
+    StepBudget {
+        backend: "kernels",
+        update: 6_400,
+        stages: [560, 2_500, 850, 1_000, 1_250],
+    },
+];
+
+/// The budgets of the backend named `backend` (`controller_core::math::BACKEND`).
+pub fn for_backend(backend: &str) -> Option<&'static StepBudget> {
+    BUDGETS.iter().find(|b| b.backend == backend)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_backend_of_the_core_has_a_budget_and_the_stages_fit_the_total() {
+        assert!(for_backend(controller_core::math::BACKEND).is_some());
+        for b in &BUDGETS {
+            assert!(b.stages.iter().all(|&s| s > 0 && s <= b.update), "{b:?}");
+        }
+    }
+}
