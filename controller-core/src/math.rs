@@ -117,6 +117,15 @@ pub fn sqrt(x: f32) -> f32 {
     }
 }
 
+/// Correctly rounded √x in every backend (libm's `sqrtf`, one `vsqrt.f32` on the M4F), for
+/// what is computed once at configuration time or reported, where micromath's ≈ 6 % error is
+/// not acceptable: the inverse thrust maps, the trajectory's K_d and minimum speed
+/// (docs/design.md §17, Choice 30).
+#[inline]
+pub fn exact_sqrt(x: f32) -> f32 {
+    libm::sqrtf(x)
+}
+
 /// ∛x (the kernels' with `kernels`, libm's otherwise).
 #[inline]
 pub fn cbrt(x: f32) -> f32 {

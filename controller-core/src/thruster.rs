@@ -29,7 +29,7 @@
 //!
 //! # Square roots in the inverse maps
 //!
-//! The inverse maps call [`libm::sqrtf`] directly instead of [`crate::math::sqrt`]. Under the
+//! The inverse maps call [`crate::math::exact_sqrt`] (libm's `sqrtf`) instead of [`crate::math::sqrt`]. Under the
 //! `micromath` feature `math::sqrt` has up to ≈ 6 % relative error; measured through the
 //! inverse maps over the ±24 V range when this choice was made, that is a thrust error of up
 //! to 1.85 N (4.5 %) on the main thruster and 0.46 N (2.3 %) on a tunnel thruster (Cardano's
@@ -272,13 +272,6 @@ impl Envelope {
     }
 }
 
-/// Exact square root for the inverse maps (see the module docs, "Square roots in the inverse
-/// maps": micromath's ≈ 6 % error is not acceptable for the reported thrust).
-#[inline]
-fn exact_sqrt(x: f32) -> f32 {
-    libm::sqrtf(x)
-}
-
 fn tunnel_thrust(v: f32) -> f32 {
     if v.is_nan() || v.is_infinite() {
         // NaN → NaN, ±∞ → ±∞ (the map is increasing and unbounded).
@@ -290,7 +283,7 @@ fn tunnel_thrust(v: f32) -> f32 {
     let m = if h.abs() > 1.0 { h.abs() } else { 1.0 };
     let hm = h / m;
     let im = 1.0 / m;
-    let s = m * exact_sqrt(hm * hm + im * im);
+    let s = m * math::exact_sqrt(hm * hm + im * im);
     // Pick the sign that adds magnitudes: |w| ≥ s ≥ 1, so u ≠ 0.
     let w = if h >= 0.0 { -h - s } else { s - h };
     let u = math::cbrt(w);
@@ -313,7 +306,7 @@ fn main_thrust(v: f32) -> f32 {
     // Δ = 0.1048² − 0.012 γ = 0.012 (V_fold − V) ≥ 0 (Sterbenz-exact near the fold).
     let gamma = v - MAIN_C as f32;
     let disc = (-4.0 * MAIN_A) as f32 * (MAIN_V_FOLD - v);
-    let root = exact_sqrt(disc);
+    let root = math::exact_sqrt(disc);
     // T = (−β + √Δ)/(2α) = −2γ/(β + √Δ); divide before doubling so huge |V| cannot overflow.
     -2.0 * (gamma / (-MAIN_B as f32 + root))
 }

@@ -647,7 +647,7 @@ impl Trajectory {
                 radius * w
             }
             TrajectoryKind::FigureEight { amplitude, .. } => {
-                amplitude * w * math::sqrt(31.0) / 16.0
+                amplitude * w * math::exact_sqrt(31.0) / 16.0
             }
             TrajectoryKind::LawnMower { scale, .. } => {
                 let a = self.rate + 5.0 * w;
@@ -655,7 +655,7 @@ impl Trajectory {
                 let c = 225.0 * w * w;
                 let u = ((2.0 * a * b - c) / (2.0 * b * b)).clamp(0.0, 1.0);
                 let f = (a - b * u) * (a - b * u) + c * u;
-                scale * math::sqrt(f)
+                scale * math::exact_sqrt(f)
             }
         }
     }
@@ -938,10 +938,10 @@ fn harmonic(n: u32, theta: f32) -> (f32, f32) {
     math::sin_cos(math::wrap_pi(n as f32 * theta))
 }
 
-/// √s rounded up: the backend's `sqrt`, one Newton step (never below √s, by AM–GM) and a few
-/// ulps of margin for the final rounding.
+/// √s rounded up: the correctly rounded root (every backend: this is configuration time), one
+/// Newton step (never below √s, by AM–GM) and a few ulps of margin for the final rounding.
 fn sqrt_upper(s: f32) -> f32 {
-    let y = math::sqrt(s);
+    let y = math::exact_sqrt(s);
     if y > 0.0 && y.is_finite() {
         0.5 * (y + s / y) * (1.0 + 4.0 * f32::EPSILON)
     } else {

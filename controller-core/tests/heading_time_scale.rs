@@ -312,8 +312,13 @@ fn derivatives_match_finite_differences_over_whole_missions() {
             for (t, mid, d1, d2) in &rows {
                 let e1 = (mid.eta_dot[c] as f64 - d1[c]).abs();
                 let e2 = (mid.eta_ddot[c] as f64 - d2[c]).abs();
+                // Under micromath, ψ_d itself is micromath's atan2, whose error (a few mrad,
+                // not smooth) makes its difference quotient over 2h no derivative of anything;
+                // ψ̇_d is checked against the f64 course in
+                // `time_scale_and_tangent_heading_match_the_path_at_t_over_k`, and ψ̈_d here.
+                let heading_from_micromath_atan2 = MICROMATH && c == 5;
                 assert!(
-                    e1 <= rel * peak1 + 1e-6,
+                    heading_from_micromath_atan2 || e1 <= rel * peak1 + 1e-6,
                     "{name} t={t} [{c}]: η̇ {} vs fd {}",
                     mid.eta_dot[c],
                     d1[c]
