@@ -317,8 +317,8 @@ mod tests {
         extern crate std;
         use std::string::ToString;
         assert_eq!(
-            LinkError::Version { got: 2 }.to_string(),
-            "protocol version 2, expected 1"
+            LinkError::Version { got: 1 }.to_string(),
+            "protocol version 1, expected 2"
         );
         assert_eq!(
             LinkError::Overflow.to_string(),

@@ -8,7 +8,10 @@
 use serde::{Deserialize, Serialize};
 
 /// The protocol version this crate speaks; sent as the first byte of every frame.
-pub const PROTOCOL_VERSION: u8 = 1;
+///
+/// 2: `StartMission` carries a [`MissionPlan`] (heading, time scale), `SetConfig` the thrust
+/// unit and the thruster mounting, `Telemetry` both.
+pub const PROTOCOL_VERSION: u8 = 2;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -109,7 +112,7 @@ pub enum Command {
     /// Thrusters off, mission dropped.
     Disarm,
     /// Start (or restart) a mission: the trajectory's t = 0 is the first control step after.
-    StartMission(MissionSpec),
+    StartMission(MissionPlan),
     /// End the mission; the board stays armed.
     StopMission,
     /// Change the fields that are `Some`; the others keep their values.
@@ -118,7 +121,58 @@ pub enum Command {
 
 impl Command {
     /// Worst-case postcard size of a `Command` (bytes).
-    pub const MAX_SIZE: usize = TAG + max(MissionSpec::MAX_SIZE, ConfigPatch::MAX_SIZE);
+    pub const MAX_SIZE: usize = TAG + max(MissionPlan::MAX_SIZE, ConfigPatch::MAX_SIZE);
+}
+
+/// A mission as the board flies it: the wire form of `controller_core::Mission` — the path
+/// ([`MissionSpec`]), how its heading is formed and how slowly it is flown (η_d(t/k),
+/// k ≥ 1). Convert with `From` both ways ([`crate::mission`]); the receiver validates with
+/// `controller_core::Trajectory::new`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MissionPlan {
+    /// The path.
+    pub path: MissionSpec,
+    /// ψ_d: the paper's or the path's course.
+    pub heading: Heading,
+    /// k ≥ 1 (1: the paper's speed).
+    pub time_scale: f32,
+}
+
+impl MissionPlan {
+    /// Worst-case postcard size of a `MissionPlan` (bytes).
+    pub const MAX_SIZE: usize = MissionSpec::MAX_SIZE + Heading::MAX_SIZE + F32;
+}
+
+/// The wire form of `controller_core::HeadingMode` (variant order is the wire format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Heading {
+    /// The paper's heading of the path.
+    Paper,
+    /// The path's course, atan2(ẏ_d, ẋ_d).
+    Tangent,
+}
+
+impl Heading {
+    /// Worst-case postcard size of a `Heading` (bytes).
+    pub const MAX_SIZE: usize = TAG;
+}
+
+/// The wire form of `controller_core::ThrustUnit`, the unit Eqs 31–32 are read in (variant
+/// order is the wire format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ThrustUnit {
+    /// Kilogram-force (the default).
+    Kgf,
+    /// Newtons.
+    Newton,
+}
+
+impl ThrustUnit {
+    /// Worst-case postcard size of a `ThrustUnit` (bytes).
+    pub const MAX_SIZE: usize = TAG;
 }
 
 /// A mission trajectory and its parameters: the wire form of
@@ -195,12 +249,25 @@ pub struct ConfigPatch {
     /// Lockstep: the board runs one control step per received [`Msg::State`] (simulation),
     /// instead of on its own timer.
     pub lockstep: Option<bool>,
+    /// The thrust unit of Eqs 31–32 (refused while armed, like every law setting).
+    pub thrust_unit: Option<ThrustUnit>,
+    /// The thruster mounting, as the reversed-thruster mask of the AUV-150 layout
+    /// (`controller_core::effectiveness::ThrusterGeometry::auv150`): bit i set ⇔ thruster i's
+    /// positive thrust pushes against its reference axis (+x, +z, +z, +y, +y). Refused while
+    /// armed, and with bits above the fifth.
+    pub reversed_thrusters: Option<u8>,
 }
 
 impl ConfigPatch {
     /// Worst-case postcard size of a `ConfigPatch` (bytes).
-    pub const MAX_SIZE: usize =
-        option(U32) + option(BOOL) + option(F32) + option(F32) + option(U8) + option(BOOL);
+    pub const MAX_SIZE: usize = option(U32)
+        + option(BOOL)
+        + option(F32)
+        + option(F32)
+        + option(U8)
+        + option(BOOL)
+        + option(ThrustUnit::MAX_SIZE)
+        + option(U8);
 
     /// Changes nothing.
     pub const EMPTY: ConfigPatch = ConfigPatch {
@@ -210,6 +277,8 @@ impl ConfigPatch {
         voltage_limit: None,
         stale_periods: None,
         lockstep: None,
+        thrust_unit: None,
+        reversed_thrusters: None,
     };
 }
 
@@ -249,6 +318,10 @@ pub struct Telemetry {
     pub rx_errors: u32,
     /// `seq` of the last [`Msg::State`] the board accepted.
     pub last_state_seq: u16,
+    /// The thrust unit the board reads Eqs 31–32 in.
+    pub thrust_unit: ThrustUnit,
+    /// The board's thruster mounting, as [`ConfigPatch::reversed_thrusters`].
+    pub reversed_thrusters: u8,
 }
 
 impl Telemetry {
@@ -264,7 +337,9 @@ impl Telemetry {
         + F32
         + U8
         + 4 * U32
-        + U16;
+        + U16
+        + ThrustUnit::MAX_SIZE
+        + U8;
 
     /// The controller fault this report carries (`None`: no fault, or a code this crate does
     /// not know).

@@ -2,8 +2,8 @@
 
 use auv_link::{
     decode_frame, encode, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, LinkError, MissionSpec, Msg, StateFrame, Telemetry, MAX_BODY, MAX_FRAME,
-    PROTOCOL_VERSION,
+    FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
+    ThrustUnit, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
 };
 use proptest::prelude::*;
 
@@ -72,6 +72,8 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         rx_frames: 1_000_000,
         rx_errors: 17,
         last_state_seq: 65_000,
+        thrust_unit: ThrustUnit::Kgf,
+        reversed_thrusters: 0b1_1110,
     }
 }
 
@@ -86,26 +88,41 @@ fn every_kind() -> Vec<Envelope> {
         Msg::Command(Command::Arm),
         Msg::Command(Command::Disarm),
         Msg::Command(Command::StopMission),
-        Msg::Command(Command::StartMission(MissionSpec::Circle {
-            radius: 10.0,
-            omega: 0.1,
-            depth: 20.0,
+        Msg::Command(Command::StartMission(
+            MissionSpec::Circle {
+                radius: 10.0,
+                omega: 0.1,
+                depth: 20.0,
+            }
+            .into(),
+        )),
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::FigureEight {
+                amplitude: 15.0,
+                omega: 0.1,
+                depth: 20.0,
+            },
+            heading: Heading::Tangent,
+            time_scale: 2.5,
         })),
-        Msg::Command(Command::StartMission(MissionSpec::FigureEight {
-            amplitude: 15.0,
-            omega: 0.1,
-            depth: 20.0,
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::LawnMower {
+                scale: 1.0,
+                omega: 0.05,
+                depth: 20.0,
+            },
+            heading: Heading::Paper,
+            time_scale: 1.0,
         })),
-        Msg::Command(Command::StartMission(MissionSpec::LawnMower {
-            scale: 1.0,
-            omega: 0.05,
-            depth: 20.0,
-        })),
-        Msg::Command(Command::StartMission(MissionSpec::Helix {
-            radius: 10.0,
-            omega: 0.1,
-            depth: 5.0,
-            depth_rate: 0.1,
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::Helix {
+                radius: 10.0,
+                omega: 0.1,
+                depth: 5.0,
+                depth_rate: 0.1,
+            },
+            heading: Heading::Tangent,
+            time_scale: 1.0,
         })),
         Msg::Command(Command::SetConfig(ConfigPatch::EMPTY)),
         Msg::Command(Command::SetConfig(ConfigPatch {
@@ -115,6 +132,8 @@ fn every_kind() -> Vec<Envelope> {
             voltage_limit: Some(24.0),
             stale_periods: Some(5),
             lockstep: Some(true),
+            thrust_unit: Some(ThrustUnit::Newton),
+            reversed_thrusters: Some(0b0_0110),
         })),
         Msg::Command(Command::SetConfig(ConfigPatch {
             delta_max: Some(10.0),
@@ -153,6 +172,8 @@ fn largest() -> Envelope {
             rx_frames: u32::MAX,
             rx_errors: u32::MAX,
             last_state_seq: u16::MAX,
+            thrust_unit: ThrustUnit::Newton,
+            reversed_thrusters: u8::MAX,
         }),
     )
 }
@@ -257,6 +278,13 @@ fn max_sizes_are_exact() {
         depth_rate: 1.0,
     };
     assert_eq!(postcard_len(&m), MissionSpec::MAX_SIZE);
+    let plan = MissionPlan {
+        path: m,
+        heading: Heading::Tangent,
+        time_scale: f32::MAX,
+    };
+    assert_eq!(postcard_len(&plan), MissionPlan::MAX_SIZE);
+    assert_eq!(postcard_len(&ThrustUnit::Newton), ThrustUnit::MAX_SIZE);
     let p = ConfigPatch {
         rate_hz: Some(u32::MAX),
         robust: Some(true),
@@ -264,6 +292,8 @@ fn max_sizes_are_exact() {
         voltage_limit: Some(f32::MAX),
         stale_periods: Some(u8::MAX),
         lockstep: Some(true),
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(u8::MAX),
     };
     assert_eq!(postcard_len(&p), ConfigPatch::MAX_SIZE);
     assert_eq!(
@@ -281,9 +311,9 @@ fn max_sizes_are_exact() {
 
 #[test]
 fn largest_message_fits_max_frame_exactly() {
-    assert_eq!(Envelope::MAX_SIZE, 115);
-    assert_eq!(MAX_BODY, 117);
-    assert_eq!(MAX_FRAME, 119);
+    assert_eq!(Envelope::MAX_SIZE, 117);
+    assert_eq!(MAX_BODY, 119);
+    assert_eq!(MAX_FRAME, 121);
     let env = largest();
     let mut out = [0u8; MAX_FRAME];
     assert_eq!(encode(&env, &mut out), Ok(MAX_FRAME));
@@ -330,7 +360,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 2, 0x7F, 0xFF] {
+    for version in [0u8, 1, 3, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -347,26 +377,27 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[2, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[3, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 2 })]
+        vec![Err(LinkError::Version { got: 3 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 1, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    let wire = frame_from_body(&[PROTOCOL_VERSION, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 2, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 2);
+    let wire = frame_from_body(&[2, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
     // A body with a byte left over, or a bad variant, or cut short: Deserialize.
     for body in [
-        &[1, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[1, 0x00, 0x03][..],
-        &[1, 0x00, 0x01, 0x05][..],
-        &[1, 0x00, 0x00, 0x01][..],
-        &[1][..],
+        &[2, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[2, 0x00, 0x03][..],
+        &[2, 0x00, 0x01, 0x05][..],
+        &[2, 0x00, 0x00, 0x01][..],
+        &[2][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -465,6 +496,24 @@ fn any_status() -> BoxedStrategy<BoardStatus> {
     .boxed()
 }
 
+fn any_plan() -> BoxedStrategy<MissionPlan> {
+    (
+        any_mission(),
+        prop_oneof![Just(Heading::Paper), Just(Heading::Tangent)],
+        any_f32(),
+    )
+        .prop_map(|(path, heading, time_scale)| MissionPlan {
+            path,
+            heading,
+            time_scale,
+        })
+        .boxed()
+}
+
+fn any_unit() -> BoxedStrategy<ThrustUnit> {
+    prop_oneof![Just(ThrustUnit::Kgf), Just(ThrustUnit::Newton)].boxed()
+}
+
 fn any_mission() -> BoxedStrategy<MissionSpec> {
     let f = any_f32;
     prop_oneof![
@@ -503,15 +552,28 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
         proptest::option::of(any_f32()),
         any::<Option<u8>>(),
         any::<Option<bool>>(),
+        proptest::option::of(any_unit()),
+        any::<Option<u8>>(),
     )
         .prop_map(
-            |(rate_hz, robust, delta_max, voltage_limit, stale_periods, lockstep)| ConfigPatch {
+            |(
                 rate_hz,
                 robust,
                 delta_max,
                 voltage_limit,
                 stale_periods,
                 lockstep,
+                thrust_unit,
+                reversed_thrusters,
+            )| ConfigPatch {
+                rate_hz,
+                robust,
+                delta_max,
+                voltage_limit,
+                stale_periods,
+                lockstep,
+                thrust_unit,
+                reversed_thrusters,
             },
         )
         .boxed()
@@ -522,7 +584,7 @@ fn any_command() -> BoxedStrategy<Command> {
         Just(Command::Arm),
         Just(Command::Disarm),
         Just(Command::StopMission),
-        any_mission().prop_map(Command::StartMission),
+        any_plan().prop_map(Command::StartMission),
         any_patch().prop_map(Command::SetConfig),
     ]
     .boxed()
@@ -548,6 +610,8 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<u32>(),
             any::<u32>(),
             any::<u16>(),
+            any_unit(),
+            any::<u8>(),
         ),
     )
         .prop_map(
@@ -561,6 +625,8 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     rx_frames,
                     rx_errors,
                     last_state_seq,
+                    thrust_unit,
+                    reversed_thrusters,
                 ),
             )| Telemetry {
                 tick,
@@ -578,6 +644,8 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 rx_frames,
                 rx_errors,
                 last_state_seq,
+                thrust_unit,
+                reversed_thrusters,
             },
         )
         .boxed()

@@ -1,7 +1,7 @@
 //! The board's status and fail-safe names, and the reason bytes on the wire. The names are what
 //! the firmware logs (its defmt snapshots hold them) and what host-sim's reports and JSON say.
 
-use auv_link::{BoardStatus, FailSafeReason, Telemetry};
+use auv_link::{BoardStatus, FailSafeReason, Telemetry, ThrustUnit};
 use controller_core::Fault;
 
 #[test]
@@ -68,6 +68,8 @@ fn telemetry_fault_code_is_the_cores() {
         rx_frames: 0,
         rx_errors: 0,
         last_state_seq: 0,
+        thrust_unit: ThrustUnit::Kgf,
+        reversed_thrusters: 0,
     };
     assert_eq!(t.fault(), None);
     for f in Fault::ALL {
