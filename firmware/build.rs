@@ -1,5 +1,6 @@
-//! Gives each image (binary) its board's memory map, and computes the self-test's golden
-//! vectors with the same `controller-core`, built for the host.
+//! Gives each image (binary) its board's memory map, computes the self-test's golden vectors
+//! with the same `controller-core`, built for the host, and provisions the STM32 image's link
+//! key (`link_key.rs`, see [`link_key`]).
 //!
 //! Memory maps: cortex-m-rt's `link.x` includes `memory.x` from the linker's search path. Each
 //! image gets its own directory holding a copy of its map as `memory.x`, on its own link line
@@ -12,6 +13,7 @@ use std::fmt::Write as _;
 use std::fs;
 use std::path::PathBuf;
 
+use auv_link::sign::LinkKey;
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
 
@@ -19,6 +21,11 @@ use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajecto
 #[allow(dead_code)]
 #[path = "src/image.rs"]
 mod image;
+
+// The STM32 image's link key from the environment (host-tested in tests/provision.rs).
+#[path = "src/provision.rs"]
+mod provision;
+use provision::{link_key, CI_TEST_KEY, KEY_VAR, UNSIGNED_VAR};
 
 fn main() {
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("cargo sets OUT_DIR"));
@@ -37,6 +44,23 @@ fn main() {
     println!("cargo:rerun-if-changed=../controller-core/src");
 
     fs::write(out.join("golden.rs"), golden()).expect("writing golden.rs");
+
+    println!("cargo:rerun-if-env-changed={KEY_VAR}");
+    println!("cargo:rerun-if-env-changed={UNSIGNED_VAR}");
+    println!("cargo:rerun-if-changed={CI_TEST_KEY}");
+    let ci_key = fs::read_to_string(root.join(CI_TEST_KEY))
+        .ok()
+        .and_then(|t| LinkKey::from_key_file(&t).ok());
+    let stm32 = env::var_os("CARGO_FEATURE_STM32F405").is_some();
+    let (code, warning) = link_key(
+        env::var(KEY_VAR).ok().as_deref(),
+        env::var(UNSIGNED_VAR).ok().as_deref(),
+        ci_key.as_ref(),
+    );
+    if let (true, Some(w)) = (stm32, warning) {
+        println!("cargo:warning={w}");
+    }
+    fs::write(out.join("link_key.rs"), code).expect("writing link_key.rs");
 }
 
 /// Deterministic inputs around each Table-1 mission (on and off the reference, with and

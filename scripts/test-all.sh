@@ -7,6 +7,8 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
+# The STM32 image needs a link key: the public CI test key unless one is given.
+source scripts/ci-link-key.sh
 
 echo "== host tests (libm backend): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic, xtask"
 cargo test --workspace --release

@@ -4,7 +4,8 @@
 //! navigation link (`embedded_io` serial), a period timer and a free-running tick counter.
 //! [`period`] is the whole loop body; it is the same on every board.
 
-use auv_link::{encode, FrameDecoder, MAX_FRAME};
+use auv_link::sign::{Direction, LinkKey, Signer, Verifier};
+use auv_link::{encode, encode_signed, Envelope, FrameDecoder, LinkError, MAX_FRAME};
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_io::{Read, ReadReady, Write};
 
@@ -41,24 +42,76 @@ pub trait Board {
     fn feed_watchdog(&mut self) {}
 }
 
-/// Link buffers: the streaming decoder and one frame of transmit space.
+/// The board's end of the link: the streaming decoder (with the verifier if signing is on),
+/// one frame of transmit space, and the signer if signing is on.
 pub struct LinkBuffers {
     pub decoder: FrameDecoder,
     pub tx: [u8; MAX_FRAME],
+    signer: Option<Signer>,
 }
 
 impl LinkBuffers {
+    /// An unsigned link: unsigned frames in and out; signed frames are refused.
     pub fn new() -> Self {
         LinkBuffers {
             decoder: FrameDecoder::new(),
             tx: [0; MAX_FRAME],
+            signer: None,
         }
+    }
+
+    /// A signed link with `key` (auv_link::sign): only frames the navigation computer signed
+    /// with it are accepted, and telemetry is signed with it.
+    pub fn signed(key: &LinkKey) -> Self {
+        LinkBuffers {
+            decoder: FrameDecoder::signed(Verifier::new(key, Direction::ToBoard)),
+            tx: [0; MAX_FRAME],
+            signer: Some(Signer::new(key, Direction::FromBoard)),
+        }
+    }
+
+    /// A signed link if `key` is given, else an unsigned one.
+    pub fn with_key(key: Option<&LinkKey>) -> Self {
+        key.map_or_else(Self::new, Self::signed)
+    }
+
+    /// Signing is on.
+    pub fn signing(&self) -> bool {
+        self.signer.is_some()
+    }
+
+    /// Encodes `env` into `tx` (signed if signing is on) and returns the frame. The board has
+    /// no clock: its timestamp stays above the last one it accepted from the navigation
+    /// computer, and above its own previous one (auv_link::sign).
+    pub fn encode(&mut self, env: &Envelope) -> Result<&[u8], LinkError> {
+        let n = match &mut self.signer {
+            None => encode(env, &mut self.tx)?,
+            Some(signer) => {
+                if let Some(t) = self.decoder.verifier().and_then(|v| v.last_timestamp()) {
+                    signer.advance_to(t);
+                }
+                encode_signed(env, signer, &mut self.tx)?
+            }
+        };
+        Ok(&self.tx[..n])
     }
 }
 
 impl Default for LinkBuffers {
     fn default() -> Self {
         Self::new()
+    }
+}
+
+/// Feeds received bytes to the decoder and each result to the supervisor: frames to
+/// [`Supervisor::on_envelope`], errors to [`Supervisor::on_link_error`].
+pub fn receive(sup: &mut Supervisor, bufs: &mut LinkBuffers, bytes: &[u8]) {
+    for &b in bytes {
+        match bufs.decoder.push(b) {
+            Some(Ok(env)) => sup.on_envelope(&env),
+            Some(Err(e)) => sup.on_link_error(&e),
+            None => {}
+        }
     }
 }
 
@@ -85,13 +138,7 @@ pub fn pump<L: Read + ReadReady>(link: &mut L, sup: &mut Supervisor, bufs: &mut 
                 continue;
             }
         };
-        for &b in &chunk[..n] {
-            match bufs.decoder.push(b) {
-                Some(Ok(env)) => sup.on_envelope(&env),
-                Some(Err(_)) => sup.on_rx_error(),
-                None => {}
-            }
-        }
+        receive(sup, bufs, &chunk[..n]);
     }
 }
 
@@ -130,8 +177,8 @@ pub fn period<B: Board>(board: &mut B, sup: &mut Supervisor, bufs: &mut LinkBuff
     };
     drive(board, &step.voltages);
     let env = sup.envelope(step.telemetry);
-    if let Ok(n) = encode(&env, &mut bufs.tx) {
-        let _ = board.link().write_all(&bufs.tx[..n]);
+    if let Ok(frame) = bufs.encode(&env) {
+        let _ = board.link().write_all(frame);
     }
     board.feed_watchdog();
     step

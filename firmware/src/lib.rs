@@ -1,7 +1,7 @@
 //! AUV-150 thruster-board firmware: a thin fixed-rate shell around `controller-core`.
 //!
-//! Hardware-free parts, tested on the host: [`supervisor`] (arming, missions, fail-safe),
-//! [`pwm`] (voltage → H-bridge duty), [`board`] (the board trait and one control period),
+//! Hardware-free parts, tested on the host: [`supervisor`] (arming, missions, fail-safe,
+//! refusals), [`limits`] (what the board's configuration may be), [`pwm`] (voltage → H-bridge duty), [`board`] (the board trait and one control period),
 //! [`serial`] (the UART's byte queues between interrupt and loop), [`image`] (which images
 //! exist and how to tell their ELFs apart) and [`qemu_clock`] (QEMU's instruction counts).
 //!
@@ -14,6 +14,7 @@
 
 pub mod board;
 pub mod image;
+pub mod limits;
 pub mod pwm;
 pub mod qemu_clock;
 pub mod serial;

@@ -9,6 +9,9 @@
 //! - Thrusters: the board has no PWM; [`MemPwm`] channels keep the commanded duty in RAM (they
 //!   implement `SetDutyCycle` like a real timer channel would).
 //! - No watchdog.
+//! - Configuration at boot: QEMU's semihosting command line (`-append "…"`, see
+//!   [`command_line`]); the flying image takes its link key from it ([`link_key`]), the
+//!   self-test its failure injections.
 
 use core::cell::Cell;
 use core::convert::Infallible;
@@ -35,6 +38,59 @@ pub fn halt(code: i32) -> ! {
     };
     cortex_m_semihosting::debug::exit(status);
     cortex_m::peripheral::SCB::sys_reset()
+}
+
+/// Room for the semihosting command line: QEMU passes the ELF's path, then `-append`'s text.
+pub const CMDLINE_LEN: usize = 512;
+
+/// The semihosting command line (`qemu-run.sh ELF -append "…"`), into `buf`; `None` if QEMU
+/// refused it (it does when the line does not fit).
+pub fn command_line(buf: &mut [u8; CMDLINE_LEN]) -> Option<&[u8]> {
+    let mut block = [buf.as_mut_ptr() as usize, buf.len()];
+    // SAFETY: SYS_GET_CMDLINE writes at most `block[1]` bytes into `buf` and the length back
+    // into `block[1]`.
+    let r = unsafe {
+        cortex_m_semihosting::syscall1(
+            cortex_m_semihosting::nr::GET_CMDLINE,
+            block.as_mut_ptr() as usize,
+        )
+    };
+    if r != 0 {
+        return None;
+    }
+    let n = block[1].min(buf.len());
+    Some(&buf[..n])
+}
+
+/// The word of the command line that provisions the link key: `link-key=` and 64 hex digits.
+pub const LINK_KEY_ARG: &str = "link-key=";
+
+/// Why the command line's key was not taken.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum KeyArgError {
+    /// The command line could not be read (longer than [`CMDLINE_LEN`]?).
+    Unreadable,
+    /// `link-key=` is followed by something that is not a key.
+    Malformed(auv_link::sign::KeyError),
+}
+
+/// The QEMU image's link key: `link-key=<64 hex digits>` on the semihosting command line
+/// (`host-sim pil --link-key-file` passes it), the QEMU analogue of a key in the board's flash
+/// configuration; it never crosses the link. `Ok(None)`: no key given, signing off.
+pub fn link_key() -> Result<Option<auv_link::sign::LinkKey>, KeyArgError> {
+    let mut buf = [0u8; CMDLINE_LEN];
+    let cmd = command_line(&mut buf).ok_or(KeyArgError::Unreadable)?;
+    let Some(word) = cmd
+        .split(|&b| b == b' ')
+        .find_map(|w| w.strip_prefix(LINK_KEY_ARG.as_bytes()))
+    else {
+        return Ok(None);
+    };
+    let text = core::str::from_utf8(word)
+        .map_err(|_| KeyArgError::Malformed(auv_link::sign::KeyError::NotHex { at: 0 }))?;
+    auv_link::sign::LinkKey::from_hex(text)
+        .map(Some)
+        .map_err(KeyArgError::Malformed)
 }
 
 const UART0: usize = 0x4000_4000;

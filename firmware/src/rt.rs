@@ -2,13 +2,14 @@
 //! (`src/bin/…`) picks its board and its way to end the program (`halt`: QEMU exits through
 //! semihosting, the STM32 resets) and hands them to these functions.
 
+use auv_link::sign::LinkKey;
 use controller_core::{Controller, ControllerConfig};
 use cortex_m_rt::ExceptionFrame;
-use defmt::{error, info};
+use defmt::{error, info, warn};
 
 use crate::board::{period, Board, LinkBuffers};
 use crate::image::Image;
-use crate::supervisor::Supervisor;
+use crate::supervisor::{BoardInfo, Supervisor};
 
 /// Ends the program with an exit code (0 = success); never returns.
 pub type Halt = fn(i32) -> !;
@@ -45,8 +46,7 @@ pub fn controller(halt: Halt) -> Controller {
 
 /// The flying loop: one [`period`] after another, forever, logging every status change and
 /// following rate changes the supervisor accepts.
-pub fn fly<B: Board>(board: &mut B, mut sup: Supervisor) -> ! {
-    let mut bufs = LinkBuffers::new();
+pub fn fly<B: Board>(board: &mut B, mut sup: Supervisor, mut bufs: LinkBuffers) -> ! {
     let mut rate = sup.rate_hz();
     board.set_rate(rate);
     let mut last = None;
@@ -78,18 +78,38 @@ pub fn report_hard_fault(ef: &ExceptionFrame) {
     error!("HardFault at pc = {:#010x}", ef.pc());
 }
 
+/// The link with the image's key (signing on) or without (off), and the boot line that says
+/// which (the key's fingerprint, never the key).
+pub fn link(key: Option<&LinkKey>) -> LinkBuffers {
+    match key {
+        Some(k) => info!(
+            "link signing on (key fingerprint {=u32:08x}): unsigned frames are refused",
+            k.fingerprint()
+        ),
+        None => warn!("link signing OFF: any peer that computes the CRC can command the board"),
+    }
+    LinkBuffers::with_key(key)
+}
+
 /// What a flying image's `main` does: marks the image, takes the core peripherals, builds the
-/// controller, brings the board up with them at the controller's rate (`init`), and flies.
+/// controller, brings the board up with them at the controller's rate (`init`), sets up the
+/// link with the image's key (`None`: signing off), and flies.
 pub fn fly_image<B: Board>(
     image: Image,
     halt: Halt,
+    key: Option<LinkKey>,
     init: impl FnOnce(cortex_m::Peripherals, u32) -> B,
 ) -> ! {
     image.embed();
     let cp = core_peripherals(halt);
     let controller = controller(halt);
     let mut board = init(cp, controller.config().rate_hz);
-    fly(&mut board, Supervisor::new(controller))
+    let bufs = link(key.as_ref());
+    let info = BoardInfo {
+        supply_voltage: board.supply_voltage(),
+        signing: bufs.signing(),
+    };
+    fly(&mut board, Supervisor::new(controller, info), bufs)
 }
 
 /// Defines an image's `#[panic_handler]` and `HardFault` handler: report, then `$halt(1)`.

@@ -1,23 +1,38 @@
-//! The board's control supervisor: arming, missions, state-frame freshness, fail-safe, and one
-//! control period around `Controller::update`. Hardware-free, so it is tested on the host.
+//! The board's control supervisor: arming, missions, state-frame freshness and order, the
+//! fail-safe, refusals, and one control period around `Controller::update`. Hardware-free, so
+//! it is tested on the host. Its state machine is the table in firmware/README.md ("State
+//! machine"), which `tests/state_table.rs` parses and walks cell by cell.
 //!
 //! Fail-safe (all thrusters neutral, 0 V) whenever:
 //! - the board is disarmed ([`BoardStatus::Disarmed`]);
 //! - armed but no mission is running ([`BoardStatus::Armed`]);
-//! - no valid state frame arrived for more than `stale_periods` control periods
+//! - no valid, in-order state frame arrived for more than `stale_periods` control periods
 //!   ([`DEFAULT_STALE_PERIODS`] unless configured);
 //! - the controller reports a fault (non-finite/implausible input, pitch limit, …);
 //! - the previous control period overran its deadline.
 //!
-//! The last three **latch**: the board stays in fail-safe until it is disarmed and re-armed,
-//! and then resumes on the next valid state frame. A corrupt or unknown frame is counted and
-//! dropped, never acted on.
+//! The last three **latch**: the board stays in fail-safe until it is disarmed and then armed
+//! (a lone `Arm` is refused), and then flies only after a new `StartMission` (disarming drops
+//! the mission). The latched reason — and the controller's fault code if a fault latched it —
+//! is in every telemetry frame until the re-arm.
+//!
+//! Frames: a corrupt, unknown-version, badly authenticated or wrong-direction frame is counted
+//! (`rx_errors`) and dropped. A frame whose sequence number is not newer than the last accepted
+//! one ([`auv_link::seq`]) is counted (`rx_stale`) and dropped; in lock-step so is a state frame
+//! off the mission clock ([`MissionClock`]). A dropped frame never restarts the stale-state
+//! timer. Every refused command is counted and its reason reported ([`Refusal`]); a refused
+//! command changes nothing.
 
+use auv_link::seq::SeqCheck;
 use auv_link::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Msg, StateFrame, Telemetry,
-    DEFAULT_STALE_PERIODS,
+    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionPlan, Msg,
+    Refusal, StateFrame, Telemetry, DEFAULT_STALE_PERIODS,
 };
-use controller_core::{Controller, ControllerConfig, Status, Trajectory, TrajectoryKind};
+use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
+use controller_core::trajectory::TrajectoryError;
+use controller_core::{Controller, ControllerConfig, Mission, Status, Trajectory};
+
+use crate::limits;
 
 /// What one control period commands.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -27,43 +42,184 @@ pub struct Step {
     pub telemetry: Telemetry,
 }
 
+/// What the supervisor needs to know about its board.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoardInfo {
+    /// H-bridge supply voltage V_s (V): `voltage_limit` may not exceed it.
+    pub supply_voltage: f32,
+    /// The link refuses unsigned frames (reported in telemetry; the decoder enforces it).
+    pub signing: bool,
+}
+
+/// The supervisor's state, the rows and columns of the state table (firmware/README.md).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Mode {
+    /// Thrusters off; nothing latched.
+    Disarmed,
+    /// Thrusters off; a fail-safe reason is still reported, until `Arm`.
+    DisarmedLatched,
+    /// Armed, no mission: thrusters off.
+    Armed,
+    /// Armed with a mission: flies while its state frames are fresh.
+    Running,
+    /// Armed, fail-safe latched: thrusters off until disarm, then arm.
+    FailSafe,
+}
+
+impl Mode {
+    /// Every mode, in the table's column order.
+    pub const ALL: [Mode; 5] = [
+        Mode::Disarmed,
+        Mode::DisarmedLatched,
+        Mode::Armed,
+        Mode::Running,
+        Mode::FailSafe,
+    ];
+
+    /// The name the state table uses.
+    pub const fn as_str(self) -> &'static str {
+        match self {
+            Mode::Disarmed => "disarmed",
+            Mode::DisarmedLatched => "disarmed (latched)",
+            Mode::Armed => "armed",
+            Mode::Running => "running",
+            Mode::FailSafe => "fail-safe",
+        }
+    }
+}
+
+/// The lock-step mission clock: the mission tick of the last accepted state frame, and the
+/// control periods run since.
+///
+/// **Choice:** in lock-step (a simulation mode: `host-sim pil`) the navigation computer owns
+/// mission time: each state frame's `t_ticks` is the mission tick it holds at, and the board
+/// runs one period per state frame. The first state frame after `StartMission` sets the clock
+/// (0 for a new mission; where the mission resumes after a re-arm). After it, a frame is on the
+/// clock when its tick is above the last accepted one and at most the number of periods run
+/// since then ahead of it. So the clock advances by exactly one tick per period while one frame
+/// arrives per period; a frame lost on the link is a period the board ran without it (its wait
+/// ends after one period), after which the next frame may be that many ticks ahead; and no
+/// frame may run the clock backwards, stand it still or jump it ahead of the board's own
+/// periods (before this, `t_ticks` could jump by 10¹⁵ or run backwards in flight). Off the
+/// clock, a frame is counted (`rx_stale`) and dropped. In free-running mode the board counts
+/// mission time itself (one tick per period since `StartMission`) and `t_ticks` is not used.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MissionClock {
+    last: Option<u64>,
+    periods: u64,
+}
+
+impl MissionClock {
+    /// A mission just started: no frame yet, no period run.
+    pub const START: MissionClock = MissionClock {
+        last: None,
+        periods: 0,
+    };
+
+    /// True if a state frame at mission tick `t` is on the clock.
+    pub const fn admits(&self, t: u64) -> bool {
+        match self.last {
+            None => true,
+            Some(last) => t > last && t - last <= self.periods,
+        }
+    }
+
+    fn accept(&mut self, t: u64) {
+        self.last = Some(t);
+        self.periods = 0;
+    }
+
+    fn period(&mut self) {
+        self.periods = self.periods.saturating_add(1);
+    }
+}
+
+/// A latched fail-safe: why, and the controller's fault code if a fault latched it (else 0).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct Latch {
+    reason: FailSafeReason,
+    fault: u8,
+}
+
 /// Board state around the controller.
 pub struct Supervisor {
     controller: Controller,
+    board: BoardInfo,
+    /// The mission and the board tick it started at.
     mission: Option<(Trajectory, u64)>,
+    clock: MissionClock,
     armed: bool,
-    latched: Option<FailSafeReason>,
+    latched: Option<Latch>,
     state: Option<StateFrame>,
     periods_since_state: u32,
     stale_periods: u8,
     lockstep: bool,
+    rx_seq: SeqCheck,
     tick: u64,
     seq_out: u16,
     rx_frames: u32,
     rx_errors: u32,
-    rejected_commands: u32,
+    rx_stale: u32,
+    rx_auth_errors: u32,
+    refused_commands: u32,
+    last_refusal: Option<Refusal>,
     loop_overruns: u32,
     worst_update_ticks: u32,
     last_state_seq: u16,
     state_fresh: bool,
+    /// The controller's thruster mounting as the link's reversed-thruster mask, computed when
+    /// the controller is set ([`mounting_of`]).
+    mounting: u8,
+}
+
+/// The reversed-thruster mask [`Telemetry::reversed_thrusters`] reports for `config`: the
+/// AUV-150 layout's mask, or [`NOT_AUV150`] for a geometry that is not the AUV-150 layout (a
+/// board built with another geometry; the link cannot set one).
+pub fn mounting_of(config: &ControllerConfig) -> u8 {
+    config.geometry.auv150_reversed().unwrap_or(NOT_AUV150)
+}
+
+/// [`Telemetry::reversed_thrusters`] of a board whose geometry is not the AUV-150 layout
+/// with some thrusters reversed: every bit set, which no valid mask has (bits above the
+/// fifth).
+pub const NOT_AUV150: u8 = u8::MAX;
+
+/// Bits of a valid reversed-thruster mask: one per thruster.
+const MOUNTING_BITS: u8 = (1 << THRUSTERS) - 1;
+
+/// Why the core refused a mission, as the board reports it: the time scale and the tangent
+/// heading (protocol 3) have their own reasons, any other parameter is an invalid mission.
+pub fn mission_refusal(e: &TrajectoryError) -> Refusal {
+    match e {
+        TrajectoryError::TooSlowForTangent { .. } => Refusal::TangentTooSlow,
+        e if e.parameter() == "time_scale" => Refusal::InvalidTimeScale,
+        _ => Refusal::InvalidMission,
+    }
 }
 
 impl Supervisor {
-    pub fn new(controller: Controller) -> Self {
+    pub fn new(controller: Controller, board: BoardInfo) -> Self {
         Supervisor {
+            mounting: mounting_of(controller.config()),
             controller,
+            board,
             mission: None,
+            clock: MissionClock::START,
             armed: false,
             latched: None,
             state: None,
             periods_since_state: u32::MAX,
             stale_periods: DEFAULT_STALE_PERIODS,
             lockstep: false,
+            rx_seq: SeqCheck::new(),
             tick: 0,
             seq_out: 0,
             rx_frames: 0,
             rx_errors: 0,
-            rejected_commands: 0,
+            rx_stale: 0,
+            rx_auth_errors: 0,
+            refused_commands: 0,
+            last_refusal: None,
             loop_overruns: 0,
             worst_update_ticks: 0,
             last_state_seq: 0,
@@ -80,32 +236,94 @@ impl Supervisor {
         self.controller.config().rate_hz
     }
 
+    /// Control periods a state frame stays valid.
+    pub fn stale_periods(&self) -> u8 {
+        self.stale_periods
+    }
+
     /// Lock-step mode (processor in the loop): one period per state frame, and the state
-    /// frame's `t_ticks` is the mission time.
+    /// frame's `t_ticks` is the mission time, on the [`MissionClock`].
     pub fn lockstep(&self) -> bool {
         self.lockstep
     }
 
-    /// True once a state frame arrived since the last period (lock-step pacing).
+    /// True once a state frame was accepted since the last period (lock-step pacing).
     pub fn state_fresh(&self) -> bool {
         self.state_fresh
+    }
+
+    /// The state-table mode the supervisor is in.
+    pub fn mode(&self) -> Mode {
+        match (self.armed, self.latched, &self.mission) {
+            (false, None, _) => Mode::Disarmed,
+            (false, Some(_), _) => Mode::DisarmedLatched,
+            (true, Some(_), _) => Mode::FailSafe,
+            (true, None, None) => Mode::Armed,
+            (true, None, Some(_)) => Mode::Running,
+        }
+    }
+
+    /// The latched fail-safe reason, until re-armed.
+    pub fn latched(&self) -> Option<FailSafeReason> {
+        self.latched.map(|l| l.reason)
+    }
+
+    pub fn rx_frames(&self) -> u32 {
+        self.rx_frames
     }
 
     pub fn rx_errors(&self) -> u32 {
         self.rx_errors
     }
 
-    pub fn rejected_commands(&self) -> u32 {
-        self.rejected_commands
+    pub fn rx_stale(&self) -> u32 {
+        self.rx_stale
     }
 
-    /// A frame failed to decode (COBS, CRC, version, size): counted and dropped.
+    pub fn rx_auth_errors(&self) -> u32 {
+        self.rx_auth_errors
+    }
+
+    pub fn refused_commands(&self) -> u32 {
+        self.refused_commands
+    }
+
+    pub fn last_refusal(&self) -> Option<Refusal> {
+        self.last_refusal
+    }
+
+    /// The byte stream broke (a UART line error): counted, like a frame that failed to decode.
     pub fn on_rx_error(&mut self) {
         self.rx_errors = self.rx_errors.saturating_add(1);
     }
 
-    /// Acts on one valid frame.
+    /// A frame failed to decode or to authenticate: counted (authentication failures also in
+    /// `rx_auth_errors`) and dropped.
+    pub fn on_link_error(&mut self, e: &LinkError) {
+        self.on_rx_error();
+        if matches!(e, LinkError::Auth(_)) {
+            self.rx_auth_errors = self.rx_auth_errors.saturating_add(1);
+        }
+    }
+
+    /// Acts on one decoded frame: drops it unless it is newer than the last accepted one (and,
+    /// for a lock-step state frame, on the mission clock).
     pub fn on_envelope(&mut self, env: &Envelope) {
+        // A board never receives telemetry: wrong direction, a receive error.
+        if let Msg::Telemetry(_) = env.msg {
+            self.on_rx_error();
+            return;
+        }
+        let on_clock = match env.msg {
+            Msg::State(s) if self.lockstep && self.mission.is_some() => {
+                self.clock.admits(s.t_ticks)
+            }
+            _ => true,
+        };
+        if !on_clock || !self.rx_seq.accept(env.seq) {
+            self.rx_stale = self.rx_stale.saturating_add(1);
+            return;
+        }
         self.rx_frames = self.rx_frames.saturating_add(1);
         match env.msg {
             Msg::State(s) => {
@@ -113,54 +331,87 @@ impl Supervisor {
                 self.periods_since_state = 0;
                 self.last_state_seq = env.seq;
                 self.state_fresh = true;
-            }
-            Msg::Command(c) => self.on_command(&c),
-            // A board never receives telemetry: unknown direction, dropped.
-            Msg::Telemetry(_) => self.on_rx_error(),
-        }
-    }
-
-    fn on_command(&mut self, c: &Command) {
-        match c {
-            Command::Arm => {
-                self.armed = true;
-                self.latched = None;
-            }
-            Command::Disarm => self.armed = false,
-            // The link's one conversion (auv_link::mission), validated by the core.
-            Command::StartMission(spec) => match Trajectory::new(TrajectoryKind::from(*spec)) {
-                Ok(t) => self.mission = Some((t, self.tick)),
-                Err(_) => self.rejected_commands = self.rejected_commands.saturating_add(1),
-            },
-            Command::StopMission => self.mission = None,
-            Command::SetConfig(patch) => {
-                if !self.apply(patch) {
-                    self.rejected_commands = self.rejected_commands.saturating_add(1);
+                if self.lockstep && self.mission.is_some() {
+                    self.clock.accept(s.t_ticks);
                 }
             }
+            Msg::Command(c) => {
+                if let Err(r) = self.on_command(&c) {
+                    self.refused_commands = self.refused_commands.saturating_add(1);
+                    self.last_refusal = Some(r);
+                }
+            }
+            Msg::Telemetry(_) => {}
         }
     }
 
-    /// Applies a configuration patch; only while disarmed, and only if the result validates.
-    fn apply(&mut self, p: &ConfigPatch) -> bool {
-        if let Some(n) = p.stale_periods {
-            if n == 0 {
-                return false;
+    fn on_command(&mut self, c: &Command) -> Result<(), Refusal> {
+        match c {
+            Command::Arm => self.arm(),
+            Command::Disarm => {
+                self.armed = false;
+                self.mission = None;
+                Ok(())
             }
-            self.stale_periods = n;
+            Command::StartMission(plan) => self.start_mission(plan),
+            Command::StopMission => {
+                self.mission = None;
+                Ok(())
+            }
+            Command::SetConfig(patch) => self.configure(patch),
         }
-        if let Some(l) = p.lockstep {
-            self.lockstep = l;
-        }
-        let touches_law = p.rate_hz.is_some()
-            || p.robust.is_some()
-            || p.delta_max.is_some()
-            || p.voltage_limit.is_some();
-        if !touches_law {
-            return true;
-        }
+    }
+
+    /// Arming from disarmed clears the latch; arming while armed changes nothing, and is
+    /// refused if a fail-safe is latched (only disarm, then arm, clears it).
+    fn arm(&mut self) -> Result<(), Refusal> {
         if self.armed {
-            return false;
+            return match self.latched {
+                Some(_) => Err(Refusal::Latched),
+                None => Ok(()),
+            };
+        }
+        self.armed = true;
+        self.latched = None;
+        Ok(())
+    }
+
+    /// Only armed, unlatched and without a mission; the mission must validate. The state
+    /// checks come first (a running mission is reported as running, whatever the new one).
+    fn start_mission(&mut self, plan: &MissionPlan) -> Result<(), Refusal> {
+        if !self.armed {
+            return Err(Refusal::NotArmed);
+        }
+        if self.latched.is_some() {
+            return Err(Refusal::Latched);
+        }
+        if self.mission.is_some() {
+            return Err(Refusal::MissionRunning);
+        }
+        // The link's one conversion (auv_link::mission), validated by the core: path, heading
+        // and time scale.
+        let trajectory = Trajectory::new(Mission::from(*plan)).map_err(|e| mission_refusal(&e))?;
+        self.mission = Some((trajectory, self.tick));
+        self.clock = MissionClock::START;
+        if self.lockstep {
+            // A state frame from before the mission is not on its clock.
+            self.state = None;
+        }
+        Ok(())
+    }
+
+    /// Validates the whole patch against the board's limits and the core, then applies all of
+    /// it, or nothing. Refused while armed, whatever it holds.
+    ///
+    /// The thruster chain (protocol 3, docs/design.md §9): the thrust unit of Eqs 31–32, the
+    /// mounting as the AUV-150's reversed-thruster mask (a bit above the fifth is refused,
+    /// [`Refusal::InvalidMounting`]) and the allocator's axis priority (a weight the core
+    /// refuses is [`Refusal::InvalidPriority`]). Each changes the controller's configuration,
+    /// so the core revalidates all of it (the envelope and the allocator's blocks are rebuilt
+    /// in `Controller::new`) before anything is applied.
+    fn configure(&mut self, p: &ConfigPatch) -> Result<(), Refusal> {
+        if self.armed {
+            return Err(Refusal::WhileArmed);
         }
         let mut cfg: ControllerConfig = *self.controller.config();
         if let Some(r) = p.rate_hz {
@@ -175,13 +426,50 @@ impl Supervisor {
         if let Some(v) = p.voltage_limit {
             cfg.voltage_limit = v;
         }
-        match Controller::new(cfg) {
-            Ok(c) => {
-                self.controller = c;
-                true
-            }
-            Err(_) => false,
+        if let Some(u) = p.thrust_unit {
+            cfg.thrust_unit = u.into();
         }
+        if let Some(m) = p.reversed_thrusters {
+            if m & !MOUNTING_BITS != 0 {
+                return Err(Refusal::InvalidMounting);
+            }
+            cfg.geometry = ThrusterGeometry::auv150(m);
+        }
+        if let Some(q) = p.priority {
+            cfg.priority = q.into();
+        }
+        let stale_periods = p.stale_periods.unwrap_or(self.stale_periods);
+        let lockstep = p.lockstep.unwrap_or(self.lockstep);
+
+        // The board's limits first (cheap), then the core's validation (bounds over the box:
+        // costly, and only if the law changes).
+        if cfg.rate_hz > limits::MAX_RATE_HZ {
+            return Err(Refusal::RateTooHigh);
+        }
+        // `>` lets NaN through to the core, which refuses it as non-finite.
+        if cfg.voltage_limit > self.board.supply_voltage {
+            return Err(Refusal::VoltageAboveSupply);
+        }
+        if !limits::stale_limit_ok(stale_periods, cfg.rate_hz) {
+            return Err(Refusal::StaleLimit);
+        }
+        let controller = if cfg == *self.controller.config() {
+            None
+        } else {
+            Some(Controller::new(cfg).map_err(|e| match e.field() {
+                Some(f) if f.name == "priority" => Refusal::InvalidPriority,
+                _ => Refusal::ControllerConfig,
+            })?)
+        };
+
+        // Everything validated: apply all of it.
+        if let Some(c) = controller {
+            self.mounting = mounting_of(c.config());
+            self.controller = c;
+        }
+        self.stale_periods = stale_periods;
+        self.lockstep = lockstep;
+        Ok(())
     }
 
     /// One control period. `overrun`: the previous period missed its deadline. `now` reads a
@@ -194,20 +482,20 @@ impl Supervisor {
         let mut voltages = [0.0f32; 5];
         let mut thrusts = [0.0f32; 5];
         let mut tau = [0.0f32; 6];
-        let (mut saturated, mut delta, mut delta_clamped, mut w_norm, mut fault) =
-            (0u8, 0.0f32, false, 0.0f32, 0u8);
-        let stale = self.periods_since_state > self.stale_periods as u32;
+        let (mut saturated, mut delta, mut delta_clamped, mut w_norm) =
+            (0u8, 0.0f32, false, 0.0f32);
+        let stale = self.periods_since_state > u32::from(self.stale_periods);
         let status = match (self.armed, self.latched, self.mission, self.state) {
             (false, _, _, _) => BoardStatus::Disarmed,
-            (true, Some(r), _, _) => BoardStatus::FailSafe(r),
+            (true, Some(l), _, _) => BoardStatus::FailSafe(l.reason),
             (true, None, None, _) => BoardStatus::Armed,
-            (true, None, Some(_), _) if overrun => self.latch(FailSafeReason::Overrun),
-            (true, None, Some(_), None) => self.latch(FailSafeReason::StaleState),
-            (true, None, Some(_), Some(_)) if stale => self.latch(FailSafeReason::StaleState),
+            (true, None, Some(_), _) if overrun => self.latch(FailSafeReason::Overrun, 0),
+            (true, None, Some(_), None) => self.latch(FailSafeReason::StaleState, 0),
+            (true, None, Some(_), Some(_)) if stale => self.latch(FailSafeReason::StaleState, 0),
             (true, None, Some((traj, start)), Some(s)) => {
                 // Mission time: the board's own ticks since StartMission; in lock-step the
-                // state frame's t_ticks, which the navigation computer counts from the
-                // mission start (so PIL does not depend on host speed).
+                // state frame's t_ticks, on the mission clock (so PIL does not depend on host
+                // speed).
                 let mission_ticks = if self.lockstep {
                     s.t_ticks
                 } else {
@@ -228,10 +516,7 @@ impl Supervisor {
                         w_norm = out.w_norm;
                         BoardStatus::Running
                     }
-                    Status::Fault(f) => {
-                        fault = f.code();
-                        self.latch(FailSafeReason::ControllerFault)
-                    }
+                    Status::Fault(f) => self.latch(FailSafeReason::ControllerFault, f.code()),
                 }
             }
         };
@@ -245,14 +530,24 @@ impl Supervisor {
             delta,
             delta_clamped,
             w_norm,
-            controller_fault: fault,
+            controller_fault: self.latched.map_or(0, |l| l.fault),
             loop_overruns: self.loop_overruns,
             worst_update_ticks: self.worst_update_ticks,
             rx_frames: self.rx_frames,
             rx_errors: self.rx_errors,
             last_state_seq: self.last_state_seq,
+            latched: self.latched(),
+            refused_commands: self.refused_commands,
+            last_refusal: self.last_refusal,
+            rx_stale: self.rx_stale,
+            rx_auth_errors: self.rx_auth_errors,
+            last_rx_seq: self.rx_seq.last().unwrap_or(0),
+            signing: self.board.signing,
+            thrust_unit: self.controller.config().thrust_unit.into(),
+            reversed_thrusters: self.mounting,
         };
         self.periods_since_state = self.periods_since_state.saturating_add(1);
+        self.clock.period();
         self.tick += 1;
         Step {
             voltages,
@@ -260,8 +555,8 @@ impl Supervisor {
         }
     }
 
-    fn latch(&mut self, reason: FailSafeReason) -> BoardStatus {
-        self.latched = Some(reason);
+    fn latch(&mut self, reason: FailSafeReason, fault: u8) -> BoardStatus {
+        self.latched = Some(Latch { reason, fault });
         BoardStatus::FailSafe(reason)
     }
 

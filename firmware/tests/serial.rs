@@ -3,11 +3,12 @@
 //! test plays the interrupt handler, `pump` the control loop.
 
 use auv_link::{encode, Command, Envelope, Msg, MAX_FRAME};
-use controller_core::{Controller, ControllerConfig};
 use embedded_io::{Read, ReadReady, Write};
 use firmware::board::{pump, LinkBuffers};
 use firmware::serial::{self, IrqSide, LineError, RxFlags, RxQueue, TxQueue, RX_CAPACITY};
 use firmware::supervisor::Supervisor;
+
+mod common;
 
 const CLEAN: RxFlags = RxFlags {
     byte: true,
@@ -28,9 +29,7 @@ fn receive(irq: &mut IrqSide, bytes: &[u8]) {
     }
 }
 
-fn supervisor() -> Supervisor {
-    Supervisor::new(Controller::new(ControllerConfig::default()).unwrap())
-}
+use common::supervisor;
 
 /// (frames accepted, receive errors) so far.
 fn counts(sup: &mut Supervisor) -> (u32, u32) {

@@ -1,56 +1,42 @@
-//! The supervisor's fail-safe rules and the PWM mapping, on the host.
+//! The supervisor's fail-safe rules, frame order, mission clock, configuration checks and
+//! refusals, and the PWM mapping, on the host. (The state table is walked cell by cell in
+//! `state_table.rs`; the defects of issue 10 each have a test in `regressions.rs`.)
 
+use auv_link::seq::SEQ_WINDOW;
 use auv_link::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, StateFrame,
-    PROTOCOL_VERSION,
+    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, Refusal,
+    Telemetry,
 };
-use controller_core::kinematics::{self, Attitude};
-use controller_core::{Controller, ControllerConfig, Table1Case, Trajectory};
+use firmware::limits::{MAX_RATE_HZ, MAX_STALE_MS};
 use firmware::pwm;
-use firmware::supervisor::Supervisor;
+use firmware::supervisor::{Mode, Supervisor};
 
-fn env(msg: Msg) -> Envelope {
-    Envelope {
-        version: PROTOCOL_VERSION,
-        seq: 1,
-        msg,
-    }
+mod common;
+use common::{running, state, supervisor, Host, CIRCLE, NOW, SUPPLY};
+
+fn status(s: &mut Supervisor) -> BoardStatus {
+    s.step(false, NOW).telemetry.status
 }
 
-fn state(k: u64) -> StateFrame {
-    let d = Trajectory::table1(Table1Case::Circular10R).sample(k, 100);
-    let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
-    StateFrame {
-        t_ticks: k,
-        eta: d.eta.into(),
-        nu: nu.into(),
-    }
+fn telemetry(s: &mut Supervisor) -> Telemetry {
+    s.step(false, NOW).telemetry
 }
 
-fn running() -> Supervisor {
-    let mut s = Supervisor::new(Controller::new(ControllerConfig::default()).unwrap());
-    s.on_envelope(&env(Msg::Command(Command::Arm)));
-    s.on_envelope(&env(Msg::Command(Command::StartMission(
-        MissionSpec::Circle {
-            radius: 10.0,
-            omega: 0.1,
-            depth: 5.0,
-        },
-    ))));
-    s.on_envelope(&env(Msg::State(state(0))));
-    s
-}
+const STALE: BoardStatus = BoardStatus::FailSafe(FailSafeReason::StaleState);
 
-const NOW: &dyn Fn() -> u32 = &|| 0;
+fn patch(p: ConfigPatch) -> Command {
+    Command::SetConfig(p)
+}
 
 #[test]
 fn disarmed_and_armed_without_mission_keep_thrusters_off() {
-    let mut s = Supervisor::new(Controller::new(ControllerConfig::default()).unwrap());
-    s.on_envelope(&env(Msg::State(state(0))));
+    let mut s = supervisor();
+    let mut h = Host::new();
+    h.give(&mut s, Msg::State(state(0)));
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, BoardStatus::Disarmed);
     assert_eq!(st.voltages, [0.0; 5]);
-    s.on_envelope(&env(Msg::Command(Command::Arm)));
+    h.command(&mut s, Command::Arm);
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, BoardStatus::Armed);
     assert_eq!(st.voltages, [0.0; 5]);
@@ -58,51 +44,53 @@ fn disarmed_and_armed_without_mission_keep_thrusters_off() {
 
 #[test]
 fn stale_state_fails_safe_after_the_configured_periods_and_latches_until_rearm() {
-    let mut s = running();
-    assert_eq!(s.step(false, NOW).telemetry.status, BoardStatus::Running);
+    let (mut s, mut h) = running();
+    assert_eq!(status(&mut s), BoardStatus::Running);
     // Default 2 periods: the 1st and 2nd period without a frame still fly on the last one.
-    assert_eq!(s.step(false, NOW).telemetry.status, BoardStatus::Running);
-    assert_eq!(s.step(false, NOW).telemetry.status, BoardStatus::Running);
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    assert_eq!(status(&mut s), BoardStatus::Running);
     let st = s.step(false, NOW);
-    assert_eq!(
-        st.telemetry.status,
-        BoardStatus::FailSafe(FailSafeReason::StaleState)
-    );
+    assert_eq!(st.telemetry.status, STALE);
     assert_eq!(st.voltages, [0.0; 5]);
-    // Frames return, but the fail-safe latches until disarm + arm.
-    s.on_envelope(&env(Msg::State(state(4))));
-    assert_eq!(
-        s.step(false, NOW).telemetry.status,
-        BoardStatus::FailSafe(FailSafeReason::StaleState)
-    );
-    s.on_envelope(&env(Msg::Command(Command::Disarm)));
-    s.on_envelope(&env(Msg::Command(Command::Arm)));
-    s.on_envelope(&env(Msg::State(state(6))));
-    assert_eq!(s.step(false, NOW).telemetry.status, BoardStatus::Running);
+    // Frames return, but the fail-safe latches until disarm + arm, and a mission is started
+    // again (disarming dropped it).
+    h.give(&mut s, Msg::State(state(4)));
+    assert_eq!(status(&mut s), STALE);
+    h.command(&mut s, Command::Disarm);
+    h.command(&mut s, Command::Arm);
+    h.give(&mut s, Msg::State(state(6)));
+    assert_eq!(status(&mut s), BoardStatus::Armed);
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    assert_eq!(status(&mut s), BoardStatus::Running);
 }
 
 #[test]
-fn stale_period_count_is_configurable() {
-    let mut s = running();
-    s.on_envelope(&env(Msg::Command(Command::SetConfig(ConfigPatch {
-        stale_periods: Some(5),
-        ..Default::default()
-    }))));
-    for _ in 0..6 {
-        assert_eq!(s.step(false, NOW).telemetry.status, BoardStatus::Running);
-    }
-    assert_eq!(
-        s.step(false, NOW).telemetry.status,
-        BoardStatus::FailSafe(FailSafeReason::StaleState)
+fn stale_period_count_is_configurable_while_disarmed() {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            stale_periods: Some(5),
+            ..ConfigPatch::EMPTY
+        }),
     );
+    assert_eq!(s.stale_periods(), 5);
+    h.command(&mut s, Command::Arm);
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    h.give(&mut s, Msg::State(state(0)));
+    for _ in 0..6 {
+        assert_eq!(status(&mut s), BoardStatus::Running);
+    }
+    assert_eq!(status(&mut s), STALE);
 }
 
 #[test]
 fn controller_fault_and_overrun_fail_safe() {
-    let mut s = running();
+    let (mut s, mut h) = running();
     let mut bad = state(1);
     bad.nu[0] = f32::INFINITY;
-    s.on_envelope(&env(Msg::State(bad)));
+    h.give(&mut s, Msg::State(bad));
     let st = s.step(false, NOW);
     assert_eq!(
         st.telemetry.status,
@@ -111,7 +99,7 @@ fn controller_fault_and_overrun_fail_safe() {
     assert_ne!(st.telemetry.controller_fault, 0);
     assert_eq!(st.voltages, [0.0; 5]);
 
-    let mut s = running();
+    let (mut s, _) = running();
     let st = s.step(true, NOW);
     assert_eq!(
         st.telemetry.status,
@@ -122,7 +110,7 @@ fn controller_fault_and_overrun_fail_safe() {
 
 #[test]
 fn running_commands_the_controllers_voltages_and_reports_them() {
-    let mut s = running();
+    let (mut s, _) = running();
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, BoardStatus::Running);
     assert_eq!(st.voltages, st.telemetry.voltages);
@@ -131,40 +119,369 @@ fn running_commands_the_controllers_voltages_and_reports_them() {
 }
 
 #[test]
-fn config_changes_only_while_disarmed_and_only_if_valid() {
-    let mut s = running();
-    let patch = |rate| {
-        env(Msg::Command(Command::SetConfig(ConfigPatch {
-            rate_hz: Some(rate),
-            ..Default::default()
-        })))
-    };
-    s.on_envelope(&patch(50));
-    assert_eq!(s.rate_hz(), 100, "armed: refused");
-    assert_eq!(s.rejected_commands(), 1);
-    s.on_envelope(&env(Msg::Command(Command::Disarm)));
-    s.on_envelope(&patch(50));
-    assert_eq!(s.rate_hz(), 50);
-    s.on_envelope(&patch(5)); // violates the loop-rate check of docs/design.md §8
-    assert_eq!(s.rate_hz(), 50);
-    assert_eq!(s.rejected_commands(), 2);
+fn the_latched_reason_is_in_every_frame_until_rearmed() {
+    let (mut s, mut h) = running();
+    s.step(true, NOW);
+    let overrun = Some(FailSafeReason::Overrun);
+    for _ in 0..3 {
+        assert_eq!(telemetry(&mut s).latched, overrun);
+    }
+    h.command(&mut s, Command::Disarm);
+    let t = telemetry(&mut s);
+    assert_eq!((t.status, t.latched), (BoardStatus::Disarmed, overrun));
+    assert_eq!(s.mode(), Mode::DisarmedLatched);
+    h.command(&mut s, Command::Arm);
+    let t = telemetry(&mut s);
+    assert_eq!((t.status, t.latched), (BoardStatus::Armed, None));
+}
+
+// ---------------------------------------------------------------------------------------------
+// Refusals
+
+#[test]
+fn every_refusal_is_counted_and_its_reason_reported_in_telemetry() {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    let t = telemetry(&mut s);
+    assert_eq!((t.refused_commands, t.last_refusal), (0, None));
+    let cases = [
+        (Command::StartMission(CIRCLE), Refusal::NotArmed),
+        (
+            patch(ConfigPatch {
+                rate_hz: Some(MAX_RATE_HZ + 1),
+                ..ConfigPatch::EMPTY
+            }),
+            Refusal::RateTooHigh,
+        ),
+        (
+            patch(ConfigPatch {
+                voltage_limit: Some(SUPPLY + 0.01),
+                ..ConfigPatch::EMPTY
+            }),
+            Refusal::VoltageAboveSupply,
+        ),
+        (
+            patch(ConfigPatch {
+                stale_periods: Some(0),
+                ..ConfigPatch::EMPTY
+            }),
+            Refusal::StaleLimit,
+        ),
+        (
+            patch(ConfigPatch {
+                // Inside the stale limit (2 periods = 200 ms), but too slow for the loop-rate
+                // rule of docs/design.md §12 (> 21.5 Hz at the defaults).
+                rate_hz: Some(10),
+                ..ConfigPatch::EMPTY
+            }),
+            Refusal::ControllerConfig,
+        ),
+        (
+            patch(ConfigPatch {
+                delta_max: Some(f32::NAN),
+                ..ConfigPatch::EMPTY
+            }),
+            Refusal::ControllerConfig,
+        ),
+        (
+            patch(ConfigPatch {
+                voltage_limit: Some(f32::NAN),
+                ..ConfigPatch::EMPTY
+            }),
+            Refusal::ControllerConfig,
+        ),
+    ];
+    for (i, (c, why)) in cases.into_iter().enumerate() {
+        h.command(&mut s, c);
+        let t = telemetry(&mut s);
+        assert_eq!(t.refused_commands, i as u32 + 1, "{c:?}");
+        assert_eq!(t.last_refusal, Some(why), "{c:?}");
+    }
+    // Armed: the state checks.
+    h.command(&mut s, Command::Arm);
+    h.command(&mut s, Command::SetConfig(ConfigPatch::EMPTY));
+    assert_eq!(s.last_refusal(), Some(Refusal::WhileArmed));
+    h.command(
+        &mut s,
+        Command::StartMission(
+            MissionSpec::Circle {
+                radius: -1.0,
+                omega: 0.1,
+                depth: 5.0,
+            }
+            .into(),
+        ),
+    );
+    assert_eq!(s.last_refusal(), Some(Refusal::InvalidMission));
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    assert_eq!(s.last_refusal(), Some(Refusal::MissionRunning));
+    s.step(true, NOW);
+    h.command(&mut s, Command::Arm);
+    assert_eq!(s.last_refusal(), Some(Refusal::Latched));
+    h.command(&mut s, Command::StopMission);
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    assert_eq!(s.last_refusal(), Some(Refusal::Latched));
+    assert_eq!(s.refused_commands(), 12);
 }
 
 #[test]
-fn an_invalid_mission_is_rejected_not_flown() {
-    let mut s = Supervisor::new(Controller::new(ControllerConfig::default()).unwrap());
-    s.on_envelope(&env(Msg::Command(Command::Arm)));
-    s.on_envelope(&env(Msg::Command(Command::StartMission(
-        MissionSpec::Circle {
-            radius: -1.0,
-            omega: 0.1,
-            depth: 5.0,
-        },
-    ))));
-    assert_eq!(s.rejected_commands(), 1);
-    s.on_envelope(&env(Msg::State(state(0))));
-    assert_eq!(s.step(false, NOW).telemetry.status, BoardStatus::Armed);
+fn a_config_patch_is_validated_whole_and_applied_whole() {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    // A valid rate with a bad voltage: nothing of it applies.
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            rate_hz: Some(50),
+            stale_periods: Some(3),
+            lockstep: Some(true),
+            voltage_limit: Some(30.0),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(s.last_refusal(), Some(Refusal::VoltageAboveSupply));
+    assert_eq!(
+        (s.rate_hz(), s.stale_periods(), s.lockstep()),
+        (100, 2, false)
+    );
+    // The same without the bad field: all of it applies.
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            rate_hz: Some(50),
+            stale_periods: Some(3),
+            lockstep: Some(true),
+            voltage_limit: Some(20.0),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(s.refused_commands(), 1);
+    assert_eq!(
+        (s.rate_hz(), s.stale_periods(), s.lockstep()),
+        (50, 3, true)
+    );
+    assert_eq!(s.controller().config().voltage_limit, 20.0);
+    // The voltage limit at exactly the supply is allowed.
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            voltage_limit: Some(SUPPLY),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(s.refused_commands(), 1);
 }
+
+#[test]
+fn the_stale_limit_is_checked_in_time_at_the_resulting_rate() {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    let max_at_100 = (MAX_STALE_MS / 10) as u8; // periods of 10 ms
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            stale_periods: Some(max_at_100),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(s.stale_periods(), max_at_100);
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            stale_periods: Some(max_at_100 + 1),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(s.last_refusal(), Some(Refusal::StaleLimit));
+    // Halving the rate doubles the time the same count allows: refused as a whole.
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            rate_hz: Some(50),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(s.last_refusal(), Some(Refusal::StaleLimit));
+    assert_eq!((s.rate_hz(), s.refused_commands()), (100, 2));
+}
+
+#[test]
+fn the_maximum_rate_is_accepted_and_one_more_is_not() {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            rate_hz: Some(MAX_RATE_HZ),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!((s.rate_hz(), s.refused_commands()), (MAX_RATE_HZ, 0));
+    for rate in [MAX_RATE_HZ + 1, 1_000_000, u32::MAX] {
+        h.command(
+            &mut s,
+            patch(ConfigPatch {
+                rate_hz: Some(rate),
+                ..ConfigPatch::EMPTY
+            }),
+        );
+        assert_eq!(s.last_refusal(), Some(Refusal::RateTooHigh));
+        assert_eq!(s.rate_hz(), MAX_RATE_HZ);
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// Frame order
+
+#[test]
+fn repeated_old_and_far_ahead_frames_are_counted_and_never_refresh() {
+    let (mut s, h) = running();
+    let now = h.seq;
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    for seq in [now, now - 1, now.wrapping_add(SEQ_WINDOW + 1)] {
+        s.on_envelope(&Envelope::new(seq, Msg::State(state(1))));
+    }
+    let t = telemetry(&mut s);
+    assert_eq!((t.rx_stale, t.rx_frames, t.last_rx_seq), (3, 3, now));
+    // None of them restarted the stale timer: the third period after the last good frame
+    // fails safe.
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    assert_eq!(status(&mut s), STALE);
+    // A dropped command does nothing either.
+    s.on_envelope(&Envelope::new(now, Msg::Command(Command::Disarm)));
+    assert_eq!(s.mode(), Mode::FailSafe);
+}
+
+#[test]
+fn sequence_numbers_wrap_around() {
+    let (mut s, mut h) = running();
+    h.seq = u16::MAX - 3;
+    // The jump from 3 to 65532 is behind (RFC 1982): dropped, so resync first as a
+    // restarted host does, from the board's last_rx_seq.
+    h.give(&mut s, Msg::State(state(1)));
+    assert_eq!(s.rx_stale(), 1);
+    h.seq = telemetry(&mut s).last_rx_seq;
+    for k in 2..12u64 {
+        h.give(&mut s, Msg::State(state(k)));
+        assert_eq!(status(&mut s), BoardStatus::Running, "seq {}", h.seq);
+    }
+    assert_eq!(s.rx_stale(), 1);
+    // Across the wrap.
+    let mut s = supervisor();
+    let mut h = Host::new();
+    h.seq = u16::MAX - 1;
+    h.command(&mut s, Command::Arm);
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    for k in 0..5u64 {
+        h.give(&mut s, Msg::State(state(k)));
+        assert_eq!(status(&mut s), BoardStatus::Running, "seq {}", h.seq);
+    }
+    assert_eq!((s.rx_stale(), s.rx_frames()), (0, 7));
+}
+
+#[test]
+fn telemetry_sent_to_the_board_is_a_receive_error() {
+    let mut s = supervisor();
+    let t = telemetry(&mut s);
+    s.on_envelope(&Envelope::new(1, Msg::Telemetry(t)));
+    let t = telemetry(&mut s);
+    assert_eq!((t.rx_errors, t.rx_frames, t.last_rx_seq), (1, 0, 0));
+}
+
+// ---------------------------------------------------------------------------------------------
+// The lock-step mission clock
+
+fn lockstep() -> (Supervisor, Host) {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            lockstep: Some(true),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    h.command(&mut s, Command::Arm);
+    (s, h)
+}
+
+/// Gives a state frame for tick `k`; true if it was taken.
+fn taken(s: &mut Supervisor, h: &mut Host, k: u64) -> bool {
+    let before = s.rx_frames();
+    h.give(s, Msg::State(state(k)));
+    s.rx_frames() == before + 1
+}
+
+#[test]
+fn the_mission_clock_takes_one_tick_per_period() {
+    let (mut s, mut h) = lockstep();
+    // Before the mission, state frames carry no mission tick.
+    assert!(taken(&mut s, &mut h, 12345));
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    // The mission's first frame sets the clock (here where a mission resumes, tick 300); then
+    // one frame a period, one tick each.
+    for k in 300..320 {
+        assert!(taken(&mut s, &mut h, k));
+        assert!(!taken(&mut s, &mut h, k + 1), "two frames in one period");
+        assert_eq!(status(&mut s), BoardStatus::Running);
+    }
+    assert_eq!(s.rx_stale(), 20);
+}
+
+#[test]
+fn the_mission_clock_allows_frames_lost_on_the_link_but_no_more() {
+    let (mut s, mut h) = lockstep();
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    assert!(taken(&mut s, &mut h, 0));
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    // Frame 1 lost: the board's wait ends after a period, which it flies on frame 0.
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    // Two periods since frame 0: tick 3 is too far ahead, tick 2 is on the clock.
+    assert!(!taken(&mut s, &mut h, 3));
+    assert!(taken(&mut s, &mut h, 2));
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    // A slow host: a period without a frame, then the next tick (1 in 2 periods) is taken.
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    assert!(taken(&mut s, &mut h, 3));
+    // Backwards and standing still: never.
+    assert_eq!(status(&mut s), BoardStatus::Running);
+    assert!(!taken(&mut s, &mut h, 3));
+    assert!(!taken(&mut s, &mut h, 2));
+    assert!(!taken(&mut s, &mut h, u64::MAX));
+    assert!(taken(&mut s, &mut h, 4));
+}
+
+#[test]
+fn the_mission_time_in_lockstep_is_the_frames_tick() {
+    // The board flies tick k's reference at tick k, as SIL does, whatever its own count.
+    let (mut s, mut h) = lockstep();
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    let ctl = s.controller().clone();
+    let traj = controller_core::Trajectory::table1(controller_core::Table1Case::Circular10R);
+    for k in [0u64, 1, 3, 4] {
+        if k == 3 {
+            status(&mut s); // a lost frame
+        }
+        let f = state(k);
+        assert!(taken(&mut s, &mut h, k));
+        let got = s.step(false, NOW);
+        assert_eq!(got.voltages, ctl.update(k, &f.eta, &f.nu, &traj).voltage);
+    }
+}
+
+#[test]
+fn start_mission_in_lockstep_drops_the_state_held_from_before() {
+    let (mut s, mut h) = lockstep();
+    assert!(taken(&mut s, &mut h, 5_000));
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    // No state on the mission's clock yet: the first period fails safe, it does not fly
+    // the mission at tick 5000.
+    assert_eq!(status(&mut s), STALE);
+}
+
+// ---------------------------------------------------------------------------------------------
+// PWM
 
 #[test]
 fn pwm_duty_is_linear_with_neutral_at_half() {

@@ -1,59 +1,99 @@
 //! The `host-sim` commands as library functions: each takes its arguments ([`clap::Args`], so
 //! the binary only parses and dispatches) and a writer for what it prints on stdout, writes its
 //! outputs, and returns how it ended ([`Exit`]). Errors (bad input, I/O) are `Err`: the binary
-//! prints them and exits 2.
+//! prints them once and exits 2.
 //!
 //! ```text
 //! host-sim                                   # = host-sim table1
 //! host-sim table1 [--json] [--out DIR]
-//! host-sim run --scenario FILE.toml [--json] [--out DIR]
-//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--json] [--out DIR]
+//! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
+//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! ```
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`] (table1, run) or of
 //! [`PilComparison`] (pil), or the Monte Carlo [`Summary`](crate::montecarlo::Summary); its
 //! keys come out sorted.
+//!
+//! Every command, before it computes anything: validates its input (scenario, flags, the step
+//! cap), checks and prepares the output folder ([`OutputDir::prepare`]: a folder, not a symlink,
+//! writable; the previous run's files removed), and for `pil` checks the firmware image. Then
+//! the runs stream their CSVs ([`CsvStream`]) and show progress ([`Progress`]), and the plots
+//! and the report follow. An output that cannot be written completely (a full disk) is named
+//! on stderr, in the report and in the JSON (`incomplete`), once, and the command exits 2; the
+//! other outputs are still written.
+//!
+//! # Exit codes
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | every run completed, the controller never in fail-safe unless expected (and PIL agreed with SIL) |
+//! | 1 | a run diverged (or lost its board), or PIL disagreed with SIL |
+//! | 2 | bad input (scenario, flags, output folder, firmware image) or an I/O error; or an output could not be written completely |
+//! | 3 | a run had the controller in fail-safe (thrusters off) for some periods and its scenario does not say `expect_faults = true` |
+//! | 130 | interrupted (Ctrl-C, SIGTERM): what was done is written and marked partial |
+//!
+//! When several apply, the first of 2, 130, 1, 3 is the exit code. In `pil`, a run with link
+//! faults injected (flags or `[link_faults]`) expects the board's fail-safe.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
+use std::sync::Mutex;
 
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 use controller_core::{Table1Case, DEFAULT_V_LIMIT};
-use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-use crate::config::{LinkFaults, TickRange};
-use crate::montecarlo::{self, MonteCarloOptions};
-use crate::output::{self, ReportRow};
+use crate::config::{CurrentModel, LinkFaults, TickRange, VariationProfile};
+use crate::interrupt;
+use crate::montecarlo::{self, MonteCarloOptions, MAX_RUNS};
+use crate::output::{self, atomic, CsvStream, OutputDir, ReportRow};
 use crate::paper;
 use crate::pil::{BoardInTheLoop, PilComparison};
+use crate::progress::Progress;
 use crate::record::{Cases, RunResult, RunSummary};
-use crate::scenario::{load_scenario, Scenario};
-use crate::sil;
+use crate::scenario::{load_config, Scenario};
+use crate::sil::{self, ControlSource, LocalController};
 
-/// How a command ended, as the process's exit code.
+/// How a command ended, as the process's exit code (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Exit {
-    /// Every run completed (and PIL agreed with SIL): exit 0.
+    /// Every run completed, no unexpected controller fault (and PIL agreed with SIL): exit 0.
     Success,
     /// A run diverged, or PIL disagreed with SIL: exit 1 (the outputs are written).
     RunFailed,
+    /// An output could not be written completely (named on stderr and in the report): exit 2.
+    OutputIncomplete,
+    /// The controller was in fail-safe in some period of a run that does not expect faults:
+    /// exit 3 (the outputs are written).
+    Faulted,
+    /// Interrupted (Ctrl-C, SIGTERM); what was done is written, marked partial: exit 130.
+    Interrupted,
 }
 
 impl Exit {
-    /// The process exit code (0 or 1; 2 is the binary's for an `Err`).
+    /// The process exit code (0, 1, 2, 3 or 130; 2 is also the binary's for an `Err`).
     pub fn code(self) -> u8 {
         match self {
             Exit::Success => 0,
             Exit::RunFailed => 1,
+            Exit::OutputIncomplete => 2,
+            Exit::Faulted => 3,
+            Exit::Interrupted => 130,
         }
     }
 
-    fn failed_if(failed: bool) -> Self {
-        if failed {
+    /// The exit of a command from what happened, in the order of precedence 2, 130, 1, 3.
+    fn of(incomplete: bool, interrupted: bool, failed: bool, faulted: bool) -> Self {
+        if incomplete {
+            Exit::OutputIncomplete
+        } else if interrupted {
+            Exit::Interrupted
+        } else if failed {
             Exit::RunFailed
+        } else if faulted {
+            Exit::Faulted
         } else {
             Exit::Success
         }
@@ -94,6 +134,10 @@ pub struct RunArgs {
     /// Report folder; default `runs/<scenario name>`.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Run a scenario beyond the step cap (host_sim::scenario::MAX_CONTROL_PERIODS,
+    /// MAX_PLANT_STEPS: one day at 100 Hz and 1 ms).
+    #[arg(long)]
+    pub allow_long_run: bool,
 }
 
 /// `pil`: processor in the loop. The firmware ELF in QEMU flies the simulated vehicle over a
@@ -113,8 +157,13 @@ pub struct PilArgs {
     /// target/thumbv7em-none-eabihf/release/firmware-qemu].
     #[arg(long)]
     pub elf: Option<PathBuf>,
-    /// Override the scenario's duration (s).
+    /// Sign the link with this key file (`#` comment lines, then 64 hex digits; e.g.
+    /// firmware/ci-test-link-key.hex): the board is started with it, and both ends refuse
+    /// unsigned frames. Without it the link is unsigned.
     #[arg(long)]
+    pub link_key_file: Option<PathBuf>,
+    /// Override the scenario's duration (s); the scenario's limits apply to it.
+    #[arg(long, allow_negative_numbers = true)]
     pub duration: Option<f64>,
     /// Drop the state frames of these ticks.
     #[arg(long, value_parser = TickRange::parse)]
@@ -130,12 +179,16 @@ pub struct PilArgs {
     /// Send nothing at all during these ticks.
     #[arg(long, value_parser = TickRange::parse)]
     pub silent: Vec<TickRange>,
+    /// Run beyond the step cap (see `run --help`).
+    #[arg(long)]
+    pub allow_long_run: bool,
 }
 
 /// `monte-carlo`: draws the Table-3 parameters uniformly in their box, runs in parallel,
 /// reports percentiles and the worst case. Deterministic per seed.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct MonteCarloArgs {
+    /// How many runs (at most host_sim::montecarlo::MAX_RUNS without --allow-long-run).
     #[arg(long)]
     pub runs: usize,
     #[arg(long, default_value_t = 1)]
@@ -144,26 +197,15 @@ pub struct MonteCarloArgs {
     #[arg(long)]
     pub scenario: Option<PathBuf>,
     /// Also draw a constant horizontal current of up to this speed (m/s).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub current: Option<f64>,
     #[arg(long)]
     pub json: bool,
     #[arg(long, default_value = "runs/monte-carlo")]
     pub out: PathBuf,
-}
-
-fn progress(n: usize, what: &str, quiet: bool) -> ProgressBar {
-    if quiet {
-        return ProgressBar::hidden();
-    }
-    let pb = ProgressBar::new(n as u64);
-    pb.set_style(
-        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} runs, {elapsed} (eta {eta})")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> "),
-    );
-    pb.set_message(what.to_string());
-    pb
+    /// Allow more than host_sim::montecarlo::MAX_RUNS runs, and runs beyond the step cap.
+    #[arg(long)]
+    pub allow_long_run: bool,
 }
 
 /// One JSON line: the value through `serde_json::Value`, so the keys come out sorted.
@@ -172,58 +214,154 @@ fn print_json(stdout: &mut dyn Write, value: &impl Serialize) -> Result<()> {
     writeln!(stdout, "{v}").context("writing stdout")
 }
 
-fn load(path: &Path) -> Result<Scenario> {
-    load_scenario(path).with_context(|| format!("scenario {}", path.display()))
+/// Reads and validates a scenario file, with the step cap lifted if `allow_long_run`.
+fn load(path: &Path, allow_long_run: bool) -> Result<Scenario> {
+    let ctx = || format!("scenario {}", path.display());
+    let mut config = load_config(path).with_context(ctx)?;
+    config.allow_long_run = allow_long_run;
+    Scenario::new(config).with_context(ctx)
 }
 
-/// Prints the runs of `rows` (JSON, or the table and the report's path) and says whether one
-/// diverged.
+/// The control periods of `scenarios`, for [`Progress`].
+fn periods<'a>(scenarios: impl IntoIterator<Item = &'a Scenario>) -> u64 {
+    scenarios.into_iter().map(|s| s.steps() + 1).sum()
+}
+
+/// Outputs that could not be written completely, collected from parallel runs.
+#[derive(Default)]
+struct Incomplete(Mutex<Vec<String>>);
+
+impl Incomplete {
+    fn push(&self, what: String) {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).push(what);
+    }
+    fn into_inner(self) -> Vec<String> {
+        self.0.into_inner().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// One run with the law from `source`, its CSV streamed into `dir` and its periods counted
+/// into `progress`; a CSV that cannot be written completely goes to `incomplete` (the run goes
+/// on: its metrics are still good).
+fn run_into(
+    dir: &OutputDir,
+    scenario: &Scenario,
+    source: &mut dyn ControlSource,
+    progress: &Progress,
+    incomplete: &Incomplete,
+) -> RunResult {
+    let cfg = scenario.config();
+    let name = output::csv_name(&cfg.name, cfg.controller.robust);
+    let mut counter = progress.observer();
+    match dir.claim(&name).and_then(|p| CsvStream::create(&p)) {
+        Ok(mut csv) => {
+            let run = sil::run_observed(scenario, source, &mut (&mut csv, &mut counter));
+            if let Err(e) = csv.finish() {
+                incomplete.push(e.to_string());
+            }
+            run
+        }
+        Err(e) => {
+            incomplete.push(format!("{name} was not written: {e:#}"));
+            sil::run_observed(scenario, source, &mut counter)
+        }
+    }
+}
+
+/// [`run_into`] with the law on the host.
+fn sil_into(
+    dir: &OutputDir,
+    scenario: &Scenario,
+    progress: &Progress,
+    incomplete: &Incomplete,
+) -> RunResult {
+    run_into(
+        dir,
+        scenario,
+        &mut LocalController::new(scenario),
+        progress,
+        incomplete,
+    )
+}
+
+/// Says once, on stderr, which outputs are incomplete.
+fn report_incomplete(incomplete: &[String]) {
+    for i in incomplete {
+        eprintln!("host-sim: error: {i}");
+    }
+}
+
+/// Prints the runs of `rows` (JSON, or the table and the report's path) and says how the
+/// command ended.
 fn print_runs(
     stdout: &mut dyn Write,
     json: bool,
     rows: &[ReportRow],
     report: &Path,
+    incomplete: Vec<String>,
 ) -> Result<Exit> {
+    report_incomplete(&incomplete);
+    let exit = runs_exit(runs(rows), !incomplete.is_empty(), false);
     if json {
         let cases: Cases<RunSummary> = Cases {
             cases: runs(rows).map(RunResult::summary).collect(),
+            incomplete,
         };
         print_json(stdout, &cases)?;
     } else {
         writeln!(stdout, "{}", output::table_text(rows))?;
         writeln!(stdout, "report: {}", report.display())?;
     }
-    Ok(Exit::failed_if(runs(rows).any(RunResult::diverged)))
+    Ok(exit)
+}
+
+/// How a command with these runs ended ([`Exit::of`]); `failed`: another reason for exit 1.
+fn runs_exit<'a>(
+    runs: impl Iterator<Item = &'a RunResult> + Clone,
+    incomplete: bool,
+    failed: bool,
+) -> Exit {
+    Exit::of(
+        incomplete,
+        runs.clone().any(RunResult::interrupted) || interrupt::requested(),
+        failed || runs.clone().any(RunResult::diverged),
+        runs.clone().any(RunResult::faulted_unexpectedly),
+    )
 }
 
 /// Every run of the rows: with, then without Δu.
-fn runs<'a: 'r, 'r>(rows: &'r [ReportRow<'a>]) -> impl Iterator<Item = &'a RunResult> + 'r {
+fn runs<'a: 'r, 'r>(rows: &'r [ReportRow<'a>]) -> impl Iterator<Item = &'a RunResult> + Clone + 'r {
     rows.iter()
         .flat_map(|r| std::iter::once(r.with).chain(r.without))
 }
 
 /// `table1`.
 pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
-    let pb = progress(12, "Table 1", args.json);
-    let pairs = paper::run_all(|| pb.inc(1))?;
-    pb.finish_and_clear();
+    let jobs = paper::jobs()?;
+    let dir = OutputDir::prepare(&args.out)?;
+    let progress = Progress::start("Table 1", periods(&jobs), !args.json);
+    let incomplete = Incomplete::default();
+    let pairs = paper::run_jobs(&jobs, |s| sil_into(&dir, s, &progress, &incomplete));
+    progress.finish();
     let rows: Vec<ReportRow> = pairs
         .iter()
         .map(|(with, without)| ReportRow::new(with, Some(without)))
         .collect();
-    let report = output::write_all(
-        &args.out,
+    let mut incomplete = incomplete.into_inner();
+    let report = output::write_plots_and_report(
+        &dir,
         "AUV-150 Table 1 reproduction (software in the loop)",
         &rows,
         paper::NOTES,
         f64::from(DEFAULT_V_LIMIT),
+        &mut incomplete,
     )?;
-    print_runs(stdout, args.json, &rows, &report)
+    print_runs(stdout, args.json, &rows, &report, incomplete)
 }
 
 /// `run`.
 pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
-    let scenario = load(&args.scenario)?;
+    let scenario = load(&args.scenario, args.allow_long_run)?;
     let cfg = scenario.config();
     let out = args
         .out
@@ -238,20 +376,58 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
     } else {
         None
     };
-    let pb = progress(1 + companion.is_some() as usize, &cfg.name, args.json);
-    let with = sil::run(&scenario);
-    pb.inc(1);
-    let without = companion.as_ref().map(sil::run);
-    pb.finish_and_clear();
+    let dir = OutputDir::prepare(&out)?;
+    let progress = Progress::start(
+        &cfg.name,
+        periods(std::iter::once(&scenario).chain(&companion)),
+        !args.json,
+    );
+    let incomplete = Incomplete::default();
+    let with = sil_into(&dir, &scenario, &progress, &incomplete);
+    // A run interrupted is not followed by its companion (nothing would be done of it).
+    let without = companion
+        .as_ref()
+        .filter(|_| !interrupt::requested())
+        .map(|c| sil_into(&dir, c, &progress, &incomplete));
+    progress.finish();
     let rows = [ReportRow::new(&with, without.as_ref())];
-    let report = output::write_all(
-        &out,
+    let mut incomplete = incomplete.into_inner();
+    let report = output::write_plots_and_report(
+        &dir,
         &format!("AUV-150 scenario {}", with.name),
         &rows,
         "",
         f64::from(cfg.controller.voltage_limit),
+        &mut incomplete,
     )?;
-    print_runs(stdout, args.json, &rows, &report)
+    print_runs(stdout, args.json, &rows, &report, incomplete)
+}
+
+/// The base scenario of `monte-carlo`: the file's, which must leave to the draw what the draw
+/// replaces, or the paper's circle of 10 m radius without its Table-3 profile.
+fn monte_carlo_base(args: &MonteCarloArgs) -> Result<Scenario> {
+    let Some(path) = &args.scenario else {
+        return Ok(paper::scenario(Table1Case::Circular10R, true)?
+            .with(|c| c.variation = VariationProfile::None)?);
+    };
+    let base = load(path, args.allow_long_run)?;
+    let cfg = base.config();
+    if cfg.variation != VariationProfile::None {
+        bail!(
+            "scenario {}: monte-carlo draws the plant's Δp itself (uniform in the Table-3 box, \
+             constant over each run) and would replace the scenario's own [variation]; remove \
+             the [variation] table (or set profile = \"none\") to run it",
+            path.display()
+        );
+    }
+    if args.current.is_some() && cfg.current != CurrentModel::None {
+        bail!(
+            "scenario {}: --current draws a constant current for each run and would replace the \
+             scenario's own [current]; remove one of the two",
+            path.display()
+        );
+    }
+    Ok(base)
 }
 
 /// `monte-carlo`.
@@ -259,31 +435,39 @@ pub fn monte_carlo(args: &MonteCarloArgs, stdout: &mut dyn Write) -> Result<Exit
     if args.runs == 0 {
         bail!("--runs must be at least 1");
     }
+    if args.runs > MAX_RUNS && !args.allow_long_run {
+        bail!(
+            "--runs {} is more than {MAX_RUNS}; give --allow-long-run to run that many",
+            args.runs
+        );
+    }
     if let Some(c) = args.current {
         if !(c.is_finite() && c >= 0.0) {
             bail!("--current must be a finite speed ≥ 0 m/s, got {c}");
         }
     }
-    let base = match &args.scenario {
-        Some(p) => load(p)?,
-        None => paper::scenario(Table1Case::Circular10R, true)?,
+    let base = monte_carlo_base(args)?;
+    let dir = OutputDir::prepare(&args.out)?;
+    let opts = MonteCarloOptions {
+        runs: args.runs,
+        seed: args.seed,
+        max_current: args.current,
     };
-    let pb = progress(args.runs, "Monte Carlo", args.json);
-    let summary = montecarlo::run(
-        &base,
-        &MonteCarloOptions {
-            runs: args.runs,
-            seed: args.seed,
-            max_current: args.current,
-        },
-        || pb.inc(1),
-    )?;
-    pb.finish_and_clear();
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
+    eprintln!(
+        "host-sim: monte-carlo: {}",
+        montecarlo::estimate(&base, &opts)?
+    );
+    let progress = Progress::start(
+        "Monte Carlo",
+        args.runs as u64 * (base.steps() + 1),
+        !args.json,
+    );
+    let summary = montecarlo::run(&base, &opts, || progress.observer())?;
+    progress.finish();
     let md = summary.markdown();
-    let report = args.out.join("report.md");
-    std::fs::write(&report, &md).with_context(|| format!("writing {}", report.display()))?;
+    let report = dir.claim("report.md")?;
+    atomic::write(&report, md.as_bytes())
+        .with_context(|| format!("writing {}", report.display()))?;
     if args.json {
         let text = serde_json::to_string(&summary).context("serialising the summary")?;
         writeln!(stdout, "{text}")?;
@@ -291,7 +475,12 @@ pub fn monte_carlo(args: &MonteCarloArgs, stdout: &mut dyn Write) -> Result<Exit
         writeln!(stdout, "{md}")?;
         writeln!(stdout, "report: {}", report.display())?;
     }
-    Ok(Exit::failed_if(summary.diverged > 0))
+    Ok(Exit::of(
+        false,
+        summary.partial,
+        summary.diverged > 0,
+        summary.faulted > 0 && !base.config().expect_faults,
+    ))
 }
 
 fn workspace_root() -> PathBuf {
@@ -302,20 +491,22 @@ fn workspace_root() -> PathBuf {
 /// than [`PIL_SIL_TOLERANCE`](crate::pil::PIL_SIL_TOLERANCE).
 pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let base: Vec<Scenario> = match (&args.scenario, args.table1) {
-        (Some(p), false) => vec![load(p)?],
+        (Some(p), false) => vec![load(p, args.allow_long_run)?],
         (None, true) => Table1Case::ALL
             .iter()
             .map(|&case| paper::scenario(case, true))
             .collect::<Result<_, _>>()?,
         _ => bail!("give --scenario FILE or --table1"),
     };
-    // The flags override the duration and add to the scenario's [link_faults].
+    // The flags override the duration and add to the scenario's [link_faults]; every check of
+    // the scenario (duration, step cap) applies to the result.
     let mut scenarios = Vec::with_capacity(base.len());
     for s in &base {
         let changed = s.with(|c| {
             if let Some(d) = args.duration {
                 c.duration = d;
             }
+            c.allow_long_run |= args.allow_long_run;
             let f = &mut c.link_faults;
             f.drop.extend(args.drop.iter().copied());
             f.corrupt.extend(args.corrupt.iter().copied());
@@ -324,6 +515,8 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
             if !args.delay.is_empty() {
                 f.delay_ticks = args.delay_ticks;
             }
+            // Injected link faults are there to put the board in fail-safe.
+            c.expect_faults |= !c.link_faults.is_empty();
         });
         scenarios.push(changed.with_context(|| match args.duration {
             Some(d) => format!("{} with --duration {d}", s.config().name),
@@ -335,39 +528,79 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .elf
         .clone()
         .unwrap_or_else(|| crate::pil::default_elf(&root));
+    crate::pil::check_flying_image(&elf).map_err(|e| anyhow!(e))?;
     let runner = root.join("scripts/qemu-run.sh");
-    std::fs::create_dir_all(&args.out)
-        .with_context(|| format!("creating {}", args.out.display()))?;
-    let pb = progress(scenarios.len(), "PIL", args.json);
+    let key = match &args.link_key_file {
+        None => None,
+        Some(p) => {
+            let text = std::fs::read_to_string(p)
+                .with_context(|| format!("reading the link key file {}", p.display()))?;
+            Some(
+                auv_link::sign::LinkKey::from_key_file(&text)
+                    .map_err(|e| anyhow!("{}: {e}", p.display()))?,
+            )
+        }
+    };
+    let dir = OutputDir::prepare(&args.out)?;
+    // Each scenario runs twice: SIL, then PIL.
+    let progress = Progress::start("PIL", 2 * periods(&scenarios), !args.json);
+    let incomplete = Incomplete::default();
     let mut cases = Vec::new();
     let mut runs = Vec::new();
     let mut failed = false;
     for s in &scenarios {
+        if interrupt::requested() {
+            break;
+        }
         let cfg = s.config();
-        let sil_run = sil::run(s);
-        let log = args.out.join(format!("{}-qemu.log", cfg.name));
-        let mut board = BoardInTheLoop::start(&elf, &runner, cfg, cfg.link_faults.clone(), &log)
-            .map_err(|e| anyhow!("{}: {e}", cfg.name))?;
-        let pil_run = sil::run_with(s, &mut board);
+        let sil_run = sil::run_observed(s, &mut LocalController::new(s), &mut progress.observer());
+        let log_path = dir.claim(&format!("{}-qemu.log", cfg.name))?;
+        let (log, log_file) = atomic::Pending::create(&log_path)
+            .with_context(|| format!("writing {}", log_path.display()))?;
+        let started = BoardInTheLoop::start(
+            &elf,
+            &runner,
+            s,
+            cfg.link_faults.clone(),
+            log_file,
+            &log_path,
+            key.as_ref(),
+        );
+        let mut board = match started {
+            Ok(b) => b,
+            Err(e) => {
+                // Keep QEMU's log: it says why.
+                let _ = log.commit();
+                bail!("{}: {e}", cfg.name);
+            }
+        };
+        let pil_run = run_into(&dir, s, &mut board, &progress, &incomplete);
         let stats = board.finish();
-        pb.inc(1);
+        if let Err(e) = log.commit() {
+            incomplete.push(format!("{} was not written: {e}", log_path.display()));
+        }
         let c = PilComparison::new(&pil_run, &sil_run, stats);
-        failed |= pil_run.diverged() || (cfg.link_faults.is_empty() && !c.agrees());
+        let interrupted = sil_run.interrupted() || pil_run.interrupted();
+        failed |= pil_run.diverged() || (cfg.link_faults.is_empty() && !interrupted && !c.agrees());
         cases.push(c);
         runs.push(pil_run);
     }
-    pb.finish_and_clear();
+    progress.finish();
     let notes = pil_notes(&cases);
     let rows: Vec<ReportRow> = runs.iter().map(|r| ReportRow::new(r, None)).collect();
-    let report = output::write_all(
-        &args.out,
+    let mut incomplete = incomplete.into_inner();
+    let report = output::write_plots_and_report(
+        &dir,
         "AUV-150 processor in the loop (firmware in QEMU)",
         &rows,
         &notes,
         f64::from(DEFAULT_V_LIMIT),
+        &mut incomplete,
     )?;
+    report_incomplete(&incomplete);
+    let exit = runs_exit(runs.iter(), !incomplete.is_empty(), failed);
     if args.json {
-        print_json(stdout, &Cases { cases })?;
+        print_json(stdout, &Cases { cases, incomplete })?;
     } else {
         writeln!(stdout, "{notes}")?;
         for c in &cases {
@@ -385,7 +618,7 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         }
         writeln!(stdout, "report: {}", report.display())?;
     }
-    Ok(Exit::failed_if(failed))
+    Ok(exit)
 }
 
 /// The report's PIL-vs-SIL section.
@@ -393,11 +626,12 @@ fn pil_notes(cases: &[PilComparison]) -> String {
     let mut notes = String::from(
         "## Processor in the loop vs software in the loop\n\n\
          | case | PIL max path (m) | SIL max path (m) | PIL − SIL (m) | frames/s | worst update \
-         (instructions) | fail-safe events | re-arms |\n|---|---|---|---|---|---|---|---|\n",
+         (instructions) | fail-safe events | re-arms | signed | board drops (old / auth) | \
+         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cases {
         notes += &format!(
-            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} |\n",
+            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
             c.run.name,
             c.run.metrics.max_path,
             c.sil_max_path,
@@ -406,6 +640,13 @@ fn pil_notes(cases: &[PilComparison]) -> String {
             c.pil.worst_update_instructions,
             c.pil.failsafe_events.len(),
             c.pil.rearms,
+            if c.pil.signed { "yes" } else { "no" },
+            c.pil.board_rx_stale,
+            c.pil.board_rx_auth_errors,
+            match &c.pil.board_last_refusal {
+                Some(r) => format!("{} (last: {r})", c.pil.board_refused_commands),
+                None => c.pil.board_refused_commands.to_string(),
+            },
         );
     }
     notes

@@ -173,12 +173,20 @@ pub struct SimConfig {
     pub divergence_limit: f64,
     /// Faults on the board link (PIL only).
     pub link_faults: LinkFaults,
+    /// The controller is expected to fault in this run (scenario key `expect_faults`): its
+    /// fail-safe periods are still counted and reported, but do not make the command fail
+    /// (exit 3, [`crate::cli::Exit::Faulted`]).
+    pub expect_faults: bool,
+    /// Lift the step cap ([`crate::scenario::MAX_CONTROL_PERIODS`],
+    /// [`crate::scenario::MAX_PLANT_STEPS`]). Not a scenario key: the explicit override is the
+    /// CLI's `--allow-long-run`.
+    pub allow_long_run: bool,
 }
 
 impl SimConfig {
     /// Defaults around a mission: 70 s, 1 ms plant step, the paper's controller at 100 Hz,
     /// no variation, no current, no noise, ideal actuators, starting on the reference, no
-    /// Table-1 case.
+    /// Table-1 case, no faults expected, the step cap in force.
     pub fn new(name: impl Into<String>, trajectory: TrajectoryKind) -> Self {
         SimConfig {
             name: name.into(),
@@ -195,6 +203,8 @@ impl SimConfig {
             initial_offset: [0.0; 6],
             divergence_limit: 50.0,
             link_faults: LinkFaults::default(),
+            expect_faults: false,
+            allow_long_run: false,
         }
     }
 }

@@ -7,7 +7,10 @@
 //! | [`scenario`] | TOML scenario files, and the one validation of a run ([`scenario::Scenario`]) |
 //! | [`plant`] | the 6-DOF plant with varying parameters, current and RK4 |
 //! | [`sil`] | the sampled-data loop: ZOH, actuator chain, noise, divergence |
-//! | [`metrics`] | the paper's Table-1 metrics from a run |
+//! | [`metrics`] | the paper's Table-1 metrics from a run, accumulated as it goes |
+//! | [`decimate`] | the bounded plot series of a long run |
+//! | [`progress`] | progress of long commands, on a terminal or not |
+//! | [`interrupt`] | Ctrl-C / SIGTERM: finish the current period, keep what is done |
 //! | [`link`] | what the simulator sends the board over `auv-link` |
 //! | [`record`] | samples, outcome, metrics and JSON summary of a run |
 //! | [`paper`] | the paper's Table 1: cases, profiles, its numbers, notes, the twelve runs |
@@ -18,6 +21,8 @@
 
 pub mod cli;
 pub mod config;
+pub mod decimate;
+pub mod interrupt;
 pub mod link;
 pub mod metrics;
 pub mod montecarlo;
@@ -25,6 +30,7 @@ pub mod output;
 pub mod paper;
 pub mod pil;
 pub mod plant;
+pub mod progress;
 pub mod record;
 pub mod scenario;
 pub mod sil;

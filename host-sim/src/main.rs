@@ -1,6 +1,8 @@
 //! `host-sim`: software-in-the-loop runs of the AUV-150 controller against the 6-DOF plant.
-//! Parses the command line and maps the outcome to the exit code; the commands are
-//! [`host_sim::cli`]'s (0: done, 1: a run diverged or PIL ≠ SIL, 2: bad input or I/O error).
+//! Parses the command line, installs the Ctrl-C/SIGTERM handler ([`host_sim::interrupt`]) and
+//! maps the outcome to the exit code; the commands are [`host_sim::cli`]'s, which documents
+//! the codes (0 done, 1 a run diverged or PIL ≠ SIL, 2 bad input, I/O error or an incomplete
+//! output, 3 an unexpected controller fault, 130 interrupted).
 
 use std::process::ExitCode;
 
@@ -33,6 +35,9 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    if let Err(e) = host_sim::interrupt::install() {
+        eprintln!("host-sim: warning: no Ctrl-C handler ({e}): an interrupt loses the run");
+    }
     let command = Cli::parse()
         .command
         .unwrap_or_else(|| Command::Table1(Table1Args::default()));

@@ -2,17 +2,38 @@
 //! over the run) and, if asked, a constant horizontal current of random direction and speed.
 //! Deterministic per seed: run i uses a generator seeded from (seed, i), whatever the thread
 //! scheduling.
+//!
+//! **What the draw replaces.** Δp replaces the base scenario's variation, so the base must
+//! have none (`host-sim monte-carlo` refuses a scenario with its own `[variation]`, and its
+//! default base is the paper's 10 m circle without its abs-sin profile); the drawn current
+//! replaces the base's current, so with `--current` the base must have none. Everything else
+//! (mission, controller, noise, lag, actuators, duration) is the base's.
+//!
+//! **Size.** At most [`MAX_RUNS`] runs unless overridden; before it starts the command prints
+//! an [`estimate`] of the time. On an interrupt the runs in flight stop, the runs not started
+//! are not run, and the [`Summary`] covers the runs completed, marked `partial`.
 
 use controller_core::model::ParamVariation;
 use controller_core::uncertainty::{ParamBox, VARIED_PARAMETERS};
+use std::time::Instant;
+
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::Serialize;
 
 use crate::config::{CurrentModel, VariationProfile};
+use crate::interrupt;
+use crate::progress::duration_text;
 use crate::record::Metrics;
 use crate::scenario::{Scenario, ScenarioError};
-use crate::sil;
+use crate::sil::{self, LocalController, Observer};
+
+/// Most runs of one Monte Carlo without the explicit override (`--allow-long-run`).
+pub const MAX_RUNS: usize = 10_000;
+
+/// Simulated time of the calibration run of [`estimate`] (s), or the base's duration if
+/// shorter.
+pub const CALIBRATION_SECONDS: f64 = 2.0;
 
 #[derive(Clone, Copy, Debug)]
 pub struct MonteCarloOptions {
@@ -45,9 +66,18 @@ pub struct MetricSummary {
 #[derive(Clone, Debug, Serialize)]
 pub struct Summary {
     pub base: String,
+    /// Runs asked for.
     pub runs: usize,
+    /// Runs completed (or diverged): the statistics cover these.
+    pub done: usize,
+    /// Interrupted before every run was done: the statistics cover `done` runs only.
+    pub partial: bool,
     pub seed: u64,
     pub diverged: usize,
+    /// Runs in which the controller was in fail-safe in some period.
+    pub faulted: usize,
+    /// What each run draws, and what of the base it replaces.
+    pub draw: String,
     pub metrics: Vec<MetricSummary>,
     /// The draw with the largest path error, and its metrics.
     pub worst: Option<(Draw, Metrics)>,
@@ -89,16 +119,46 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[rank.min(sorted.len()) - 1]
 }
 
-/// Runs `opts.runs` draws around `base` in parallel (the controller is `base`'s, built once).
-pub fn run(
+/// How long `opts.runs` runs around `base` should take, as a sentence: a calibration run of
+/// the base ([`CALIBRATION_SECONDS`] of simulated time) is timed, its time per plant step
+/// scaled to every plant step of every run and divided by the threads (rayon's).
+pub fn estimate(base: &Scenario, opts: &MonteCarloOptions) -> Result<String, ScenarioError> {
+    let short = base.with(|c| c.duration = c.duration.min(CALIBRATION_SECONDS))?;
+    let t0 = Instant::now();
+    sil::run(&short);
+    let wall = t0.elapsed().as_secs_f64();
+    let plant_steps = |s: &Scenario| (s.steps() * s.substeps() as u64).max(1) as f64;
+    let per_step = wall / plant_steps(&short);
+    let threads = rayon::current_num_threads().max(1);
+    let total = per_step * plant_steps(base) * opts.runs as f64 / threads as f64;
+    Ok(format!(
+        "{} runs of {} ({} s, {} plant steps each): about {} on {threads} thread(s) (a {} s \
+         calibration run took {:.3} s; scaled by plant steps)",
+        opts.runs,
+        base.config().name,
+        base.config().duration,
+        plant_steps(base),
+        duration_text(total),
+        short.config().duration,
+        wall
+    ))
+}
+
+/// Runs `opts.runs` draws around `base` in parallel (the controller is `base`'s, built once);
+/// each run's samples go to an `observer()` (progress).
+pub fn run<O: Observer>(
     base: &Scenario,
     opts: &MonteCarloOptions,
-    on_done: impl Fn() + Sync,
+    observer: impl Fn() -> O + Sync,
 ) -> Result<Summary, ScenarioError> {
     let name = &base.config().name;
-    let results: Result<Vec<(Draw, Metrics, bool)>, ScenarioError> = (0..opts.runs)
+    type Done = Option<(Draw, Metrics, bool, bool)>;
+    let results: Result<Vec<Done>, ScenarioError> = (0..opts.runs)
         .into_par_iter()
         .map(|i| {
+            if interrupt::requested() {
+                return Ok(None);
+            }
             let d = draw(opts, i);
             let scenario = base.with(|cfg| {
                 cfg.name = format!("{name}-mc{i}");
@@ -107,13 +167,18 @@ pub fn run(
                     cfg.current = CurrentModel::Constant(d.current);
                 }
             })?;
-            let r = sil::run(&scenario);
-            on_done();
-            let diverged = r.diverged();
-            Ok((d, r.metrics, diverged))
+            let r = sil::run_observed(
+                &scenario,
+                &mut LocalController::new(&scenario),
+                &mut observer(),
+            );
+            if r.interrupted() {
+                return Ok(None);
+            }
+            Ok(Some((d, r.metrics, r.diverged(), !r.faults.is_empty())))
         })
         .collect();
-    let results = results?;
+    let results: Vec<(Draw, Metrics, bool, bool)> = results?.into_iter().flatten().collect();
     type Getter = (&'static str, fn(&Metrics) -> f64);
     let getters: [Getter; 10] = [
         ("max_x", |m| m.max_x),
@@ -131,7 +196,7 @@ pub fn run(
         .iter()
         .map(|(name, get)| {
             let mut v: Vec<(f64, usize)> =
-                results.iter().map(|(d, m, _)| (get(m), d.run)).collect();
+                results.iter().map(|(d, m, ..)| (get(m), d.run)).collect();
             v.sort_by(|a, b| a.0.total_cmp(&b.0));
             let sorted: Vec<f64> = v.iter().map(|x| x.0).collect();
             MetricSummary {
@@ -147,12 +212,26 @@ pub fn run(
     let worst = results
         .iter()
         .max_by(|a, b| a.1.max_path.total_cmp(&b.1.max_path))
-        .map(|(d, m, _)| (d.clone(), *m));
+        .map(|(d, m, ..)| (d.clone(), *m));
+    let draw = match opts.max_current {
+        Some(v) => format!(
+            "Δp uniform in the Table-3 box, constant over each run (replaces the base's \
+             variation, which is none); a constant horizontal current of speed uniform in \
+             [0, {v}] m/s and uniform direction (replaces the base's current, which is none)"
+        ),
+        None => "Δp uniform in the Table-3 box, constant over each run (replaces the base's \
+                 variation, which is none); the base's own current"
+            .to_string(),
+    };
     Ok(Summary {
         base: name.clone(),
         runs: opts.runs,
+        done: results.len(),
+        partial: results.len() < opts.runs,
         seed: opts.seed,
         diverged: results.iter().filter(|r| r.2).count(),
+        faulted: results.iter().filter(|r| r.3).count(),
+        draw,
         metrics,
         worst,
     })
@@ -161,9 +240,18 @@ pub fn run(
 impl Summary {
     pub fn markdown(&self) -> String {
         let mut s = format!(
-            "# Monte Carlo over the Table-3 box\n\nbase scenario `{}`, {} runs, seed {}, diverged: {}\n\n| metric | p50 | p90 | p99 | max | worst run |\n|---|---|---|---|---|---|\n",
-            self.base, self.runs, self.seed, self.diverged
+            "# Monte Carlo over the Table-3 box{}\n\nbase scenario `{}`, {} runs, seed {}, diverged: {}, controller in fail-safe: {}\n\nEach run: {}.\n\n",
+            if self.partial { " (PARTIAL)" } else { "" },
+            self.base, self.runs, self.seed, self.diverged, self.faulted, self.draw
         );
+        if self.partial {
+            s += &format!(
+                "**Partial: interrupted after {} of {} runs**; the statistics below cover those \
+                 {} runs only.\n\n",
+                self.done, self.runs, self.done
+            );
+        }
+        s += "| metric | p50 | p90 | p99 | max | worst run |\n|---|---|---|---|---|---|\n";
         for m in &self.metrics {
             s += &format!(
                 "| {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |\n",

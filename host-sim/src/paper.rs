@@ -145,22 +145,35 @@ pub const NOTES: &str = "\
 /// Runs all six cases with and without Δu in parallel; returns (with, without) per case in
 /// the order of [`Table1Case::ALL`]. `on_done` is called after each run (progress).
 pub fn run_all(on_done: impl Fn() + Sync) -> Result<Vec<(RunResult, RunResult)>, ScenarioError> {
-    let jobs: Vec<Scenario> = Table1Case::ALL
+    Ok(run_jobs(&jobs()?, |s| {
+        let r = sil::run(s);
+        on_done();
+        r
+    }))
+}
+
+/// The twelve runs of Table 1: per case of [`Table1Case::ALL`] with, then without Δu.
+pub fn jobs() -> Result<Vec<Scenario>, ScenarioError> {
+    Table1Case::ALL
         .iter()
         .flat_map(|&c| [scenario(c, true), scenario(c, false)])
-        .collect::<Result<_, _>>()?;
+        .collect()
+}
+
+/// Runs [`jobs`] in parallel with `run` (the CLI's streams each run's CSV); returns (with,
+/// without) per case.
+pub fn run_jobs(
+    jobs: &[Scenario],
+    run: impl Fn(&Scenario) -> RunResult + Sync,
+) -> Vec<(RunResult, RunResult)> {
     let mut results = jobs
         .par_iter()
-        .map(|s| {
-            let r = sil::run(s);
-            on_done();
-            r
-        })
+        .map(&run)
         .collect::<Vec<RunResult>>()
         .into_iter();
     let mut pairs = Vec::new();
     while let (Some(with), Some(without)) = (results.next(), results.next()) {
         pairs.push((with, without));
     }
-    Ok(pairs)
+    pairs
 }

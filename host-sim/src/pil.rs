@@ -2,17 +2,30 @@
 //! navigation link — on a loopback TCP socket; the simulator plays the vehicle and its
 //! navigation computer.
 //!
-//! Set-up: `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods }`,
-//! `Arm`, then `StartMission` with the first state frame. In lock-step the board runs one
-//! control period per state frame and takes the frame's `t_ticks` as mission time, so the
-//! result does not depend on host speed. Each period the simulator sends a state frame from
+//! Set-up: the runner waits for the board's first telemetry and numbers its own frames from the
+//! board's `last_rx_seq` on (a restarted runner is heard again: `auv_link::seq`), then sends
+//! `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods, thrust unit,
+//! thruster mounting, axis priority }` from the scenario's validated controller and `Arm`,
+//! and waits for the board to report itself armed with that thrust unit and mounting (a
+//! refused command is reported with the board's reason); then `StartMission` with the
+//! scenario's validated mission (path, heading, time scale) and the first state frame. Every
+//! telemetry frame must name the thrust unit the plant reads the voltages in, or the run
+//! stops (docs/design.md §9). In lock-step the board runs
+//! one control period per state frame and takes the frame's `t_ticks` as mission time (on its
+//! mission clock), so the result does not depend on host speed.
+//!
+//! Signing ([`auv_link::sign`]): with a key, QEMU is started with `-append link-key=…` (the
+//! QEMU image's configuration; the key never crosses the link), the runner signs every frame
+//! (timestamps: 10 µs units since 2015-01-01 UTC, as MAVLink) and refuses telemetry that is not
+//! signed by the board. Telemetry frames are also checked for sequence order. Each period the simulator sends a state frame from
 //! the plant and applies the returned telemetry (voltages, or τ for ideal actuators) through
 //! the same actuator chain as SIL ([`crate::sil::run_with`]).
 //!
 //! Link faults ([`LinkFaults`]) drop, corrupt, delay or silence state frames over tick ranges.
-//! The board must go to fail-safe within its stale-state limit; once the link is healthy
-//! again the simulator re-arms it (disarm + arm) and it must resume. Every fail-safe entry and
-//! exit is recorded.
+//! The board must go to fail-safe within its stale-state limit; a delayed frame is an old state
+//! the board drops (off its mission clock). Once the link is healthy again the simulator
+//! re-arms it (disarm, arm, and start the mission again where it is, since disarming drops it)
+//! and it must resume. Every fail-safe entry and exit is recorded.
 
 use std::io::{Read, Write};
 use std::net::{TcpListener, TcpStream};
@@ -21,16 +34,20 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+use auv_link::seq::SeqCheck;
+use auv_link::sign::{AuthError, Direction, LinkKey, Signer, Verifier};
 use auv_link::{
-    encode, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope, FrameDecoder, Msg,
-    StateFrame, Telemetry, DEFAULT_STALE_PERIODS, MAX_FRAME, PROTOCOL_VERSION,
+    encode, encode_signed, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope,
+    FrameDecoder, LinkError, MissionPlan, Msg, StateFrame, Telemetry, ThrustUnit,
+    DEFAULT_STALE_PERIODS, MAX_FRAME, PROTOCOL_VERSION,
 };
 use serde::{Deserialize, Serialize};
 
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 
-use crate::config::{LinkFaults, SimConfig};
+use crate::config::LinkFaults;
 use crate::record::{ControlStatus, RunResult, RunSummary};
+use crate::scenario::Scenario;
 use crate::sil::{ControlOut, ControlSource};
 
 /// Largest |PIL − SIL| of the max path error (m) that a fault-free PIL run may show: 1 mm.
@@ -74,6 +91,29 @@ pub struct PilStats {
     pub board_loop_overruns: u32,
     pub rearms: u32,
     pub failsafe_events: Vec<FailSafeEvent>,
+    /// The link was signed (both ends).
+    #[serde(default)]
+    pub signed: bool,
+    /// Frames the board dropped as repeated, old or off its mission clock (its `rx_stale`).
+    #[serde(default)]
+    pub board_rx_stale: u32,
+    /// Frames the board refused for their authentication (its `rx_auth_errors`).
+    #[serde(default)]
+    pub board_rx_auth_errors: u32,
+    /// Commands the board refused, and the last reason ([`auv_link::Refusal::as_str`]).
+    #[serde(default)]
+    pub board_refused_commands: u32,
+    #[serde(default)]
+    pub board_last_refusal: Option<String>,
+    /// Telemetry frames this end refused: undecodable, badly signed, or out of sequence.
+    #[serde(default)]
+    pub telemetry_refused: u64,
+    /// The thrust unit of Eqs 31–32 the board reported flying (`"kgf"` or `"newton"`), and
+    /// its thruster mounting as the reversed-thruster mask (`Telemetry::reversed_thrusters`).
+    #[serde(default)]
+    pub board_thrust_unit: Option<String>,
+    #[serde(default)]
+    pub board_reversed_thrusters: Option<u8>,
 }
 
 impl FailSafeEventKind {
@@ -134,12 +174,20 @@ pub struct BoardInTheLoop {
     child: Child,
     stream: TcpStream,
     decoder: FrameDecoder,
+    /// Signing on: signs every frame sent.
+    signer: Option<Signer>,
+    /// The board's telemetry numbers.
+    telemetry_seq: SeqCheck,
     seq: u16,
     rate_hz: u32,
     faults: LinkFaults,
-    mission: auv_link::MissionSpec,
+    mission: MissionPlan,
+    /// The thrust unit the plant reads the board's voltages in: every telemetry frame must
+    /// report it.
+    thrust_unit: ThrustUnit,
     started: bool,
-    history: Vec<StateFrame>,
+    /// The last `delay_ticks + 1` state frames (what a delayed frame is taken from).
+    history: std::collections::VecDeque<StateFrame>,
     pending: std::collections::VecDeque<Telemetry>,
     last_tick: Option<u64>,
     last_status: Option<BoardStatus>,
@@ -151,28 +199,44 @@ pub struct BoardInTheLoop {
 
 impl BoardInTheLoop {
     /// Starts QEMU with `elf` (the QEMU flying image), waits for its UART to connect, and
-    /// configures and arms the board. `runner` is `scripts/qemu-run.sh`; QEMU's decoded log
-    /// goes to `log_path`.
+    /// configures and arms the board with `scenario`'s validated controller (its mission is
+    /// sent with the first state frame); with `key`, the board and this end sign the link.
+    /// `runner` is `scripts/qemu-run.sh`; QEMU's decoded log goes to `log` (opened by the
+    /// caller, who decides where and how it is written), which messages call `log_path`.
     pub fn start(
         elf: &Path,
         runner: &Path,
-        cfg: &SimConfig,
+        scenario: &Scenario,
         faults: LinkFaults,
+        log: std::fs::File,
         log_path: &Path,
+        key: Option<&LinkKey>,
     ) -> Result<Self, String> {
         check_flying_image(elf)?;
+        let c = scenario.controller().config();
+        // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
+        let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
+            "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
+        })?;
+        let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
-        let log = std::fs::File::create(log_path)
-            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
         let log_err = log.try_clone().map_err(|e| e.to_string())?;
-        let child = Command::new("bash")
+        let mut qemu = Command::new("bash");
+        qemu
             // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
             // under `timeout`, two processes down).
             .process_group(0)
             .arg(runner)
-            .arg(elf)
+            .arg(elf);
+        if let Some(k) = key {
+            // The QEMU image's provisioning (firmware::qemu::link_key); visible to this
+            // machine's process list, which is acceptable for a simulator's key.
+            let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
+            qemu.arg("-append").arg(format!("link-key={hex}"));
+        }
+        let child = qemu
             .env("QEMU_SERIAL", format!("tcp:127.0.0.1:{port},nodelay=on"))
             .env("QEMU_TIMEOUT", "3600")
             .stdin(Stdio::null())
@@ -205,22 +269,37 @@ impl BoardInTheLoop {
         let mut b = BoardInTheLoop {
             child,
             stream,
-            decoder: FrameDecoder::new(),
+            decoder: match key {
+                Some(k) => FrameDecoder::signed(Verifier::new(k, Direction::FromBoard)),
+                None => FrameDecoder::new(),
+            },
+            signer: key.map(|k| Signer::new(k, Direction::ToBoard)),
+            telemetry_seq: SeqCheck::new(),
             seq: 0,
-            rate_hz: cfg.controller.rate_hz,
+            rate_hz: c.rate_hz,
             faults,
-            mission: auv_link::MissionSpec::from(cfg.trajectory),
+            mission: MissionPlan::from(scenario.trajectory().mission()),
+            thrust_unit,
             started: false,
-            history: Vec::new(),
+            history: std::collections::VecDeque::new(),
             pending: std::collections::VecDeque::new(),
             last_tick: None,
             last_status: None,
             needs_rearm: false,
             t0: Instant::now(),
-            stats: PilStats::default(),
+            stats: PilStats {
+                signed: key.is_some(),
+                ..PilStats::default()
+            },
             log_path: log_path.to_path_buf(),
         };
-        let c = &cfg.controller;
+        // Continue the board's numbering: a board that already heard a runner (this one
+        // restarted) drops frames numbered at or before its last (auv_link::seq).
+        let first = b.next_telemetry()?;
+        if first.rx_frames > 0 {
+            b.seq = first.last_rx_seq.wrapping_add(1);
+        }
+        let refused_before = first.refused_commands;
         b.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
             rate_hz: Some(c.rate_hz),
             robust: Some(c.robust),
@@ -228,13 +307,29 @@ impl BoardInTheLoop {
             voltage_limit: Some(c.voltage_limit),
             stale_periods: Some(DEFAULT_STALE_PERIODS),
             lockstep: Some(true),
+            thrust_unit: Some(thrust_unit),
+            reversed_thrusters: Some(mounting),
+            priority: Some(c.priority.into()),
         })))?;
         b.send(Msg::Command(LinkCommand::Arm))?;
         // Wait until the board reports itself armed: the configuration and arming took.
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
             let t = b.next_telemetry()?;
+            if t.refused_commands > refused_before {
+                return Err(format!(
+                    "the board refused the set-up: {}",
+                    t.last_refusal.map_or("(no reason)", |r| r.as_str())
+                ));
+            }
             if t.status == BoardStatus::Armed {
+                if t.reversed_thrusters != mounting {
+                    return Err(format!(
+                        "the board flies thruster mounting {:#07b}, not the scenario's {mounting:#07b}",
+                        t.reversed_thrusters
+                    ));
+                }
+                b.check_unit(&t)?;
                 break;
             }
             if Instant::now() > deadline {
@@ -243,6 +338,20 @@ impl BoardInTheLoop {
         }
         b.t0 = Instant::now();
         Ok(b)
+    }
+
+    /// The board reports the thrust unit the plant reads its voltages in.
+    fn check_unit(&self, t: &Telemetry) -> Result<(), String> {
+        if t.thrust_unit == self.thrust_unit {
+            Ok(())
+        } else {
+            Err(format!(
+                "the board reports thrust unit {}, but the plant reads its voltages in {} (tick {})",
+                unit_name(t.thrust_unit),
+                unit_name(self.thrust_unit),
+                t.tick
+            ))
+        }
     }
 
     fn send(&mut self, msg: Msg) -> Result<(), String> {
@@ -258,7 +367,14 @@ impl BoardInTheLoop {
             msg,
         };
         self.seq = self.seq.wrapping_add(1);
-        encode(&env, buf).map_err(|e| format!("encoding: {e}"))
+        match &mut self.signer {
+            None => encode(&env, buf),
+            Some(signer) => {
+                signer.advance_to(mavlink_time());
+                encode_signed(&env, signer, buf)
+            }
+        }
+        .map_err(|e| format!("encoding: {e}"))
     }
 
     fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
@@ -291,12 +407,25 @@ impl BoardInTheLoop {
                 ));
             }
             for &b in &chunk[..n] {
-                if let Some(Ok(Envelope {
-                    msg: Msg::Telemetry(t),
-                    ..
-                })) = self.decoder.push(b)
-                {
-                    self.pending.push_back(t);
+                match self.decoder.push(b) {
+                    None => {}
+                    Some(Ok(Envelope {
+                        seq,
+                        msg: Msg::Telemetry(t),
+                        ..
+                    })) if self.telemetry_seq.accept(seq) => self.pending.push_back(t),
+                    // The two ends disagree on signing: nothing will ever be accepted.
+                    Some(Err(LinkError::Auth(
+                        e @ (AuthError::SigningOff | AuthError::Unsigned),
+                    ))) => {
+                        return Err(format!(
+                            "the board's telemetry is {} but this end has signing {}: {e}; give the board and host-sim the same key (--link-key-file), or neither",
+                            if e == AuthError::SigningOff { "signed" } else { "unsigned" },
+                            on_off(self.signer.is_some())
+                        ));
+                    }
+                    // Undecodable, badly signed, out of sequence, or not telemetry.
+                    Some(_) => self.stats.telemetry_refused += 1,
                 }
             }
         }
@@ -335,7 +464,13 @@ impl BoardInTheLoop {
         }
         self.last_status = Some(t.status);
         self.stats.board_rx_errors = t.rx_errors;
+        self.stats.board_rx_stale = t.rx_stale;
+        self.stats.board_rx_auth_errors = t.rx_auth_errors;
+        self.stats.board_refused_commands = t.refused_commands;
+        self.stats.board_last_refusal = t.last_refusal.map(|r| r.as_str().to_string());
         self.stats.board_loop_overruns = t.loop_overruns;
+        self.stats.board_thrust_unit = Some(unit_name(t.thrust_unit).to_string());
+        self.stats.board_reversed_thrusters = Some(t.reversed_thrusters);
         self.stats.worst_update_instructions =
             t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
     }
@@ -378,7 +513,10 @@ impl ControlSource for BoardInTheLoop {
             eta: *eta,
             nu: *nu,
         };
-        self.history.push(frame);
+        self.history.push_back(frame);
+        if self.history.len() > (self.faults.delay_ticks as usize).saturating_add(1) {
+            self.history.pop_front();
+        }
         let silent = LinkFaults::any(&self.faults.silent, k);
         let dropped = LinkFaults::any(&self.faults.drop, k);
         let corrupt = LinkFaults::any(&self.faults.corrupt, k);
@@ -389,8 +527,14 @@ impl ControlSource for BoardInTheLoop {
         let mut buf = [0u8; MAX_FRAME];
         if !silent {
             if self.needs_rearm && healthy {
-                // Recovery: the link is good again; re-arm (the fail-safe latches until then).
-                for c in [LinkCommand::Disarm, LinkCommand::Arm] {
+                // Recovery: the link is good again; re-arm (the fail-safe latches until
+                // then) and start the mission again, since disarming dropped it. Its first
+                // state frame below sets the board's mission clock to this tick.
+                for c in [
+                    LinkCommand::Disarm,
+                    LinkCommand::Arm,
+                    LinkCommand::StartMission(self.mission),
+                ] {
                     let n = self.encode(Msg::Command(c), &mut buf)?;
                     out.extend_from_slice(&buf[..n]);
                 }
@@ -415,7 +559,9 @@ impl ControlSource for BoardInTheLoop {
                 } else {
                     frame
                 };
-                if !corrupt {
+                // A corrupted frame is refused, and a delayed one holds an old state that the
+                // board drops as off its mission clock: neither is answered.
+                if !corrupt && !delayed {
                     expect_seq = Some(self.seq);
                 }
                 let n = self.encode(Msg::State(sent), &mut buf)?;
@@ -440,6 +586,7 @@ impl ControlSource for BoardInTheLoop {
             }
         };
         self.note_status(&t, k);
+        self.check_unit(&t)?;
         Ok(ControlOut {
             status: ControlStatus::Board(t.status),
             tau: t.tau,
@@ -450,6 +597,30 @@ impl ControlSource for BoardInTheLoop {
             w_norm: t.w_norm,
         })
     }
+}
+
+/// The core's name of a wire thrust unit (`"kgf"`, `"newton"`: the scenario key's values).
+fn unit_name(u: ThrustUnit) -> &'static str {
+    controller_core::ThrustUnit::from(u).as_str()
+}
+
+fn on_off(b: bool) -> &'static str {
+    if b {
+        "on"
+    } else {
+        "off"
+    }
+}
+
+/// MAVLink 2's signing time: 10 µs units since 2015-01-01 00:00 UTC (1 420 070 400 s after the
+/// Unix epoch), so that a restarted runner still counts upwards.
+pub fn mavlink_time() -> u64 {
+    const EPOCH_2015: u64 = 1_420_070_400;
+    std::time::SystemTime::now()
+        .duration_since(std::time::UNIX_EPOCH)
+        .map_or(0, |d| {
+            d.as_secs().saturating_sub(EPOCH_2015) * 100_000 + u64::from(d.subsec_micros() / 10)
+        })
 }
 
 /// The QEMU flying image as `cargo build -p firmware --release --target thumbv7em-none-eabihf

@@ -1,5 +1,6 @@
 //! What a run leaves behind: one [`Sample`] per control period, the outcome, and the metrics.
 
+use std::collections::BTreeMap;
 use std::fmt;
 
 use auv_link::BoardStatus;
@@ -94,10 +95,16 @@ pub enum Outcome {
         t: f64,
         reason: String,
     },
+    /// Stopped at `t` on request (Ctrl-C, SIGTERM: [`crate::interrupt`]); everything recorded
+    /// before `t` is kept and every output says it is partial.
+    Interrupted {
+        t: f64,
+    },
 }
 
 impl fmt::Display for Outcome {
-    /// "completed" or "DIVERGED at t = … s: reason" (the reason on one line).
+    /// "completed", "DIVERGED at t = … s: reason" (the reason on one line) or
+    /// "INTERRUPTED at t = … s (partial)".
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Outcome::Completed => f.write_str("completed"),
@@ -105,7 +112,61 @@ impl fmt::Display for Outcome {
                 let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
                 write!(f, "DIVERGED at t = {t:.2} s: {reason}")
             }
+            Outcome::Interrupted { t } => write!(f, "INTERRUPTED at t = {t:.2} s (partial)"),
         }
+    }
+}
+
+/// The control periods of a run in which the law did not run (thrusters off: the core's
+/// fail-safe, or the board's), counted per status.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FaultCounts {
+    /// Periods per status, by the CSV `status` token ([`ControlStatus`]'s `Display`, e.g.
+    /// `fault:pitch-limit`, `board:fail-safe:stale-state`); statuses that did not occur are
+    /// absent.
+    pub periods: BTreeMap<String, u64>,
+    /// Time of the first such period (s); `None` when there was none.
+    pub first_t: Option<f64>,
+}
+
+impl FaultCounts {
+    /// Counts `sample` if its status is not ok.
+    pub fn record(&mut self, sample: &Sample) {
+        if sample.status.is_ok() {
+            return;
+        }
+        *self.periods.entry(sample.status.to_string()).or_default() += 1;
+        self.first_t.get_or_insert(sample.t);
+    }
+
+    /// Every period in which the law did not run.
+    pub fn total(&self) -> u64 {
+        self.periods.values().sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.periods.is_empty()
+    }
+}
+
+impl fmt::Display for FaultCounts {
+    /// "0", or the total and the periods per status:
+    /// "12 (fault:pitch-limit 10, fault:non-finite-result 2; first at t = 3.20 s)".
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.total())?;
+        if self.is_empty() {
+            return Ok(());
+        }
+        let parts: Vec<String> = self
+            .periods
+            .iter()
+            .map(|(status, n)| format!("{status} {n}"))
+            .collect();
+        write!(f, " ({}", parts.join(", "))?;
+        if let Some(t) = self.first_t {
+            write!(f, "; first at t = {t:.2} s")?;
+        }
+        f.write_str(")")
     }
 }
 
@@ -139,6 +200,14 @@ pub struct RunResult {
     pub robust: bool,
     pub outcome: Outcome,
     pub metrics: Metrics,
+    /// The periods in fail-safe, per status.
+    pub faults: FaultCounts,
+    /// The scenario expects faults ([`crate::config::SimConfig::expect_faults`]): they are
+    /// reported but do not fail the command.
+    pub faults_expected: bool,
+    /// The samples the plots draw: every sample of a run of at most
+    /// [`crate::decimate::PLOT_SAMPLES`] periods, else a decimated series (see
+    /// [`crate::decimate`]). The CSV has every period (it is written as the run goes).
     #[serde(skip)]
     pub samples: Vec<Sample>,
 }
@@ -155,6 +224,15 @@ pub struct RunSummary {
     pub metrics: Metrics,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diverged: Option<Divergence>,
+    /// The time the run was interrupted at (Ctrl-C), if it was: its metrics cover [0, t).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<f64>,
+    /// The periods in fail-safe, per status (`{"periods": {}, "first_t": null}` for none).
+    #[serde(default)]
+    pub faults: FaultCounts,
+    /// Whether the scenario expected faults.
+    #[serde(default)]
+    pub faults_expected: bool,
 }
 
 /// When and why a run stopped early ([`Outcome::Diverged`]).
@@ -164,10 +242,13 @@ pub struct Divergence {
     pub reason: String,
 }
 
-/// The JSON object a command prints: `{"cases": [...]}`.
+/// The JSON object a command prints: `{"cases": [...]}`, and `"incomplete": [...]` when an
+/// output could not be written completely (each entry names the file and why).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Cases<T> {
     pub cases: Vec<T>,
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub incomplete: Vec<String>,
 }
 
 impl RunResult {
@@ -178,17 +259,64 @@ impl RunResult {
             robust: self.robust,
             metrics: self.metrics,
             diverged: match &self.outcome {
-                Outcome::Completed => None,
                 Outcome::Diverged { t, reason } => Some(Divergence {
                     t: *t,
                     reason: reason.clone(),
                 }),
+                _ => None,
             },
+            interrupted: match self.outcome {
+                Outcome::Interrupted { t } => Some(t),
+                _ => None,
+            },
+            faults: self.faults.clone(),
+            faults_expected: self.faults_expected,
         }
     }
 
-    /// True if the run stopped early.
+    /// True if the run stopped early because it diverged.
     pub fn diverged(&self) -> bool {
         matches!(self.outcome, Outcome::Diverged { .. })
+    }
+
+    /// True if the run was interrupted (its outputs are partial).
+    pub fn interrupted(&self) -> bool {
+        matches!(self.outcome, Outcome::Interrupted { .. })
+    }
+
+    /// True if the controller was in fail-safe in some period and the scenario did not expect
+    /// it.
+    pub fn faulted_unexpectedly(&self) -> bool {
+        !self.faults.is_empty() && !self.faults_expected
+    }
+
+    /// "with Δu" or "without Δu", from [`RunResult::robust`]: the label of the run in tables,
+    /// plots and file names.
+    pub fn du_label(&self) -> &'static str {
+        du_label(self.robust)
+    }
+
+    /// `with` or `without` ([`RunResult::robust`]): the suffix of the run's CSV,
+    /// `{name}-with.csv`.
+    pub fn du_suffix(&self) -> &'static str {
+        du_suffix(self.robust)
+    }
+}
+
+/// `with` (robust) or `without`: how file names say whether Δu was on.
+pub fn du_suffix(robust: bool) -> &'static str {
+    if robust {
+        "with"
+    } else {
+        "without"
+    }
+}
+
+/// "with Δu" (robust) or "without Δu".
+pub fn du_label(robust: bool) -> &'static str {
+    if robust {
+        "with Δu"
+    } else {
+        "without Δu"
     }
 }

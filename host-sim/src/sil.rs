@@ -22,9 +22,11 @@ use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
 use crate::config::CurrentModel;
+use crate::decimate::Decimator;
+use crate::interrupt;
 use crate::metrics;
 use crate::plant::{Plant, PlantState, PlantTerms};
-use crate::record::{ControlStatus, Outcome, RunResult, Sample};
+use crate::record::{ControlStatus, FaultCounts, Outcome, RunResult, Sample};
 use crate::scenario::Scenario;
 
 /// Ocean current state (Gauss–Markov is a random process, stepped with the plant).
@@ -129,14 +131,86 @@ impl ControlSource for LocalController<'_> {
     }
 }
 
+/// The vehicle on the reference at t = 0: η = η_d(0), ν = J⁻¹ η̇_d(0).
+pub fn reference_state(trajectory: &Trajectory, rate_hz: u32) -> PlantState {
+    start_state(trajectory, rate_hz, &[0.0; 6])
+}
+
+/// Where a run starts (docs/design.md §6): on the reference, η = η_d(0) + `offset`, with the
+/// reference's velocity ν = J⁻¹(η) η̇_d(0).
+fn start_state(trajectory: &Trajectory, rate_hz: u32, offset: &[f64; 6]) -> PlantState {
+    let d0 = trajectory.sample(0, rate_hz);
+    let eta = d0.eta.cast::<f64>() + Vector6::from(*offset);
+    let nu = kinematics::jacobian_inv(&Attitude::from_eta(&eta)) * d0.eta_dot.cast::<f64>();
+    PlantState { eta, nu }
+}
+
 /// Runs one simulation with the law on the host (software in the loop).
 pub fn run(scenario: &Scenario) -> RunResult {
     run_with(scenario, &mut LocalController::new(scenario))
 }
 
+/// What sees every sample of a run as it is made: the streaming CSV
+/// ([`crate::output::csv::CsvStream`]), the progress counter ([`crate::progress`]). `()` sees
+/// nothing.
+pub trait Observer {
+    fn sample(&mut self, sample: &Sample);
+}
+
+impl Observer for () {
+    fn sample(&mut self, _: &Sample) {}
+}
+
+impl<T: Observer + ?Sized> Observer for &mut T {
+    fn sample(&mut self, s: &Sample) {
+        (**self).sample(s);
+    }
+}
+
+impl<A: Observer, B: Observer> Observer for (A, B) {
+    fn sample(&mut self, s: &Sample) {
+        self.0.sample(s);
+        self.1.sample(s);
+    }
+}
+
+/// The heading the simulated navigation reports: the plant's ψ while |ψ| ≤
+/// [`HEADING_REPORT_BOUND`], else ψ reduced by whole turns into (−π, π].
+///
+/// **Choice:** a navigation solution reports a heading, not a count of turns: the plant's ψ
+/// grows without bound on a circle (ω t), and the controller refuses |angle| beyond
+/// `controller_core::controller::MAX_ANGLE` (1000 rad), which a 24 h circle reaches after
+/// 10 000 s (the run then went to fail-safe and diverged). The reduction is applied only
+/// beyond 4π, which the paper's 70 s missions never reach (their ψ stays below 7.1 rad), so
+/// the Table-1 runs are bit for bit as before; the controller wraps the yaw error anyway
+/// (docs/design.md §4), so the jump by whole turns is invisible to the law.
+pub fn reported_heading(psi: f64) -> f64 {
+    if psi.abs() <= HEADING_REPORT_BOUND {
+        psi
+    } else {
+        wrap_pi(psi)
+    }
+}
+
+/// |ψ| (rad) up to which the simulated navigation reports the plant's heading unchanged
+/// ([`reported_heading`]).
+pub const HEADING_REPORT_BOUND: f64 = 4.0 * std::f64::consts::PI;
+
 /// Runs one simulation with the law wherever `source` runs it. The scenario's controller gives
 /// the allocation the plant's thrusters use.
 pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResult {
+    run_observed(scenario, source, &mut ())
+}
+
+/// [`run_with`], with every sample shown to `observer` as it is made. Memory stays bounded
+/// whatever the duration: the metrics and the fault counts are accumulated, and the run keeps
+/// only the plot series ([`crate::decimate`]). Stops early, with [`Outcome::Interrupted`],
+/// when an interrupt is requested ([`crate::interrupt`]).
+pub fn run_observed(
+    scenario: &Scenario,
+    source: &mut dyn ControlSource,
+    observer: &mut dyn Observer,
+) -> RunResult {
     let cfg = scenario.config();
     let controller = scenario.controller();
     let trajectory = scenario.trajectory();
@@ -151,23 +225,30 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
     let maps = thruster::default_maps();
 
     // Start on the reference (docs/design.md §6), plus the configured offset.
-    let d0 = trajectory.sample(0, rate);
-    let mut state = PlantState {
-        eta: d0.eta.cast::<f64>() + Vector6::from(cfg.initial_offset),
-        nu: Vector6::zeros(),
-    };
-    state.nu = kinematics::jacobian_inv(&Attitude::from_eta(&state.eta)) * d0.eta_dot.cast::<f64>();
+    let mut state = start_state(trajectory, rate, &cfg.initial_offset);
 
     let mut current = Current::new(&cfg.current);
     let mut noise_rng = rand::rngs::StdRng::seed_from_u64(cfg.noise.as_ref().map_or(0, |n| n.seed));
     let lag_alpha = cfg.thruster_lag.map(|tl| 1.0 - (-h / tl).exp());
     let mut thrust_applied: Option<[f64; THRUSTERS]> = None;
 
-    let mut samples = Vec::with_capacity(steps as usize + 1);
+    let mut plot = Decimator::new(steps + 1);
+    let mut metrics = metrics::Accumulator::default();
+    let mut faults = FaultCounts::default();
+    let mut record = |s: Sample| {
+        metrics.push(&s);
+        faults.record(&s);
+        observer.sample(&s);
+        plot.push(&s);
+    };
     let mut outcome = Outcome::Completed;
 
     for k in 0..=steps {
         let t = k as f64 * period;
+        if interrupt::requested() {
+            outcome = Outcome::Interrupted { t };
+            break;
+        }
         let d = trajectory.sample(k, rate);
         let eta_d = to_f64(&d.eta.into());
         let mut error = [0.0; 6];
@@ -196,6 +277,7 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
 
         // 1. Measure and control.
         let (mut eta_m, mut nu_m) = (state.eta, state.nu);
+        eta_m[5] = reported_heading(eta_m[5]);
         if let Some(n) = &cfg.noise {
             for i in 0..6 {
                 let a: f64 = StandardNormal.sample(&mut noise_rng);
@@ -246,7 +328,7 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
             rec.thrust = thrust_applied.unwrap_or(target);
             rec.tau_applied =
                 (alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(rec.thrust)).into();
-            samples.push(rec);
+            record(rec);
             break;
         }
 
@@ -283,7 +365,7 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
         }
         rec.thrust = first_applied.unwrap_or(target);
         rec.tau_applied = (alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(rec.thrust)).into();
-        samples.push(rec);
+        record(rec);
         thrust_applied = Some(applied);
         if matches!(outcome, Outcome::Diverged { .. }) {
             break;
@@ -294,8 +376,10 @@ pub fn run_with(scenario: &Scenario, source: &mut dyn ControlSource) -> RunResul
         name: cfg.name.clone(),
         case: cfg.case,
         robust: cfg.controller.robust,
-        metrics: metrics::compute(&samples),
+        metrics: metrics.metrics(),
         outcome,
-        samples,
+        faults,
+        faults_expected: cfg.expect_faults,
+        samples: plot.finish(),
     }
 }

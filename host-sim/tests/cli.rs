@@ -154,8 +154,8 @@ fn a_diverging_run_says_so_keeps_its_data_and_exits_1() {
     );
     let t = d["t"].as_f64().unwrap();
     assert!(t > 0.0 && t < 70.0);
-    // Everything up to the stop is on disk.
-    let csv = std::fs::read_to_string(dir.join("out").join("runaway-with.csv")).unwrap();
+    // Everything up to the stop is on disk, under the name of a run without Δu.
+    let csv = std::fs::read_to_string(dir.join("out").join("runaway-without.csv")).unwrap();
     assert!(csv.lines().count() > 10);
     let report = std::fs::read_to_string(dir.join("out").join("report.md")).unwrap();
     assert!(report.contains("DIVERGED"), "{report}");
@@ -223,6 +223,7 @@ fn the_run_command_runs_in_process() {
         scenario: path.clone(),
         json: true,
         out: Some(dir.join("out")),
+        allow_long_run: false,
     };
     let mut stdout = Vec::new();
     assert_eq!(cli::run(&args, &mut stdout).unwrap(), Exit::Success);

@@ -103,6 +103,8 @@ fn synthetic(name: &str, robust: bool, n: usize, gain: f64) -> RunResult {
             peak_voltage: 24.0,
             saturated_fraction: 0.25,
         },
+        faults: Default::default(),
+        faults_expected: false,
         samples,
     }
 }

@@ -4,6 +4,7 @@
 //! to (postcard ‖ CRC), what a frame may contain, and how errors are reported.
 
 use crate::msg::{Envelope, PROTOCOL_VERSION};
+use crate::sign::{AuthError, Signer, Verifier, SIGNATURE_LEN};
 use core::fmt;
 
 /// CRC-16/IBM-3740 (a.k.a. CRC-16/CCITT-FALSE): poly 0x1021, init 0xFFFF, no reflection,
@@ -13,8 +14,8 @@ pub(crate) const CRC: crc::Crc<u16> = crc::Crc::<u16>::new(&crc::CRC_16_IBM_3740
 /// Length of the CRC trailer (bytes, little-endian).
 pub const CRC_LEN: usize = 2;
 
-/// Worst-case length of the un-stuffed frame body: postcard(Envelope) ‖ CRC.
-pub const MAX_BODY: usize = Envelope::MAX_SIZE + CRC_LEN;
+/// Worst-case length of the un-stuffed frame body: postcard(Envelope) ‖ signature ‖ CRC.
+pub const MAX_BODY: usize = Envelope::MAX_SIZE + SIGNATURE_LEN + CRC_LEN;
 
 /// Worst-case length of a complete frame on the wire: COBS of the body plus the `0x00`
 /// delimiter. An `out` buffer of this size makes [`encode`] infallible, and a receiver never
@@ -51,6 +52,11 @@ pub enum LinkError {
     /// [`encode`]: postcard refused the message (cannot happen while `Envelope::MAX_SIZE` is
     /// right).
     Serialize,
+    /// CRC, version and body are fine, but the frame's authentication is not
+    /// ([`crate::sign`]): unsigned on a signed link, signed on an unsigned one, a replayed
+    /// timestamp, a wrong direction or a bad MAC. From [`encode_signed`]: the signer's
+    /// timestamp is exhausted.
+    Auth(AuthError),
 }
 
 impl fmt::Display for LinkError {
@@ -65,20 +71,46 @@ impl fmt::Display for LinkError {
             }
             LinkError::BufferTooSmall => f.write_str("output buffer too small for the frame"),
             LinkError::Serialize => f.write_str("message could not be serialized"),
+            LinkError::Auth(e) => write!(f, "authentication: {e}"),
         }
     }
 }
 
 impl core::error::Error for LinkError {}
 
-/// Encodes `env` as one complete frame, delimiter included, into `out`, and returns the frame's
-/// length. Never panics; fails only if `out` is too short (`out.len() >= MAX_FRAME` always
-/// suffices). The version field is sent as it is (use [`Envelope::new`] for the current one).
+/// Encodes `env` as one complete unsigned frame, delimiter included, into `out`, and returns
+/// the frame's length. Never panics; fails only if `out` is too short (`out.len() >= MAX_FRAME`
+/// always suffices). The version field is sent as it is (use [`Envelope::new`] for the current
+/// one).
 pub fn encode(env: &Envelope, out: &mut [u8]) -> Result<usize, LinkError> {
+    encode_with(env, None, out)
+}
+
+/// As [`encode`], with the signature trailer of [`crate::sign`] (the signer's next timestamp;
+/// one is used even if `out` turns out too short). Fails also if the signer's timestamp is
+/// exhausted.
+pub fn encode_signed(
+    env: &Envelope,
+    signer: &mut Signer,
+    out: &mut [u8],
+) -> Result<usize, LinkError> {
+    encode_with(env, Some(signer), out)
+}
+
+fn encode_with(
+    env: &Envelope,
+    signer: Option<&mut Signer>,
+    out: &mut [u8],
+) -> Result<usize, LinkError> {
     let mut body = [0u8; MAX_BODY];
-    let n = postcard::to_slice(env, &mut body[..Envelope::MAX_SIZE])
+    let mut n = postcard::to_slice(env, &mut body[..Envelope::MAX_SIZE])
         .map_err(|_| LinkError::Serialize)?
         .len();
+    if let Some(signer) = signer {
+        let trailer = signer.sign(&body[..n]).map_err(LinkError::Auth)?;
+        body[n..n + SIGNATURE_LEN].copy_from_slice(&trailer);
+        n += SIGNATURE_LEN;
+    }
     let crc = CRC.checksum(&body[..n]).to_le_bytes();
     body[n..n + CRC_LEN].copy_from_slice(&crc);
     let len = cobs::try_encode(&body[..n + CRC_LEN], out).map_err(|_| LinkError::BufferTooSmall)?;
@@ -86,10 +118,24 @@ pub fn encode(env: &Envelope, out: &mut [u8]) -> Result<usize, LinkError> {
     Ok(len + 1)
 }
 
-/// Decodes one frame given without its `0x00` delimiter. The buffer is used as scratch (COBS is
-/// undone in place). Checks, in order: length (≤ `MAX_FRAME − 1`, else `Overflow`), COBS, CRC,
-/// version byte, then the postcard body, which must use every byte. Never panics.
+/// Decodes one frame of an unsigned link, given without its `0x00` delimiter. The buffer is
+/// used as scratch (COBS is undone in place). Checks, in order: length (≤ `MAX_FRAME − 1`, else
+/// `Overflow`), COBS, CRC, version byte, then the postcard body, which must be followed by
+/// nothing (a signature trailer is [`AuthError::SigningOff`]). Never panics.
 pub fn decode_frame(frame: &mut [u8]) -> Result<Envelope, LinkError> {
+    decode(frame, None)
+}
+
+/// As [`decode_frame`], on a signed link: the body must be followed by a signature trailer
+/// that `verifier` accepts (direction, a newer timestamp, the MAC; [`crate::sign`]).
+pub fn decode_frame_signed(
+    frame: &mut [u8],
+    verifier: &mut Verifier,
+) -> Result<Envelope, LinkError> {
+    decode(frame, Some(verifier))
+}
+
+fn decode(frame: &mut [u8], verifier: Option<&mut Verifier>) -> Result<Envelope, LinkError> {
     if frame.len() > MAX_FRAME - 1 {
         return Err(LinkError::Overflow);
     }
@@ -114,8 +160,19 @@ pub fn decode_frame(frame: &mut [u8]) -> Result<Envelope, LinkError> {
         Some(&v) if v != PROTOCOL_VERSION => return Err(LinkError::Version { got: v }),
         Some(_) => {}
     }
-    match postcard::take_from_bytes::<Envelope>(payload) {
-        Ok((env, [])) => Ok(env),
+    let (env, rest) =
+        postcard::take_from_bytes::<Envelope>(payload).map_err(|_| LinkError::Deserialize)?;
+    let covered = &payload[..payload.len() - rest.len()];
+    match (rest.len(), verifier) {
+        (0, None) => Ok(env),
+        (0, Some(_)) => Err(LinkError::Auth(AuthError::Unsigned)),
+        (SIGNATURE_LEN, None) => Err(LinkError::Auth(AuthError::SigningOff)),
+        (SIGNATURE_LEN, Some(v)) => {
+            let trailer =
+                <&[u8; SIGNATURE_LEN]>::try_from(rest).map_err(|_| LinkError::Deserialize)?;
+            v.verify(covered, trailer).map_err(LinkError::Auth)?;
+            Ok(env)
+        }
         _ => Err(LinkError::Deserialize),
     }
 }
@@ -135,6 +192,8 @@ pub struct FrameDecoder {
     discarding: bool,
     frames: u32,
     errors: u32,
+    /// Signing on: every frame must carry a signature this verifier accepts.
+    verifier: Option<Verifier>,
 }
 
 impl Default for FrameDecoder {
@@ -144,7 +203,8 @@ impl Default for FrameDecoder {
 }
 
 impl FrameDecoder {
-    /// An empty decoder; the first frame may start at the first byte.
+    /// An empty decoder of an unsigned link ([`decode_frame`]); the first frame may start at the
+    /// first byte.
     pub const fn new() -> Self {
         FrameDecoder {
             buf: [0; MAX_FRAME - 1],
@@ -152,7 +212,21 @@ impl FrameDecoder {
             discarding: false,
             frames: 0,
             errors: 0,
+            verifier: None,
         }
+    }
+
+    /// An empty decoder of a signed link ([`decode_frame_signed`] with `verifier`).
+    pub fn signed(verifier: Verifier) -> Self {
+        FrameDecoder {
+            verifier: Some(verifier),
+            ..Self::new()
+        }
+    }
+
+    /// The verifier of a signed link (`None`: signing off).
+    pub const fn verifier(&self) -> Option<&Verifier> {
+        self.verifier.as_ref()
     }
 
     /// Takes one received byte. Returns `Some` when the byte completes a frame (a `0x00` after
@@ -165,7 +239,7 @@ impl FrameDecoder {
                 return None;
             }
             let result = match self.buf.get_mut(..len) {
-                Some(frame) => decode_frame(frame),
+                Some(frame) => decode(frame, self.verifier.as_mut()),
                 None => Err(LinkError::Overflow),
             };
             return Some(self.count(result));
@@ -318,7 +392,7 @@ mod tests {
         use std::string::ToString;
         assert_eq!(
             LinkError::Version { got: 1 }.to_string(),
-            "protocol version 1, expected 2"
+            "protocol version 1, expected 3"
         );
         assert_eq!(
             LinkError::Overflow.to_string(),

@@ -5,42 +5,53 @@
 //!
 //! ```text
 //! wire:  COBS( body ) ‖ 0x00
-//! body:  postcard(Envelope) ‖ CRC-16 of postcard(Envelope), little-endian (2 bytes)
+//! body:  postcard(Envelope) ‖ [signature] ‖ CRC-16 of everything before it, little-endian (2 bytes)
+//! signature (signed links only, 13 bytes): link id (1) ‖ timestamp (6, LE) ‖ truncated MAC (6)
 //! ```
 //!
 //! - **Serialization:** [postcard](https://docs.rs/postcard) 1.x of [`Envelope`]. The first
 //!   byte of the body is always [`Envelope::version`] (a `u8` is one byte in postcard), so a
 //!   receiver checks the version before it interprets anything else.
+//! - **Signature:** optional, in the manner of MAVLink 2 signing: truncated HMAC-SHA-256 with a
+//!   48-bit timestamp that increases strictly per direction ([`sign`]). postcard's encoding of
+//!   an `Envelope` ends where the envelope ends, so what follows it is the trailer: nothing on
+//!   an unsigned frame, exactly [`sign::SIGNATURE_LEN`] bytes on a signed one, anything else
+//!   malformed. Each end has signing on or off ([`FrameDecoder::signed`], [`encode_signed`]);
+//!   with it on, unsigned frames are refused, and with it off, signed ones are.
 //! - **CRC:** CRC-16/IBM-3740, a.k.a. CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, not
-//!   reflected, no final XOR; check value 0x29B1), over the postcard bytes only, appended
-//!   little-endian. It detects every error of up to 3 bits and every burst of up to 16 bits
-//!   in the body.
+//!   reflected, no final XOR; check value 0x29B1), over the postcard bytes and the signature,
+//!   appended little-endian. It detects every error of up to 3 bits and every burst of up to
+//!   16 bits in the body (it is not authentication: anyone can compute it).
 //! - **Framing:** Consistent Overhead Byte Stuffing of the body, by the
 //!   [`cobs`](https://docs.rs/cobs) crate (not postcard's COBS helpers, which would stuff the
 //!   postcard bytes without the CRC): code byte `c` = 1..=255 followed by `c − 1` non-zero
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 121 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 117 postcard bytes + 2 CRC bytes + 1 COBS code byte + 1
-//!   delimiter). At 460 800 baud (46 080 bytes/s, the STM32 board's link) that is 2.6 ms, so a
-//!   State frame in one direction and a Telemetry frame in the other fit in a 10 ms (100 Hz)
-//!   control period with room to spare; 115 200 baud (10.5 ms) would not.
+//! - **Size:** at most [`MAX_FRAME`] = 157 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 140 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
+//!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
+//!   board's link) the largest frame takes 3.4 ms, so a State frame in one direction and a
+//!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
+//!   uses 34 % of the board's transmit bandwidth); 115 200 baud (13.6 ms) would not.
 //!
 //! # Receiving
 //!
 //! [`FrameDecoder::push`] takes one byte at a time; when a `0x00` completes a frame it undoes
-//! COBS in place, checks the CRC, then the version byte, then deserializes, requiring the body
-//! to be used to the last byte. Anything that fails is reported as a [`LinkError`] (to be
-//! counted in [`Telemetry::rx_errors`], never acted on) and the decoder starts afresh at the
-//! next `0x00`. A frame longer than `MAX_FRAME − 1` bytes is reported as
+//! COBS in place, checks the CRC, then the version byte, then deserializes, then checks the
+//! trailer (none, or a signature its verifier accepts). Anything that fails is reported as a
+//! [`LinkError`] (to be counted in [`Telemetry::rx_errors`], never acted on) and the decoder
+//! starts afresh at the next `0x00`. A frame longer than `MAX_FRAME − 1` bytes is reported as
 //! [`LinkError::Overflow`] when it overflows and dropped up to the next `0x00`.
 //!
 //! # Messages
 //!
 //! [`Envelope`] `{ version: u8 = PROTOCOL_VERSION, seq: u16, msg: Msg }`; `seq` counts frames
-//! per sender (wrapping). The navigation computer sends [`Msg::State`] (the navigation solution
-//! η, ν at a control tick) and [`Msg::Command`] (arm / disarm, start a [`MissionPlan`] /
+//! per sender (wrapping), and a receiver accepts only a frame newer than the last it accepted,
+//! in serial-number arithmetic with a window ([`seq`]). The navigation computer sends
+//! [`Msg::State`] (the navigation solution η, ν at a control tick) and [`Msg::Command`] (arm /
+//! disarm, start a [`MissionPlan`] /
 //! stop, or change settings with a [`ConfigPatch`]); the board answers with
 //! [`Msg::Telemetry`], whose [`Telemetry::last_state_seq`] echoes the `seq` of the last State
 //! frame it accepted, and which names the thrust unit and mounting the board flies. A
@@ -82,9 +93,17 @@
 mod frame;
 pub mod mission;
 mod msg;
+mod refusal;
+pub mod seq;
+pub mod sign;
 
-pub use frame::{decode_frame, encode, FrameDecoder, LinkError, CRC_LEN, MAX_BODY, MAX_FRAME};
-pub use msg::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Heading, MissionPlan, MissionSpec,
-    Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS, PROTOCOL_VERSION,
+pub use frame::{
+    decode_frame, decode_frame_signed, encode, encode_signed, FrameDecoder, LinkError, CRC_LEN,
+    MAX_BODY, MAX_FRAME,
 };
+pub use msg::{
+    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Heading,
+    MissionPlan, MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
+    PROTOCOL_VERSION,
+};
+pub use refusal::Refusal;

@@ -1,6 +1,6 @@
 //! The one conversion between the link's wire types and the core's, both ways:
 //! [`MissionSpec`] ↔ [`TrajectoryKind`], [`MissionPlan`] ↔ [`Mission`], [`Heading`] ↔
-//! [`HeadingMode`] and the wire [`ThrustUnit`] ↔ the core's. The board
+//! [`HeadingMode`], and the wire [`ThrustUnit`] and [`AxisPriority`] ↔ the core's. The board
 //! (`Command::StartMission` → trajectory, `SetConfig` → configuration) and the host
 //! (scenario → `StartMission`, `SetConfig`) both use it, so the two ends cannot disagree on a
 //! field.
@@ -16,7 +16,7 @@
 
 use controller_core::{HeadingMode, Mission, TrajectoryKind};
 
-use crate::msg::{Heading, MissionPlan, MissionSpec, ThrustUnit};
+use crate::msg::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
 
 /// Both `From` impls from one list of variants and fields, so the two directions cannot drift
 /// apart. A variant or field missing from the list is a compile error (non-exhaustive match,
@@ -103,5 +103,19 @@ impl From<MissionSpec> for MissionPlan {
     /// The paper's mission on this path ([`Mission::paper`]).
     fn from(path: MissionSpec) -> Self {
         Mission::paper(path.into()).into()
+    }
+}
+
+impl From<controller_core::allocator::AxisPriority> for AxisPriority {
+    fn from(p: controller_core::allocator::AxisPriority) -> Self {
+        let controller_core::allocator::AxisPriority { rank, weight } = p;
+        AxisPriority { rank, weight }
+    }
+}
+
+impl From<AxisPriority> for controller_core::allocator::AxisPriority {
+    fn from(p: AxisPriority) -> Self {
+        let AxisPriority { rank, weight } = p;
+        controller_core::allocator::AxisPriority { rank, weight }
     }
 }

@@ -7,11 +7,18 @@
 
 use serde::{Deserialize, Serialize};
 
+use crate::refusal::Refusal;
+
 /// The protocol version this crate speaks; sent as the first byte of every frame.
 ///
-/// 2: `StartMission` carries a [`MissionPlan`] (heading, time scale), `SetConfig` the thrust
-/// unit and the thruster mounting, `Telemetry` both.
-pub const PROTOCOL_VERSION: u8 = 2;
+/// 2: sequence numbers checked ([`crate::seq`]), optional signature trailer
+/// ([`crate::sign`]), and the telemetry's latched reason, refusals, drop counters, last
+/// accepted sequence number and signing flag.
+///
+/// 3: `StartMission` carries a [`MissionPlan`] (heading, time scale); `SetConfig` the thrust
+/// unit, the thruster mounting and the axis priority; `Telemetry` the unit and mounting the
+/// board flies; refusals for an invalid time scale, tangent heading, mounting or priority.
+pub const PROTOCOL_VERSION: u8 = 3;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -45,7 +52,8 @@ pub struct Envelope {
     /// [`PROTOCOL_VERSION`] of the sender. Receivers reject any other value
     /// ([`LinkError::Version`](crate::LinkError::Version)) without looking at the rest.
     pub version: u8,
-    /// Sender's frame counter: +1 per frame sent, wrapping. Each direction has its own.
+    /// Sender's frame counter: +1 per frame sent, wrapping. Each direction has its own. A
+    /// receiver accepts only frames newer than the last it accepted ([`crate::seq`]).
     pub seq: u16,
     /// The payload.
     pub msg: Msg,
@@ -254,8 +262,29 @@ pub struct ConfigPatch {
     /// The thruster mounting, as the reversed-thruster mask of the AUV-150 layout
     /// (`controller_core::effectiveness::ThrusterGeometry::auv150`): bit i set ⇔ thruster i's
     /// positive thrust pushes against its reference axis (+x, +z, +z, +y, +y). Refused while
-    /// armed, and with bits above the fifth.
+    /// armed, and with bits above the fifth ([`Refusal::InvalidMounting`]).
     pub reversed_thrusters: Option<u8>,
+    /// Which forces the saturation-aware allocator gives up first. Refused while armed, and
+    /// when the core refuses a weight ([`Refusal::InvalidPriority`]).
+    pub priority: Option<AxisPriority>,
+}
+
+/// The wire form of `controller_core::allocator::AxisPriority`: per row of τ = [X Y Z K M N],
+/// the rank (higher is met first) and the least-squares weight between axes of equal rank
+/// (finite and > 0 on the actuated axes; the roll entries are carried and not used). Convert
+/// with `From` both ways ([`crate::mission`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AxisPriority {
+    /// Priority of each axis; higher is more important.
+    pub rank: [u8; 6],
+    /// Least-squares weight of each axis.
+    pub weight: [f32; 6],
+}
+
+impl AxisPriority {
+    /// Worst-case postcard size of an `AxisPriority` (bytes).
+    pub const MAX_SIZE: usize = 6 * U8 + 6 * F32;
 }
 
 impl ConfigPatch {
@@ -267,7 +296,8 @@ impl ConfigPatch {
         + option(U8)
         + option(BOOL)
         + option(ThrustUnit::MAX_SIZE)
-        + option(U8);
+        + option(U8)
+        + option(AxisPriority::MAX_SIZE);
 
     /// Changes nothing.
     pub const EMPTY: ConfigPatch = ConfigPatch {
@@ -279,6 +309,7 @@ impl ConfigPatch {
         lockstep: None,
         thrust_unit: None,
         reversed_thrusters: None,
+        priority: None,
     };
 }
 
@@ -306,7 +337,8 @@ pub struct Telemetry {
     /// ‖w‖ = ‖BᵀPe‖.
     pub w_norm: f32,
     /// 0: no controller fault; otherwise the fault's code, [`controller_core::Fault::code`]
-    /// (read it back with [`Telemetry::fault`]).
+    /// (read it back with [`Telemetry::fault`]). A fault that latched the fail-safe is
+    /// reported in every frame until the board is re-armed (with [`Telemetry::latched`]).
     pub controller_fault: u8,
     /// Control steps that missed their deadline since boot.
     pub loop_overruns: u32,
@@ -318,6 +350,27 @@ pub struct Telemetry {
     pub rx_errors: u32,
     /// `seq` of the last [`Msg::State`] the board accepted.
     pub last_state_seq: u16,
+    // Protocol 2: appended fields.
+    /// The latched fail-safe reason, in every frame from the period it latched until the board
+    /// is re-armed (disarm, then arm): also while disarmed.
+    pub latched: Option<FailSafeReason>,
+    /// Commands refused since boot (each changed nothing).
+    pub refused_commands: u32,
+    /// Why the last refused command was refused (`None` before the first).
+    pub last_refusal: Option<Refusal>,
+    /// Frames dropped since boot as repeated, old or out of order: a sequence number that is
+    /// not newer ([`crate::seq`]), or a lock-step state frame off the mission clock. They
+    /// never restart the stale-state timer.
+    pub rx_stale: u32,
+    /// Frames refused since boot for their authentication ([`crate::sign`]; also counted in
+    /// `rx_errors`).
+    pub rx_auth_errors: u32,
+    /// `seq` of the last frame (any message) the board accepted; a restarted navigation
+    /// computer continues from the next number ([`crate::seq`]).
+    pub last_rx_seq: u16,
+    /// The board's link has signing on (it refuses unsigned frames).
+    pub signing: bool,
+    // Protocol 3: appended fields.
     /// The thrust unit the board reads Eqs 31–32 in.
     pub thrust_unit: ThrustUnit,
     /// The board's thruster mounting, as [`ConfigPatch::reversed_thrusters`].
@@ -338,6 +391,12 @@ impl Telemetry {
         + U8
         + 4 * U32
         + U16
+        + option(FailSafeReason::MAX_SIZE)
+        + U32
+        + option(Refusal::MAX_SIZE)
+        + 2 * U32
+        + U16
+        + BOOL
         + ThrustUnit::MAX_SIZE
         + U8;
 

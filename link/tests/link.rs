@@ -1,9 +1,10 @@
 //! Frame round trips, corruption, resynchronisation, size bounds and fuzzing of the decoder.
 
+use auv_link::sign::{AuthError, SIGNATURE_LEN};
 use auv_link::{
-    decode_frame, encode, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
-    ThrustUnit, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
+    decode_frame, encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope,
+    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, Refusal,
+    StateFrame, Telemetry, ThrustUnit, CRC_LEN, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
 };
 use proptest::prelude::*;
 
@@ -72,6 +73,13 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         rx_frames: 1_000_000,
         rx_errors: 17,
         last_state_seq: 65_000,
+        latched: Some(FailSafeReason::ControllerFault),
+        refused_commands: 4,
+        last_refusal: Some(Refusal::WhileArmed),
+        rx_stale: 300,
+        rx_auth_errors: 2,
+        last_rx_seq: 65_001,
+        signing: true,
         thrust_unit: ThrustUnit::Kgf,
         reversed_thrusters: 0b1_1110,
     }
@@ -134,6 +142,10 @@ fn every_kind() -> Vec<Envelope> {
             lockstep: Some(true),
             thrust_unit: Some(ThrustUnit::Newton),
             reversed_thrusters: Some(0b0_0110),
+            priority: Some(AxisPriority {
+                rank: [5, 4, 3, 0, 2, 1],
+                weight: [1.0, 2.0, 0.5, 1.0, 3.0, 0.25],
+            }),
         })),
         Msg::Command(Command::SetConfig(ConfigPatch {
             delta_max: Some(10.0),
@@ -172,6 +184,13 @@ fn largest() -> Envelope {
             rx_frames: u32::MAX,
             rx_errors: u32::MAX,
             last_state_seq: u16::MAX,
+            latched: Some(FailSafeReason::Overrun),
+            refused_commands: u32::MAX,
+            last_refusal: Some(Refusal::ControllerConfig),
+            rx_stale: u32::MAX,
+            rx_auth_errors: u32::MAX,
+            last_rx_seq: u16::MAX,
+            signing: true,
             thrust_unit: ThrustUnit::Newton,
             reversed_thrusters: u8::MAX,
         }),
@@ -294,6 +313,10 @@ fn max_sizes_are_exact() {
         lockstep: Some(true),
         thrust_unit: Some(ThrustUnit::Newton),
         reversed_thrusters: Some(u8::MAX),
+        priority: Some(AxisPriority {
+            rank: [u8::MAX; 6],
+            weight: [f32::MAX; 6],
+        }),
     };
     assert_eq!(postcard_len(&p), ConfigPatch::MAX_SIZE);
     assert_eq!(
@@ -311,17 +334,32 @@ fn max_sizes_are_exact() {
 
 #[test]
 fn largest_message_fits_max_frame_exactly() {
-    assert_eq!(Envelope::MAX_SIZE, 117);
-    assert_eq!(MAX_BODY, 119);
-    assert_eq!(MAX_FRAME, 121);
+    assert_eq!(Envelope::MAX_SIZE, 140);
+    assert_eq!(MAX_BODY, 155);
+    assert_eq!(MAX_FRAME, 157);
+    // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
+    // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
+    let unsigned = MAX_FRAME - SIGNATURE_LEN;
     let mut out = [0u8; MAX_FRAME];
-    assert_eq!(encode(&env, &mut out), Ok(MAX_FRAME));
+    assert_eq!(encode(&env, &mut out), Ok(unsigned));
     assert_eq!(
-        encode(&env, &mut [0u8; MAX_FRAME - 1]),
+        encode(&env, &mut [0u8; MAX_FRAME - SIGNATURE_LEN - 1]),
         Err(LinkError::BufferTooSmall)
     );
-    assert_eq!(decode_stream(&out), vec![Ok(env)]);
+    assert_eq!(decode_stream(&out[..unsigned]), vec![Ok(env)]);
+}
+
+#[test]
+fn a_telemetry_frame_fits_a_100_hz_period_at_the_boards_baud() {
+    // The STM32 board's link: 460 800 baud, 8N1 (10 bits a byte). A period must carry a
+    // telemetry frame one way and a state frame the other; the UART is full duplex, so the
+    // larger of the two must fit, with the signature.
+    let bytes_per_second = 460_800 / 10;
+    let frame_us = MAX_FRAME * 1_000_000 / bytes_per_second;
+    assert!(frame_us < 10_000 / 2, "{frame_us} µs");
+    // Body arithmetic: the CRC follows the signature.
+    assert_eq!(MAX_BODY, Envelope::MAX_SIZE + SIGNATURE_LEN + CRC_LEN);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -360,7 +398,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 1, 3, 0x7F, 0xFF] {
+    for version in [0u8, 1, 2, 4, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -377,27 +415,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[3, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[4, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 3 })]
+        vec![Err(LinkError::Version { got: 4 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 2, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    assert_eq!(PROTOCOL_VERSION, 2);
-    let wire = frame_from_body(&[2, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 3, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 3);
+    let wire = frame_from_body(&[3, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
-    // A body with a byte left over, or a bad variant, or cut short: Deserialize.
+    // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
+    // short: Deserialize.
     for body in [
-        &[2, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[2, 0x00, 0x03][..],
-        &[2, 0x00, 0x01, 0x05][..],
-        &[2, 0x00, 0x00, 0x01][..],
-        &[2][..],
+        &[3, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[3, 0x00, 0x03][..],
+        &[3, 0x00, 0x01, 0x05][..],
+        &[3, 0x00, 0x00, 0x01][..],
+        &[3][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -405,6 +446,12 @@ fn hand_made_frames_match_the_documented_format() {
             "{body:?}"
         );
     }
+    // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
+    let signed = [&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    assert_eq!(
+        decode_stream(&frame_from_body(&signed)),
+        vec![Err(LinkError::Auth(AuthError::SigningOff))]
+    );
     // A bad CRC.
     let mut body = vec![PROTOCOL_VERSION, 0xAC, 0x02, 0x01, 0x00];
     let crc = crc16(&body);
@@ -460,6 +507,7 @@ fn errors_display() {
         LinkError::Version { got: 9 },
         LinkError::BufferTooSmall,
         LinkError::Serialize,
+        LinkError::Auth(AuthError::BadMac),
     ] {
         let s = e.to_string();
         assert!(!s.is_empty(), "{e:?}");
@@ -554,6 +602,7 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
         any::<Option<bool>>(),
         proptest::option::of(any_unit()),
         any::<Option<u8>>(),
+        proptest::option::of(any_priority()),
     )
         .prop_map(
             |(
@@ -565,6 +614,7 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
                 lockstep,
                 thrust_unit,
                 reversed_thrusters,
+                priority,
             )| ConfigPatch {
                 rate_hz,
                 robust,
@@ -574,8 +624,25 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
                 lockstep,
                 thrust_unit,
                 reversed_thrusters,
+                priority,
             },
         )
+        .boxed()
+}
+
+fn any_priority() -> BoxedStrategy<AxisPriority> {
+    (
+        any::<[u8; 6]>(),
+        [
+            any_f32(),
+            any_f32(),
+            any_f32(),
+            any_f32(),
+            any_f32(),
+            any_f32(),
+        ],
+    )
+        .prop_map(|(rank, weight)| AxisPriority { rank, weight })
         .boxed()
 }
 
@@ -610,6 +677,15 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<u32>(),
             any::<u32>(),
             any::<u16>(),
+        ),
+        (
+            prop::option::of(any_reason()),
+            any::<u32>(),
+            prop::option::of(any_refusal()),
+            any::<u32>(),
+            any::<u32>(),
+            any::<u16>(),
+            any::<bool>(),
             any_unit(),
             any::<u8>(),
         ),
@@ -625,6 +701,15 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     rx_frames,
                     rx_errors,
                     last_state_seq,
+                ),
+                (
+                    latched,
+                    refused_commands,
+                    last_refusal,
+                    rx_stale,
+                    rx_auth_errors,
+                    last_rx_seq,
+                    signing,
                     thrust_unit,
                     reversed_thrusters,
                 ),
@@ -644,11 +729,22 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 rx_frames,
                 rx_errors,
                 last_state_seq,
+                latched,
+                refused_commands,
+                last_refusal,
+                rx_stale,
+                rx_auth_errors,
+                last_rx_seq,
+                signing,
                 thrust_unit,
                 reversed_thrusters,
             },
         )
         .boxed()
+}
+
+fn any_refusal() -> BoxedStrategy<Refusal> {
+    prop::sample::select(Refusal::ALL.to_vec()).boxed()
 }
 
 fn any_msg() -> BoxedStrategy<Msg> {

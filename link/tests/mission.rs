@@ -3,8 +3,8 @@
 //! documented postcard layout of `MissionSpec` and `MissionPlan`.
 
 use auv_link::{
-    decode_frame, encode, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg, ThrustUnit,
-    MAX_FRAME,
+    decode_frame, encode, AxisPriority, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg,
+    ThrustUnit, MAX_FRAME,
 };
 use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
@@ -138,6 +138,14 @@ fn every_kind_round_trips_through_a_frame() {
     for u in controller_core::ThrustUnit::ALL {
         assert_eq!(controller_core::ThrustUnit::from(ThrustUnit::from(u)), u);
     }
+    // The axis priority, field for field (a non-default one, so a swapped field would show).
+    let p = controller_core::allocator::AxisPriority {
+        rank: [1, 5, 2, 0, 4, 3],
+        weight: [0.5, 1.0, 2.0, 3.0, 4.0, 8.0],
+    };
+    let wire = AxisPriority::from(p);
+    assert_eq!((wire.rank, wire.weight), (p.rank, p.weight));
+    assert_eq!(controller_core::allocator::AxisPriority::from(wire), p);
 }
 
 #[test]

@@ -1,7 +1,7 @@
 //! The board's status and fail-safe names, and the reason bytes on the wire. The names are what
 //! the firmware logs (its defmt snapshots hold them) and what host-sim's reports and JSON say.
 
-use auv_link::{BoardStatus, FailSafeReason, Telemetry, ThrustUnit};
+use auv_link::{BoardStatus, FailSafeReason, Refusal, Telemetry, ThrustUnit};
 use controller_core::Fault;
 
 #[test]
@@ -68,6 +68,13 @@ fn telemetry_fault_code_is_the_cores() {
         rx_frames: 0,
         rx_errors: 0,
         last_state_seq: 0,
+        latched: Some(FailSafeReason::ControllerFault),
+        refused_commands: 0,
+        last_refusal: None,
+        rx_stale: 0,
+        rx_auth_errors: 0,
+        last_rx_seq: 0,
+        signing: false,
         thrust_unit: ThrustUnit::Kgf,
         reversed_thrusters: 0,
     };
@@ -78,4 +85,21 @@ fn telemetry_fault_code_is_the_cores() {
     }
     t.controller_fault = 200;
     assert_eq!(t.fault(), None);
+}
+
+#[test]
+fn refusal_names_are_unique_comma_free_and_their_bytes_are_the_wire() {
+    for (i, r) in Refusal::ALL.into_iter().enumerate() {
+        let mut buf = [0u8; Refusal::MAX_SIZE];
+        assert_eq!(postcard::to_slice(&r, &mut buf).unwrap(), &[r as u8]);
+        assert_eq!(r as u8 as usize, i, "ALL is in wire order");
+        assert_eq!(r.to_string(), r.as_str());
+        assert!(!r.as_str().is_empty() && !r.as_str().contains(','));
+        assert_eq!(Refusal::from_name(r.as_str()), Some(r));
+        for other in Refusal::ALL {
+            assert!(other == r || other.as_str() != r.as_str());
+        }
+    }
+    assert_eq!(Refusal::from_name("no such reason"), None);
+    assert_eq!(Refusal::Latched.as_str(), "fail-safe latched");
 }

@@ -9,7 +9,7 @@ use controller_core::kinematics::{self, Attitude};
 use controller_core::{
     Controller, ControllerConfig, Status, Table1Case, Trajectory, TrajectoryKind,
 };
-use firmware::supervisor::Supervisor;
+use firmware::supervisor::{BoardInfo, Supervisor};
 use host_sim::link::state_frame;
 use nalgebra::Vector6;
 
@@ -69,7 +69,13 @@ fn the_board_builds_the_same_mission_from_the_link() {
 fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
     let ctl = Controller::new(ControllerConfig::default()).unwrap();
     for (name, tr) in missions() {
-        let mut sup = Supervisor::new(Controller::new(ControllerConfig::default()).unwrap());
+        let mut sup = Supervisor::new(
+            Controller::new(ControllerConfig::default()).unwrap(),
+            BoardInfo {
+                supply_voltage: controller_core::DEFAULT_V_LIMIT,
+                signing: false,
+            },
+        );
         let mut dec = FrameDecoder::new();
         deliver(&mut sup, &mut dec, 0, Msg::Command(Command::Arm));
         deliver(

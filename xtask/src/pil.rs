@@ -1,6 +1,8 @@
 //! Processor in the loop: the QEMU flying image flies the simulated vehicle through
-//! `host-sim pil`. Two checks: a short lawn-mower mission must equal SIL bit for bit, and a
-//! link-fault case must enter and leave fail-safe at its exact ticks.
+//! `host-sim pil`. Three checks: a short lawn-mower mission must equal SIL bit for bit, on an
+//! unsigned and on a signed link (the public CI test key, `firmware/ci-test-link-key.hex`), and
+//! a link-fault case must enter and leave fail-safe at its exact ticks and drop its delayed
+//! (old) state frames.
 
 use std::path::Path;
 use std::process::Command;
@@ -14,8 +16,13 @@ use host_sim::record::Cases;
 use crate::ci::Ci;
 use crate::images::{Built, Variant};
 
+/// The key the signed PIL run uses (workspace-relative): public, for tests only.
+const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
+
 pub fn run(ci: &mut Ci, built: &Built) {
-    ci.step("processor in the loop: a short mission (PIL must equal SIL) and a link-fault case");
+    ci.step(
+        "processor in the loop: a short mission unsigned and signed (PIL must equal SIL) and a link-fault case",
+    );
     let Some(elf) = built.elf(Variant::QEMU) else {
         ci.fail("PIL: no QEMU flying image (its build failed, see above)");
         return;
@@ -48,6 +55,8 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     let scratch = ci.scratch();
     let run = |ci: &mut Ci, name: &str, args: &[&str]| -> Option<(bool, Case)> {
         let out = scratch.join(format!("pil-{name}"));
+        // host-sim refuses an output folder it did not write (no manifest): start afresh.
+        let _ = std::fs::remove_dir_all(&out);
         let mut cmd = Command::new(host_sim);
         cmd.current_dir(&ci.root)
             .arg("pil")
@@ -102,40 +111,71 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
         }
     };
 
-    // 1. PIL = SIL: the same f32 core on the same inputs, bit for bit.
-    if let Some((ok, c)) = run(
-        ci,
-        "short",
-        &[
-            "--scenario",
-            "host-sim/scenarios/lawn-mower-20x10.toml",
-            "--duration",
-            "10",
-        ],
-    ) {
+    // 1. PIL = SIL: the same f32 core on the same inputs, bit for bit, unsigned and signed
+    //    (signing changes what crosses the link, never what the board computes).
+    let short = [
+        "--scenario",
+        "host-sim/scenarios/lawn-mower-20x10.toml",
+        "--duration",
+        "10",
+    ];
+    let key = ci.root.join(CI_TEST_KEY);
+    let key = key.to_string_lossy().into_owned();
+    // Signed, the first half of the same mission (its PIL = SIL check is the same; CI time).
+    let signed = [&short[..3], &["5", "--link-key-file", &key]].concat();
+    for (name, args, want_signed) in [
+        ("short", &short[..], false),
+        ("short-signed", &signed[..], true),
+    ] {
+        let Some((ok, c)) = run(ci, name, args) else {
+            continue;
+        };
         println!(
-            "PIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s, worst update {} instructions",
+            "{name}: PIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s, worst update {} instructions, signed {}, board auth errors {}, telemetry refused {}",
             c.run.metrics.max_path,
             c.sil_max_path,
             c.pil.frames_per_second,
-            c.pil.worst_update_instructions
+            c.pil.worst_update_instructions,
+            c.pil.signed,
+            c.pil.board_rx_auth_errors,
+            c.pil.telemetry_refused
         );
-        whole_counts(ci, "short mission", &c);
+        whole_counts(ci, name, &c);
         if !ok || c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits() {
             ci.fail(format!(
-                "PIL short mission: PIL max path {} m is not SIL's {} m bit for bit (host-sim {}); the board and SIL run the same f32 core on the same state frames, so look for a change in what crosses the link or in the firmware's period",
+                "PIL {name}: PIL max path {} m is not SIL's {} m bit for bit (host-sim {}); the board and SIL run the same f32 core on the same state frames, so look for a change in what crosses the link or in the firmware's period",
                 c.run.metrics.max_path,
                 c.sil_max_path,
                 if ok { "passed its 1 mm check" } else { "failed" }
             ));
         }
+        let clean = c.pil.board_rx_errors == 0
+            && c.pil.board_rx_stale == 0
+            && c.pil.board_refused_commands == 0
+            && c.pil.telemetry_refused == 0;
+        if c.pil.signed != want_signed || !clean {
+            ci.fail(format!(
+                "PIL {name}: expected a {} link with no receive error, dropped frame or refusal at either end; got signed {}, board rx errors {}, dropped {}, refused {} ({:?}), telemetry refused {}",
+                if want_signed { "signed" } else { "unsigned" },
+                c.pil.signed,
+                c.pil.board_rx_errors,
+                c.pil.board_rx_stale,
+                c.pil.board_refused_commands,
+                c.pil.board_last_refusal,
+                c.pil.telemetry_refused
+            ));
+        }
     }
 
-    // 2. Link faults: drop, corruption and a short delay stay within the stale limit; silence
-    //    from tick SILENT.0 is fail-safe (stale state) once DEFAULT_STALE_PERIODS periods have
-    //    passed without a frame, and the re-arm on the first healthy frame (SILENT.1) ends it.
+    // 2. Link faults: drop, corruption and a short delay stay within the stale limit; the
+    //    delayed frames hold old states, which the board drops (off its mission clock) and
+    //    counts; silence from tick SILENT.0 is fail-safe (stale state) once
+    //    DEFAULT_STALE_PERIODS periods have passed without a frame, and the re-arm (and
+    //    restart of the mission) on the first healthy frame (SILENT.1) ends it.
     const SILENT: (u64, u64) = (300, 310);
+    const DELAY: (u64, u64) = (200, 202);
     let silent = format!("{}..{}", SILENT.0, SILENT.1);
+    let delay = format!("{}..{}", DELAY.0, DELAY.1);
     if let Some((ok, c)) = run(
         ci,
         "faults",
@@ -149,7 +189,7 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
             "--corrupt",
             "150..152",
             "--delay",
-            "200..210",
+            &delay,
             "--silent",
             &silent,
         ],
@@ -182,6 +222,13 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
             ci.fail(format!(
                 "PIL link-fault case: the board counted {} receive errors; the two corrupted frames must be counted",
                 c.pil.board_rx_errors
+            ));
+        }
+        if u64::from(c.pil.board_rx_stale) != DELAY.1 - DELAY.0 {
+            ci.fail(format!(
+                "PIL link-fault case: the board dropped {} frames as old; the {} delayed state frames (ticks {delay}) must be dropped, and nothing else",
+                c.pil.board_rx_stale,
+                DELAY.1 - DELAY.0
             ));
         }
     }

@@ -52,10 +52,43 @@ pub fn run(ci: &mut Ci, built: &Built) {
             ));
         }
         check_instruction_counts(ci, backend, &run.log);
+        check_signing_budget(ci, backend, &run.log);
         compare_log(ci, backend, &run.log);
         if v.backend == Backend::Libm {
             inject_failures(ci, elf);
         }
+    }
+}
+
+/// Instructions signing adds to the largest telemetry frame the board sends (the self-test's
+/// `signing instructions per frame: sign=N`): the measured count plus ≈ 20 % headroom. Twice
+/// per period the board signs or verifies one frame: together ≈ half an `update`.
+pub const SIGN_INSTRUCTION_BUDGET: u64 = 12_000;
+/// Instructions signing adds to receiving a state frame (`verify=N`), likewise.
+pub const VERIFY_INSTRUCTION_BUDGET: u64 = 10_000;
+
+/// The self-test's `signing instructions per frame: sign=N verify=M` against the budgets.
+fn check_signing_budget(ci: &mut Ci, backend: &str, log: &str) {
+    let count = |key: &str| {
+        log.lines()
+            .find(|l| l.contains("signing instructions per frame:"))
+            .and_then(|l| l.split_whitespace().find_map(|t| t.strip_prefix(key)))
+            .and_then(|n| n.parse::<u64>().ok())
+    };
+    match (count("sign="), count("verify=")) {
+        (Some(sign), Some(verify)) => {
+            println!(
+                "{backend}: signing adds {sign} instructions to a telemetry frame (budget {SIGN_INSTRUCTION_BUDGET}) and {verify} to a state frame (budget {VERIFY_INSTRUCTION_BUDGET})"
+            );
+            if sign > SIGN_INSTRUCTION_BUDGET || verify > VERIFY_INSTRUCTION_BUDGET {
+                ci.fail(format!(
+                    "self-test ({backend}): signing costs sign={sign} verify={verify} instructions per frame, over the budgets {SIGN_INSTRUCTION_BUDGET} / {VERIFY_INSTRUCTION_BUDGET} (xtask/src/selftest.rs)"
+                ));
+            }
+        }
+        _ => ci.fail(format!(
+            "self-test ({backend}): no `signing instructions per frame: sign=N verify=M` line in its log"
+        )),
     }
 }
 

@@ -1,16 +1,32 @@
 //! The QEMU flying image (`cargo fw`): the thruster-board loop on `mps2-an386`, the navigation
-//! link on UART0. This is the image `host-sim pil` flies (it checks the marker).
+//! link on UART0. This is the image `host-sim pil` flies (it checks the marker). Signing is on
+//! if the semihosting command line provisions a key (`-append link-key=<64 hex digits>`;
+//! `host-sim pil --link-key-file` does), off otherwise; a malformed key stops the board.
 #![no_std]
 #![no_main]
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::image::Image;
-use firmware::qemu::{halt, QemuBoard};
+use firmware::qemu::{self, halt, KeyArgError, QemuBoard};
 
 #[entry]
 fn main() -> ! {
-    firmware::rt::fly_image(Image::Qemu, halt, |cp, rate_hz| {
+    let key = match qemu::link_key() {
+        Ok(key) => key,
+        Err(KeyArgError::Unreadable) => {
+            defmt::error!("semihosting command line unreadable: no link key, not flying");
+            halt(1)
+        }
+        Err(KeyArgError::Malformed(_)) => {
+            defmt::error!(
+                "{=str} is not followed by 64 hexadecimal digits: not flying",
+                qemu::LINK_KEY_ARG
+            );
+            halt(1)
+        }
+    };
+    firmware::rt::fly_image(Image::Qemu, halt, key, |cp, rate_hz| {
         QemuBoard::init(cp.SYST, rate_hz)
     })
 }

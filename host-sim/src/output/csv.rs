@@ -1,11 +1,14 @@
 //! The per-period CSV of a run: one row per control period, columns [`CSV_COLUMNS`].
 
-use std::fs;
-use std::path::Path;
+use std::fs::{self, File};
+use std::io::Write;
+use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 
+use super::atomic::Pending;
 use crate::record::{RunResult, Sample};
+use crate::sil::Observer;
 
 /// The columns of [`write_csv`], in order.
 pub const CSV_COLUMNS: [&str; 47] = [
@@ -87,19 +90,134 @@ fn csv_record(s: &Sample, rec: &mut Vec<String>) {
 /// payload, status.
 ///
 /// Units as in [`Sample`] (s, m, rad, N, N m, V, kg). The parent directory is created if
-/// needed. An empty run writes the header only.
+/// needed. An empty run writes the header only. Written whole or not at all
+/// ([`super::atomic`]). The commands stream the CSV as the run goes instead ([`CsvStream`]);
+/// this writes the samples a [`RunResult`] holds.
 pub fn write_csv(path: &Path, run: &RunResult) -> Result<()> {
-    let ctx = || format!("writing {}", path.display());
     if let Some(parent) = path.parent().filter(|p| !p.as_os_str().is_empty()) {
-        fs::create_dir_all(parent).with_context(ctx)?;
+        fs::create_dir_all(parent).with_context(|| format!("writing {}", path.display()))?;
     }
-    let mut w = csv::Writer::from_path(path).with_context(ctx)?;
-    w.write_record(CSV_COLUMNS).with_context(ctx)?;
-    let mut rec = Vec::with_capacity(CSV_COLUMNS.len());
+    let mut csv = CsvStream::create(path)?;
     for s in &run.samples {
-        csv_record(s, &mut rec);
-        w.write_record(&rec).with_context(ctx)?;
+        csv.push(s);
     }
-    w.flush().with_context(ctx)?;
+    csv.finish()?;
     Ok(())
+}
+
+/// The CSV of one run written as the run goes, one row per sample ([`Observer`]): memory
+/// stays bounded whatever the duration. The rows go to a temporary file, which
+/// [`CsvStream::finish`] flushes and renames onto the final name ([`super::atomic`]).
+///
+/// A write error (a full disk: ENOSPC) stops the writing but not the run: the error and the
+/// time of the first row lost are kept, [`CsvStream::finish`] returns them as a
+/// [`CsvIncomplete`] naming the file, and the temporary file is removed (which also gives the
+/// disk space back for the report).
+pub struct CsvStream {
+    pending: Pending,
+    rows: CsvRows<File>,
+}
+
+impl CsvStream {
+    /// Starts `dest`'s temporary file and writes the header.
+    pub fn create(dest: &Path) -> Result<Self> {
+        let (pending, file) =
+            Pending::create(dest).with_context(|| format!("writing {}", dest.display()))?;
+        Ok(CsvStream {
+            pending,
+            rows: CsvRows::new(file),
+        })
+    }
+
+    /// Writes one row (after an error: nothing).
+    pub fn push(&mut self, s: &Sample) {
+        self.rows.push(s);
+    }
+
+    /// The CSV in place under its final name, or why it is not.
+    pub fn finish(self) -> Result<PathBuf, CsvIncomplete> {
+        let dest = self.pending.dest().to_path_buf();
+        let incomplete = |error: String| CsvIncomplete {
+            path: dest.clone(),
+            error,
+        };
+        self.rows.finish().map_err(incomplete)?;
+        self.pending
+            .commit()
+            .map_err(|e| incomplete(format!("putting it in place: {e}")))
+    }
+}
+
+impl Observer for CsvStream {
+    fn sample(&mut self, s: &Sample) {
+        self.push(s);
+    }
+}
+
+/// A CSV that could not be written completely: `path` does not exist (its temporary file was
+/// removed); `error` says where the writing stopped and why.
+#[derive(Debug)]
+pub struct CsvIncomplete {
+    pub path: PathBuf,
+    pub error: String,
+}
+
+impl std::fmt::Display for CsvIncomplete {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} is incomplete and was not written: {}",
+            self.path.display(),
+            self.error
+        )
+    }
+}
+
+impl std::error::Error for CsvIncomplete {}
+
+/// The rows of a CSV into any writer: the header at once, then one row per sample; the first
+/// write error stops the writing and is kept (with the time of the row it lost).
+pub struct CsvRows<W: Write> {
+    writer: Option<csv::Writer<W>>,
+    rec: Vec<String>,
+    error: Option<String>,
+}
+
+impl<W: Write> CsvRows<W> {
+    /// The header row into `w`.
+    pub fn new(w: W) -> Self {
+        let mut writer = csv::Writer::from_writer(w);
+        let error = writer
+            .write_record(CSV_COLUMNS)
+            .err()
+            .map(|e| format!("writing the header: {e}"));
+        CsvRows {
+            writer: Some(writer),
+            rec: Vec::with_capacity(CSV_COLUMNS.len()),
+            error,
+        }
+    }
+
+    pub fn push(&mut self, s: &Sample) {
+        if self.error.is_some() {
+            return;
+        }
+        let Some(w) = self.writer.as_mut() else {
+            return;
+        };
+        csv_record(s, &mut self.rec);
+        if let Err(e) = w.write_record(&self.rec) {
+            self.error = Some(format!("writing stopped at t = {:.3} s: {e}", s.t));
+        }
+    }
+
+    /// Flushes; the writer back, or the first error.
+    pub fn finish(mut self) -> Result<W, String> {
+        if let Some(e) = self.error.take() {
+            return Err(e);
+        }
+        let w = self.writer.take().ok_or("no writer")?;
+        w.into_inner()
+            .map_err(|e| format!("writing the last rows: {}", e.error()))
+    }
 }

@@ -9,6 +9,7 @@ use anyhow::{Context, Result};
 use controller_core::DEFAULT_V_LIMIT;
 use plotters::prelude::RGBColor;
 
+use super::atomic::Pending;
 use super::plot::{
     figure, min_max, render, usable, Line, Panel, Stroke, C_DESIRED, C_LIMIT, C_WITH, C_WITHOUT,
 };
@@ -93,14 +94,14 @@ fn plot_xy(path: &Path, with: &RunResult, without: Option<&RunResult>) -> Result
     p.equal_aspect = true;
     if let Some(wo) = without {
         p.lines.push(Line::new(
-            "actual, without Δu",
+            format!("actual, {}", wo.du_label()),
             C_WITHOUT,
             Stroke::Solid,
             wo.samples.iter().map(|s| (s.eta[0], s.eta[1])).collect(),
         ));
     }
     p.lines.push(Line::new(
-        "actual, with Δu",
+        format!("actual, {}", with.du_label()),
         C_WITH,
         Stroke::Solid,
         with.samples.iter().map(|s| (s.eta[0], s.eta[1])).collect(),
@@ -130,14 +131,14 @@ fn plot_errors(path: &Path, with: &RunResult, without: Option<&RunResult>) -> Re
             p.x_range = t_range;
             if let Some(wo) = without {
                 p.lines.push(Line::new(
-                    "without Δu",
+                    wo.du_label(),
                     C_WITHOUT,
                     Stroke::Solid,
                     series(wo, |s| s.error[i]),
                 ));
             }
             p.lines.push(Line::new(
-                "with Δu",
+                with.du_label(),
                 C_WITH,
                 Stroke::Solid,
                 series(with, |s| s.error[i]),
@@ -171,14 +172,14 @@ fn plot_heading(path: &Path, with: &RunResult, without: Option<&RunResult>) -> R
     p.x_range = time_range(with, without);
     if let Some(wo) = without {
         p.lines.push(Line::new(
-            "ψ without Δu",
+            format!("ψ {}", wo.du_label()),
             C_WITHOUT,
             Stroke::Solid,
             unwrap_angles(&series(wo, |s| s.eta[5])),
         ));
     }
     p.lines.push(Line::new(
-        "ψ with Δu",
+        format!("ψ {}", with.du_label()),
         C_WITH,
         Stroke::Solid,
         unwrap_angles(&series(with, |s| s.eta[5])),
@@ -195,9 +196,9 @@ fn plot_heading(path: &Path, with: &RunResult, without: Option<&RunResult>) -> R
     })
 }
 
-fn voltage_panel(run: &RunResult, which: &str, limit: f64, t_range: Option<(f64, f64)>) -> Panel {
+fn voltage_panel(run: &RunResult, limit: f64, t_range: Option<(f64, f64)>) -> Panel {
     let mut p = Panel::new(
-        format!("thruster voltages, {which} Δu"),
+        format!("thruster voltages, {}", run.du_label()),
         "t (s)",
         "voltage (V)",
     );
@@ -235,11 +236,15 @@ fn plot_actuators(
     limit: f64,
 ) -> Result<()> {
     let t_range = time_range(with, without);
-    let mut panels = vec![voltage_panel(with, "with", limit, t_range)];
+    let mut panels = vec![voltage_panel(with, limit, t_range)];
     if let Some(wo) = without {
-        panels.push(voltage_panel(wo, "without", limit, t_range));
+        panels.push(voltage_panel(wo, limit, t_range));
     }
-    let mut d = Panel::new("robust gain δ(e,t), with Δu", "t (s)", "δ");
+    let mut d = Panel::new(
+        format!("robust gain δ(e,t), {}", with.du_label()),
+        "t (s)",
+        "δ",
+    );
     d.x_range = t_range;
     d.lines.push(Line::new(
         "δ(e,t)",
@@ -308,22 +313,45 @@ pub fn plot_case_with_limit(
     voltage_limit: f64,
 ) -> Result<Vec<PathBuf>> {
     fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    let stem = file_stem(&with.name);
-    let mut files = Vec::with_capacity(5);
-    let plots: [(&str, PlotFn); 4] = [
-        ("xy", plot_xy),
-        ("errors", plot_errors),
-        ("payload", plot_payload),
-        ("heading", plot_heading),
-    ];
-    for (suffix, plot) in plots {
-        let path = dir.join(format!("{stem}-{suffix}.png"));
-        plot(&path, with, without).with_context(|| format!("writing {}", path.display()))?;
-        files.push(path);
+    let mut files = Vec::with_capacity(PLOTS.len());
+    for (name, (_, plot)) in plot_names(&with.name).into_iter().zip(PLOTS) {
+        files.push(write_plot(&dir.join(name), |path| match plot {
+            Plot::Figure(f) => f(path, with, without),
+            Plot::Actuators => plot_actuators(path, with, without, voltage_limit),
+        })?);
     }
-    let path = dir.join(format!("{stem}-actuators.png"));
-    plot_actuators(&path, with, without, voltage_limit)
-        .with_context(|| format!("writing {}", path.display()))?;
-    files.push(path);
     Ok(files)
+}
+
+/// The figures, in the order of [`plot_case`]'s files.
+enum Plot {
+    Figure(PlotFn),
+    Actuators,
+}
+
+const PLOTS: [(&str, Plot); 5] = [
+    ("xy", Plot::Figure(plot_xy)),
+    ("errors", Plot::Figure(plot_errors)),
+    ("payload", Plot::Figure(plot_payload)),
+    ("heading", Plot::Figure(plot_heading)),
+    ("actuators", Plot::Actuators),
+];
+
+/// The file names of the plots of a run called `name`, in the order [`plot_case`] writes them.
+pub fn plot_names(name: &str) -> Vec<String> {
+    let stem = file_stem(name);
+    PLOTS
+        .iter()
+        .map(|(suffix, _)| format!("{stem}-{suffix}.png"))
+        .collect()
+}
+
+/// Draws into a temporary file next to `dest` and renames it into place
+/// ([`super::atomic`]): a failed plot leaves no file under its name.
+fn write_plot(dest: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<PathBuf> {
+    let ctx = || format!("writing {}", dest.display());
+    let (pending, file) = Pending::create(dest).with_context(ctx)?;
+    drop(file);
+    draw(pending.tmp_path()).with_context(ctx)?;
+    pending.commit().with_context(ctx)
 }

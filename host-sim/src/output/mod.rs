@@ -1,49 +1,61 @@
-//! What a run leaves on disk: the per-period CSV ([`csv`]), PNG plots in the manner of the
-//! paper's Figs 2–5 ([`figures`], drawn with the plotting layer [`plot`]), and the Table-1
-//! report, Markdown file and terminal text ([`report`]).
+//! What a run leaves on disk: the per-period CSV ([`csv`], streamed as the run goes), PNG plots
+//! in the manner of the paper's Figs 2–5 ([`figures`], drawn with the plotting layer [`plot`]),
+//! and the Table-1 report, Markdown file and terminal text ([`report`]); all of it in an
+//! output folder checked before the computation and holding only its last run's files
+//! ([`dir`]), each file written whole or not at all ([`atomic`]).
 //!
 //! Nothing here panics on data: NaN and ±∞ values (and magnitudes beyond 1e100) are skipped in
 //! plots (a line is broken at them), written as `NaN`/`inf` in the CSV and in tables, and an
 //! empty run gives plots that say "no data". A diverged run is always named as such, with its
 //! time and reason, in plot subtitles and in the tables.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 
+pub mod atomic;
 pub mod csv;
+pub mod dir;
 pub mod figures;
 mod plot;
 pub mod report;
 
-pub use self::csv::{write_csv, CSV_COLUMNS};
-pub use self::figures::{plot_case, plot_case_with_limit};
-pub use self::report::{table_markdown, table_text, write_report, ReportRow};
+pub use self::csv::{write_csv, CsvStream, CSV_COLUMNS};
+pub use self::dir::OutputDir;
+pub use self::figures::{plot_case, plot_case_with_limit, plot_names};
+pub use self::report::{report_markdown, table_markdown, table_text, write_report, ReportRow};
 
-/// Writes everything for the report rows' runs into `out` (created if needed): per row the CSV
-/// of the run with Δu (`{name}-with.csv`) and of its companion without (`-without.csv`), the
-/// five plots (voltages against ±`voltage_limit`), then `report.md` with the table, the plots
-/// and `notes`. Returns the report's path.
-pub fn write_all(
-    out: &Path,
+/// The CSV file name of a run called `name`, with (`robust`) or without Δu:
+/// `{name}-with.csv` / `{name}-without.csv`.
+pub fn csv_name(name: &str, robust: bool) -> String {
+    format!("{name}-{}.csv", crate::record::du_suffix(robust))
+}
+
+/// Writes the plots of the report rows' runs (five per row, voltages against
+/// ±`voltage_limit`) and then `report.md` with the table, the plots, the `incomplete` outputs
+/// and `notes` into `dir` (the CSVs were streamed while the runs went). A plot that cannot be
+/// written is added to `incomplete` and the rest go on; the report's own failure is the error.
+/// Returns the report's path.
+pub fn write_plots_and_report(
+    dir: &OutputDir,
     title: &str,
     rows: &[ReportRow],
     notes: &str,
     voltage_limit: f64,
+    incomplete: &mut Vec<String>,
 ) -> Result<PathBuf> {
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let mut plots = Vec::new();
     for row in rows {
-        write_csv(&out.join(format!("{}-with.csv", row.with.name)), row.with)?;
-        if let Some(w) = row.without {
-            write_csv(&out.join(format!("{}-without.csv", w.name)), w)?;
+        let written = plot_names(&row.with.name)
+            .iter()
+            .try_for_each(|name| dir.claim(name).map(|_| ()))
+            .and_then(|()| plot_case_with_limit(dir.path(), row.with, row.without, voltage_limit));
+        match written {
+            Ok(files) => plots.extend(files),
+            Err(e) => incomplete.push(format!("plots of {}: {e:#}", row.with.name)),
         }
-        plots.extend(plot_case_with_limit(
-            out,
-            row.with,
-            row.without,
-            voltage_limit,
-        )?);
     }
-    write_report(out, title, rows, &plots, notes)
+    let path = dir.claim("report.md")?;
+    let text = report_markdown(dir.path(), title, rows, &plots, notes, incomplete);
+    atomic::write(&path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))
 }

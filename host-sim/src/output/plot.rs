@@ -407,11 +407,21 @@ pub(super) fn figure(
     panels: &[Panel],
 ) -> Result<()> {
     let area = root.titled(title, (FONT, 26)).map_err(plot_err)?;
-    let mut sub = format!("with Δu: {}", with.outcome);
-    let mut diverged = matches!(with.outcome, Outcome::Diverged { .. });
+    // A run's outcome, and the periods its thrusters were off, if any.
+    let state = |r: &RunResult| {
+        let mut s = format!("{}: {}", r.du_label(), r.outcome);
+        if !r.faults.is_empty() {
+            let _ = write!(s, ", fail-safe in {} periods", r.faults.total());
+        }
+        s
+    };
+    let alarming =
+        |r: &RunResult| !matches!(r.outcome, Outcome::Completed) || r.faulted_unexpectedly();
+    let mut sub = state(with);
+    let mut diverged = alarming(with);
     if let Some(wo) = without {
-        let _ = write!(sub, "   ·   without Δu: {}", wo.outcome);
-        diverged |= matches!(wo.outcome, Outcome::Diverged { .. });
+        let _ = write!(sub, "   ·   {}", state(wo));
+        diverged |= alarming(wo);
     }
     if with.samples.is_empty() || without.is_some_and(|w| w.samples.is_empty()) {
         sub.push_str("   ·   (a run has no samples)");

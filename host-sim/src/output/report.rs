@@ -8,8 +8,9 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use controller_core::Table1Case;
 
+use super::atomic;
 use crate::paper;
-use crate::record::{Metrics, Outcome, RunResult};
+use crate::record::{Metrics, RunResult};
 
 /// One row of a report table: a case, its run with Δu, optionally its run without Δu, and
 /// the paper's Table-1 case it reproduces, if any (its numbers are printed beside ours).
@@ -51,7 +52,7 @@ fn fmt_fixed(v: f64, decimals: usize) -> String {
     }
 }
 
-const TABLE_HEADER: [&str; 13] = [
+const TABLE_HEADER: [&str; 14] = [
     "case",
     "Δu",
     "max x (m)",
@@ -64,23 +65,36 @@ const TABLE_HEADER: [&str; 13] = [
     "max yaw (rad)",
     "peak |V| (V)",
     "saturated",
+    "faults",
     "outcome",
 ];
+
+/// The runs of a row as the table shows them: the run without Δu, then the run with Δu (each
+/// labelled by its own [`RunResult::robust`]); where the paper has numbers and one of the two
+/// was not run, `None` in its place.
+fn row_runs<'a>(row: &ReportRow<'a>) -> Vec<(Option<&'a RunResult>, bool)> {
+    let mut out = Vec::new();
+    for robust in [false, true] {
+        let runs: Vec<&RunResult> = std::iter::once(row.with)
+            .chain(row.without)
+            .filter(|r| r.robust == robust)
+            .collect();
+        if runs.is_empty() && row.case.is_some() {
+            out.push((None, robust));
+        }
+        out.extend(runs.into_iter().map(|r| (Some(r), robust)));
+    }
+    out
+}
 
 /// The table's cells: per case the run without Δu (if run or if the paper has numbers), then
 /// the run with Δu. Max errors read "ours (paper)".
 fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
     let mut out = Vec::new();
     for row in rows {
-        let runs = [(row.without, 0usize, false), (Some(row.with), 1usize, true)];
-        for (run, col, robust) in runs {
-            if run.is_none() && row.case.is_none() {
-                continue;
-            }
-            let mut du = if robust { "with" } else { "without" }.to_string();
-            if run.is_some_and(|r| r.robust != robust) {
-                let _ = write!(du, " (run.robust = {}!)", !robust);
-            }
+        for (run, robust) in row_runs(row) {
+            let col = usize::from(robust);
+            let du = if robust { "with" } else { "without" }.to_string();
             let name = run.map_or(row.with.name.as_str(), |r| r.name.as_str());
             let m = run.map(|r| r.metrics);
             let ours_vs = |ours: Option<f64>, paper: Option<f64>| -> String {
@@ -110,6 +124,14 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
                 other(|m| m.saturated_fraction, &|v| {
                     format!("{} %", fmt_fixed(100.0 * v, 1))
                 }),
+                run.map_or("—".to_string(), |r| {
+                    let expected = if r.faults_expected && !r.faults.is_empty() {
+                        ", expected"
+                    } else {
+                        ""
+                    };
+                    format!("{}{expected}", r.faults)
+                }),
                 run.map_or("not run".to_string(), |r| r.outcome.to_string()),
             ]);
         }
@@ -123,9 +145,12 @@ fn md_escape(s: &str) -> String {
 
 /// Markdown table: per case one row without Δu and one with, each giving x, y, z and path max
 /// errors as "ours (paper)" (the paper's value only where [`ReportRow::case`] is given), rms
-/// path, max roll/pitch/yaw error, peak voltage, saturated fraction, and the outcome (a
-/// diverged run says "DIVERGED at t = … s: reason"). A missing `without` run with paper
-/// numbers gets a row with "—" and "not run".
+/// path, max roll/pitch/yaw error, peak voltage, saturated fraction, the control periods in
+/// fail-safe per status ("0", or e.g. "12 (fault:pitch-limit 12; first at t = 3.20 s)",
+/// ", expected" added when the scenario expects faults), and the outcome (a diverged run says
+/// "DIVERGED at t = … s: reason"). Each row is labelled with or without Δu by its own run's
+/// `robust`. A run the paper has numbers for that was not run gets a row with "—" and
+/// "not run".
 pub fn table_markdown(rows: &[ReportRow]) -> String {
     let mut s = String::new();
     let line = |cells: &mut dyn Iterator<Item = String>| {
@@ -218,10 +243,8 @@ fn link_target(dir: &Path, plot: &Path) -> String {
     }
 }
 
-/// Writes `dir/report.md` (creating `dir`): `# title`, a line on how to read the table,
-/// a warning if any run diverged, [`table_markdown`], each plot embedded as
-/// `![file](path)` (relative to `dir` when inside it) under its file name, and `notes`
-/// verbatim under "## Notes" (omitted if empty). Returns the report's path.
+/// Writes `dir/report.md` (creating `dir`, whole or not at all: [`super::atomic`]): the
+/// [`report_markdown`] of the rows with nothing incomplete. Returns the report's path.
 pub fn write_report(
     dir: &Path,
     title: &str,
@@ -230,40 +253,106 @@ pub fn write_report(
     notes: &str,
 ) -> Result<PathBuf> {
     let path = dir.join("report.md");
+    let s = report_markdown(dir, title, rows, plots, notes, &[]);
+    fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+    atomic::write(&path, s.as_bytes()).with_context(|| format!("writing {}", path.display()))
+}
+
+/// The text of `report.md` in `dir`: `# title`, a line on how to read the table, then the
+/// warnings — outputs that are `incomplete` (each line says which file and why), runs that
+/// were interrupted (the report is then **partial**), diverged, or had the controller in
+/// fail-safe (unexpectedly, or as the scenario expected) —, [`table_markdown`], each plot
+/// embedded as `![file](path)` (relative to `dir` when inside it) under its file name, and
+/// `notes` verbatim under "## Notes" (omitted if empty).
+pub fn report_markdown(
+    dir: &Path,
+    title: &str,
+    rows: &[ReportRow],
+    plots: &[PathBuf],
+    notes: &str,
+    incomplete: &[String],
+) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "# {title}\n");
+    let runs: Vec<&RunResult> = rows
+        .iter()
+        .flat_map(|r| std::iter::once(r.with).chain(r.without))
+        .collect();
+    let partial = runs.iter().any(|r| r.interrupted()) || !incomplete.is_empty();
+    let _ = writeln!(
+        s,
+        "# {title}{}
+",
+        if partial { " (PARTIAL)" } else { "" }
+    );
     s.push_str(
         "Maximum errors over each run in metres as **ours (paper)**, the paper's numbers from \
          its Table 1 (docs/design.md §7) where the case is one of its six; path = \
          √(max|e_x|² + max|e_y|² + max|e_z|²), rms path = √mean(e_x² + e_y² + e_z²). Angles in \
          rad. Peak |V| is the largest thruster voltage commanded; saturated is the fraction of \
-         control periods with at least one thruster at the supply limit.\n\n",
+         control periods with at least one thruster at the supply limit; faults counts the \
+         control periods in which the controller was in fail-safe (every thruster off), per \
+         status.\n\n",
     );
-    let diverged: Vec<String> = rows
-        .iter()
-        .flat_map(|r| std::iter::once(r.with).chain(r.without))
-        .filter_map(|r| match &r.outcome {
-            Outcome::Diverged { .. } => Some(format!(
-                "{} ({} Δu): {}",
-                r.name,
-                if r.robust { "with" } else { "without" },
-                r.outcome
-            )),
-            Outcome::Completed => None,
-        })
-        .collect();
-    if !diverged.is_empty() {
-        let _ = writeln!(
-            s,
-            "**Warning: {} run(s) diverged** — their metrics cover only the time before \
-             they stopped:\n",
-            diverged.len()
-        );
-        for d in &diverged {
+    let mut warn = |head: String, items: Vec<String>| {
+        if items.is_empty() {
+            return;
+        }
+        let _ = writeln!(s, "{head}\n");
+        for d in &items {
             let _ = writeln!(s, "- {}", md_escape(d));
         }
         s.push('\n');
-    }
+    };
+    warn(
+        format!(
+            "**Warning: {} output(s) are incomplete** and were not written:",
+            incomplete.len()
+        ),
+        incomplete.to_vec(),
+    );
+    let named = |r: &RunResult, what: String| format!("{} ({}): {what}", r.name, r.du_label());
+    let pick = |f: &dyn Fn(&RunResult) -> Option<String>| -> Vec<String> {
+        runs.iter()
+            .filter_map(|r| f(r).map(|w| named(r, w)))
+            .collect()
+    };
+    let interrupted = pick(&|r| r.interrupted().then(|| r.outcome.to_string()));
+    warn(
+        format!(
+            "**Partial: {} run(s) were interrupted** — their metrics and files cover only the \
+             time before they stopped:",
+            interrupted.len()
+        ),
+        interrupted,
+    );
+    let diverged = pick(&|r| r.diverged().then(|| r.outcome.to_string()));
+    warn(
+        format!(
+            "**Warning: {} run(s) diverged** — their metrics cover only the time before \
+             they stopped:",
+            diverged.len()
+        ),
+        diverged,
+    );
+    let faulted = pick(&|r| r.faulted_unexpectedly().then(|| r.faults.to_string()));
+    warn(
+        format!(
+            "**Warning: {} run(s) had the controller in fail-safe** (every thruster off) for \
+             some periods, which the scenario does not expect (`expect_faults`):",
+            faulted.len()
+        ),
+        faulted,
+    );
+    let expected =
+        pick(&|r| (r.faults_expected && !r.faults.is_empty()).then(|| r.faults.to_string()));
+    warn(
+        format!(
+            "{} run(s) had the controller in fail-safe for some periods, as their scenario \
+             expects (`expect_faults = true`):",
+            expected.len()
+        ),
+        expected,
+    );
     s.push_str(&table_markdown(rows));
     if !plots.is_empty() {
         s.push_str("\n## Plots\n");
@@ -281,7 +370,5 @@ pub fn write_report(
             s.push('\n');
         }
     }
-    fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
-    fs::write(&path, s).with_context(|| format!("writing {}", path.display()))?;
-    Ok(path)
+    s
 }

@@ -3,8 +3,10 @@
 //! ([`Controller::new`], [`Trajectory::new`]); here their errors are only mapped to keys.
 
 use controller_core::config::ConfigField;
+use controller_core::controller::{MAX_ANGULAR_RATE, MAX_LINEAR_SPEED, MAX_POSITION};
 use controller_core::model::{self, ParamVariation, VehicleParams, VARIED_PARAMETER_NAMES};
 use controller_core::{Controller, Trajectory, TrajectoryKind};
+use controller_core::{Fault, Status};
 
 use crate::config::{CurrentModel, SimConfig, VariationProfile};
 
@@ -14,6 +16,19 @@ use super::ScenarioError;
 pub const MAX_DURATION: f64 = 86_400.0;
 /// Longest accepted `plant_step` (s).
 pub const MAX_PLANT_STEP: f64 = 0.1;
+/// Most control periods (duration × rate_hz) a run may have (one day at the default 100 Hz):
+/// each period is a CSV row (≈ 1 kB) and a controller update. More needs the explicit override
+/// [`SimConfig::allow_long_run`] (the CLI's `--allow-long-run`).
+pub const MAX_CONTROL_PERIODS: u64 = 8_640_000;
+/// Most plant RK4 steps a run may have (one day at the default 1 ms step): the work of a run.
+/// More needs [`SimConfig::allow_long_run`].
+pub const MAX_PLANT_STEPS: u64 = 86_400_000;
+/// Even with the override, step counts stay below 2⁵³, where counting in f64 is exact (a
+/// `plant_step` of 1e-300 would otherwise loop for ever).
+const ABSOLUTE_MAX_STEPS: f64 = 9_007_199_254_740_992.0;
+/// Largest ω·plant_step of an abs-sin variation (rad): at least 2π/0.1 ≈ 63 plant steps per
+/// period of sin, so that the plant resolves the variation (and ω·t stays finite).
+pub const MAX_VARIATION_OMEGA_STEP: f64 = 0.1;
 
 type Res<T> = Result<T, ScenarioError>;
 
@@ -85,6 +100,8 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     }
     // The loop holds τ over a whole number of plant steps (sil::run).
     let substeps = (period / h).round();
+    let steps = (config.duration * rate).round();
+    step_cap(config, steps, substeps)?;
     if (substeps * h - period).abs() >= 1e-9 * period {
         return Err(invalid(
             "plant_step",
@@ -98,14 +115,50 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     if let Some(lag) = config.thruster_lag {
         positive("thruster_lag", lag)?;
     }
-    variation(&config.variation)?;
-    current(&config.current)?;
+    variation(&config.variation, h)?;
+    current(&config.current, h)?;
     if let Some(n) = &config.noise {
         each("noise.eta_sigma", &n.eta_sigma, non_negative)?;
         each("noise.nu_sigma", &n.nu_sigma, non_negative)?;
     }
-    let steps = (config.duration * rate).round() as u64;
-    Ok((steps, substeps as usize))
+    Ok((steps as u64, substeps as usize))
+}
+
+/// The run's size against [`MAX_CONTROL_PERIODS`] and [`MAX_PLANT_STEPS`] (unless
+/// `allow_long_run`), and against 2⁵³ always: `steps` = duration × rate_hz control periods
+/// (the run samples ticks 0..=steps), `substeps` plant steps each.
+fn step_cap(config: &SimConfig, steps: f64, substeps: f64) -> Res<()> {
+    let periods = steps;
+    let plant = steps * substeps;
+    let how = "(duration × rate_hz control periods, each 1/(rate_hz × plant_step) plant steps)";
+    if periods > ABSOLUTE_MAX_STEPS || plant > ABSOLUTE_MAX_STEPS {
+        return Err(invalid(
+            "plant_step",
+            format!(
+                "the run would take {plant:.3e} plant steps and {periods:.3e} control periods \
+                 {how}: more than 2^53, beyond any run"
+            ),
+        ));
+    }
+    if config.allow_long_run {
+        return Ok(());
+    }
+    let over = |count: f64, cap: u64, what: &str, key: &str| -> Res<()> {
+        if count > cap as f64 {
+            Err(invalid(
+                key,
+                format!(
+                    "the run would take {count:.0} {what} {how}, more than the cap of {cap} \
+                     (one day at the default 100 Hz and 1 ms); shorten it, or give \
+                     --allow-long-run to run it anyway (the CSV grows by ≈ 1 kB a period)"
+                ),
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    over(periods, MAX_CONTROL_PERIODS, "control periods", "duration")?;
+    over(plant, MAX_PLANT_STEPS, "plant steps", "plant_step")
 }
 
 fn finite(key: &str, x: f64) -> Res<f64> {
@@ -182,13 +235,25 @@ fn delta(prefix: &str, d: &ParamVariation<f64>) -> Res<()> {
     }
 }
 
-fn variation(v: &VariationProfile) -> Res<()> {
+fn variation(v: &VariationProfile, plant_step: f64) -> Res<()> {
     match v {
         VariationProfile::None => Ok(()),
         VariationProfile::Constant(d) => delta("variation", d),
         VariationProfile::AbsSin { max, omega } => {
             delta("variation", max)?;
-            positive("variation.omega", *omega).map(|_| ())
+            let omega = positive("variation.omega", *omega)?;
+            if omega * plant_step > MAX_VARIATION_OMEGA_STEP {
+                return Err(invalid(
+                    "variation.omega",
+                    format!(
+                        "{omega} rad/s is too fast for the plant step {plant_step} s: ω·plant_step \
+                         must be ≤ {MAX_VARIATION_OMEGA_STEP} (≥ 63 plant steps per period), so \
+                         ω ≤ {} rad/s",
+                        MAX_VARIATION_OMEGA_STEP / plant_step
+                    ),
+                ));
+            }
+            Ok(())
         }
         VariationProfile::Staircase(steps) => {
             if steps.is_empty() {
@@ -229,7 +294,7 @@ fn variation(v: &VariationProfile) -> Res<()> {
     }
 }
 
-fn current(c: &CurrentModel) -> Res<()> {
+fn current(c: &CurrentModel, plant_step: f64) -> Res<()> {
     match c {
         CurrentModel::None => Ok(()),
         CurrentModel::Constant(v) => each("current.velocity", v, finite),
@@ -238,7 +303,97 @@ fn current(c: &CurrentModel) -> Res<()> {
         } => {
             each("current.mean", mean, finite)?;
             each("current.sigma", sigma, non_negative)?;
-            positive("current.tau", *tau).map(|_| ())
+            let tau = positive("current.tau", *tau)?;
+            // Euler–Maruyama of v̇ = −(v − mean)/τ + …: v ← (1 − h/τ) v + …, unstable for
+            // h > 2τ, and its stationary variance is σ²/(1 − h/2τ) (≤ 5 % high for τ ≥ 10 h).
+            if tau < plant_step {
+                return Err(invalid(
+                    "current.tau",
+                    format!(
+                        "{tau} s is below the plant step {plant_step} s: the Gauss–Markov process \
+                         is stepped by Euler–Maruyama at the plant step, which is unstable for \
+                         tau < plant_step/2 and inflates the variance by 1/(1 − plant_step/(2 tau)) \
+                         (×2 at tau = plant_step); use tau ≥ plant_step, better ≥ 10 plant steps"
+                    ),
+                ));
+            }
+            Ok(())
         }
     }
+}
+
+/// Every control tick of the mission up to this many is checked by [`mission`]; a longer
+/// mission is checked at this many evenly spaced ticks.
+const MISSION_SAMPLES: u64 = 100_000;
+
+/// What the run would do to the controller, refused before it starts (with the reason):
+/// - a reference that leaves the range the controller accepts as input
+///   ([`MAX_POSITION`] per position component, [`MAX_LINEAR_SPEED`] for ‖η̇_d‖ of the
+///   position, [`MAX_ANGULAR_RATE`] for the Euler-angle rates): a vehicle on it would be in
+///   fail-safe (`fault:input-out-of-range`) from then on;
+/// - a law that overflows f32 on the reference itself (zero error, the first period): then
+///   every update would (`fault:non-finite-result`), e.g. for gains like 1e30.
+pub(super) fn mission(
+    config: &SimConfig,
+    controller: &Controller,
+    trajectory: &Trajectory,
+    steps: u64,
+) -> Res<()> {
+    let rate = config.controller.rate_hz;
+    let n = steps.clamp(1, MISSION_SAMPLES);
+    let t_of = |k: u64| k as f64 / f64::from(rate);
+    for j in 0..=n {
+        let k = (u128::from(j) * u128::from(steps) / u128::from(n)) as u64;
+        let d = trajectory.sample(k, rate);
+        let speed = d.eta_dot.fixed_rows::<3>(0).norm();
+        let turn = d.eta_dot.fixed_rows::<3>(3).norm();
+        let position = d.eta.fixed_rows::<3>(0).amax();
+        let refuse = |what: String| {
+            invalid(
+                "trajectory",
+                format!(
+                    "at t = {:.2} s {what}: a vehicle on this reference would be in fail-safe \
+                     (fault:input-out-of-range)",
+                    t_of(k)
+                ),
+            )
+        };
+        if !speed.is_finite() || speed > MAX_LINEAR_SPEED {
+            return Err(refuse(format!(
+                "the reference moves at {speed} m/s, above the {MAX_LINEAR_SPEED} m/s the \
+                 controller accepts"
+            )));
+        }
+        if !turn.is_finite() || turn > MAX_ANGULAR_RATE {
+            return Err(refuse(format!(
+                "the reference turns at {turn} rad/s, above the {MAX_ANGULAR_RATE} rad/s the \
+                 controller accepts"
+            )));
+        }
+        if !position.is_finite() || position > MAX_POSITION {
+            return Err(refuse(format!(
+                "the reference is {position} m from the mission origin along an axis, beyond \
+                 the ±{MAX_POSITION} m the controller accepts (shorten the mission)"
+            )));
+        }
+    }
+    let start = crate::sil::reference_state(trajectory, rate);
+    let out = controller.update(
+        0,
+        &start.eta.cast::<f32>().into(),
+        &start.nu.cast::<f32>().into(),
+        trajectory,
+    );
+    if out.status == Status::Fault(Fault::NonFiniteResult) {
+        return Err(invalid(
+            "controller",
+            format!(
+                "on the reference itself (zero tracking error, first period) the law overflows \
+                 f32 ({}): every update would put the thrusters off; the gains k1, k2 (or q) are \
+                 too large",
+                out.status
+            ),
+        ));
+    }
+    Ok(())
 }

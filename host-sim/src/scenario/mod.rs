@@ -28,12 +28,14 @@
 //! name = "circular-10R"       # file-name safe; default: the file stem (load_scenario) or "scenario"
 //! table1_case = "circular-10R" # this run is that case of the paper's Table 1: reports print
 //!                             # the paper's numbers beside ours; default: none
-//! duration = 70.0             # s, (0, 86400]
+//! duration = 70.0             # s, (0, 86400]; and the step cap below
 //! plant_step = 0.001          # s, (0, 0.1] and ≤ the control period 1/rate_hz
 //! ideal_actuators = true      # thrusters deliver the allocated thrust whatever the voltage limit
 //! initial_offset = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # added to η(0) = η_d(0), m and rad
 //! divergence_limit = 50.0     # m, > 0
 //! thruster_lag = 0.1          # s, > 0; leave out for no lag
+//! expect_faults = false       # true: periods with the controller in fail-safe are reported but
+//!                             # do not fail the command (else exit 3); default false
 //!
 //! [trajectory]                # required
 //! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix"
@@ -97,6 +99,24 @@
 //! silent = ["300..310"]       # nothing sent at all
 //! ```
 //!
+//! **Arrays** have exactly the length shown (`k1` six numbers, `q` two, `velocity` three…):
+//! more or fewer entries, or an entry that is not a number, is an error at the key.
+//!
+//! **Limits checked with the run as a whole** (each refusal names its key and says why):
+//! - the step cap: at most [`MAX_CONTROL_PERIODS`] control periods (duration × rate_hz) and
+//!   [`MAX_PLANT_STEPS`] plant steps (one day at 100 Hz and 1 ms), unless
+//!   [`SimConfig::allow_long_run`] (the CLI's `--allow-long-run`); never beyond 2⁵³;
+//! - `current.tau` ≥ `plant_step` (Euler–Maruyama of the Gauss–Markov current is unstable
+//!   below half the step, and its variance is σ²/(1 − h/2τ));
+//! - `variation.omega` · `plant_step` ≤ [`MAX_VARIATION_OMEGA_STEP`] (the plant resolves the
+//!   variation; 1e308 used to give NaN parameters);
+//! - the reference stays inside what the controller accepts as input
+//!   (`controller_core::controller::MAX_POSITION`, `MAX_LINEAR_SPEED`, `MAX_ANGULAR_RATE`;
+//!   checked at every tick up to 10⁵ ticks, else at 10⁵ evenly spaced ones): a faster or
+//!   longer mission would be flown in fail-safe;
+//! - the law does not overflow f32 on the reference itself (gains like k1 = 1e30, which the
+//!   loop-rate rule on k2 does not catch, made every update a fail-safe).
+//!
 //! **Δ fields of `constant` and `abs-sin`** (their names:
 //! [`VARIED_PARAMETER_NAMES`](controller_core::model::VARIED_PARAMETER_NAMES)): with none of
 //! the nine given, Δ is Table 3's maximum
@@ -117,9 +137,12 @@ use controller_core::{Controller, Trajectory};
 use crate::config::SimConfig;
 
 mod check;
+mod exact;
 mod parse;
 
-pub use check::{MAX_DURATION, MAX_PLANT_STEP};
+pub use check::{
+    MAX_CONTROL_PERIODS, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS, MAX_VARIATION_OMEGA_STEP,
+};
 pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
 
 /// Why a scenario could not be loaded or validated.
@@ -186,7 +209,7 @@ impl Scenario {
     pub fn new(config: SimConfig) -> Result<Self, ScenarioError> {
         let controller = check::controller(&config)?;
         let trajectory = check::trajectory(&config.trajectory)?;
-        Self::assemble(config, controller, trajectory)
+        Self::assemble(config, controller, trajectory, true)
     }
 
     /// This scenario with `change` applied to its configuration, validated again. The built
@@ -205,15 +228,23 @@ impl Scenario {
         } else {
             check::trajectory(&config.trajectory)?
         };
-        Self::assemble(config, controller, trajectory)
+        // The mission's reference depends only on these (a Monte Carlo draw keeps them all).
+        let same_mission = config.controller == self.config.controller
+            && config.trajectory == self.config.trajectory
+            && config.duration == self.config.duration;
+        Self::assemble(config, controller, trajectory, !same_mission)
     }
 
     fn assemble(
         config: SimConfig,
         controller: Controller,
         trajectory: Trajectory,
+        check_mission: bool,
     ) -> Result<Self, ScenarioError> {
         let (steps, substeps) = check::run(&config)?;
+        if check_mission {
+            check::mission(&config, &controller, &trajectory, steps)?;
+        }
         Ok(Scenario {
             config,
             controller,
@@ -269,6 +300,13 @@ pub fn parse_scenario(text: &str) -> Result<Scenario, ScenarioError> {
 /// Reads, parses and validates a scenario file. A scenario without `name` takes the file stem.
 /// A read error carries the path.
 pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
+    Scenario::new(load_config(path)?)
+}
+
+/// Reads and parses a scenario file into its [`SimConfig`], not yet validated (for a caller
+/// that sets what a file cannot, e.g. [`SimConfig::allow_long_run`], before
+/// [`Scenario::new`]). A scenario without `name` takes the file stem.
+pub fn load_config(path: &Path) -> Result<SimConfig, ScenarioError> {
     let text = std::fs::read_to_string(path).map_err(|source| ScenarioError::Io {
         path: path.to_path_buf(),
         source,
@@ -278,5 +316,5 @@ pub fn load_scenario(path: &Path) -> Result<Scenario, ScenarioError> {
         .and_then(|s| s.to_str())
         .filter(|s| !s.is_empty())
         .unwrap_or(DEFAULT_NAME);
-    Scenario::new(parse::parse(&text, stem)?)
+    parse::parse(&text, stem)
 }

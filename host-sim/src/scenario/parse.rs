@@ -10,6 +10,7 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
 use super::check::invalid;
+use super::exact;
 use super::ScenarioError;
 use crate::config::{
     CurrentModel, LinkFaults, SensorNoise, SimConfig, TickRange, VariationProfile,
@@ -40,9 +41,11 @@ struct RawScenario {
     duration: Option<f64>,
     plant_step: Option<f64>,
     ideal_actuators: Option<bool>,
+    #[serde(default, deserialize_with = "exact::option")]
     initial_offset: Option<[f64; 6]>,
     divergence_limit: Option<f64>,
     thruster_lag: Option<f64>,
+    expect_faults: Option<bool>,
     /// The core's own type: kind-specific keys, defaults and unknown keys are its serde form's.
     trajectory: TrajectoryKind,
     variation: Option<RawVariation>,
@@ -204,8 +207,11 @@ impl CurrentName {
 #[serde(deny_unknown_fields)]
 struct RawCurrent {
     model: CurrentName,
+    #[serde(default, deserialize_with = "exact::option")]
     velocity: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::option")]
     mean: Option<[f64; 3]>,
+    #[serde(default, deserialize_with = "exact::option")]
     sigma: Option<[f64; 3]>,
     tau: Option<f64>,
     seed: Option<u64>,
@@ -214,7 +220,9 @@ struct RawCurrent {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawNoise {
+    #[serde(default, deserialize_with = "exact::option")]
     eta_sigma: Option<[f64; 6]>,
+    #[serde(default, deserialize_with = "exact::option")]
     nu_sigma: Option<[f64; 6]>,
     seed: Option<u64>,
 }
@@ -238,8 +246,11 @@ enum BBoundName {
 struct RawController {
     robust: Option<bool>,
     law: Option<LawName>,
+    #[serde(default, deserialize_with = "exact::option")]
     k1: Option<[f64; 6]>,
+    #[serde(default, deserialize_with = "exact::option")]
     k2: Option<[f64; 6]>,
+    #[serde(default, deserialize_with = "exact::option")]
     q: Option<[f64; 2]>,
     beta: Option<f64>,
     mu: Option<f64>,
@@ -315,6 +326,7 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
         config.divergence_limit = limit;
     }
     config.thruster_lag = raw.thruster_lag;
+    config.expect_faults = raw.expect_faults.unwrap_or(false);
     if let Some(raw) = raw.variation {
         config.variation = build_variation(&raw)?;
     }

@@ -152,8 +152,15 @@ pub fn same_command(a: &Command, b: &Command) -> bool {
                 lockstep,
                 thrust_unit,
                 reversed_thrusters,
+                priority,
             } = a;
-            *thrust_unit == b.thrust_unit
+            let same_priority = match (priority, &b.priority) {
+                (None, None) => true,
+                (Some(p), Some(q)) => p.rank == q.rank && fs(&p.weight, &q.weight),
+                _ => false,
+            };
+            same_priority
+                && *thrust_unit == b.thrust_unit
                 && *reversed_thrusters == b.reversed_thrusters
                 && *rate_hz == b.rate_hz
                 && *robust == b.robust
@@ -239,6 +246,13 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         rx_frames,
         rx_errors,
         last_state_seq,
+        latched,
+        refused_commands,
+        last_refusal,
+        rx_stale,
+        rx_auth_errors,
+        last_rx_seq,
+        signing,
         thrust_unit,
         reversed_thrusters,
     } = a;
@@ -259,4 +273,11 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         && *rx_frames == b.rx_frames
         && *rx_errors == b.rx_errors
         && *last_state_seq == b.last_state_seq
+        && *latched == b.latched
+        && *refused_commands == b.refused_commands
+        && *last_refusal == b.last_refusal
+        && *rx_stale == b.rx_stale
+        && *rx_auth_errors == b.rx_auth_errors
+        && *last_rx_seq == b.last_rx_seq
+        && *signing == b.signing
 }

@@ -2,16 +2,20 @@
 //! `update`, the link and fail-safe exercise, the PWM mapping, and the failure injection that
 //! proves each kind of failure is visible.
 
-use auv_link::{encode, Command, Envelope, FrameDecoder, MissionSpec, Msg, StateFrame, MAX_FRAME};
-use auv_link::{BoardStatus, FailSafeReason};
+use auv_link::sign::{Direction, LinkKey, Signer, Verifier};
+use auv_link::{encode, encode_signed, Command, ConfigPatch, Envelope, FrameDecoder, Msg};
+use auv_link::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
+use auv_link::{BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, MAX_FRAME};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use defmt::{error, info};
+use firmware::board::{self, LinkBuffers};
 use firmware::pwm;
+use firmware::qemu::CMDLINE_LEN;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
-use firmware::supervisor::Supervisor;
+use firmware::supervisor::{BoardInfo, Mode, Supervisor};
 
 use crate::stack;
 
@@ -134,149 +138,409 @@ fn golden_vectors() -> (bool, u32, u32) {
     (ok, max, mean)
 }
 
-fn frame(sup: &mut Supervisor, dec: &mut FrameDecoder, env: &Envelope, corrupt: bool) {
+/// A test key for the self-test's signed link (not a secret: it signs nothing real).
+const SELFTEST_KEY: [u8; 32] = [0x5E; 32];
+
+/// Encodes `env` and feeds it to the board's end of the link, as the UART would (signed with
+/// `signer` if given; `corrupt` flips a bit in the middle). Returns the frame's bytes.
+fn frame(
+    sup: &mut Supervisor,
+    link: &mut LinkBuffers,
+    env: &Envelope,
+    signer: Option<&mut Signer>,
+    corrupt: bool,
+) -> ([u8; MAX_FRAME], usize) {
     let mut buf = [0u8; MAX_FRAME];
-    let n = match encode(env, &mut buf) {
-        Ok(n) => n,
-        Err(_) => return,
-    };
+    let n = match signer {
+        None => encode(env, &mut buf),
+        Some(s) => encode_signed(env, s, &mut buf),
+    }
+    .unwrap_or(0);
     if corrupt && n > 3 {
         buf[n / 2] ^= 0x10;
     }
-    for &b in &buf[..n] {
-        match dec.push(b) {
-            Some(Ok(e)) => sup.on_envelope(&e),
-            Some(Err(_)) => sup.on_rx_error(),
-            None => {}
+    board::receive(sup, link, &buf[..n]);
+    (buf, n)
+}
+
+fn circle_state(k: u64) -> StateFrame {
+    let d = Trajectory::table1(Table1Case::Circular10R).sample(k, 100);
+    let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
+    StateFrame {
+        t_ticks: k,
+        eta: d.eta.into(),
+        nu: nu.into(),
+    }
+}
+
+const MISSION: MissionPlan = MissionPlan {
+    path: MissionSpec::Circle {
+        radius: 10.0,
+        omega: 0.1,
+        depth: 5.0,
+    },
+    heading: Heading::Paper,
+    time_scale: 1.0,
+};
+
+fn board_info(signing: bool) -> BoardInfo {
+    BoardInfo {
+        supply_voltage: firmware::qemu::SUPPLY_VOLTAGE,
+        signing,
+    }
+}
+
+/// The navigation computer's end of the self-test's link: numbers the frames it sends.
+struct Host {
+    seq: u16,
+}
+
+impl Host {
+    fn env(&mut self, msg: Msg) -> Envelope {
+        self.seq = self.seq.wrapping_add(1);
+        Envelope::new(self.seq, msg)
+    }
+
+    fn send(&mut self, sup: &mut Supervisor, link: &mut LinkBuffers, msg: Msg, corrupt: bool) {
+        let env = self.env(msg);
+        frame(sup, link, &env, None, corrupt);
+    }
+
+    /// Disarm, arm, start the mission: what clears a latched fail-safe and flies again.
+    fn restart(&mut self, sup: &mut Supervisor, link: &mut LinkBuffers) {
+        for c in [
+            Command::Disarm,
+            Command::Arm,
+            Command::StartMission(MISSION),
+        ] {
+            self.send(sup, link, Msg::Command(c), false);
         }
     }
 }
 
-/// Arm, fly, lose the link, get a corrupt frame, re-arm, fault, overrun — through real
-/// encoded frames — and check each status and that fail-safe means 0 V.
+/// One period; logs its status and checks it (and 0 V unless running).
+fn expect(
+    sup: &mut Supervisor,
+    ok: &mut bool,
+    what: &str,
+    want: BoardStatus,
+    overrun: bool,
+) -> Telemetry {
+    let s = sup.step(overrun, &|| 0u32);
+    let off = s.voltages.iter().all(|v| *v == 0.0);
+    let good = s.telemetry.status == want && (want == BoardStatus::Running || off);
+    info!("{}: {}", what, s.telemetry.status.as_str());
+    if !good {
+        error!("expected {}", want.as_str());
+    }
+    *ok &= good;
+    s.telemetry
+}
+
+/// Arm, fly, lose the link, get a corrupt frame, a lone arm, re-arm, a repeated frame, fault,
+/// overrun — through real encoded frames — and check each status, that fail-safe means 0 V,
+/// and that what must latch stays reported.
 fn fail_safe_exercise() -> bool {
     let controller = match Controller::new(ControllerConfig::default()) {
         Ok(c) => c,
         Err(_) => return false,
     };
-    let mut sup = Supervisor::new(controller);
-    let mut dec = FrameDecoder::new();
-    let mut seq = 0u16;
-    let mut env = |msg: Msg| {
-        seq = seq.wrapping_add(1);
-        Envelope {
-            version: auv_link::PROTOCOL_VERSION,
-            seq,
-            msg,
-        }
-    };
-    let tr = Trajectory::table1(Table1Case::Circular10R);
-    let state = |k: u64| {
-        let d = tr.sample(k, 100);
-        let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
-        StateFrame {
-            t_ticks: k,
-            eta: d.eta.into(),
-            nu: nu.into(),
-        }
-    };
-    let now = || 0u32;
+    let mut sup = Supervisor::new(controller, board_info(false));
+    let mut link = LinkBuffers::new();
+    let mut host = Host { seq: 0 };
     let mut ok = true;
-    let mut expect = |sup: &mut Supervisor, what: &str, want: BoardStatus, overrun: bool| {
-        let s = sup.step(overrun, &now);
-        let off = s.voltages.iter().all(|v| *v == 0.0);
-        let good = s.telemetry.status == want && (want == BoardStatus::Running || off);
-        info!("{}: {}", what, s.telemetry.status.as_str());
-        if !good {
-            error!("expected {}", want.as_str());
-        }
-        ok &= good;
-    };
-    expect(&mut sup, "power-up", BoardStatus::Disarmed, false);
-    frame(&mut sup, &mut dec, &env(Msg::Command(Command::Arm)), false);
-    expect(&mut sup, "armed, no mission", BoardStatus::Armed, false);
-    let mission = MissionSpec::Circle {
-        radius: 10.0,
-        omega: 0.1,
-        depth: 5.0,
-    };
-    frame(
-        &mut sup,
-        &mut dec,
-        &env(Msg::Command(Command::StartMission(mission))),
+    let sup = &mut sup;
+    let link = &mut link;
+    expect(sup, &mut ok, "power-up", BoardStatus::Disarmed, false);
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    expect(sup, &mut ok, "armed, no mission", BoardStatus::Armed, false);
+    host.send(
+        sup,
+        link,
+        Msg::Command(Command::StartMission(MISSION)),
         false,
     );
     for k in 0..3 {
-        frame(&mut sup, &mut dec, &env(Msg::State(state(k))), false);
-        expect(&mut sup, "state frame", BoardStatus::Running, false);
+        host.send(sup, link, Msg::State(circle_state(k)), false);
+        expect(sup, &mut ok, "state frame", BoardStatus::Running, false);
     }
     expect(
-        &mut sup,
+        sup,
+        &mut ok,
         "link silent 1 period",
         BoardStatus::Running,
         false,
     );
     expect(
-        &mut sup,
+        sup,
+        &mut ok,
         "link silent 2 periods",
         BoardStatus::Running,
         false,
     );
-    expect(
-        &mut sup,
-        "link silent 3 periods",
-        BoardStatus::FailSafe(FailSafeReason::StaleState),
-        false,
-    );
+    let stale = BoardStatus::FailSafe(FailSafeReason::StaleState);
+    expect(sup, &mut ok, "link silent 3 periods", stale, false);
     let errors = sup.rx_errors();
-    frame(
-        &mut sup,
-        &mut dec,
-        &env(Msg::Command(Command::Disarm)),
-        true,
-    );
+    host.send(sup, link, Msg::Command(Command::Disarm), true);
     let counted = sup.rx_errors() == errors + 1;
     info!("corrupt frame counted and dropped: {}", counted);
-    frame(&mut sup, &mut dec, &env(Msg::State(state(6))), false);
+    host.send(sup, link, Msg::State(circle_state(6)), false);
+    expect(sup, &mut ok, "link back, not re-armed", stale, false);
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    let t = expect(sup, &mut ok, "lone arm", stale, false);
+    let lone_refused = t.last_refusal == Some(Refusal::Latched) && t.latched.is_some();
+    info!("lone arm refused, reason still reported: {}", lone_refused);
+    host.restart(sup, link);
+    let env = host.env(Msg::State(circle_state(7)));
+    let (again, n) = frame(sup, link, &env, None, false);
     expect(
-        &mut sup,
-        "link back, not re-armed",
-        BoardStatus::FailSafe(FailSafeReason::StaleState),
+        sup,
+        &mut ok,
+        "disarmed, armed, mission restarted",
+        BoardStatus::Running,
         false,
     );
-    frame(
-        &mut sup,
-        &mut dec,
-        &env(Msg::Command(Command::Disarm)),
-        false,
-    );
-    frame(&mut sup, &mut dec, &env(Msg::Command(Command::Arm)), false);
-    frame(&mut sup, &mut dec, &env(Msg::State(state(7))), false);
-    expect(&mut sup, "re-armed", BoardStatus::Running, false);
-    let mut bad = state(8);
+    let dropped_before = sup.rx_stale();
+    board::receive(sup, link, &again[..n]);
+    let repeat_dropped = sup.rx_stale() == dropped_before + 1;
+    info!("repeated state frame dropped: {}", repeat_dropped);
+    let mut bad = circle_state(8);
     bad.eta[2] = f32::NAN;
-    frame(&mut sup, &mut dec, &env(Msg::State(bad)), false);
+    host.send(sup, link, Msg::State(bad), false);
+    let fault = BoardStatus::FailSafe(FailSafeReason::ControllerFault);
+    let first = expect(sup, &mut ok, "NaN depth", fault, false);
+    let next = expect(sup, &mut ok, "next period", fault, false);
+    let fault_kept = first.controller_fault != 0 && next.controller_fault == first.controller_fault;
+    info!("fault code reported while latched: {}", fault_kept);
+    host.restart(sup, link);
+    host.send(sup, link, Msg::State(circle_state(9)), false);
     expect(
-        &mut sup,
-        "NaN depth",
-        BoardStatus::FailSafe(FailSafeReason::ControllerFault),
-        false,
-    );
-    frame(
-        &mut sup,
-        &mut dec,
-        &env(Msg::Command(Command::Disarm)),
-        false,
-    );
-    frame(&mut sup, &mut dec, &env(Msg::Command(Command::Arm)), false);
-    frame(&mut sup, &mut dec, &env(Msg::State(state(9))), false);
-    expect(
-        &mut sup,
+        sup,
+        &mut ok,
         "overrun",
         BoardStatus::FailSafe(FailSafeReason::Overrun),
         true,
     );
-    ok && counted
+    ok && counted && lone_refused && repeat_dropped && fault_kept
+}
+
+/// Instructions `board::receive` spends on one frame (decode, then the supervisor's work).
+fn timed_frame(sup: &mut Supervisor, link: &mut LinkBuffers, host: &mut Host, msg: Msg) -> u32 {
+    let env = host.env(msg);
+    let mut buf = [0u8; MAX_FRAME];
+    let n = encode(&env, &mut buf).unwrap_or(0);
+    let t0 = SYST::get_current();
+    board::receive(sup, link, &buf[..n]);
+    let t1 = SYST::get_current();
+    elapsed(t0, t1) * INSTRUCTIONS_PER_TICK
+}
+
+/// The thruster chain and the mission settings of protocol 3 through real frames: a
+/// `SetConfig` of the thrust unit, mounting and priority is applied whole and reported in
+/// telemetry, refused while armed and with an invalid mask; a `StartMission` with the tangent
+/// heading and a time scale flies, one with a time scale below 1 is refused with its reason.
+/// Logs the instructions each costs the board.
+fn real_chain_exercise() -> bool {
+    let Ok(controller) = Controller::new(ControllerConfig::default()) else {
+        return false;
+    };
+    let mut sup = Supervisor::new(controller, board_info(false));
+    let mut link = LinkBuffers::new();
+    let mut host = Host { seq: 0 };
+    let (sup, link) = (&mut sup, &mut link);
+    let now = || 0u32;
+    let boot = sup.step(false, &now).telemetry;
+    let kgf_reported = boot.thrust_unit == ThrustUnit::Kgf
+        && boot.reversed_thrusters == controller_core::effectiveness::AUV150_REVERSED;
+    let chain = ConfigPatch {
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(0),
+        priority: Some(AxisPriority::from(
+            controller_core::allocator::AxisPriority::default(),
+        )),
+        ..ConfigPatch::EMPTY
+    };
+    let set_config = timed_frame(
+        sup,
+        link,
+        &mut host,
+        Msg::Command(Command::SetConfig(chain)),
+    );
+    let t = sup.step(false, &now).telemetry;
+    let applied =
+        t.thrust_unit == ThrustUnit::Newton && t.reversed_thrusters == 0 && t.refused_commands == 0;
+    let bad_mask = ConfigPatch {
+        reversed_thrusters: Some(1 << 5),
+        ..ConfigPatch::EMPTY
+    };
+    host.send(sup, link, Msg::Command(Command::SetConfig(bad_mask)), false);
+    let mask_refused = sup.last_refusal() == Some(Refusal::InvalidMounting);
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    host.send(sup, link, Msg::Command(Command::SetConfig(chain)), false);
+    let armed_refused = sup.last_refusal() == Some(Refusal::WhileArmed);
+    let slow = MissionPlan {
+        time_scale: 0.5,
+        ..MISSION
+    };
+    host.send(sup, link, Msg::Command(Command::StartMission(slow)), false);
+    let scale_refused = sup.last_refusal() == Some(Refusal::InvalidTimeScale);
+    let tangent = MissionPlan {
+        heading: Heading::Tangent,
+        time_scale: 2.0,
+        ..MISSION
+    };
+    let start = timed_frame(
+        sup,
+        link,
+        &mut host,
+        Msg::Command(Command::StartMission(tangent)),
+    );
+    let flying = sup.mode() == Mode::Running && sup.refused_commands() == 3;
+    info!(
+        "real chain: boot reports kgf and the default mounting {}, SetConfig newton/mounting/priority applied {}, invalid mask refused {}, refused while armed {}, time scale 0.5 refused {}, tangent mission at k = 2 running {}",
+        kgf_reported, applied, mask_refused, armed_refused, scale_refused, flying
+    );
+    info!(
+        "real chain: instructions for SetConfig (unit, mounting, priority) {}, for StartMission (tangent, k = 2) {}",
+        set_config, start
+    );
+    kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
+}
+
+/// A signed link: an unsigned frame and a replayed signed frame are refused, a signed one is
+/// taken; the telemetry says signing is on.
+fn signed_link_exercise() -> bool {
+    let Ok(controller) = Controller::new(ControllerConfig::default()) else {
+        return false;
+    };
+    let key = LinkKey::new(SELFTEST_KEY);
+    let mut sup = Supervisor::new(controller, board_info(true));
+    let mut link = LinkBuffers::signed(&key);
+    let mut host = Signer::new(&key, Direction::ToBoard);
+    let now = || 0u32;
+    frame(
+        &mut sup,
+        &mut link,
+        &Envelope::new(1, Msg::Command(Command::Arm)),
+        None,
+        false,
+    );
+    let unsigned_refused = sup.mode() == Mode::Disarmed && sup.rx_auth_errors() == 1;
+    let (signed, n) = frame(
+        &mut sup,
+        &mut link,
+        &Envelope::new(2, Msg::Command(Command::Arm)),
+        Some(&mut host),
+        false,
+    );
+    let signed_taken = sup.mode() == Mode::Armed;
+    frame(
+        &mut sup,
+        &mut link,
+        &Envelope::new(3, Msg::Command(Command::Disarm)),
+        Some(&mut host),
+        false,
+    );
+    board::receive(&mut sup, &mut link, &signed[..n]);
+    let replay_refused = sup.mode() == Mode::Disarmed && sup.rx_auth_errors() == 2;
+    let t = sup.step(false, &now).telemetry;
+    info!(
+        "signed link: unsigned refused {}, signed taken {}, replay refused {}, telemetry says signing {}",
+        unsigned_refused, signed_taken, replay_refused, t.signing
+    );
+    unsigned_refused && signed_taken && replay_refused && t.signing
+}
+
+/// The largest telemetry frame the board sends.
+fn largest_telemetry() -> Envelope {
+    Envelope::new(
+        u16::MAX,
+        Msg::Telemetry(Telemetry {
+            tick: u64::MAX,
+            status: BoardStatus::FailSafe(FailSafeReason::Overrun),
+            voltages: [f32::MAX; 5],
+            thrusts: [f32::MIN; 5],
+            tau: [f32::MAX; 6],
+            saturated: u8::MAX,
+            delta: f32::MAX,
+            delta_clamped: true,
+            w_norm: f32::MAX,
+            controller_fault: u8::MAX,
+            loop_overruns: u32::MAX,
+            worst_update_ticks: u32::MAX,
+            rx_frames: u32::MAX,
+            rx_errors: u32::MAX,
+            last_state_seq: u16::MAX,
+            latched: Some(FailSafeReason::Overrun),
+            refused_commands: u32::MAX,
+            last_refusal: Some(Refusal::ControllerConfig),
+            rx_stale: u32::MAX,
+            rx_auth_errors: u32::MAX,
+            last_rx_seq: u16::MAX,
+            signing: true,
+            thrust_unit: ThrustUnit::Newton,
+            reversed_thrusters: u8::MAX,
+        }),
+    )
+}
+
+/// Instructions to sign (encode) the largest telemetry frame and to receive (decode and
+/// verify) a state frame, signed and unsigned: what signing costs the board per frame, twice
+/// per period. Returns (sign, verify) of the signed link, or `None` if a frame failed.
+fn signing_cost() -> Option<(u32, u32)> {
+    let key = LinkKey::new(SELFTEST_KEY);
+    let telemetry = largest_telemetry();
+    let state = Envelope::new(7, Msg::State(circle_state(1234)));
+    let mut counts = [[0u32; 2]; 2];
+    let mut ok = true;
+    for (i, signed) in [false, true].into_iter().enumerate() {
+        let mut board_end = LinkBuffers::with_key(signed.then_some(&key));
+        let t0 = SYST::get_current();
+        let sent = board_end.encode(&telemetry).map(|f| f.len());
+        let t1 = SYST::get_current();
+        counts[i][0] = elapsed(t0, t1) * INSTRUCTIONS_PER_TICK;
+        ok &= sent.is_ok();
+        let mut host = Signer::new(&key, Direction::ToBoard);
+        let mut wire = [0u8; MAX_FRAME];
+        let n = if signed {
+            encode_signed(&state, &mut host, &mut wire)
+        } else {
+            encode(&state, &mut wire)
+        }
+        .unwrap_or(0);
+        let mut dec = if signed {
+            FrameDecoder::signed(Verifier::new(&key, Direction::ToBoard))
+        } else {
+            FrameDecoder::new()
+        };
+        let mut got = None;
+        let t0 = SYST::get_current();
+        for &b in &wire[..n] {
+            if let Some(r) = dec.push(b) {
+                got = Some(r);
+            }
+        }
+        let t1 = SYST::get_current();
+        counts[i][1] = elapsed(t0, t1) * INSTRUCTIONS_PER_TICK;
+        ok &= got == Some(Ok(state));
+        let link = if signed { "signed" } else { "unsigned" };
+        info!(
+            "{} link: the largest telemetry frame is {} bytes, a state frame {} bytes",
+            link,
+            sent.unwrap_or(0),
+            n
+        );
+        info!(
+            "{} link: sending that telemetry frame {} instructions, receiving that state frame {} instructions",
+            link, counts[i][0], counts[i][1]
+        );
+    }
+    info!(
+        "signing instructions per frame: sign={} verify={}",
+        counts[1][0].saturating_sub(counts[0][0]),
+        counts[1][1].saturating_sub(counts[0][1])
+    );
+    ok.then_some((counts[1][0], counts[1][1]))
 }
 
 fn pwm_mapping() -> bool {
@@ -290,28 +554,6 @@ fn pwm_mapping() -> bool {
     neutral == 500 && full == 1000 && reverse == 0
 }
 
-/// Room for the semihosting command line: QEMU passes the ELF's path, then `-append`'s text.
-const CMDLINE_LEN: usize = 512;
-
-/// The semihosting command line (`qemu-run.sh ELF -append "…"`), into `buf`; `None` if QEMU
-/// refused it (it does when the line does not fit).
-fn command_line(buf: &mut [u8; CMDLINE_LEN]) -> Option<&[u8]> {
-    let mut block = [buf.as_mut_ptr() as usize, buf.len()];
-    // SAFETY: SYS_GET_CMDLINE writes at most `block[1]` bytes into `buf` and the length back
-    // into `block[1]`.
-    let r = unsafe {
-        cortex_m_semihosting::syscall1(
-            cortex_m_semihosting::nr::GET_CMDLINE,
-            block.as_mut_ptr() as usize,
-        )
-    };
-    if r != 0 {
-        return None;
-    }
-    let n = block[1].min(buf.len());
-    Some(&buf[..n])
-}
-
 fn contains(hay: &[u8], needle: &[u8]) -> bool {
     hay.windows(needle.len()).any(|w| w == needle)
 }
@@ -320,7 +562,7 @@ fn contains(hay: &[u8], needle: &[u8]) -> bool {
 /// makes the self-test fail in that way.
 fn inject_faults() -> bool {
     let mut buf = [0u8; CMDLINE_LEN];
-    let Some(cmd) = command_line(&mut buf) else {
+    let Some(cmd) = firmware::qemu::command_line(&mut buf) else {
         // Say so: CI's injections would otherwise pass for a self-test that cannot fail.
         defmt::warn!(
             "semihosting command line unreadable (longer than {} bytes?): no failure injection",
@@ -373,13 +615,14 @@ pub fn run(mut syst: SYST) -> bool {
             UPDATE_INSTRUCTION_BUDGET
         );
     }
-    let link_ok = fail_safe_exercise();
+    let link_ok = fail_safe_exercise() && signed_link_exercise() && real_chain_exercise();
+    let signing_ok = signing_cost().is_some();
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
     if wrong {
         error!("injected wrong answer: treating the golden vectors as failed");
     }
-    let ok = config_ok && golden_ok && !wrong && budget_ok && link_ok && pwm_ok;
+    let ok = config_ok && golden_ok && !wrong && budget_ok && link_ok && signing_ok && pwm_ok;
     if ok {
         info!("self-test passed");
     } else {

@@ -1,0 +1,371 @@
+//! The commands as a careless or hostile user runs them (issue 10): faults, labels, output
+//! folders, symlinks, reuse, interrupts, progress without a terminal, Monte Carlo's bounds.
+//! Every test runs the binary, as a user would, and reads its exit code, stderr and files.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+
+fn host_sim() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+}
+
+fn tempdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("host-sim-cmd-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn scenario(dir: &Path, name: &str, text: &str) -> PathBuf {
+    let p = dir.join(format!("{name}.toml"));
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn run(args: &[&str], scenario: &Path, out: &Path) -> Output {
+    host_sim()
+        .arg("run")
+        .args(args)
+        .arg("--scenario")
+        .arg(scenario)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// 3 s of a circle starting pitched 83°, past the 80° pitch limit: the controller starts in
+/// fail-safe.
+const PITCHED: &str = "duration = 3\ninitial_offset = [0, 0, 0, 0, 1.45, 0]\n\
+     [trajectory]\nkind = \"circle\"\nradius = 10\n";
+
+#[test]
+fn controller_faults_are_counted_shown_and_exit_3_unless_expected() {
+    let dir = tempdir("faults");
+    let s = scenario(&dir, "pitched", &format!("name = \"pitched\"\n{PITCHED}"));
+    let o = run(&["--json"], &s, &dir.join("out"));
+    assert_eq!(o.status.code(), Some(3), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let with = &v["cases"][0];
+    let n = with["faults"]["periods"]["fault:pitch-limit"]
+        .as_u64()
+        .unwrap();
+    assert!(n >= 1, "{v}");
+    assert_eq!(with["faults"]["first_t"].as_f64(), Some(0.0));
+    assert!(
+        with["diverged"].is_null(),
+        "a fault is not a divergence: {v}"
+    );
+    // The CSV's status column has exactly that many fault rows.
+    let csv = std::fs::read_to_string(dir.join("out/pitched-with.csv")).unwrap();
+    let rows = csv
+        .lines()
+        .filter(|l| l.ends_with(",fault:pitch-limit"))
+        .count();
+    assert_eq!(rows as u64, n);
+    // The table and the report show it.
+    let o = run(&[], &s, &dir.join("out"));
+    assert_eq!(o.status.code(), Some(3));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        table.contains("faults") && table.contains(&format!("{n} (fault:pitch-limit {n}")),
+        "{table}"
+    );
+    let report = std::fs::read_to_string(dir.join("out/report.md")).unwrap();
+    assert!(
+        report.contains("had the controller in fail-safe"),
+        "{report}"
+    );
+
+    // Expected: reported the same, exit 0.
+    let s = scenario(
+        &dir,
+        "pitched-ok",
+        &format!("name = \"pitched\"\nexpect_faults = true\n{PITCHED}"),
+    );
+    let o = run(&["--json"], &s, &dir.join("out"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(
+        v["cases"][0]["faults"]["periods"]["fault:pitch-limit"].as_u64(),
+        Some(n)
+    );
+    assert_eq!(v["cases"][0]["faults_expected"], true);
+}
+
+#[test]
+fn a_run_without_du_is_labelled_without_du() {
+    let dir = tempdir("labels");
+    let s = scenario(
+        &dir,
+        "plain",
+        "name = \"plain\"\nduration = 2\n[trajectory]\nkind = \"circle\"\nradius = 10\n\
+         [controller]\nrobust = false\n",
+    );
+    let out = dir.join("out");
+    let o = run(&[], &s, &out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.join("plain-without.csv").exists());
+    assert!(!out.join("plain-with.csv").exists());
+    let table = String::from_utf8_lossy(&o.stdout);
+    let row = table.lines().find(|l| l.starts_with("plain")).unwrap();
+    assert!(
+        row.contains("without") && !row.contains("robust"),
+        "{table}"
+    );
+    assert!(
+        !table.lines().any(|l| l.starts_with("plain  with ")),
+        "{table}"
+    );
+}
+
+#[test]
+fn a_bad_output_folder_is_refused_before_the_run() {
+    let dir = tempdir("badout");
+    // A day at 100 Hz: minutes of work, if it were started.
+    let s = scenario(
+        &dir,
+        "day",
+        "duration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n",
+    );
+    let file = dir.join("a-file");
+    std::fs::write(&file, "mine").unwrap();
+    let o = run(&[], &s, &file);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("is not a folder"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&file).unwrap(), "mine");
+
+    // A symlink as the folder: refused, nothing written where it points.
+    let target = dir.join("elsewhere");
+    std::fs::create_dir_all(&target).unwrap();
+    let link = dir.join("link");
+    std::os::unix::fs::symlink(&target, &link).unwrap();
+    let o = run(&[], &s, &link);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("symlink"), "{}", stderr(&o));
+    assert_eq!(std::fs::read_dir(&target).unwrap().count(), 0);
+
+    // A folder of someone else's files: refused, untouched, and the error said once.
+    let foreign = dir.join("foreign");
+    std::fs::create_dir_all(&foreign).unwrap();
+    std::fs::write(foreign.join("notes.csv"), "mine").unwrap();
+    let o = run(&[], &s, &foreign);
+    assert_eq!(o.status.code(), Some(2));
+    let e = stderr(&o);
+    assert!(e.contains("notes.csv") && e.contains("manifest"), "{e}");
+    assert_eq!(e.matches("error").count(), 1, "{e}");
+    assert_eq!(
+        std::fs::read_to_string(foreign.join("notes.csv")).unwrap(),
+        "mine"
+    );
+}
+
+const SHORT: &str = "duration = 1\n[trajectory]\nkind = \"circle\"\nradius = 10\n";
+
+#[test]
+fn a_reused_folder_holds_only_the_last_runs_files_and_symlinks_are_not_followed() {
+    let dir = tempdir("reuse");
+    let out = dir.join("out");
+    let a = scenario(&dir, "a", &format!("name = \"alpha\"\n{SHORT}"));
+    let b = scenario(&dir, "b", &format!("name = \"beta\"\n{SHORT}"));
+    assert!(run(&[], &a, &out).status.success());
+    assert!(out.join("alpha-with.csv").exists());
+    std::fs::write(out.join("my-notes.txt"), "mine").unwrap();
+
+    // A symlink planted where the next run writes its report, and one in place of a listed
+    // output: neither is followed.
+    let victim = dir.join("victim.txt");
+    std::fs::write(&victim, "precious").unwrap();
+    std::fs::remove_file(out.join("report.md")).unwrap();
+    std::os::unix::fs::symlink(&victim, out.join("report.md")).unwrap();
+    std::fs::remove_file(out.join("alpha-xy.png")).unwrap();
+    std::os::unix::fs::symlink(&victim, out.join("alpha-xy.png")).unwrap();
+
+    let o = run(&[], &b, &out);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert_eq!(std::fs::read_to_string(&victim).unwrap(), "precious");
+    let report = std::fs::symlink_metadata(out.join("report.md")).unwrap();
+    assert!(report.is_file(), "report.md is a file again, not the link");
+    let mut names: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .collect();
+    names.sort();
+    assert!(names.iter().all(|n| !n.starts_with("alpha")), "{names:?}");
+    assert!(names.contains(&"beta-with.csv".to_string()), "{names:?}");
+    assert!(names.contains(&"my-notes.txt".to_string()), "{names:?}");
+    let manifest = std::fs::read_to_string(out.join("host-sim-manifest.txt")).unwrap();
+    assert!(manifest.contains("beta-with.csv") && !manifest.contains("alpha"));
+    assert!(!manifest.contains("my-notes.txt"));
+}
+
+/// Starts `host-sim args…` with stderr piped, waits for a stderr line containing `ready`,
+/// sends SIGINT, and returns the output (stderr lines included).
+fn interrupt_after(args: &[&str], ready: &str) -> (Option<i32>, String, Vec<String>) {
+    let mut child = host_sim()
+        .args(args)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut lines = Vec::new();
+    let mut err = BufReader::new(child.stderr.take().unwrap()).lines();
+    for line in err.by_ref() {
+        let line = line.unwrap();
+        let go = line.contains(ready);
+        lines.push(line);
+        if go {
+            break;
+        }
+    }
+    let pid = child.id().to_string();
+    assert!(Command::new("kill")
+        .args(["-INT", &pid])
+        .status()
+        .unwrap()
+        .success());
+    lines.extend(err.map_while(Result::ok));
+    let out = child.wait_with_output().unwrap();
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout).into_owned(),
+        lines,
+    )
+}
+
+#[test]
+fn a_long_run_shows_progress_without_a_terminal_and_keeps_its_data_on_ctrl_c() {
+    let dir = tempdir("sigint");
+    let s = scenario(
+        &dir,
+        "hour",
+        "name = \"hour\"\nduration = 3600\n[trajectory]\nkind = \"circle\"\nradius = 10\n",
+    );
+    let out = dir.join("out");
+    let (code, stdout, lines) = interrupt_after(
+        &[
+            "run",
+            "--scenario",
+            s.to_str().unwrap(),
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "control periods",
+    );
+    assert_eq!(code, Some(130), "{lines:?}");
+    // The progress line (stderr is a pipe here, not a terminal).
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.starts_with("host-sim: hour:") && l.contains("elapsed")),
+        "{lines:?}"
+    );
+    // The run's CSV is complete up to the stop, and everything says it is partial.
+    let csv = std::fs::read_to_string(out.join("hour-with.csv")).unwrap();
+    let rows = csv.lines().count();
+    assert!(rows > 100 && rows < 360_002, "{rows}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("(PARTIAL)") && report.contains("INTERRUPTED"),
+        "{report}"
+    );
+    assert!(stdout.contains("INTERRUPTED"), "{stdout}");
+    // No temporary file is left behind.
+    assert!(std::fs::read_dir(&out).unwrap().all(|e| !e
+        .unwrap()
+        .file_name()
+        .to_string_lossy()
+        .starts_with(".host-sim-tmp")));
+}
+
+#[test]
+fn monte_carlo_bounds_its_runs_estimates_their_time_and_writes_a_partial_report_on_ctrl_c() {
+    let dir = tempdir("mc");
+    let out = dir.join("out");
+    let (code, _, lines) = interrupt_after(
+        &[
+            "monte-carlo",
+            "--runs",
+            "5000",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        "calibration run",
+    );
+    assert_eq!(code, Some(130), "{lines:?}");
+    assert!(
+        lines
+            .iter()
+            .any(|l| l.contains("5000 runs") && l.contains("about")),
+        "{lines:?}"
+    );
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(report.contains("Partial: interrupted after"), "{report}");
+    assert!(report.contains("of 5000 runs"), "{report}");
+
+    // Beyond the bound, refused before anything runs.
+    let o = host_sim()
+        .args(["monte-carlo", "--runs", "20000", "--out"])
+        .arg(dir.join("big"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("--allow-long-run"), "{}", stderr(&o));
+}
+
+#[test]
+fn monte_carlo_refuses_to_replace_a_scenarios_own_variation() {
+    let dir = tempdir("mc-var");
+    let shipped = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/circular-10R.toml");
+    let o = host_sim()
+        .args(["monte-carlo", "--runs", "1", "--scenario"])
+        .arg(&shipped)
+        .arg("--out")
+        .arg(dir.join("out"))
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("[variation]"), "{}", stderr(&o));
+}
+
+#[test]
+fn a_negative_current_parses_and_is_refused_with_its_reason() {
+    let o = host_sim()
+        .args(["monte-carlo", "--runs", "1", "--current", "-0.5"])
+        .output()
+        .unwrap();
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("--current must be a finite speed ≥ 0 m/s, got -0.5"),
+        "{}",
+        stderr(&o)
+    );
+}
+
+#[test]
+fn pil_duration_obeys_the_duration_cap_and_the_step_cap() {
+    let dir = tempdir("pil-cap");
+    let fast = scenario(
+        &dir,
+        "fast",
+        "[trajectory]\nkind = \"circle\"\nradius = 10\n[controller]\nrate_hz = 1000\n",
+    );
+    for (duration, key) in [("1e9", "duration"), ("10000", "--allow-long-run")] {
+        let o = host_sim()
+            .args(["pil", "--scenario"])
+            .arg(&fast)
+            .args(["--duration", duration, "--elf", "/nonexistent", "--out"])
+            .arg(dir.join("out"))
+            .output()
+            .unwrap();
+        assert_eq!(o.status.code(), Some(2), "{duration}");
+        // Refused as a scenario value, before the firmware image is even looked at.
+        let e = stderr(&o);
+        assert!(e.contains(key) && !e.contains("/nonexistent"), "{e}");
+    }
+}
