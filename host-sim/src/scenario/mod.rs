@@ -208,7 +208,7 @@ impl Scenario {
     /// trajectory.
     pub fn new(config: SimConfig) -> Result<Self, ScenarioError> {
         let controller = check::controller(&config)?;
-        let trajectory = check::trajectory(&config.trajectory)?;
+        let trajectory = check::trajectory(&config.mission())?;
         Self::assemble(config, controller, trajectory, true)
     }
 
@@ -223,14 +223,14 @@ impl Scenario {
         } else {
             check::controller(&config)?
         };
-        let trajectory = if config.trajectory == self.config.trajectory {
+        let trajectory = if config.mission() == self.config.mission() {
             self.trajectory
         } else {
-            check::trajectory(&config.trajectory)?
+            check::trajectory(&config.mission())?
         };
         // The mission's reference depends only on these (a Monte Carlo draw keeps them all).
         let same_mission = config.controller == self.config.controller
-            && config.trajectory == self.config.trajectory
+            && config.mission() == self.config.mission()
             && config.duration == self.config.duration;
         Self::assemble(config, controller, trajectory, !same_mission)
     }
