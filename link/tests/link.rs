@@ -334,6 +334,12 @@ fn max_sizes_are_exact() {
 
 #[test]
 fn largest_message_fits_max_frame_exactly() {
+    // Protocol 3's commands, by hand from the layout: a full ConfigPatch is 6 + 2 + 5 + 5 + 2
+    // + 2 (protocol 2) + 2 (unit) + 2 (mask) + 31 (priority: 6 ranks, 6 weights) bytes; a
+    // StartMission is its tag, the path (17), the heading (1) and the time scale (4).
+    assert_eq!(ConfigPatch::MAX_SIZE, 57);
+    assert_eq!(Command::MAX_SIZE, 58);
+    assert_eq!(MissionPlan::MAX_SIZE + 1, 23);
     assert_eq!(Envelope::MAX_SIZE, 140);
     assert_eq!(MAX_BODY, 155);
     assert_eq!(MAX_FRAME, 157);

@@ -401,7 +401,7 @@ fn real_chain_exercise() -> bool {
         kgf_reported, applied, mask_refused, armed_refused, scale_refused, flying
     );
     info!(
-        "real chain: instructions for SetConfig (unit, mounting, priority) {}, for StartMission (tangent, k = 2) {}",
+        "real chain instructions (a SetConfig of unit, mounting and priority; a StartMission, tangent at twice the time): set_config={} start_mission={}",
         set_config, start
     );
     kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
