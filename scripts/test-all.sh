@@ -11,10 +11,10 @@ bash scripts/setup.sh
 source scripts/ci-link-key.sh
 
 echo "== host tests (libm backend): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic, xtask"
-cargo test --workspace --release
+cargo test --workspace --profile host
 
 echo "== controller-core tests with the micromath backend"
-cargo test -p controller-core --release --features micromath
+cargo test -p controller-core --profile host --features micromath
 
 echo "== controller-core cross-build for thumbv7em-none-eabihf"
 cargo build -p controller-core --release --target thumbv7em-none-eabihf

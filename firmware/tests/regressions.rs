@@ -4,9 +4,12 @@
 //! periods, status, the fault code, `last_state_seq`, the loop rate, the lock-step flag and
 //! the refusal count), so that the same file also runs against the code before the fix: the
 //! `compat` module below is the only part that differs there (`Supervisor::new` took the
-//! controller alone, and the refusal count was `rejected_commands`). Every test here fails on
-//! that code. The defects that need the new interface to be seen at all (signing, refusal
-//! reasons in telemetry) are tested in `supervisor.rs` and `signed_link.rs`.
+//! controller alone, and the refusal count was `rejected_commands`), with `common`'s
+//! `supervisor`, `state`, `CIRCLE` and `NOW` (main had no `tests/common`). Every test here
+//! fails on that code. The defects that need the new interface to be seen at all (signing,
+//! refusal reasons in telemetry) are tested in `supervisor.rs`, `link/tests/sign.rs` and the
+//! supervisor fuzz harness (`supervisor_fuzz.rs`, which drives the board's signed end of the
+//! link).
 
 use auv_link::{BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg};
 use firmware::supervisor::Supervisor;
@@ -33,7 +36,11 @@ struct Seq(u16);
 impl Seq {
     fn env(&mut self, msg: Msg) -> Envelope {
         self.0 = self.0.wrapping_add(1);
-        Envelope::new(self.0, msg)
+        Envelope {
+            version: auv_link::PROTOCOL_VERSION,
+            seq: self.0,
+            msg,
+        }
     }
     fn give(&mut self, s: &mut Supervisor, msg: Msg) {
         let e = self.env(msg);

@@ -10,7 +10,7 @@ use auv_link::{
 };
 use controller_core::allocator;
 use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED};
-use controller_core::{Controller, ControllerConfig, HeadingMode, Mission, Trajectory};
+use controller_core::{Controller, ControllerConfig, Mission, Trajectory};
 use firmware::supervisor::{Mode, Supervisor, NOT_AUV150};
 
 mod common;

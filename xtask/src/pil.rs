@@ -30,6 +30,10 @@ const REAL_CHAIN: &str = "host-sim/scenarios/real/figure-eight-30x30.toml";
 /// Seconds of the real-chain mission: 300 periods, a few seconds of QEMU.
 const REAL_CHAIN_SECONDS: &str = "3";
 
+/// The workspace's host test profile (`[profile.host]` in Cargo.toml), whose `host-sim` the
+/// PIL checks run.
+const HOST_PROFILE: &str = "host";
+
 pub fn run(ci: &mut Ci, built: &Built) {
     ci.step(
         "processor in the loop: a short mission unsigned and signed, a short real-chain mission (PIL must equal SIL) and a link-fault case",
@@ -38,13 +42,13 @@ pub fn run(ci: &mut Ci, built: &Built) {
         ci.fail("PIL: no QEMU flying image (its build failed, see above)");
         return;
     };
-    let what = "cargo build --release -p host-sim";
+    // The very build of the README's test command (scripts/test-all.sh), so that host-sim is
+    // built once: `cargo build -p host-sim` alone resolves features differently (no
+    // dev-dependencies) and would build host-sim a second time.
+    let args = ["test", "--workspace", "--profile", HOST_PROFILE, "--no-run"];
+    let what = format!("cargo {}", args.join(" "));
     println!("{what}");
-    match ci
-        .cargo()
-        .args(["build", "--release", "-p", "host-sim"])
-        .status()
-    {
+    match ci.cargo().args(args).status() {
         Ok(s) if s.success() => {}
         other => {
             ci.fail(format!(
@@ -53,7 +57,7 @@ pub fn run(ci: &mut Ci, built: &Built) {
             return;
         }
     }
-    let host_sim = ci.target_dir.join("release").join("host-sim");
+    let host_sim = ci.target_dir.join(HOST_PROFILE).join("host-sim");
     let elf = elf.to_path_buf();
     pil_checks(ci, &host_sim, &elf);
 }

@@ -26,12 +26,16 @@ pub fn board_info(signing: bool) -> BoardInfo {
     }
 }
 
+/// The default controller (built once: `Controller::new` takes the bounds over the box).
+pub fn controller() -> Controller {
+    static C: std::sync::OnceLock<Controller> = std::sync::OnceLock::new();
+    C.get_or_init(|| Controller::new(ControllerConfig::default()).unwrap())
+        .clone()
+}
+
 /// A supervisor with the default controller, as the boards boot (signing off).
 pub fn supervisor() -> Supervisor {
-    Supervisor::new(
-        Controller::new(ControllerConfig::default()).unwrap(),
-        board_info(false),
-    )
+    Supervisor::new(controller(), board_info(false))
 }
 
 /// The mission every test flies: the paper's 10 m circle, as the paper flies it (its heading,

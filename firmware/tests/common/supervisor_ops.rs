@@ -1,0 +1,803 @@
+//! What the supervisor's fuzz target (`fuzz/fuzz_targets/supervisor.rs`) and its stable
+//! proptest twin (`firmware/tests/supervisor_fuzz.rs`) share, as source (both `#[path]`-include
+//! this file): the reading of arbitrary bytes as a sequence of link events and control periods,
+//! the navigation computer (and its forgers) that turn them into real frames, an independent
+//! model of what the board may accept, and the invariants checked after every event.
+//!
+//! Input layout: byte 0 bit 0 turns the board's signing on; then ops until the input ends, each
+//! an op byte (`b % OPS`, the `OP_*` constants) and its arguments (missing bytes read as 0):
+//!
+//! | op | event |
+//! |----|-------|
+//! | `OP_STATE` | a state frame: seq step `s` (1 byte: `s = 0` → +1, else `s − 128` as i8-ish, or a 2-byte jump when `s = 255`), tick mode, value, perturbation |
+//! | `OP_COMMAND` | a command: kind, then its arguments (missions and patches from fuzz bytes, biased to valid ones) |
+//! | `OP_TELEMETRY` | a telemetry frame sent to the board (the wrong direction) |
+//! | `OP_PERIOD` | one control period; bit 0 of the argument: the previous period overran |
+//! | `OP_REPLAY` | an earlier frame (of the last 8) sent again, byte for byte |
+//! | `OP_CORRUPT` | an earlier frame with one bit flipped |
+//! | `OP_RAW` | up to 64 raw bytes (length byte), then a delimiter |
+//! | `OP_PERIODS` | up to 16 control periods in a row |
+//!
+//! Every frame the harness builds is signed one of five ways (an argument byte): as the board
+//! expects (signed with the key if signing is on, else unsigned), the other way, with a wrong
+//! key, for the wrong direction (a reflected board frame), or by a restarted signer with an
+//! arbitrary (usually old) timestamp.
+//!
+//! Invariants (the issue's, and what they imply), checked against the [`Model`], which learns
+//! only from what the harness sent and from the supervisor's public counters:
+//! - **No panic**, and every period's voltages are finite and within `voltage_limit`.
+//! - **Only in-order, authentic frames reach the supervisor:** a frame the supervisor accepts
+//!   (`rx_frames` + 1) has a sequence number newer than the last accepted one (RFC 1982 within
+//!   [`SEQ_WINDOW`]); with signing on, every frame that reaches the supervisor at all (accepted
+//!   or dropped as stale) was signed with the key, for this direction, with a timestamp above
+//!   every earlier one; with signing off, none was signed. In lock-step, an accepted state frame
+//!   during a mission is on the mission clock (its tick rises by 1 ..= the periods run since the
+//!   last one). Every frame the harness built is counted exactly once (accepted, stale or error).
+//! - **Thrusters off unless armed with a fresh, in-order state:** a period with any voltage ≠ 0
+//!   (or reported `Running`) needs the model armed, with a mission, nothing latched, no overrun,
+//!   and an accepted state frame at most `stale_periods` periods old (in lock-step, accepted
+//!   since the mission started).
+//! - **A latched fail-safe never clears without disarm + arm:** once a period reports
+//!   `FailSafe(r)`, every telemetry frame reports `latched = r` and no thrust, and a lone `Arm`
+//!   is refused, until an accepted `Disarm` followed by an accepted `Arm`.
+//! - **Commands do what the state table says, or nothing:** a refused `SetConfig` changes no
+//!   setting (atomic), an accepted one happened disarmed; an accepted `StartMission` happened
+//!   armed, unlatched and without a mission; `Disarm` and `StopMission` are never refused and
+//!   drop the mission; a refused `Arm` happened only armed and latched.
+
+#![allow(dead_code)]
+
+use auv_link::seq::SEQ_WINDOW;
+use auv_link::sign::{AuthError, Direction, LinkKey, Signer, MAX_TIMESTAMP};
+use auv_link::{
+    decode_frame, encode, encode_signed, BoardStatus, Command, ConfigPatch, Envelope,
+    FailSafeReason, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
+    ThrustUnit, DEFAULT_STALE_PERIODS, MAX_FRAME,
+};
+use controller_core::kinematics::{self, Attitude};
+use controller_core::{Controller, ControllerConfig, Table1Case, Trajectory};
+use firmware::board::{self, LinkBuffers};
+use firmware::supervisor::{BoardInfo, Supervisor};
+
+pub const OP_STATE: u8 = 0;
+pub const OP_COMMAND: u8 = 1;
+pub const OP_TELEMETRY: u8 = 2;
+pub const OP_PERIOD: u8 = 3;
+pub const OP_REPLAY: u8 = 4;
+pub const OP_CORRUPT: u8 = 5;
+pub const OP_RAW: u8 = 6;
+pub const OP_PERIODS: u8 = 7;
+/// Number of ops (`op byte % OPS`).
+pub const OPS: u8 = 8;
+
+/// Command kinds (the byte after `OP_COMMAND`, `% 5`).
+pub const CMD_ARM: u8 = 0;
+pub const CMD_DISARM: u8 = 1;
+pub const CMD_START: u8 = 2;
+pub const CMD_STOP: u8 = 3;
+pub const CMD_CONFIG: u8 = 4;
+
+/// How a frame is signed (the signing byte, `% 5`).
+pub const SIGN_AS_EXPECTED: u8 = 0;
+pub const SIGN_OTHER_WAY: u8 = 1;
+pub const SIGN_WRONG_KEY: u8 = 2;
+pub const SIGN_WRONG_DIRECTION: u8 = 3;
+pub const SIGN_RESTARTED: u8 = 4;
+
+/// The board's supply (V), as the boards state it.
+pub const SUPPLY: f32 = controller_core::DEFAULT_V_LIMIT;
+/// The link key of the signed runs, and a forger's.
+pub const KEY: LinkKey = LinkKey::new([0x5C; 32]);
+pub const WRONG_KEY: LinkKey = LinkKey::new([0x5D; 32]);
+
+/// What one run did, so that tests can check the invariants were not vacuous.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Stats {
+    pub frames_sent: u32,
+    pub frames_accepted: u32,
+    pub periods: u32,
+    pub periods_on: u32,
+    pub latches: u32,
+    pub rearms_after_latch: u32,
+    pub refusals: u32,
+}
+
+/// Reads the input; missing bytes are 0.
+struct Bytes<'a> {
+    data: &'a [u8],
+    at: usize,
+}
+
+impl Bytes<'_> {
+    fn more(&self) -> bool {
+        self.at < self.data.len()
+    }
+    fn u8(&mut self) -> u8 {
+        let b = self.peek_u8();
+        self.at += 1;
+        b
+    }
+    /// The next byte, without taking it.
+    fn peek_u8(&self) -> u8 {
+        self.data.get(self.at).copied().unwrap_or(0)
+    }
+    fn u16(&mut self) -> u16 {
+        u16::from_le_bytes([self.u8(), self.u8()])
+    }
+    fn u32(&mut self) -> u32 {
+        u32::from_le_bytes([self.u8(), self.u8(), self.u8(), self.u8()])
+    }
+    fn u64(&mut self) -> u64 {
+        u64::from(self.u32()) | u64::from(self.u32()) << 32
+    }
+    fn f32(&mut self) -> f32 {
+        f32::from_bits(self.u32())
+    }
+    fn take(&mut self, n: usize) -> &[u8] {
+        let start = self.at.min(self.data.len());
+        let end = (start + n).min(self.data.len());
+        self.at = start + n;
+        &self.data[start..end]
+    }
+}
+
+/// How a frame the harness built was authenticated.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Auth {
+    /// No signature.
+    Unsigned,
+    /// Signed with the key, for the board, with this timestamp.
+    Good(u64),
+    /// Signed, but not in a way the board may accept (wrong key or direction).
+    Forged,
+}
+
+/// A frame the harness built: its envelope and how it was signed.
+type Known = Option<(Envelope, Auth)>;
+
+/// What the board may have done: learnt only from the frames sent and the supervisor's public
+/// counters and telemetry.
+#[derive(Clone, Copy, Debug)]
+struct Model {
+    armed: bool,
+    mission: bool,
+    lockstep: bool,
+    stale_periods: u8,
+    latched: Option<FailSafeReason>,
+    /// Disarmed since the latch (the next accepted `Arm` clears it).
+    disarmed_since_latch: bool,
+    last_seq: Option<u16>,
+    last_timestamp: Option<u64>,
+    /// Periods run since the last accepted state frame (`None`: none, or, in lock-step, none
+    /// since the mission started).
+    periods_since_state: Option<u64>,
+    /// Lock-step mission clock: the last accepted tick, and periods since.
+    clock: Option<(u64, u64)>,
+}
+
+impl Model {
+    fn new() -> Self {
+        Model {
+            armed: false,
+            mission: false,
+            lockstep: false,
+            stale_periods: DEFAULT_STALE_PERIODS,
+            latched: None,
+            disarmed_since_latch: false,
+            last_seq: None,
+            last_timestamp: None,
+            periods_since_state: None,
+            clock: None,
+        }
+    }
+
+    fn fresh(&self) -> bool {
+        self.periods_since_state
+            .is_some_and(|n| n <= u64::from(self.stale_periods))
+    }
+}
+
+/// The default controller (built once: `Controller::new` takes the bounds over the box).
+fn controller() -> Controller {
+    static C: std::sync::OnceLock<Controller> = std::sync::OnceLock::new();
+    C.get_or_init(|| Controller::new(ControllerConfig::default()).expect("default config"))
+        .clone()
+}
+
+/// The reference on the paper's 10 m circle at tick `k` (the vehicle exactly on it).
+fn on_circle(k: u64) -> StateFrame {
+    let d = Trajectory::table1(Table1Case::Circular10R).sample(k, 100);
+    let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
+    StateFrame {
+        t_ticks: k,
+        eta: d.eta.into(),
+        nu: nu.into(),
+    }
+}
+
+struct Harness {
+    sup: Supervisor,
+    link: LinkBuffers,
+    signing: bool,
+    seq: u16,
+    signer: Signer,
+    forger: Signer,
+    reflector: Signer,
+    /// The last frames sent, and what each is (for replays).
+    history: Vec<(Vec<u8>, Known)>,
+    model: Model,
+    stats: Stats,
+}
+
+/// Runs the input through a fresh supervisor and checks every invariant (module docs); panics
+/// on a violation. Returns what the run did.
+pub fn run(data: &[u8]) -> Stats {
+    let mut input = Bytes { data, at: 0 };
+    let signing = input.u8() & 1 == 1;
+    let mut h = Harness {
+        sup: Supervisor::new(
+            controller(),
+            BoardInfo {
+                supply_voltage: SUPPLY,
+                signing,
+            },
+        ),
+        link: if signing {
+            LinkBuffers::signed(&KEY)
+        } else {
+            LinkBuffers::new()
+        },
+        signing,
+        seq: 0,
+        signer: Signer::new(&KEY, Direction::ToBoard),
+        forger: Signer::new(&WRONG_KEY, Direction::ToBoard),
+        reflector: Signer::new(&KEY, Direction::FromBoard),
+        history: Vec::new(),
+        model: Model::new(),
+        stats: Stats::default(),
+    };
+    // Bounded work per input whatever its length.
+    let mut ops = 0;
+    while input.more() && ops < 512 {
+        ops += 1;
+        match input.u8() % OPS {
+            OP_STATE => {
+                let seq = next_seq(&mut h, &mut input);
+                let s = state_frame(&h, &mut input);
+                let how = input.u8();
+                h.send(seq, Msg::State(s), how, &mut input);
+            }
+            OP_COMMAND => {
+                let seq = next_seq(&mut h, &mut input);
+                let c = command(&mut input);
+                let how = input.u8();
+                h.send(seq, Msg::Command(c), how, &mut input);
+            }
+            OP_TELEMETRY => {
+                let seq = next_seq(&mut h, &mut input);
+                let how = input.u8();
+                let t = h.period(false);
+                h.send(seq, Msg::Telemetry(t), how, &mut input);
+            }
+            OP_PERIOD => {
+                let overrun = input.u8() & 1 == 1;
+                h.period(overrun);
+            }
+            OP_PERIODS => {
+                for _ in 0..=(input.u8() % 16) {
+                    h.period(false);
+                }
+            }
+            OP_REPLAY => {
+                if !h.history.is_empty() {
+                    let i = usize::from(input.u8()) % h.history.len();
+                    let (frame, known) = h.history[i].clone();
+                    h.deliver(&frame, known);
+                    h.remember(frame, known);
+                }
+            }
+            OP_CORRUPT => {
+                if !h.history.is_empty() {
+                    let i = usize::from(input.u8()) % h.history.len();
+                    let mut frame = h.history[i].0.clone();
+                    // Not the delimiter: every delivery ends with one, so the decoder is
+                    // aligned on frames when the next one starts.
+                    let bit = usize::from(input.u16()) % (8 * (frame.len() - 1));
+                    frame[bit / 8] ^= 1 << (bit % 8);
+                    h.raw(&frame);
+                }
+            }
+            _ => {
+                let n = usize::from(input.u8() % 65);
+                let mut bytes = input.take(n).to_vec();
+                bytes.push(0);
+                h.raw(&bytes);
+            }
+        }
+    }
+    h.stats
+}
+
+/// The next sequence number: usually +1; sometimes a repeat, a step back or a jump.
+fn next_seq(h: &mut Harness, input: &mut Bytes) -> u16 {
+    let s = input.u8();
+    let step = match s {
+        0..=200 => 1,
+        255 => input.u16(),
+        _ => u16::from(s).wrapping_sub(228), // −27 ..= +26
+    };
+    h.seq = h.seq.wrapping_add(step);
+    h.seq
+}
+
+/// A state frame: on the reference at the next tick of the mission clock (or the next after
+/// `value`), at an arbitrary tick, and sometimes with one component replaced by arbitrary bits.
+fn state_frame(h: &Harness, input: &mut Bytes) -> StateFrame {
+    let mode = input.u8();
+    let next = h.model.clock.map_or(0, |(t, _)| t + 1);
+    let t = match mode % 4 {
+        0 => next,
+        1 => next.wrapping_add(u64::from(input.u8())),
+        2 => next.wrapping_sub(u64::from(input.u8())),
+        _ => input.u64(),
+    };
+    // The reference only depends on t mod its period; keep the sample finite for huge ticks.
+    let mut s = on_circle(t % 1_000_000);
+    s.t_ticks = t;
+    if mode & 0x80 != 0 {
+        let i = usize::from(input.u8() % 12);
+        let v = input.f32();
+        if i < 6 {
+            s.eta[i] = v;
+        } else {
+            s.nu[i - 6] = v;
+        }
+    }
+    s
+}
+
+/// A mission: [`path`]'s, with the tangent heading if bit 6 of its first byte is set and, if
+/// bit 5 is, a time scale from the input (else 1) — so byte 0 is the paper's circle as before.
+fn mission(input: &mut Bytes) -> MissionPlan {
+    let kind = input.peek_u8();
+    let path = path(input);
+    MissionPlan {
+        path,
+        heading: if kind & 0x40 != 0 {
+            Heading::Tangent
+        } else {
+            Heading::Paper
+        },
+        time_scale: if kind & 0x20 != 0 { input.f32() } else { 1.0 },
+    }
+}
+
+fn path(input: &mut Bytes) -> MissionSpec {
+    let kind = input.u8();
+    if kind & 0x80 == 0 {
+        return MissionSpec::Circle {
+            radius: 10.0,
+            omega: 0.1,
+            depth: 5.0,
+        };
+    }
+    let (a, b, c) = (input.f32(), input.f32(), input.f32());
+    match kind % 4 {
+        0 => MissionSpec::Circle {
+            radius: a,
+            omega: b,
+            depth: c,
+        },
+        1 => MissionSpec::FigureEight {
+            amplitude: a,
+            omega: b,
+            depth: c,
+        },
+        2 => MissionSpec::LawnMower {
+            scale: a,
+            omega: b,
+            depth: c,
+        },
+        _ => MissionSpec::Helix {
+            radius: a,
+            omega: b,
+            depth: c,
+            depth_rate: input.f32(),
+        },
+    }
+}
+
+/// A config patch: each field present or not, with values from a few meaningful ones
+/// (valid, at and beyond the limits) or arbitrary bits.
+fn patch(input: &mut Bytes) -> ConfigPatch {
+    let present = input.u8();
+    let pick = |input: &mut Bytes, values: &[f32]| {
+        let i = usize::from(input.u8()) % (values.len() + 1);
+        values.get(i).copied().unwrap_or_else(|| input.f32())
+    };
+    ConfigPatch {
+        rate_hz: (present & 1 != 0).then(|| {
+            let values = [100, 50, 200, 201, 0, u32::MAX, 10];
+            let i = usize::from(input.u8()) % (values.len() + 1);
+            values.get(i).copied().unwrap_or_else(|| input.u32())
+        }),
+        robust: (present & 2 != 0).then(|| input.u8() & 1 == 1),
+        delta_max: (present & 4 != 0).then(|| pick(input, &[1.0, 0.5, 0.0, -1.0, f32::NAN])),
+        voltage_limit: (present & 8 != 0)
+            .then(|| pick(input, &[SUPPLY, 12.0, SUPPLY + 0.5, 0.0, f32::INFINITY])),
+        stale_periods: (present & 16 != 0).then(|| input.u8()),
+        lockstep: (present & 32 != 0).then(|| input.u8() & 1 == 1),
+        // Protocol 3's chain: any unit, any mask byte (a sixth thruster is refused); the
+        // priority stays unset (no bit left in `present`; tests/thruster_chain.rs covers it).
+        thrust_unit: (present & 64 != 0).then(|| {
+            if input.u8() & 1 == 0 {
+                ThrustUnit::Kgf
+            } else {
+                ThrustUnit::Newton
+            }
+        }),
+        reversed_thrusters: (present & 128 != 0).then(|| input.u8()),
+        priority: None,
+    }
+}
+
+fn command(input: &mut Bytes) -> Command {
+    match input.u8() % 5 {
+        CMD_ARM => Command::Arm,
+        CMD_DISARM => Command::Disarm,
+        CMD_START => Command::StartMission(mission(input)),
+        CMD_STOP => Command::StopMission,
+        _ => Command::SetConfig(patch(input)),
+    }
+}
+
+/// The supervisor's settings a `SetConfig` may change.
+fn settings(sup: &Supervisor) -> (ControllerConfig, u8, bool) {
+    (
+        *sup.controller().config(),
+        sup.stale_periods(),
+        sup.lockstep(),
+    )
+}
+
+impl Harness {
+    fn counters(&self) -> (u32, u32, u32, u32, u32) {
+        (
+            self.sup.rx_frames(),
+            self.sup.rx_stale(),
+            self.sup.rx_errors(),
+            self.sup.refused_commands(),
+            self.sup.rx_auth_errors(),
+        )
+    }
+
+    /// Builds the frame for `(seq, msg)`, signed as `how` says, sends it and checks what the
+    /// supervisor did with it.
+    fn send(&mut self, seq: u16, msg: Msg, how: u8, input: &mut Bytes) {
+        let env = Envelope::new(seq, msg);
+        let mut out = [0u8; MAX_FRAME];
+        let signed = match how % 5 {
+            SIGN_AS_EXPECTED => self.signing,
+            SIGN_OTHER_WAY => !self.signing,
+            _ => true,
+        };
+        let (n, auth) = if !signed {
+            (encode(&env, &mut out), Auth::Unsigned)
+        } else {
+            match how % 5 {
+                SIGN_WRONG_KEY => (
+                    encode_signed(&env, &mut self.forger, &mut out),
+                    Auth::Forged,
+                ),
+                SIGN_WRONG_DIRECTION => (
+                    encode_signed(&env, &mut self.reflector, &mut out),
+                    Auth::Forged,
+                ),
+                SIGN_RESTARTED => {
+                    let mut restarted = Signer::new(&KEY, Direction::ToBoard);
+                    restarted.advance_to(input.u64() >> 16);
+                    let n = encode_signed(&env, &mut restarted, &mut out);
+                    (n, Auth::Good(restarted.timestamp()))
+                }
+                _ => {
+                    let n = encode_signed(&env, &mut self.signer, &mut out);
+                    (n, Auth::Good(self.signer.timestamp()))
+                }
+            }
+        };
+        // Only a restarted signer at the last timestamp can fail to sign.
+        let Ok(n) = n else { return };
+        let frame = out[..n].to_vec();
+        self.deliver(&frame, Some((env, auth)));
+        self.remember(frame, Some((env, auth)));
+    }
+
+    fn remember(&mut self, frame: Vec<u8>, known: Known) {
+        if self.history.len() == 8 {
+            self.history.remove(0);
+        }
+        self.history.push((frame, known));
+    }
+
+    /// Bytes the harness did not build as a frame (a corruption, raw bytes), split at the
+    /// delimiters. A chunk equal to a frame sent earlier is that frame; otherwise, with
+    /// signing off, it is what `decode_frame` says it is, if it decodes; with signing on it
+    /// cannot be authentic (nobody but the harness holds the key).
+    fn raw(&mut self, bytes: &[u8]) {
+        for chunk in bytes.split_inclusive(|&b| b == 0) {
+            let body = chunk.strip_suffix(&[0]).unwrap_or(chunk);
+            let earlier = self
+                .history
+                .iter()
+                .find(|(f, _)| f.as_slice() == chunk)
+                .and_then(|(_, k)| *k);
+            let known = earlier.or_else(|| {
+                if self.signing {
+                    None
+                } else {
+                    decode_frame(&mut body.to_vec())
+                        .ok()
+                        .map(|e| (e, Auth::Unsigned))
+                }
+            });
+            self.deliver(chunk, known);
+        }
+    }
+
+    /// Feeds `frame` to the board's end of the link and checks the supervisor's reaction
+    /// against the model. `known`: the envelope and how it was signed, if it is a frame.
+    fn deliver(&mut self, frame: &[u8], known: Known) {
+        let before = self.counters();
+        let settings_before = settings(&self.sup);
+        board::receive(&mut self.sup, &mut self.link, frame);
+        let after = self.counters();
+        let d = |a: u32, b: u32| a.checked_sub(b).expect("counters never go down");
+        let (accepted, stale, errors, refused, auth_errors) = (
+            d(after.0, before.0),
+            d(after.1, before.1),
+            d(after.2, before.2),
+            d(after.3, before.3),
+            d(after.4, before.4),
+        );
+        let Some((env, auth)) = known else {
+            assert_eq!(
+                (accepted, stale),
+                (0, 0),
+                "only a frame reaches the supervisor"
+            );
+            assert_eq!(refused, 0);
+            return;
+        };
+        self.stats.frames_sent += 1;
+        assert_eq!(
+            accepted + stale + errors,
+            1,
+            "a frame is counted once: {env:?}"
+        );
+        // A frame the harness built fails at the link only on authentication (or, signing off,
+        // on a signature); an error without one is the supervisor's (telemetry to the board).
+        let passed_link = accepted + stale == 1 || (errors == 1 && auth_errors == 0);
+        if passed_link {
+            // It passed the link's checks: authentic as the board's mode requires.
+            match (self.signing, auth) {
+                (false, a) => assert_eq!(a, Auth::Unsigned, "signing off: {env:?}"),
+                (true, Auth::Good(t)) => {
+                    if let Some(last) = self.model.last_timestamp {
+                        assert!(t > last, "replayed timestamp {t} ≤ {last} accepted");
+                    }
+                    self.model.last_timestamp = Some(t);
+                    // As a navigation computer would: its next stamp goes above it.
+                    self.signer.advance_to(t);
+                }
+                (true, a) => panic!("signing on, {a:?} frame reached the supervisor: {env:?}"),
+            }
+        }
+        if matches!(env.msg, Msg::Telemetry(_)) {
+            assert_eq!(accepted + stale, 0, "telemetry to the board is an error");
+        }
+        if accepted == 0 {
+            assert_eq!(refused, 0, "a dropped frame is not a command");
+            assert_eq!(
+                settings(&self.sup),
+                settings_before,
+                "a dropped frame changes nothing"
+            );
+            return;
+        }
+        self.stats.frames_accepted += 1;
+        if let Some(last) = self.model.last_seq {
+            let dist = env.seq.wrapping_sub(last);
+            assert!(
+                (1..=SEQ_WINDOW).contains(&dist),
+                "seq {} accepted after {last}",
+                env.seq
+            );
+        }
+        self.model.last_seq = Some(env.seq);
+        match env.msg {
+            Msg::State(s) => {
+                assert_eq!(refused, 0);
+                if self.model.lockstep && self.model.mission {
+                    if let Some((t, periods)) = self.model.clock {
+                        assert!(
+                            s.t_ticks > t && s.t_ticks - t <= periods,
+                            "tick {} accepted after {t}, {periods} periods on",
+                            s.t_ticks
+                        );
+                    }
+                    self.model.clock = Some((s.t_ticks, 0));
+                }
+                self.model.periods_since_state = Some(0);
+            }
+            Msg::Command(c) => {
+                let refused = refused == 1;
+                if refused {
+                    self.stats.refusals += 1;
+                    assert!(self.sup.last_refusal().is_some());
+                }
+                self.command(&c, refused);
+                if refused || !matches!(c, Command::SetConfig(_)) {
+                    assert_eq!(
+                        settings(&self.sup),
+                        settings_before,
+                        "{c:?} changed settings"
+                    );
+                }
+            }
+            Msg::Telemetry(_) => unreachable!("checked above"),
+        }
+    }
+
+    fn command(&mut self, c: &Command, refused: bool) {
+        let m = &mut self.model;
+        match c {
+            Command::Arm => {
+                if refused {
+                    assert!(m.armed && m.latched.is_some(), "Arm refused: {m:?}");
+                } else {
+                    assert!(
+                        !(m.armed && m.latched.is_some()),
+                        "lone Arm accepted, latched"
+                    );
+                    if !m.armed {
+                        if m.latched.is_some() {
+                            assert!(m.disarmed_since_latch);
+                            self.stats.rearms_after_latch += 1;
+                        }
+                        m.latched = None;
+                        m.disarmed_since_latch = false;
+                    }
+                    m.armed = true;
+                }
+            }
+            Command::Disarm | Command::StopMission => {
+                assert!(!refused, "{c:?} refused");
+                if matches!(c, Command::Disarm) {
+                    m.armed = false;
+                    m.disarmed_since_latch = m.latched.is_some();
+                }
+                m.mission = false;
+            }
+            Command::StartMission(_) => {
+                if !refused {
+                    assert!(
+                        m.armed && m.latched.is_none() && !m.mission,
+                        "StartMission accepted: {m:?}"
+                    );
+                    m.mission = true;
+                    m.clock = None;
+                    if m.lockstep {
+                        m.periods_since_state = None;
+                    }
+                }
+            }
+            Command::SetConfig(p) => {
+                if !refused {
+                    assert!(!m.armed, "SetConfig accepted armed");
+                    if let Some(n) = p.stale_periods {
+                        m.stale_periods = n;
+                    }
+                    if let Some(l) = p.lockstep {
+                        m.lockstep = l;
+                    }
+                    assert_eq!(self.sup.stale_periods(), m.stale_periods, "whole patch");
+                    assert_eq!(self.sup.lockstep(), m.lockstep, "whole patch");
+                    let cfg = self.sup.controller().config();
+                    assert!(p.rate_hz.is_none_or(|r| r == cfg.rate_hz), "whole patch");
+                    assert!(
+                        p.voltage_limit
+                            .is_none_or(|v| v.to_bits() == cfg.voltage_limit.to_bits()),
+                        "whole patch"
+                    );
+                    assert!(
+                        cfg.voltage_limit <= SUPPLY,
+                        "voltage limit above the supply"
+                    );
+                }
+            }
+        }
+    }
+
+    /// One control period, checked; returns its telemetry.
+    fn period(&mut self, overrun: bool) -> Telemetry {
+        let step = self.sup.step(overrun, &|| 0);
+        let t: Telemetry = step.telemetry;
+        self.stats.periods += 1;
+        let limit = self.sup.controller().config().voltage_limit;
+        for v in step.voltages {
+            assert!(
+                v.is_finite() && v.abs() <= limit,
+                "voltage {v}, limit {limit}"
+            );
+        }
+        let on = step.voltages.iter().any(|v| *v != 0.0);
+        let m = self.model;
+        let may_fly = m.armed && m.mission && m.latched.is_none() && !overrun && m.fresh();
+        if on || t.status == BoardStatus::Running {
+            assert!(
+                may_fly,
+                "thrusters on {:?}, {t:?}, model {m:?}",
+                step.voltages
+            );
+            assert_eq!(t.status, BoardStatus::Running);
+            self.stats.periods_on += 1;
+        }
+        match m.latched {
+            Some(r) => {
+                assert!(!on);
+                assert_eq!(t.latched, Some(r), "the latched reason in every frame");
+                let want = if m.armed {
+                    BoardStatus::FailSafe(r)
+                } else {
+                    BoardStatus::Disarmed
+                };
+                assert_eq!(t.status, want);
+            }
+            None => match t.status {
+                BoardStatus::FailSafe(r) => {
+                    assert!(m.armed && m.mission, "fail-safe without a mission: {m:?}");
+                    let want = if overrun {
+                        FailSafeReason::Overrun
+                    } else if !m.fresh() {
+                        FailSafeReason::StaleState
+                    } else {
+                        FailSafeReason::ControllerFault
+                    };
+                    assert_eq!(r, want, "model {m:?}");
+                    assert_eq!(t.latched, Some(r));
+                    self.model.latched = Some(r);
+                    self.stats.latches += 1;
+                }
+                status => {
+                    assert_eq!(t.latched, None);
+                    let want = match (m.armed, m.mission) {
+                        (false, _) => BoardStatus::Disarmed,
+                        (true, false) => BoardStatus::Armed,
+                        (true, true) => BoardStatus::Running,
+                    };
+                    assert_eq!(status, want, "model {m:?}");
+                }
+            },
+        }
+        // The telemetry goes out: it always fits a frame. Signed, the board stamps above the
+        // last stamp it accepted: once a peer holding the key has stamped at (or within a few
+        // frames of) 2⁴⁸ − 1, the board cannot sign again until it resets (a finding of this
+        // fuzz target, as MAVLink's scheme: a new key is due).
+        let env = self.sup.envelope(t);
+        match self.link.encode(&env) {
+            Ok(frame) => assert!(frame.len() <= MAX_FRAME),
+            Err(LinkError::Auth(AuthError::TimestampExhausted)) => assert!(
+                self.model
+                    .last_timestamp
+                    .is_some_and(|ts| ts > MAX_TIMESTAMP - 100_000),
+                "board's stamps exhausted after {:?}",
+                self.model.last_timestamp
+            ),
+            Err(e) => panic!("telemetry does not encode: {e:?}"),
+        }
+        let m = &mut self.model;
+        m.periods_since_state = m.periods_since_state.map(|n| n + 1);
+        m.clock = m.clock.map(|(t, n)| (t, n + 1));
+        t
+    }
+}
