@@ -58,15 +58,14 @@ fn trim_makes_gs_force_rows_vanish_and_keeps_its_moments() {
             );
             let g = model::restoring(&t, &att);
             let g0 = model::restoring(&p, &att);
-            for i in 0..3 {
-                assert_eq!(g[i], 0.0, "corner {corner}: g[{i}] = {}", g[i]);
-            }
-            for i in 3..6 {
+            assert!(
+                g.iter().take(3).all(|&f| f == 0.0),
+                "corner {corner}: forces {g}"
+            );
+            for (m, m0) in g.iter().zip(g0.iter()).skip(3) {
                 assert!(
-                    (g[i] - g0[i]).abs() <= 1e-9 * (1.0 + g0[i].abs()),
-                    "corner {corner}: moment {i}: {} vs {}",
-                    g[i],
-                    g0[i]
+                    (m - m0).abs() <= 1e-9 * (1.0 + m0.abs()),
+                    "corner {corner}: moment {m} vs {m0}"
                 );
             }
         }
@@ -270,10 +269,9 @@ fn the_newton_reading_shrinks_every_envelope_and_grounds_the_real_circle() {
         .with(|c| c.controller.thrust_unit = ThrustUnit::Newton)
         .unwrap();
     let (ek, en) = (kgf.controller().envelope(), newton.controller().envelope());
-    for i in 0..5 {
-        let r = ek.max[i] / en.max[i];
-        assert!((r - 9.80665).abs() < 1e-3, "{i}: {r}");
-        assert!((ek.min[i] / en.min[i] - 9.80665).abs() < 1e-3);
+    let pairs = ek.max.iter().zip(&en.max).chain(ek.min.iter().zip(&en.min));
+    for (k, n) in pairs {
+        assert!((k / n - 9.80665).abs() < 1e-3, "{k} vs {n}");
     }
     // 255 N m of CG moment against tunnels of 20 N: no speed helps.
     let p = preflight::check(&newton, DEFAULT_MARGIN).unwrap();
