@@ -594,8 +594,10 @@ fn axis_priority(order: &[String]) -> Res<AxisPriority> {
             format!("{} axes given, need {}", order.len(), expected()),
         ));
     }
-    let mut priority = AxisPriority::default();
-    priority.rank = [0; 6];
+    let mut priority = AxisPriority {
+        rank: [0; 6],
+        ..AxisPriority::default()
+    };
     for (i, name) in order.iter().enumerate() {
         let axis = AXIS_NAMES
             .iter()
