@@ -340,7 +340,7 @@ fn an_invalid_heading_or_time_scale_is_refused_with_its_reason() {
             Refusal::InvalidMission,
         ),
     ];
-    assert!(0.01 < Trajectory::MIN_TANGENT_SPEED);
+    const { assert!(0.01 < Trajectory::MIN_TANGENT_SPEED) };
     let mut s = supervisor();
     let mut h = Host::new();
     h.command(&mut s, Command::Arm);
