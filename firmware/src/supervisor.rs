@@ -25,10 +25,12 @@
 
 use auv_link::seq::SeqCheck;
 use auv_link::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionSpec, Msg,
+    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionPlan, Msg,
     Refusal, StateFrame, Telemetry, DEFAULT_STALE_PERIODS,
 };
-use controller_core::{Controller, ControllerConfig, Status, Trajectory, TrajectoryKind};
+use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
+use controller_core::trajectory::TrajectoryError;
+use controller_core::{Controller, ControllerConfig, Mission, Status, Trajectory};
 
 use crate::limits;
 
@@ -165,11 +167,40 @@ pub struct Supervisor {
     worst_update_ticks: u32,
     last_state_seq: u16,
     state_fresh: bool,
+    /// The controller's thruster mounting as the link's reversed-thruster mask, computed when
+    /// the controller is set ([`mounting_of`]).
+    mounting: u8,
+}
+
+/// The reversed-thruster mask [`Telemetry::reversed_thrusters`] reports for `config`: the
+/// AUV-150 layout's mask, or [`NOT_AUV150`] for a geometry that is not the AUV-150 layout (a
+/// board built with another geometry; the link cannot set one).
+pub fn mounting_of(config: &ControllerConfig) -> u8 {
+    config.geometry.auv150_reversed().unwrap_or(NOT_AUV150)
+}
+
+/// [`Telemetry::reversed_thrusters`] of a board whose geometry is not the AUV-150 layout
+/// with some thrusters reversed: every bit set, which no valid mask has (bits above the
+/// fifth).
+pub const NOT_AUV150: u8 = u8::MAX;
+
+/// Bits of a valid reversed-thruster mask: one per thruster.
+const MOUNTING_BITS: u8 = (1 << THRUSTERS) - 1;
+
+/// Why the core refused a mission, as the board reports it: the time scale and the tangent
+/// heading (protocol 3) have their own reasons, any other parameter is an invalid mission.
+pub fn mission_refusal(e: &TrajectoryError) -> Refusal {
+    match e {
+        TrajectoryError::TooSlowForTangent { .. } => Refusal::TangentTooSlow,
+        e if e.parameter() == "time_scale" => Refusal::InvalidTimeScale,
+        _ => Refusal::InvalidMission,
+    }
 }
 
 impl Supervisor {
     pub fn new(controller: Controller, board: BoardInfo) -> Self {
         Supervisor {
+            mounting: mounting_of(controller.config()),
             controller,
             board,
             mission: None,
@@ -322,7 +353,7 @@ impl Supervisor {
                 self.mission = None;
                 Ok(())
             }
-            Command::StartMission(spec) => self.start_mission(spec),
+            Command::StartMission(plan) => self.start_mission(plan),
             Command::StopMission => {
                 self.mission = None;
                 Ok(())
@@ -347,7 +378,7 @@ impl Supervisor {
 
     /// Only armed, unlatched and without a mission; the mission must validate. The state
     /// checks come first (a running mission is reported as running, whatever the new one).
-    fn start_mission(&mut self, spec: &MissionSpec) -> Result<(), Refusal> {
+    fn start_mission(&mut self, plan: &MissionPlan) -> Result<(), Refusal> {
         if !self.armed {
             return Err(Refusal::NotArmed);
         }
@@ -357,9 +388,9 @@ impl Supervisor {
         if self.mission.is_some() {
             return Err(Refusal::MissionRunning);
         }
-        // The link's one conversion (auv_link::mission), validated by the core.
-        let trajectory =
-            Trajectory::new(TrajectoryKind::from(*spec)).map_err(|_| Refusal::InvalidMission)?;
+        // The link's one conversion (auv_link::mission), validated by the core: path, heading
+        // and time scale.
+        let trajectory = Trajectory::new(Mission::from(*plan)).map_err(|e| mission_refusal(&e))?;
         self.mission = Some((trajectory, self.tick));
         self.clock = MissionClock::START;
         if self.lockstep {
@@ -371,6 +402,13 @@ impl Supervisor {
 
     /// Validates the whole patch against the board's limits and the core, then applies all of
     /// it, or nothing. Refused while armed, whatever it holds.
+    ///
+    /// The thruster chain (protocol 3, docs/design.md §9): the thrust unit of Eqs 31–32, the
+    /// mounting as the AUV-150's reversed-thruster mask (a bit above the fifth is refused,
+    /// [`Refusal::InvalidMounting`]) and the allocator's axis priority (a weight the core
+    /// refuses is [`Refusal::InvalidPriority`]). Each changes the controller's configuration,
+    /// so the core revalidates all of it (the envelope and the allocator's blocks are rebuilt
+    /// in `Controller::new`) before anything is applied.
     fn configure(&mut self, p: &ConfigPatch) -> Result<(), Refusal> {
         if self.armed {
             return Err(Refusal::WhileArmed);
@@ -387,6 +425,18 @@ impl Supervisor {
         }
         if let Some(v) = p.voltage_limit {
             cfg.voltage_limit = v;
+        }
+        if let Some(u) = p.thrust_unit {
+            cfg.thrust_unit = u.into();
+        }
+        if let Some(m) = p.reversed_thrusters {
+            if m & !MOUNTING_BITS != 0 {
+                return Err(Refusal::InvalidMounting);
+            }
+            cfg.geometry = ThrusterGeometry::auv150(m);
+        }
+        if let Some(q) = p.priority {
+            cfg.priority = q.into();
         }
         let stale_periods = p.stale_periods.unwrap_or(self.stale_periods);
         let lockstep = p.lockstep.unwrap_or(self.lockstep);
@@ -406,11 +456,15 @@ impl Supervisor {
         let controller = if cfg == *self.controller.config() {
             None
         } else {
-            Some(Controller::new(cfg).map_err(|_| Refusal::ControllerConfig)?)
+            Some(Controller::new(cfg).map_err(|e| match e.field() {
+                Some(f) if f.name == "priority" => Refusal::InvalidPriority,
+                _ => Refusal::ControllerConfig,
+            })?)
         };
 
         // Everything validated: apply all of it.
         if let Some(c) = controller {
+            self.mounting = mounting_of(c.config());
             self.controller = c;
         }
         self.stale_periods = stale_periods;
@@ -489,6 +543,8 @@ impl Supervisor {
             rx_auth_errors: self.rx_auth_errors,
             last_rx_seq: self.rx_seq.last().unwrap_or(0),
             signing: self.board.signing,
+            thrust_unit: self.controller.config().thrust_unit.into(),
+            reversed_thrusters: self.mounting,
         };
         self.periods_since_state = self.periods_since_state.saturating_add(1);
         self.clock.period();

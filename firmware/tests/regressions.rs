@@ -200,11 +200,14 @@ fn start_mission_while_running_is_refused_and_the_trajectory_kept() {
         if k == 2 {
             q.command(
                 &mut s,
-                Command::StartMission(MissionSpec::Circle {
-                    radius: 20.0,
-                    omega: 0.05,
-                    depth: 8.0,
-                }),
+                Command::StartMission(
+                    MissionSpec::Circle {
+                        radius: 20.0,
+                        omega: 0.05,
+                        depth: 8.0,
+                    }
+                    .into(),
+                ),
             );
         }
         let a = s.step(false, NOW);

@@ -245,7 +245,9 @@ impl Rig {
             Event::Arm => self.command(Command::Arm),
             Event::Disarm => self.command(Command::Disarm),
             Event::StartMission => self.command(Command::StartMission(CIRCLE)),
-            Event::StartMissionInvalid => self.command(Command::StartMission(invalid_mission)),
+            Event::StartMissionInvalid => {
+                self.command(Command::StartMission(invalid_mission.into()))
+            }
             Event::StopMission => self.command(Command::StopMission),
             Event::SetConfig => self.command(Command::SetConfig(ConfigPatch {
                 stale_periods: Some(3),

@@ -203,11 +203,14 @@ fn every_refusal_is_counted_and_its_reason_reported_in_telemetry() {
     assert_eq!(s.last_refusal(), Some(Refusal::WhileArmed));
     h.command(
         &mut s,
-        Command::StartMission(MissionSpec::Circle {
-            radius: -1.0,
-            omega: 0.1,
-            depth: 5.0,
-        }),
+        Command::StartMission(
+            MissionSpec::Circle {
+                radius: -1.0,
+                omega: 0.1,
+                depth: 5.0,
+            }
+            .into(),
+        ),
     );
     assert_eq!(s.last_refusal(), Some(Refusal::InvalidMission));
     h.command(&mut s, Command::StartMission(CIRCLE));

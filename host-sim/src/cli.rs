@@ -9,7 +9,13 @@
 //! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
 //! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
+//! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
 //! ```
+//!
+//! `check` is the preflight feasibility check ([`crate::preflight`]): it simulates nothing, and
+//! exits 0 when the mission is feasible at its time scale, 1 when it is not (the verdict says
+//! whether a time scale helps), 2 on bad input. `run` and `table1` print the same verdict for
+//! each mission, one line each, and put it in the report; they never refuse to run.
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`] (table1, run) or of
 //! [`PilComparison`] (pil), or the Monte Carlo [`Summary`](crate::montecarlo::Summary); its
@@ -28,13 +34,15 @@
 //! | code | meaning |
 //! |---|---|
 //! | 0 | every run completed, the controller never in fail-safe unless expected (and PIL agreed with SIL) |
-//! | 1 | a run diverged (or lost its board), or PIL disagreed with SIL |
+//! | 1 | a run diverged (or lost its board), or PIL disagreed with SIL; `check`: the mission is infeasible |
 //! | 2 | bad input (scenario, flags, output folder, firmware image) or an I/O error; or an output could not be written completely |
 //! | 3 | a run had the controller in fail-safe (thrusters off) for some periods and its scenario does not say `expect_faults = true` |
 //! | 130 | interrupted (Ctrl-C, SIGTERM): what was done is written and marked partial |
 //!
 //! When several apply, the first of 2, 130, 1, 3 is the exit code. In `pil`, a run with link
-//! faults injected (flags or `[link_faults]`) expects the board's fail-safe.
+//! faults injected (flags or `[link_faults]`) expects the board's fail-safe. In `table1`, the
+//! paper's missions flown through the real chain are there to show what happens when the
+//! preflight says infeasible: their divergence and faults are reported, not an exit code.
 
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -48,10 +56,12 @@ use serde::Serialize;
 use crate::config::{CurrentModel, LinkFaults, TickRange, VariationProfile};
 use crate::interrupt;
 use crate::montecarlo::{self, MonteCarloOptions, MAX_RUNS};
-use crate::output::{self, atomic, CsvStream, OutputDir, ReportRow};
+use crate::output::{self, atomic, CsvStream, OutputDir, RealRow, ReportRow};
 use crate::paper;
 use crate::pil::{BoardInTheLoop, PilComparison};
+use crate::preflight::{self, Preflight, DEFAULT_MARGIN};
 use crate::progress::Progress;
+use crate::real;
 use crate::record::{Cases, RunResult, RunSummary};
 use crate::scenario::{load_config, Scenario};
 use crate::sil::{self, ControlSource, LocalController};
@@ -70,6 +80,8 @@ pub enum Exit {
     Faulted,
     /// Interrupted (Ctrl-C, SIGTERM); what was done is written, marked partial: exit 130.
     Interrupted,
+    /// `check`: the mission is not feasible at its time scale: exit 1.
+    Infeasible,
 }
 
 impl Exit {
@@ -77,7 +89,7 @@ impl Exit {
     pub fn code(self) -> u8 {
         match self {
             Exit::Success => 0,
-            Exit::RunFailed => 1,
+            Exit::RunFailed | Exit::Infeasible => 1,
             Exit::OutputIncomplete => 2,
             Exit::Faulted => 3,
             Exit::Interrupted => 130,
@@ -138,6 +150,20 @@ pub struct RunArgs {
     /// MAX_PLANT_STEPS: one day at 100 Hz and 1 ms).
     #[arg(long)]
     pub allow_long_run: bool,
+}
+
+/// `check`: the preflight feasibility check of one scenario (nothing is simulated).
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct CheckArgs {
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Print one JSON object (the check's [`Preflight`]) instead of the text.
+    #[arg(long)]
+    pub json: bool,
+    /// Fraction of each thruster's envelope the reference may use, in (0, 1]; the rest is left
+    /// to the feedback.
+    #[arg(long, default_value_t = DEFAULT_MARGIN)]
+    pub margin: f64,
 }
 
 /// `pil`: processor in the loop. The firmware ELF in QEMU flies the simulated vehicle over a
@@ -297,6 +323,7 @@ fn print_runs(
     stdout: &mut dyn Write,
     json: bool,
     rows: &[ReportRow],
+    checks: &[Preflight],
     report: &Path,
     incomplete: Vec<String>,
 ) -> Result<Exit> {
@@ -306,13 +333,44 @@ fn print_runs(
         let cases: Cases<RunSummary> = Cases {
             cases: runs(rows).map(RunResult::summary).collect(),
             incomplete,
+            preflight: checks.to_vec(),
         };
         print_json(stdout, &cases)?;
     } else {
+        for c in checks {
+            writeln!(stdout, "{c}")?;
+        }
         writeln!(stdout, "{}", output::table_text(rows))?;
         writeln!(stdout, "report: {}", report.display())?;
     }
     Ok(exit)
+}
+
+/// The preflight checks of `scenarios` (in parallel), at the default margin.
+fn preflights<'a>(scenarios: impl IntoIterator<Item = &'a Scenario>) -> Result<Vec<Preflight>> {
+    use rayon::prelude::*;
+    let v: Vec<&Scenario> = scenarios.into_iter().collect();
+    v.par_iter()
+        .map(|s| {
+            preflight::check(s, DEFAULT_MARGIN)
+                .map_err(|e| anyhow!("preflight of {}: {e}", s.config().name))
+        })
+        .collect()
+}
+
+/// The report section of preflight verdicts: one line each.
+fn preflight_section(checks: &[Preflight]) -> String {
+    let mut s = format!(
+        "## Preflight (docs/design.md §9)\n\nWhether the real thrusters can fly each mission \
+         (`host-sim check --scenario FILE`): the force the reference needs at every corner of \
+         the parameter box, through the board's allocator, against {:.0} % of each thruster's \
+         envelope.\n\n",
+        100.0 * DEFAULT_MARGIN
+    );
+    for c in checks {
+        s.push_str(&format!("- {}\n", c.to_string().replace('|', "\\|")));
+    }
+    s
 }
 
 /// How a command with these runs ended ([`Exit::of`]); `failed`: another reason for exit 1.
@@ -335,28 +393,154 @@ fn runs<'a: 'r, 'r>(rows: &'r [ReportRow<'a>]) -> impl Iterator<Item = &'a RunRe
         .flat_map(|r| std::iter::once(r.with).chain(r.without))
 }
 
-/// `table1`.
+/// What the report says about the real-vehicle table.
+const REAL_NOTES: &str = "\
+## The real vehicle (docs/design.md §9)
+
+The missions of `scenarios/real/` fly the Table-1 paths as a vehicle team would: heading along
+the course, the Table-3 payload trimmed to neutral buoyancy, Eqs 31–32 in kgf, and the real
+actuator chain (the board's voltages, clamped at ±24 V, turned back into thrust by Eqs 31–32),
+each at the time scale the preflight check proposes. Below them, the paper's own six missions
+(its headings, untrimmed payload, time scale 1) through the same real chain: what the preflight
+calls infeasible, flown anyway.
+";
+
+/// `table1`: the paper's Table 1 (ideal actuators), then the real vehicle: the missions of
+/// `scenarios/real/` and the paper's six through the real chain, with their preflight verdicts.
 pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
+    use rayon::prelude::*;
     let jobs = paper::jobs()?;
+    let real_jobs = real::real_scenarios()?;
+    let chain_jobs = real::paper_real_chain_scenarios(&real_jobs)?;
     let dir = OutputDir::prepare(&args.out)?;
-    let progress = Progress::start("Table 1", periods(&jobs), !args.json);
+    // The paper's missions' verdicts (the Table-1 cases, with Δu: the same mission as the
+    // real-chain runs), then the real ones.
+    let checks = preflights(chain_jobs.iter().chain(&real_jobs))?;
+    let all: Vec<&Scenario> = jobs.iter().chain(&real_jobs).chain(&chain_jobs).collect();
+    let progress = Progress::start("Table 1", periods(all.iter().copied()), !args.json);
     let incomplete = Incomplete::default();
-    let pairs = paper::run_jobs(&jobs, |s| sil_into(&dir, s, &progress, &incomplete));
-    progress.finish();
-    let rows: Vec<ReportRow> = pairs
-        .iter()
-        .map(|(with, without)| ReportRow::new(with, Some(without)))
+    let results: Vec<RunResult> = all
+        .par_iter()
+        .map(|s| sil_into(&dir, s, &progress, &incomplete))
         .collect();
+    progress.finish();
+    let (paper_runs, rest) = results.split_at(jobs.len());
+    let (real_runs, chain_runs) = rest.split_at(real_jobs.len());
+    let rows: Vec<ReportRow> = paper_runs
+        .chunks(2)
+        .map(|pair| ReportRow::new(&pair[0], pair.get(1)))
+        .collect();
+    let (chain_checks, real_checks) = checks.split_at(chain_jobs.len());
+    let real_rows: Vec<RealRow> = real_runs
+        .iter()
+        .zip(real_checks)
+        .chain(chain_runs.iter().zip(chain_checks))
+        .map(|(run, preflight)| RealRow { run, preflight })
+        .collect();
+    let sections = format!(
+        "{REAL_NOTES}\n{}\n{}\n\n{}",
+        output::real_table_markdown(&real_rows),
+        output::report::real_table_legend(),
+        preflight_section(&checks)
+    );
+    let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
     let report = output::write_plots_and_report(
         &dir,
         "AUV-150 Table 1 reproduction (software in the loop)",
         &rows,
+        &sections,
+        &real_plots,
         paper::NOTES,
         f64::from(DEFAULT_V_LIMIT),
         &mut incomplete,
     )?;
-    print_runs(stdout, args.json, &rows, &report, incomplete)
+    report_incomplete(&incomplete);
+    // The paper's missions through the real chain are expected to fail: they show what an
+    // infeasible verdict means, and do not make the command fail.
+    let exit = runs_exit(
+        paper_runs.iter().chain(real_runs),
+        !incomplete.is_empty(),
+        false,
+    );
+    if args.json {
+        let cases: Cases<RunSummary> = Cases {
+            cases: results.iter().map(RunResult::summary).collect(),
+            incomplete,
+            preflight: checks,
+        };
+        print_json(stdout, &cases)?;
+    } else {
+        writeln!(stdout, "{}", output::table_text(&rows))?;
+        writeln!(
+            stdout,
+            "The real vehicle: the missions of scenarios/real/ and the paper's through the real chain (kgf, ±24 V)"
+        )?;
+        for c in &checks {
+            writeln!(stdout, "{c}")?;
+        }
+        writeln!(stdout)?;
+        write!(stdout, "{}", output::real_table_text(&real_rows))?;
+        writeln!(stdout, "{}\n", output::report::real_table_legend())?;
+        writeln!(stdout, "report: {}", report.display())?;
+    }
+    Ok(exit)
+}
+
+/// `check`: the preflight check of one scenario; exit 0 feasible, 1 infeasible.
+pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    if !(args.margin > 0.0 && args.margin <= 1.0) {
+        bail!(
+            "--margin must be a fraction of the envelope in (0, 1], got {}",
+            args.margin
+        );
+    }
+    let scenario = load(&args.scenario, false)?;
+    let p = preflight::check(&scenario, args.margin).map_err(|e| anyhow!(e))?;
+    if args.json {
+        print_json(stdout, &p)?;
+    } else {
+        writeln!(stdout, "{p}")?;
+        writeln!(stdout, "{}", preflight_table(&p))?;
+    }
+    Ok(if p.feasible() {
+        Exit::Success
+    } else {
+        Exit::Infeasible
+    })
+}
+
+/// The per-thruster part of `check`'s text.
+fn preflight_table(p: &Preflight) -> String {
+    let mut s = format!(
+        "thrust unit {}, heading {}, trimmed {}, time scale {}, margin {:.0} %\n",
+        p.thrust_unit,
+        p.heading,
+        p.trimmed,
+        p.time_scale,
+        100.0 * p.margin
+    );
+    s.push_str(&format!(
+        "{:<10} {:>18} {:>22} {:>22} {:>8}\n",
+        "thruster", "envelope (N)", "min demand (N) at t", "max demand (N) at t", "usage"
+    ));
+    for t in &p.thrusters {
+        s.push_str(&format!(
+            "{:<10} {:>18} {:>22} {:>22} {:>6.0} %\n",
+            t.thruster,
+            format!("[{:.1}, {:.1}]", t.envelope[0], t.envelope[1]),
+            format!("{:.1} at {:.2} s", t.min, t.t_min),
+            format!("{:.1} at {:.2} s", t.max, t.t_max),
+            100.0 * t.usage
+        ));
+    }
+    if let Some(k) = p.smallest_time_scale {
+        s.push_str(&format!(
+            "smallest feasible time scale: {k} (the same path then takes {:.1} s)\n",
+            p.duration * k / p.time_scale
+        ));
+    }
+    s
 }
 
 /// `run`.
@@ -377,6 +561,9 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         None
     };
     let dir = OutputDir::prepare(&out)?;
+    // The verdict of the mission as the scenario flies it (with Δu: the check does not depend
+    // on the law).
+    let checks = preflights(std::iter::once(&scenario))?;
     let progress = Progress::start(
         &cfg.name,
         periods(std::iter::once(&scenario).chain(&companion)),
@@ -396,11 +583,13 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         &dir,
         &format!("AUV-150 scenario {}", with.name),
         &rows,
+        &preflight_section(&checks),
+        &[],
         "",
         f64::from(cfg.controller.voltage_limit),
         &mut incomplete,
     )?;
-    print_runs(stdout, args.json, &rows, &report, incomplete)
+    print_runs(stdout, args.json, &rows, &checks, &report, incomplete)
 }
 
 /// The base scenario of `monte-carlo`: the file's, which must leave to the draw what the draw
@@ -560,7 +749,7 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         let started = BoardInTheLoop::start(
             &elf,
             &runner,
-            cfg,
+            s,
             cfg.link_faults.clone(),
             log_file,
             &log_path,
@@ -593,6 +782,8 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         &dir,
         "AUV-150 processor in the loop (firmware in QEMU)",
         &rows,
+        "",
+        &[],
         &notes,
         f64::from(DEFAULT_V_LIMIT),
         &mut incomplete,
@@ -600,7 +791,14 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     report_incomplete(&incomplete);
     let exit = runs_exit(runs.iter(), !incomplete.is_empty(), failed);
     if args.json {
-        print_json(stdout, &Cases { cases, incomplete })?;
+        print_json(
+            stdout,
+            &Cases {
+                cases,
+                incomplete,
+                preflight: Vec::new(),
+            },
+        )?;
     } else {
         writeln!(stdout, "{notes}")?;
         for c in &cases {

@@ -5,7 +5,7 @@
 //! cases.
 
 use controller_core::model::ParamVariation;
-use controller_core::{ControllerConfig, Table1Case, TrajectoryKind};
+use controller_core::{ControllerConfig, HeadingMode, Mission, Table1Case, TrajectoryKind};
 
 /// How the plant's parameters vary with time (Table 3, docs/design.md §2). Δp is added to the
 /// nominal parameters of the **plant only**; the controller keeps the nominal model.
@@ -152,7 +152,14 @@ pub struct SimConfig {
     /// The paper's Table-1 case this run reproduces, if any: the reports print the paper's
     /// numbers beside it ([`crate::paper`]).
     pub case: Option<Table1Case>,
+    /// The mission's path (scenario table `[trajectory]`).
     pub trajectory: TrajectoryKind,
+    /// How the mission's heading ψ_d is formed (`trajectory.heading`, default the paper's;
+    /// docs/design.md §9).
+    pub heading: HeadingMode,
+    /// The mission's time scale k ≥ 1: the reference is η_d(t/k) (`trajectory.time_scale`,
+    /// default 1; docs/design.md §9).
+    pub time_scale: f32,
     /// Simulated time (s). Paper: 70.
     pub duration: f64,
     /// Plant RK4 step (s). Default 1 ms.
@@ -160,6 +167,10 @@ pub struct SimConfig {
     /// The controller (its `rate_hz` is the sampled loop's rate; zero-order hold in between).
     pub controller: ControllerConfig,
     pub variation: VariationProfile,
+    /// The payload is ballasted to neutral buoyancy, W = B (scenario key `variation.trimmed`,
+    /// default false; plant only): its mass, inertia and CG shift still act, its net weight
+    /// does not ([`crate::plant::trimmed`], docs/design.md §9).
+    pub trimmed: bool,
     pub current: CurrentModel,
     pub noise: Option<SensorNoise>,
     /// First-order thruster lag time constant (s), if any.
@@ -184,18 +195,32 @@ pub struct SimConfig {
 }
 
 impl SimConfig {
-    /// Defaults around a mission: 70 s, 1 ms plant step, the paper's controller at 100 Hz,
-    /// no variation, no current, no noise, ideal actuators, starting on the reference, no
-    /// Table-1 case, no faults expected, the step cap in force.
+    /// The mission the controller flies (and the board is sent in `StartMission`): the path,
+    /// its heading and its time scale.
+    pub fn mission(&self) -> Mission {
+        Mission {
+            path: self.trajectory,
+            heading: self.heading,
+            time_scale: self.time_scale,
+        }
+    }
+
+    /// Defaults around a path: the paper's heading at time scale 1, 70 s, 1 ms plant step, the
+    /// paper's controller at 100 Hz, no variation (untrimmed), no current, no noise, ideal
+    /// actuators, starting on the reference, no Table-1 case, no faults expected, the step cap
+    /// in force.
     pub fn new(name: impl Into<String>, trajectory: TrajectoryKind) -> Self {
         SimConfig {
             name: name.into(),
             case: None,
             trajectory,
+            heading: HeadingMode::Paper,
+            time_scale: 1.0,
             duration: 70.0,
             plant_step: 0.001,
             controller: ControllerConfig::default(),
             variation: VariationProfile::None,
+            trimmed: false,
             current: CurrentModel::None,
             noise: None,
             thruster_lag: None,

@@ -14,6 +14,8 @@
 //! | [`link`] | what the simulator sends the board over `auv-link` |
 //! | [`record`] | samples, outcome, metrics and JSON summary of a run |
 //! | [`paper`] | the paper's Table 1: cases, profiles, its numbers, notes, the twelve runs |
+//! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale |
+//! | [`real`] | the real vehicle's six missions (`scenarios/real/`) and the paper's through the real chain |
 //! | [`pil`] | processor in the loop: the firmware in QEMU flies the plant; PIL vs SIL |
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box |
 //! | [`output`] | CSV, plots, report |
@@ -30,7 +32,9 @@ pub mod output;
 pub mod paper;
 pub mod pil;
 pub mod plant;
+pub mod preflight;
 pub mod progress;
+pub mod real;
 pub mod record;
 pub mod scenario;
 pub mod sil;

@@ -1,13 +1,14 @@
 //! `host-sim`: software-in-the-loop runs of the AUV-150 controller against the 6-DOF plant.
 //! Parses the command line, installs the Ctrl-C/SIGTERM handler ([`host_sim::interrupt`]) and
 //! maps the outcome to the exit code; the commands are [`host_sim::cli`]'s, which documents
-//! the codes (0 done, 1 a run diverged or PIL ≠ SIL, 2 bad input, I/O error or an incomplete
-//! output, 3 an unexpected controller fault, 130 interrupted).
+//! the codes (0 done, 1 a run diverged or PIL ≠ SIL or `check` found the mission infeasible,
+//! 2 bad input, I/O error or an incomplete output, 3 an unexpected controller fault,
+//! 130 interrupted).
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cli::{self, MonteCarloArgs, PilArgs, RunArgs, Table1Args};
+use host_sim::cli::{self, CheckArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args};
 
 #[derive(Parser)]
 #[command(
@@ -29,6 +30,10 @@ enum Command {
     /// Processor in the loop: the firmware ELF in QEMU flies the simulated vehicle over a
     /// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).
     Pil(PilArgs),
+    /// Preflight: can the real thrusters fly this scenario (every corner of the parameter box,
+    /// the board's allocator, a margin of the envelope), and if not, at what time scale?
+    /// Simulates nothing. Exit 0 feasible, 1 infeasible, 2 bad input.
+    Check(CheckArgs),
     /// Draws the Table-3 parameters uniformly in their box, runs in parallel, reports
     /// percentiles and the worst case. Deterministic per seed.
     MonteCarlo(MonteCarloArgs),
@@ -47,6 +52,7 @@ fn main() -> ExitCode {
         Command::Run(args) => cli::run(&args, stdout),
         Command::Pil(args) => cli::pil(&args, stdout),
         Command::MonteCarlo(args) => cli::monte_carlo(&args, stdout),
+        Command::Check(args) => cli::check(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

@@ -4,9 +4,13 @@
 //!
 //! Set-up: the runner waits for the board's first telemetry and numbers its own frames from the
 //! board's `last_rx_seq` on (a restarted runner is heard again: `auv_link::seq`), then sends
-//! `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods }` and `Arm`,
-//! and waits for the board to report itself armed (a refused command is reported with the
-//! board's reason); then `StartMission` with the first state frame. In lock-step the board runs
+//! `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods, thrust unit,
+//! thruster mounting, axis priority }` from the scenario's validated controller and `Arm`,
+//! and waits for the board to report itself armed with that thrust unit and mounting (a
+//! refused command is reported with the board's reason); then `StartMission` with the
+//! scenario's validated mission (path, heading, time scale) and the first state frame. Every
+//! telemetry frame must name the thrust unit the plant reads the voltages in, or the run
+//! stops (docs/design.md §9). In lock-step the board runs
 //! one control period per state frame and takes the frame's `t_ticks` as mission time (on its
 //! mission clock), so the result does not depend on host speed.
 //!
@@ -34,15 +38,16 @@ use auv_link::seq::SeqCheck;
 use auv_link::sign::{AuthError, Direction, LinkKey, Signer, Verifier};
 use auv_link::{
     encode, encode_signed, BoardStatus, Command as LinkCommand, ConfigPatch, Envelope,
-    FrameDecoder, LinkError, Msg, StateFrame, Telemetry, DEFAULT_STALE_PERIODS, MAX_FRAME,
-    PROTOCOL_VERSION,
+    FrameDecoder, LinkError, MissionPlan, Msg, StateFrame, Telemetry, ThrustUnit,
+    DEFAULT_STALE_PERIODS, MAX_FRAME, PROTOCOL_VERSION,
 };
 use serde::{Deserialize, Serialize};
 
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 
-use crate::config::{LinkFaults, SimConfig};
+use crate::config::LinkFaults;
 use crate::record::{ControlStatus, RunResult, RunSummary};
+use crate::scenario::Scenario;
 use crate::sil::{ControlOut, ControlSource};
 
 /// Largest |PIL − SIL| of the max path error (m) that a fault-free PIL run may show: 1 mm.
@@ -103,6 +108,12 @@ pub struct PilStats {
     /// Telemetry frames this end refused: undecodable, badly signed, or out of sequence.
     #[serde(default)]
     pub telemetry_refused: u64,
+    /// The thrust unit of Eqs 31–32 the board reported flying (`"kgf"` or `"newton"`), and
+    /// its thruster mounting as the reversed-thruster mask (`Telemetry::reversed_thrusters`).
+    #[serde(default)]
+    pub board_thrust_unit: Option<String>,
+    #[serde(default)]
+    pub board_reversed_thrusters: Option<u8>,
 }
 
 impl FailSafeEventKind {
@@ -170,7 +181,10 @@ pub struct BoardInTheLoop {
     seq: u16,
     rate_hz: u32,
     faults: LinkFaults,
-    mission: auv_link::MissionSpec,
+    mission: MissionPlan,
+    /// The thrust unit the plant reads the board's voltages in: every telemetry frame must
+    /// report it.
+    thrust_unit: ThrustUnit,
     started: bool,
     /// The last `delay_ticks + 1` state frames (what a delayed frame is taken from).
     history: std::collections::VecDeque<StateFrame>,
@@ -185,19 +199,26 @@ pub struct BoardInTheLoop {
 
 impl BoardInTheLoop {
     /// Starts QEMU with `elf` (the QEMU flying image), waits for its UART to connect, and
-    /// configures and arms the board; with `key`, the board and this end sign the link.
+    /// configures and arms the board with `scenario`'s validated controller (its mission is
+    /// sent with the first state frame); with `key`, the board and this end sign the link.
     /// `runner` is `scripts/qemu-run.sh`; QEMU's decoded log goes to `log` (opened by the
     /// caller, who decides where and how it is written), which messages call `log_path`.
     pub fn start(
         elf: &Path,
         runner: &Path,
-        cfg: &SimConfig,
+        scenario: &Scenario,
         faults: LinkFaults,
         log: std::fs::File,
         log_path: &Path,
         key: Option<&LinkKey>,
     ) -> Result<Self, String> {
         check_flying_image(elf)?;
+        let c = scenario.controller().config();
+        // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
+        let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
+            "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
+        })?;
+        let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
@@ -255,9 +276,10 @@ impl BoardInTheLoop {
             signer: key.map(|k| Signer::new(k, Direction::ToBoard)),
             telemetry_seq: SeqCheck::new(),
             seq: 0,
-            rate_hz: cfg.controller.rate_hz,
+            rate_hz: c.rate_hz,
             faults,
-            mission: auv_link::MissionSpec::from(cfg.trajectory),
+            mission: MissionPlan::from(scenario.trajectory().mission()),
+            thrust_unit,
             started: false,
             history: std::collections::VecDeque::new(),
             pending: std::collections::VecDeque::new(),
@@ -278,7 +300,6 @@ impl BoardInTheLoop {
             b.seq = first.last_rx_seq.wrapping_add(1);
         }
         let refused_before = first.refused_commands;
-        let c = &cfg.controller;
         b.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
             rate_hz: Some(c.rate_hz),
             robust: Some(c.robust),
@@ -286,6 +307,9 @@ impl BoardInTheLoop {
             voltage_limit: Some(c.voltage_limit),
             stale_periods: Some(DEFAULT_STALE_PERIODS),
             lockstep: Some(true),
+            thrust_unit: Some(thrust_unit),
+            reversed_thrusters: Some(mounting),
+            priority: Some(c.priority.into()),
         })))?;
         b.send(Msg::Command(LinkCommand::Arm))?;
         // Wait until the board reports itself armed: the configuration and arming took.
@@ -299,6 +323,13 @@ impl BoardInTheLoop {
                 ));
             }
             if t.status == BoardStatus::Armed {
+                if t.reversed_thrusters != mounting {
+                    return Err(format!(
+                        "the board flies thruster mounting {:#07b}, not the scenario's {mounting:#07b}",
+                        t.reversed_thrusters
+                    ));
+                }
+                b.check_unit(&t)?;
                 break;
             }
             if Instant::now() > deadline {
@@ -307,6 +338,20 @@ impl BoardInTheLoop {
         }
         b.t0 = Instant::now();
         Ok(b)
+    }
+
+    /// The board reports the thrust unit the plant reads its voltages in.
+    fn check_unit(&self, t: &Telemetry) -> Result<(), String> {
+        if t.thrust_unit == self.thrust_unit {
+            Ok(())
+        } else {
+            Err(format!(
+                "the board reports thrust unit {}, but the plant reads its voltages in {} (tick {})",
+                unit_name(t.thrust_unit),
+                unit_name(self.thrust_unit),
+                t.tick
+            ))
+        }
     }
 
     fn send(&mut self, msg: Msg) -> Result<(), String> {
@@ -424,6 +469,8 @@ impl BoardInTheLoop {
         self.stats.board_refused_commands = t.refused_commands;
         self.stats.board_last_refusal = t.last_refusal.map(|r| r.as_str().to_string());
         self.stats.board_loop_overruns = t.loop_overruns;
+        self.stats.board_thrust_unit = Some(unit_name(t.thrust_unit).to_string());
+        self.stats.board_reversed_thrusters = Some(t.reversed_thrusters);
         self.stats.worst_update_instructions =
             t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
     }
@@ -539,6 +586,7 @@ impl ControlSource for BoardInTheLoop {
             }
         };
         self.note_status(&t, k);
+        self.check_unit(&t)?;
         Ok(ControlOut {
             status: ControlStatus::Board(t.status),
             tau: t.tau,
@@ -549,6 +597,11 @@ impl ControlSource for BoardInTheLoop {
             w_norm: t.w_norm,
         })
     }
+}
+
+/// The core's name of a wire thrust unit (`"kgf"`, `"newton"`: the scenario key's values).
+fn unit_name(u: ThrustUnit) -> &'static str {
+    controller_core::ThrustUnit::from(u).as_str()
 }
 
 fn on_off(b: bool) -> &'static str {

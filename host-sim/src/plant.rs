@@ -28,6 +28,27 @@ impl PlantState {
     }
 }
 
+/// The parameters `p` with the payload trimmed (scenario key `variation.trimmed`,
+/// docs/design.md §9): ballasted to neutral buoyancy, B = W = m g, while the mass, the inertia
+/// and the CG shift stay as they are.
+///
+/// **Choice** (docs/design.md §9): the trim buoyancy B − B₀ acts at the centre of origin CO, so
+/// it adds a force and no moment: the buoyancy arms are scaled by B₀/B, which keeps every
+/// buoyancy moment (x_B B, y_B B, z_B B) as it was. Then g's force rows vanish (ΔW = 0) and its
+/// moment rows are those of the untrimmed payload: the CG shift still pitches and heels the
+/// vehicle.
+pub fn trimmed(p: &VehicleParams<f64>) -> VehicleParams<f64> {
+    let w = p.weight();
+    let scale = p.buoyancy / w;
+    VehicleParams {
+        buoyancy: w,
+        r_b_xy: p.r_b_xy.map(|x| x * scale),
+        z_b_roll: p.z_b_roll * scale,
+        z_b_pitch: p.z_b_pitch * scale,
+        ..*p
+    }
+}
+
 /// Which physical terms the plant includes (all on for simulation; tests switch some off to
 /// check invariants).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -132,6 +153,39 @@ impl Plant {
             rhs -= model::restoring(&self.params, &att);
         }
         Ok((eta_dot, self.m_chol.solve(&rhs)))
+    }
+
+    /// The body force τ that gives the acceleration `nu_dot` in state `s` under the
+    /// earth-fixed current `current`: Eq (1) solved for τ (the inverse of
+    /// [`derivative`](Self::derivative)),
+    ///
+    /// τ = M ν̇ + C_RB(ν) ν + C_A(ν_r) ν_r − M_A ν̇_c + D(ν_r) ν_r + g(η).
+    ///
+    /// The preflight check ([`crate::preflight`]) asks it for the force a reference needs.
+    pub fn required_force(
+        &self,
+        s: &PlantState,
+        nu_dot: &Vector6<f64>,
+        current: &Vector3<f64>,
+    ) -> Vector6<f64> {
+        let att = Attitude::from_eta(&s.eta);
+        let omega = Vector3::new(s.nu[3], s.nu[4], s.nu[5]);
+        let vc_body = kinematics::rotation(&att).transpose() * current;
+        let nu_c = Vector6::new(vc_body.x, vc_body.y, vc_body.z, 0.0, 0.0, 0.0);
+        let dvc = -omega.cross(&vc_body);
+        let nu_c_dot = Vector6::new(dvc.x, dvc.y, dvc.z, 0.0, 0.0, 0.0);
+        let nu_r = s.nu - nu_c;
+        let mut tau = (self.m_rb + self.m_a) * nu_dot
+            + model::coriolis(&self.m_rb, &s.nu) * s.nu
+            + model::coriolis(&self.m_a, &nu_r) * nu_r
+            - self.m_a * nu_c_dot;
+        if self.terms.damping {
+            tau += model::damping(&self.params, &nu_r) * nu_r;
+        }
+        if self.terms.restoring {
+            tau += model::restoring(&self.params, &att);
+        }
+        tau
     }
 
     /// One classical RK4 step of length `h` with τ and the current held (zero-order hold).

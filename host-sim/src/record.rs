@@ -7,6 +7,10 @@ use auv_link::BoardStatus;
 use controller_core::{Status, Table1Case};
 use serde::{Deserialize, Serialize};
 
+/// The thrusters' names in thruster order (`controller_core::effectiveness`), for plots,
+/// tables and the preflight check.
+pub const THRUSTER_NAMES: [&str; 5] = ["main", "vert fore", "vert aft", "horz fore", "horz aft"];
+
 /// What produced a control period's output, and its state: the core's own [`Status`] when the
 /// law runs on the host (SIL), the board's [`BoardStatus`] when it runs on the board (PIL).
 ///
@@ -242,13 +246,17 @@ pub struct Divergence {
     pub reason: String,
 }
 
-/// The JSON object a command prints: `{"cases": [...]}`, and `"incomplete": [...]` when an
-/// output could not be written completely (each entry names the file and why).
+/// The JSON object a command prints: `{"cases": [...]}`, `"incomplete": [...]` when an
+/// output could not be written completely (each entry names the file and why), and
+/// `"preflight": [...]` with the preflight check of each mission (`run`, `table1`).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Cases<T> {
     pub cases: Vec<T>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub incomplete: Vec<String>,
+    /// The preflight checks of the missions (`run`, `table1`; docs/design.md §9).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub preflight: Vec<crate::preflight::Preflight>,
 }
 
 impl RunResult {

@@ -4,10 +4,12 @@
 //! Per control period k (t = k/rate):
 //! 1. measure η, ν (plus seeded sensor noise), round to f32, call `Controller::update(k, …)`;
 //! 2. actuation: ideal — the allocated thrusts B₅⁻¹τ are delivered whatever the voltage;
-//!    real — the controller's (clamped) voltages go through the inverse of Eqs 31–32 to
-//!    thrust; a controller fault means every thruster off (0 N);
+//!    real — the controller's (clamped) voltages go through the inverse of Eqs 31–32, read in
+//!    the controller's thrust unit (the simulated thrusters are the ones the board is
+//!    configured for), to thrust; a controller fault means every thruster off (0 N);
 //! 3. optional first-order thruster lag, then τ_applied = B·thrust;
-//! 4. RK4 substeps with τ held, the plant's parameters and the current evaluated per substep.
+//! 4. RK4 substeps with τ held, the plant's parameters (trimmed if the scenario says so,
+//!    [`crate::plant::trimmed`]) and the current evaluated per substep.
 //!
 //! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
 //! run with a reason; every sample recorded until then is kept.
@@ -301,9 +303,11 @@ pub fn run_observed(
                 to_f64(&controller.allocation().thrusts(&Vector6::from(out.tau)))
             }
             true => {
+                // The thrusters read Eqs 31–32 in the controller's unit (docs/design.md §9).
+                let unit = cfg.controller.thrust_unit;
                 let mut t = [0.0; THRUSTERS];
                 for i in 0..THRUSTERS {
-                    t[i] = maps[i].thrust(out.voltage[i]) as f64;
+                    t[i] = maps[i].newtons_of_voltage(unit, out.voltage[i]) as f64;
                 }
                 t
             }
@@ -348,7 +352,10 @@ pub fn run_observed(
             }
             let tau = alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(applied);
             let ts = t + j as f64 * h;
-            let params = nominal.with_variation(&cfg.variation.at(ts));
+            let mut params = nominal.with_variation(&cfg.variation.at(ts));
+            if cfg.trimmed {
+                params = crate::plant::trimmed(&params);
+            }
             let stepped = Plant::new(params, PlantTerms::default())
                 .and_then(|plant| plant.rk4_step(&state, &tau, &current.v, h));
             match stepped {

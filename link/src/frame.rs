@@ -392,7 +392,7 @@ mod tests {
         use std::string::ToString;
         assert_eq!(
             LinkError::Version { got: 1 }.to_string(),
-            "protocol version 1, expected 2"
+            "protocol version 1, expected 3"
         );
         assert_eq!(
             LinkError::Overflow.to_string(),

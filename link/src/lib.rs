@@ -28,12 +28,13 @@
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 155 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 138 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//! - **Size:** at most [`MAX_FRAME`] = 157 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 140 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
 //!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
-//!   most 80 bytes signed). At 460 800 baud (46 080 bytes/s, the STM32 board's link) the
-//!   largest frame takes 3.4 ms, so a State frame in one direction and a Telemetry frame in the
-//!   other fit in a 10 ms (100 Hz) control period; 115 200 baud (13.5 ms) would not.
+//!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
+//!   board's link) the largest frame takes 3.4 ms, so a State frame in one direction and a
+//!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
+//!   uses 34 % of the board's transmit bandwidth); 115 200 baud (13.6 ms) would not.
 //!
 //! # Receiving
 //!
@@ -48,13 +49,15 @@
 //!
 //! [`Envelope`] `{ version: u8 = PROTOCOL_VERSION, seq: u16, msg: Msg }`; `seq` counts frames
 //! per sender (wrapping), and a receiver accepts only a frame newer than the last it accepted,
-//! in serial-number arithmetic with a window ([`seq`]). The navigation computer sends [`Msg::State`] (the navigation solution
-//! η, ν at a control tick) and [`Msg::Command`] (arm / disarm, start a [`MissionSpec`] /
+//! in serial-number arithmetic with a window ([`seq`]). The navigation computer sends
+//! [`Msg::State`] (the navigation solution η, ν at a control tick) and [`Msg::Command`] (arm /
+//! disarm, start a [`MissionPlan`] /
 //! stop, or change settings with a [`ConfigPatch`]); the board answers with
 //! [`Msg::Telemetry`], whose [`Telemetry::last_state_seq`] echoes the `seq` of the last State
-//! frame it accepted. A [`MissionSpec`] is the wire form of `controller_core::TrajectoryKind`:
-//! both ends convert with the `From` impls of [`mission`], the only place that maps one to the
-//! other.
+//! frame it accepted, and which names the thrust unit and mounting the board flies. A
+//! [`MissionPlan`] is the wire form of `controller_core::Mission` (a [`MissionSpec`] path, a
+//! [`Heading`], a time scale), and [`ThrustUnit`] of the core's unit: both ends convert with
+//! the `From` impls of [`mission`], the only place that maps one to the other.
 //!
 //! postcard lays a message out as follows (worst-case sizes in the `MAX_SIZE` constants of each
 //! type): fields in declaration order, no padding, no field names; `u8` and `bool` as one byte;
@@ -99,7 +102,8 @@ pub use frame::{
     MAX_BODY, MAX_FRAME,
 };
 pub use msg::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, StateFrame,
-    Telemetry, DEFAULT_STALE_PERIODS, PROTOCOL_VERSION,
+    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Heading,
+    MissionPlan, MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
+    PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;

@@ -1,6 +1,9 @@
-//! The one conversion between the link's wire type [`MissionSpec`] and the core's
-//! [`TrajectoryKind`], both ways. The board (`Command::StartMission` → trajectory) and the
-//! host (scenario → `StartMission`) both use it, so the two ends cannot disagree on a field.
+//! The one conversion between the link's wire types and the core's, both ways:
+//! [`MissionSpec`] ↔ [`TrajectoryKind`], [`MissionPlan`] ↔ [`Mission`], [`Heading`] ↔
+//! [`HeadingMode`], and the wire [`ThrustUnit`] and [`AxisPriority`] ↔ the core's. The board
+//! (`Command::StartMission` → trajectory, `SetConfig` → configuration) and the host
+//! (scenario → `StartMission`, `SetConfig`) both use it, so the two ends cannot disagree on a
+//! field.
 //!
 //! The conversion is field for field and loses nothing: every `f32` keeps its bits (NaN
 //! payloads included). It does not validate: the receiver builds the trajectory with
@@ -11,9 +14,9 @@
 //! without a protocol change. A kind added to the core fails to compile here until the link
 //! carries it.
 
-use controller_core::TrajectoryKind;
+use controller_core::{HeadingMode, Mission, TrajectoryKind};
 
-use crate::msg::MissionSpec;
+use crate::msg::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
 
 /// Both `From` impls from one list of variants and fields, so the two directions cannot drift
 /// apart. A variant or field missing from the list is a compile error (non-exhaustive match,
@@ -43,4 +46,76 @@ field_for_field! {
     FigureEight { amplitude, omega, depth },
     LawnMower { scale, omega, depth },
     Helix { radius, omega, depth, depth_rate },
+}
+
+/// Both `From` impls of a field-less enum pair from one list of variants.
+macro_rules! variant_for_variant {
+    ($wire:ident, $core:ty, $($variant:ident),+ $(,)?) => {
+        impl From<$core> for $wire {
+            fn from(v: $core) -> Self {
+                match v {
+                    $(<$core>::$variant => $wire::$variant,)+
+                }
+            }
+        }
+
+        impl From<$wire> for $core {
+            fn from(v: $wire) -> Self {
+                match v {
+                    $($wire::$variant => <$core>::$variant,)+
+                }
+            }
+        }
+    };
+}
+
+variant_for_variant!(Heading, HeadingMode, Paper, Tangent);
+variant_for_variant!(ThrustUnit, controller_core::ThrustUnit, Kgf, Newton);
+
+impl From<Mission> for MissionPlan {
+    fn from(m: Mission) -> Self {
+        MissionPlan {
+            path: m.path.into(),
+            heading: m.heading.into(),
+            time_scale: m.time_scale,
+        }
+    }
+}
+
+impl From<MissionPlan> for Mission {
+    fn from(m: MissionPlan) -> Self {
+        Mission {
+            path: m.path.into(),
+            heading: m.heading.into(),
+            time_scale: m.time_scale,
+        }
+    }
+}
+
+impl From<TrajectoryKind> for MissionPlan {
+    /// The paper's mission on this path ([`Mission::paper`]).
+    fn from(kind: TrajectoryKind) -> Self {
+        Mission::paper(kind).into()
+    }
+}
+
+impl From<MissionSpec> for MissionPlan {
+    /// The paper's mission on this path ([`Mission::paper`]).
+    fn from(path: MissionSpec) -> Self {
+        Mission::paper(path.into()).into()
+    }
+}
+
+impl From<controller_core::allocator::AxisPriority> for AxisPriority {
+    fn from(p: controller_core::allocator::AxisPriority) -> Self {
+        let controller_core::allocator::AxisPriority { rank, weight } = p;
+        AxisPriority { rank, weight }
+    }
+}
+
+impl From<AxisPriority> for controller_core::allocator::AxisPriority {
+    fn from(p: AxisPriority) -> Self {
+        let AxisPriority { rank, weight } = p;
+        controller_core::allocator::AxisPriority { rank, weight }
+    }
 }

@@ -14,7 +14,11 @@ use crate::refusal::Refusal;
 /// 2: sequence numbers checked ([`crate::seq`]), optional signature trailer
 /// ([`crate::sign`]), and the telemetry's latched reason, refusals, drop counters, last
 /// accepted sequence number and signing flag.
-pub const PROTOCOL_VERSION: u8 = 2;
+///
+/// 3: `StartMission` carries a [`MissionPlan`] (heading, time scale); `SetConfig` the thrust
+/// unit, the thruster mounting and the axis priority; `Telemetry` the unit and mounting the
+/// board flies; refusals for an invalid time scale, tangent heading, mounting or priority.
+pub const PROTOCOL_VERSION: u8 = 3;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -116,7 +120,7 @@ pub enum Command {
     /// Thrusters off, mission dropped.
     Disarm,
     /// Start (or restart) a mission: the trajectory's t = 0 is the first control step after.
-    StartMission(MissionSpec),
+    StartMission(MissionPlan),
     /// End the mission; the board stays armed.
     StopMission,
     /// Change the fields that are `Some`; the others keep their values.
@@ -125,7 +129,58 @@ pub enum Command {
 
 impl Command {
     /// Worst-case postcard size of a `Command` (bytes).
-    pub const MAX_SIZE: usize = TAG + max(MissionSpec::MAX_SIZE, ConfigPatch::MAX_SIZE);
+    pub const MAX_SIZE: usize = TAG + max(MissionPlan::MAX_SIZE, ConfigPatch::MAX_SIZE);
+}
+
+/// A mission as the board flies it: the wire form of `controller_core::Mission` — the path
+/// ([`MissionSpec`]), how its heading is formed and how slowly it is flown (η_d(t/k),
+/// k ≥ 1). Convert with `From` both ways ([`crate::mission`]); the receiver validates with
+/// `controller_core::Trajectory::new`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct MissionPlan {
+    /// The path.
+    pub path: MissionSpec,
+    /// ψ_d: the paper's or the path's course.
+    pub heading: Heading,
+    /// k ≥ 1 (1: the paper's speed).
+    pub time_scale: f32,
+}
+
+impl MissionPlan {
+    /// Worst-case postcard size of a `MissionPlan` (bytes).
+    pub const MAX_SIZE: usize = MissionSpec::MAX_SIZE + Heading::MAX_SIZE + F32;
+}
+
+/// The wire form of `controller_core::HeadingMode` (variant order is the wire format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum Heading {
+    /// The paper's heading of the path.
+    Paper,
+    /// The path's course, atan2(ẏ_d, ẋ_d).
+    Tangent,
+}
+
+impl Heading {
+    /// Worst-case postcard size of a `Heading` (bytes).
+    pub const MAX_SIZE: usize = TAG;
+}
+
+/// The wire form of `controller_core::ThrustUnit`, the unit Eqs 31–32 are read in (variant
+/// order is the wire format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum ThrustUnit {
+    /// Kilogram-force (the default).
+    Kgf,
+    /// Newtons.
+    Newton,
+}
+
+impl ThrustUnit {
+    /// Worst-case postcard size of a `ThrustUnit` (bytes).
+    pub const MAX_SIZE: usize = TAG;
 }
 
 /// A mission trajectory and its parameters: the wire form of
@@ -202,12 +257,47 @@ pub struct ConfigPatch {
     /// Lockstep: the board runs one control step per received [`Msg::State`] (simulation),
     /// instead of on its own timer.
     pub lockstep: Option<bool>,
+    /// The thrust unit of Eqs 31–32 (refused while armed, like every law setting).
+    pub thrust_unit: Option<ThrustUnit>,
+    /// The thruster mounting, as the reversed-thruster mask of the AUV-150 layout
+    /// (`controller_core::effectiveness::ThrusterGeometry::auv150`): bit i set ⇔ thruster i's
+    /// positive thrust pushes against its reference axis (+x, +z, +z, +y, +y). Refused while
+    /// armed, and with bits above the fifth ([`Refusal::InvalidMounting`]).
+    pub reversed_thrusters: Option<u8>,
+    /// Which forces the saturation-aware allocator gives up first. Refused while armed, and
+    /// when the core refuses a weight ([`Refusal::InvalidPriority`]).
+    pub priority: Option<AxisPriority>,
+}
+
+/// The wire form of `controller_core::allocator::AxisPriority`: per row of τ = [X Y Z K M N],
+/// the rank (higher is met first) and the least-squares weight between axes of equal rank
+/// (finite and > 0 on the actuated axes; the roll entries are carried and not used). Convert
+/// with `From` both ways ([`crate::mission`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct AxisPriority {
+    /// Priority of each axis; higher is more important.
+    pub rank: [u8; 6],
+    /// Least-squares weight of each axis.
+    pub weight: [f32; 6],
+}
+
+impl AxisPriority {
+    /// Worst-case postcard size of an `AxisPriority` (bytes).
+    pub const MAX_SIZE: usize = 6 * U8 + 6 * F32;
 }
 
 impl ConfigPatch {
     /// Worst-case postcard size of a `ConfigPatch` (bytes).
-    pub const MAX_SIZE: usize =
-        option(U32) + option(BOOL) + option(F32) + option(F32) + option(U8) + option(BOOL);
+    pub const MAX_SIZE: usize = option(U32)
+        + option(BOOL)
+        + option(F32)
+        + option(F32)
+        + option(U8)
+        + option(BOOL)
+        + option(ThrustUnit::MAX_SIZE)
+        + option(U8)
+        + option(AxisPriority::MAX_SIZE);
 
     /// Changes nothing.
     pub const EMPTY: ConfigPatch = ConfigPatch {
@@ -217,6 +307,9 @@ impl ConfigPatch {
         voltage_limit: None,
         stale_periods: None,
         lockstep: None,
+        thrust_unit: None,
+        reversed_thrusters: None,
+        priority: None,
     };
 }
 
@@ -277,6 +370,11 @@ pub struct Telemetry {
     pub last_rx_seq: u16,
     /// The board's link has signing on (it refuses unsigned frames).
     pub signing: bool,
+    // Protocol 3: appended fields.
+    /// The thrust unit the board reads Eqs 31–32 in.
+    pub thrust_unit: ThrustUnit,
+    /// The board's thruster mounting, as [`ConfigPatch::reversed_thrusters`].
+    pub reversed_thrusters: u8,
 }
 
 impl Telemetry {
@@ -298,7 +396,9 @@ impl Telemetry {
         + option(Refusal::MAX_SIZE)
         + 2 * U32
         + U16
-        + BOOL;
+        + BOOL
+        + ThrustUnit::MAX_SIZE
+        + U8;
 
     /// The controller fault this report carries (`None`: no fault, or a code this crate does
     /// not know).

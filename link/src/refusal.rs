@@ -35,6 +35,19 @@ pub enum Refusal {
     /// `SetConfig` whose resulting controller configuration the core refuses
     /// (`controller_core::Controller::new`: e.g. the loop-rate rule, or δ_max ≤ 0).
     ControllerConfig = 8,
+    // Protocol 3.
+    /// `StartMission` whose time scale the core refuses (`controller_core::Trajectory::new`:
+    /// k must be finite and in [1, `Trajectory::MAX_TIME_SCALE`]).
+    InvalidTimeScale = 9,
+    /// `StartMission` with the tangent heading on a path (at its time scale) whose horizontal
+    /// speed falls below `Trajectory::MIN_TANGENT_SPEED`: the course is undefined there.
+    TangentTooSlow = 10,
+    /// `SetConfig` whose reversed-thruster mask has a bit above the fifth (there are five
+    /// thrusters).
+    InvalidMounting = 11,
+    /// `SetConfig` whose axis priority the core refuses (a weight of an actuated axis that is
+    /// not finite and > 0).
+    InvalidPriority = 12,
 }
 
 impl Refusal {
@@ -71,6 +84,10 @@ refusal_names! {
     RateTooHigh => "rate too high",
     StaleLimit => "stale limit out of range",
     ControllerConfig => "controller config invalid",
+    InvalidTimeScale => "invalid time scale",
+    TangentTooSlow => "too slow for tangent heading",
+    InvalidMounting => "invalid thruster mounting",
+    InvalidPriority => "invalid axis priority",
 }
 
 impl Refusal {

@@ -2,9 +2,9 @@
 
 use auv_link::sign::{AuthError, SIGNATURE_LEN};
 use auv_link::{
-    decode_frame, encode, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, LinkError, MissionSpec, Msg, Refusal, StateFrame, Telemetry, CRC_LEN, MAX_BODY,
-    MAX_FRAME, PROTOCOL_VERSION,
+    decode_frame, encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope,
+    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, Refusal,
+    StateFrame, Telemetry, ThrustUnit, CRC_LEN, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
 };
 use proptest::prelude::*;
 
@@ -80,6 +80,8 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         rx_auth_errors: 2,
         last_rx_seq: 65_001,
         signing: true,
+        thrust_unit: ThrustUnit::Kgf,
+        reversed_thrusters: 0b1_1110,
     }
 }
 
@@ -94,26 +96,41 @@ fn every_kind() -> Vec<Envelope> {
         Msg::Command(Command::Arm),
         Msg::Command(Command::Disarm),
         Msg::Command(Command::StopMission),
-        Msg::Command(Command::StartMission(MissionSpec::Circle {
-            radius: 10.0,
-            omega: 0.1,
-            depth: 20.0,
+        Msg::Command(Command::StartMission(
+            MissionSpec::Circle {
+                radius: 10.0,
+                omega: 0.1,
+                depth: 20.0,
+            }
+            .into(),
+        )),
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::FigureEight {
+                amplitude: 15.0,
+                omega: 0.1,
+                depth: 20.0,
+            },
+            heading: Heading::Tangent,
+            time_scale: 2.5,
         })),
-        Msg::Command(Command::StartMission(MissionSpec::FigureEight {
-            amplitude: 15.0,
-            omega: 0.1,
-            depth: 20.0,
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::LawnMower {
+                scale: 1.0,
+                omega: 0.05,
+                depth: 20.0,
+            },
+            heading: Heading::Paper,
+            time_scale: 1.0,
         })),
-        Msg::Command(Command::StartMission(MissionSpec::LawnMower {
-            scale: 1.0,
-            omega: 0.05,
-            depth: 20.0,
-        })),
-        Msg::Command(Command::StartMission(MissionSpec::Helix {
-            radius: 10.0,
-            omega: 0.1,
-            depth: 5.0,
-            depth_rate: 0.1,
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::Helix {
+                radius: 10.0,
+                omega: 0.1,
+                depth: 5.0,
+                depth_rate: 0.1,
+            },
+            heading: Heading::Tangent,
+            time_scale: 1.0,
         })),
         Msg::Command(Command::SetConfig(ConfigPatch::EMPTY)),
         Msg::Command(Command::SetConfig(ConfigPatch {
@@ -123,6 +140,12 @@ fn every_kind() -> Vec<Envelope> {
             voltage_limit: Some(24.0),
             stale_periods: Some(5),
             lockstep: Some(true),
+            thrust_unit: Some(ThrustUnit::Newton),
+            reversed_thrusters: Some(0b0_0110),
+            priority: Some(AxisPriority {
+                rank: [5, 4, 3, 0, 2, 1],
+                weight: [1.0, 2.0, 0.5, 1.0, 3.0, 0.25],
+            }),
         })),
         Msg::Command(Command::SetConfig(ConfigPatch {
             delta_max: Some(10.0),
@@ -168,6 +191,8 @@ fn largest() -> Envelope {
             rx_auth_errors: u32::MAX,
             last_rx_seq: u16::MAX,
             signing: true,
+            thrust_unit: ThrustUnit::Newton,
+            reversed_thrusters: u8::MAX,
         }),
     )
 }
@@ -272,6 +297,13 @@ fn max_sizes_are_exact() {
         depth_rate: 1.0,
     };
     assert_eq!(postcard_len(&m), MissionSpec::MAX_SIZE);
+    let plan = MissionPlan {
+        path: m,
+        heading: Heading::Tangent,
+        time_scale: f32::MAX,
+    };
+    assert_eq!(postcard_len(&plan), MissionPlan::MAX_SIZE);
+    assert_eq!(postcard_len(&ThrustUnit::Newton), ThrustUnit::MAX_SIZE);
     let p = ConfigPatch {
         rate_hz: Some(u32::MAX),
         robust: Some(true),
@@ -279,6 +311,12 @@ fn max_sizes_are_exact() {
         voltage_limit: Some(f32::MAX),
         stale_periods: Some(u8::MAX),
         lockstep: Some(true),
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(u8::MAX),
+        priority: Some(AxisPriority {
+            rank: [u8::MAX; 6],
+            weight: [f32::MAX; 6],
+        }),
     };
     assert_eq!(postcard_len(&p), ConfigPatch::MAX_SIZE);
     assert_eq!(
@@ -296,9 +334,15 @@ fn max_sizes_are_exact() {
 
 #[test]
 fn largest_message_fits_max_frame_exactly() {
-    assert_eq!(Envelope::MAX_SIZE, 138);
-    assert_eq!(MAX_BODY, 153);
-    assert_eq!(MAX_FRAME, 155);
+    // Protocol 3's commands, by hand from the layout: a full ConfigPatch is 6 + 2 + 5 + 5 + 2
+    // + 2 (protocol 2) + 2 (unit) + 2 (mask) + 31 (priority: 6 ranks, 6 weights) bytes; a
+    // StartMission is its tag, the path (17), the heading (1) and the time scale (4).
+    assert_eq!(ConfigPatch::MAX_SIZE, 57);
+    assert_eq!(Command::MAX_SIZE, 58);
+    assert_eq!(MissionPlan::MAX_SIZE + 1, 23);
+    assert_eq!(Envelope::MAX_SIZE, 140);
+    assert_eq!(MAX_BODY, 155);
+    assert_eq!(MAX_FRAME, 157);
     // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
     // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
@@ -360,7 +404,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 1, 3, 0x7F, 0xFF] {
+    for version in [0u8, 1, 2, 4, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -377,30 +421,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[3, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[4, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 3 })]
+        vec![Err(LinkError::Version { got: 4 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 2, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    assert_eq!(PROTOCOL_VERSION, 2);
-    let wire = frame_from_body(&[2, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 3, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 3);
+    let wire = frame_from_body(&[3, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
     // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
     // short: Deserialize.
     for body in [
-        &[2, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[&[2, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
-        &[&[2, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
-        &[2, 0x00, 0x03][..],
-        &[2, 0x00, 0x01, 0x05][..],
-        &[2, 0x00, 0x00, 0x01][..],
-        &[2][..],
+        &[3, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[3, 0x00, 0x03][..],
+        &[3, 0x00, 0x01, 0x05][..],
+        &[3, 0x00, 0x00, 0x01][..],
+        &[3][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -409,7 +453,7 @@ fn hand_made_frames_match_the_documented_format() {
         );
     }
     // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
-    let signed = [&[2, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    let signed = [&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
     assert_eq!(
         decode_stream(&frame_from_body(&signed)),
         vec![Err(LinkError::Auth(AuthError::SigningOff))]
@@ -506,6 +550,24 @@ fn any_status() -> BoxedStrategy<BoardStatus> {
     .boxed()
 }
 
+fn any_plan() -> BoxedStrategy<MissionPlan> {
+    (
+        any_mission(),
+        prop_oneof![Just(Heading::Paper), Just(Heading::Tangent)],
+        any_f32(),
+    )
+        .prop_map(|(path, heading, time_scale)| MissionPlan {
+            path,
+            heading,
+            time_scale,
+        })
+        .boxed()
+}
+
+fn any_unit() -> BoxedStrategy<ThrustUnit> {
+    prop_oneof![Just(ThrustUnit::Kgf), Just(ThrustUnit::Newton)].boxed()
+}
+
 fn any_mission() -> BoxedStrategy<MissionSpec> {
     let f = any_f32;
     prop_oneof![
@@ -544,17 +606,49 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
         proptest::option::of(any_f32()),
         any::<Option<u8>>(),
         any::<Option<bool>>(),
+        proptest::option::of(any_unit()),
+        any::<Option<u8>>(),
+        proptest::option::of(any_priority()),
     )
         .prop_map(
-            |(rate_hz, robust, delta_max, voltage_limit, stale_periods, lockstep)| ConfigPatch {
+            |(
                 rate_hz,
                 robust,
                 delta_max,
                 voltage_limit,
                 stale_periods,
                 lockstep,
+                thrust_unit,
+                reversed_thrusters,
+                priority,
+            )| ConfigPatch {
+                rate_hz,
+                robust,
+                delta_max,
+                voltage_limit,
+                stale_periods,
+                lockstep,
+                thrust_unit,
+                reversed_thrusters,
+                priority,
             },
         )
+        .boxed()
+}
+
+fn any_priority() -> BoxedStrategy<AxisPriority> {
+    (
+        any::<[u8; 6]>(),
+        [
+            any_f32(),
+            any_f32(),
+            any_f32(),
+            any_f32(),
+            any_f32(),
+            any_f32(),
+        ],
+    )
+        .prop_map(|(rank, weight)| AxisPriority { rank, weight })
         .boxed()
 }
 
@@ -563,7 +657,7 @@ fn any_command() -> BoxedStrategy<Command> {
         Just(Command::Arm),
         Just(Command::Disarm),
         Just(Command::StopMission),
-        any_mission().prop_map(Command::StartMission),
+        any_plan().prop_map(Command::StartMission),
         any_patch().prop_map(Command::SetConfig),
     ]
     .boxed()
@@ -598,6 +692,8 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<u32>(),
             any::<u16>(),
             any::<bool>(),
+            any_unit(),
+            any::<u8>(),
         ),
     )
         .prop_map(
@@ -620,6 +716,8 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     rx_auth_errors,
                     last_rx_seq,
                     signing,
+                    thrust_unit,
+                    reversed_thrusters,
                 ),
             )| Telemetry {
                 tick,
@@ -644,6 +742,8 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 rx_auth_errors,
                 last_rx_seq,
                 signing,
+                thrust_unit,
+                reversed_thrusters,
             },
         )
         .boxed()

@@ -1,8 +1,12 @@
-//! The link's one mission conversion: every `TrajectoryKind` crosses a real frame and comes
-//! back equal, and the wire bytes are the documented postcard layout of `MissionSpec`.
+//! The link's one mission conversion: every `TrajectoryKind` (and every heading and time scale
+//! of a `Mission`) crosses a real frame and comes back equal, and the wire bytes are the
+//! documented postcard layout of `MissionSpec` and `MissionPlan`.
 
-use auv_link::{decode_frame, encode, Command, Envelope, MissionSpec, Msg, MAX_FRAME};
-use controller_core::{Table1Case, Trajectory, TrajectoryKind};
+use auv_link::{
+    decode_frame, encode, AxisPriority, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg,
+    ThrustUnit, MAX_FRAME,
+};
+use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
 /// Which kind a mission is. Exhaustive on purpose: a kind added to the core does not compile
 /// here until this test (and so the round trip) covers it.
@@ -98,23 +102,50 @@ fn every_kind_round_trips_through_a_frame() {
     let mut seen = [false; KINDS];
     for (seq, kind) in missions().into_iter().enumerate() {
         seen[kind_index(&kind)] = true;
-        let env = Envelope::new(
-            seq as u16,
-            Msg::Command(Command::StartMission(MissionSpec::from(kind))),
-        );
-        let mut wire = [0u8; MAX_FRAME];
-        let n = encode(&env, &mut wire).expect("a mission fits a frame");
-        let back = decode_frame(&mut wire[..n - 1]).expect("the frame decodes");
-        let Msg::Command(Command::StartMission(spec)) = back.msg else {
-            panic!("decoded {back:?}");
-        };
-        let again = TrajectoryKind::from(spec);
-        assert!(same_bits(&again, &kind), "{kind:?} came back as {again:?}");
-        if fields(&kind).iter().all(|x| !x.is_nan()) {
-            assert_eq!(again, kind);
+        for (heading, time_scale) in [(HeadingMode::Paper, 1.0), (HeadingMode::Tangent, 3.25)] {
+            let mission = Mission {
+                path: kind,
+                heading,
+                time_scale,
+            };
+            let env = Envelope::new(
+                seq as u16,
+                Msg::Command(Command::StartMission(MissionPlan::from(mission))),
+            );
+            let mut wire = [0u8; MAX_FRAME];
+            let n = encode(&env, &mut wire).expect("a mission fits a frame");
+            let back = decode_frame(&mut wire[..n - 1]).expect("the frame decodes");
+            let Msg::Command(Command::StartMission(plan)) = back.msg else {
+                panic!("decoded {back:?}");
+            };
+            let again = Mission::from(plan);
+            assert!(
+                same_bits(&again.path, &kind),
+                "{kind:?} came back as {again:?}"
+            );
+            assert_eq!((again.heading, again.time_scale), (heading, time_scale));
+            if fields(&kind).iter().all(|x| !x.is_nan()) {
+                assert_eq!(again, mission);
+            }
         }
     }
     assert_eq!(seen, [true; KINDS], "some kind never crossed the link");
+    // A bare path is the paper's mission.
+    assert_eq!(
+        Mission::from(MissionPlan::from(Table1Case::Circular10R.kind())),
+        Mission::paper(Table1Case::Circular10R.kind())
+    );
+    for u in controller_core::ThrustUnit::ALL {
+        assert_eq!(controller_core::ThrustUnit::from(ThrustUnit::from(u)), u);
+    }
+    // The axis priority, field for field (a non-default one, so a swapped field would show).
+    let p = controller_core::allocator::AxisPriority {
+        rank: [1, 5, 2, 0, 4, 3],
+        weight: [0.5, 1.0, 2.0, 3.0, 4.0, 8.0],
+    };
+    let wire = AxisPriority::from(p);
+    assert_eq!((wire.rank, wire.weight), (p.rank, p.weight));
+    assert_eq!(controller_core::allocator::AxisPriority::from(wire), p);
 }
 
 #[test]
@@ -130,6 +161,18 @@ fn wire_bytes_are_the_documented_layout() {
         let mut buf = [0u8; MissionSpec::MAX_SIZE];
         let got = postcard::to_slice(&MissionSpec::from(kind), &mut buf).expect("fits MAX_SIZE");
         assert_eq!(got, &want[..], "{kind:?}");
+        // A plan: the path's bytes, the heading's variant index (paper 0, tangent 1), then the
+        // time scale as an f32 little-endian.
+        let plan = MissionPlan {
+            path: kind.into(),
+            heading: Heading::Tangent,
+            time_scale: 2.5,
+        };
+        want.push(1);
+        want.extend(2.5f32.to_le_bytes());
+        let mut buf = [0u8; MissionPlan::MAX_SIZE];
+        let got = postcard::to_slice(&plan, &mut buf).expect("fits MAX_SIZE");
+        assert_eq!(got, &want[..], "{plan:?}");
     }
 }
 

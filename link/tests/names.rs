@@ -1,7 +1,7 @@
 //! The board's status and fail-safe names, and the reason bytes on the wire. The names are what
 //! the firmware logs (its defmt snapshots hold them) and what host-sim's reports and JSON say.
 
-use auv_link::{BoardStatus, FailSafeReason, Refusal, Telemetry};
+use auv_link::{BoardStatus, FailSafeReason, Refusal, Telemetry, ThrustUnit};
 use controller_core::Fault;
 
 #[test]
@@ -75,6 +75,8 @@ fn telemetry_fault_code_is_the_cores() {
         rx_auth_errors: 0,
         last_rx_seq: 0,
         signing: false,
+        thrust_unit: ThrustUnit::Kgf,
+        reversed_thrusters: 0,
     };
     assert_eq!(t.fault(), None);
     for f in Fault::ALL {

@@ -9,7 +9,8 @@ use auv_link::sign::{
 };
 use auv_link::{
     decode_frame, decode_frame_signed, encode, encode_signed, BoardStatus, Command, Envelope,
-    FailSafeReason, FrameDecoder, LinkError, Msg, Refusal, StateFrame, Telemetry, MAX_FRAME,
+    FailSafeReason, FrameDecoder, LinkError, Msg, Refusal, StateFrame, Telemetry, ThrustUnit,
+    MAX_FRAME,
 };
 use frames::{crc16, stuff};
 use hmac::{Hmac, KeyInit, Mac};
@@ -40,9 +41,9 @@ fn arm(seq: u16) -> Envelope {
 
 #[test]
 fn a_signed_frame_is_the_documented_layout() {
-    // postcard(Envelope{2, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
+    // postcard(Envelope{3, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
     // the first 6 bytes of HMAC-SHA-256(key, everything before the MAC) ‖ CRC-16 of it all.
-    let covered = [2u8, 0xAC, 0x02, 0x01, 0x00];
+    let covered = [3u8, 0xAC, 0x02, 0x01, 0x00];
     let id_time = [0u8, 5, 0, 0, 0, 0, 0];
     let mut mac = <Hmac<Sha256> as KeyInit>::new_from_slice(&KEY).unwrap();
     mac.update(&covered);
@@ -85,6 +86,8 @@ fn the_largest_signed_frame_is_max_frame() {
             rx_auth_errors: u32::MAX,
             last_rx_seq: u16::MAX,
             signing: true,
+            thrust_unit: ThrustUnit::Newton,
+            reversed_thrusters: u8::MAX,
         }),
     );
     let mut signer = Signer::new(&key(), Direction::FromBoard);

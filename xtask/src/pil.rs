@@ -1,14 +1,17 @@
 //! Processor in the loop: the QEMU flying image flies the simulated vehicle through
-//! `host-sim pil`. Three checks: a short lawn-mower mission must equal SIL bit for bit, on an
-//! unsigned and on a signed link (the public CI test key, `firmware/ci-test-link-key.hex`), and
-//! a link-fault case must enter and leave fail-safe at its exact ticks and drop its delayed
-//! (old) state frames.
+//! `host-sim pil`. Four checks: a short lawn-mower mission must equal SIL bit for bit, on an
+//! unsigned and on a signed link (the public CI test key, `firmware/ci-test-link-key.hex`); a
+//! short real-chain mission (kgf, tangent heading, time scale > 1, the real actuator chain,
+//! the real vehicle's mounting: [`REAL_CHAIN`]) must equal SIL bit for bit with the board
+//! reporting the scenario's thrust unit and mounting; and a link-fault case must enter and
+//! leave fail-safe at its exact ticks and drop its delayed (old) state frames.
 
 use std::path::Path;
 use std::process::Command;
 
 use auv_link::FailSafeReason;
 use auv_link::DEFAULT_STALE_PERIODS;
+use controller_core::HeadingMode;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 use host_sim::pil::{FailSafeEventKind, PilComparison};
 use host_sim::record::Cases;
@@ -19,13 +22,21 @@ use crate::images::{Built, Variant};
 /// The key the signed PIL run uses (workspace-relative): public, for tests only.
 const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
 
+/// The real-chain mission PIL flies (workspace-relative): one of the real-vehicle missions
+/// (docs/design.md §9), chosen because its time scale is above 1, flown for
+/// [`REAL_CHAIN_SECONDS`] only (CI time). The check reads it with host-sim's own loader and
+/// refuses to run unless it is what the check claims to fly.
+const REAL_CHAIN: &str = "host-sim/scenarios/real/figure-eight-30x30.toml";
+/// Seconds of the real-chain mission: 300 periods, a few seconds of QEMU.
+const REAL_CHAIN_SECONDS: &str = "3";
+
 /// The workspace's host test profile (`[profile.host]` in Cargo.toml), whose `host-sim` the
 /// PIL checks run.
 const HOST_PROFILE: &str = "host";
 
 pub fn run(ci: &mut Ci, built: &Built) {
     ci.step(
-        "processor in the loop: a short mission unsigned and signed (PIL must equal SIL) and a link-fault case",
+        "processor in the loop: a short mission unsigned and signed, a short real-chain mission (PIL must equal SIL) and a link-fault case",
     );
     let Some(elf) = built.elf(Variant::QEMU) else {
         ci.fail("PIL: no QEMU flying image (its build failed, see above)");
@@ -127,10 +138,23 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     let key = key.to_string_lossy().into_owned();
     // Signed, the first half of the same mission (its PIL = SIL check is the same; CI time).
     let signed = [&short[..3], &["5", "--link-key-file", &key]].concat();
+    // The real chain: the board gets the thrust unit, mounting and priority through SetConfig
+    // and the heading and time scale through StartMission.
+    let real = ["--scenario", REAL_CHAIN, "--duration", REAL_CHAIN_SECONDS];
+    let real_chain = real_chain_scenario(ci);
     for (name, args, want_signed) in [
         ("short", &short[..], false),
         ("short-signed", &signed[..], true),
+        ("real-chain", &real[..], false),
     ] {
+        let want_chain = if name == "real-chain" {
+            match &real_chain {
+                Some(c) => Some(c),
+                None => continue,
+            }
+        } else {
+            None
+        };
         let Some((ok, c)) = run(ci, name, args) else {
             continue;
         };
@@ -152,6 +176,23 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
                 c.sil_max_path,
                 if ok { "passed its 1 mm check" } else { "failed" }
             ));
+        }
+        if let Some((unit, mounting)) = want_chain {
+            println!(
+                "{name}: board flew thrust unit {:?}, reversed-thruster mask {:?}; peak |V| {:.2} V, saturated {:.1} % of periods",
+                c.pil.board_thrust_unit,
+                c.pil.board_reversed_thrusters,
+                c.run.metrics.peak_voltage,
+                100.0 * c.run.metrics.saturated_fraction
+            );
+            if c.pil.board_thrust_unit.as_deref() != Some(*unit)
+                || c.pil.board_reversed_thrusters != Some(*mounting)
+            {
+                ci.fail(format!(
+                    "PIL {name}: the board reported thrust unit {:?} and mounting {:?}; the scenario flies {unit} and {mounting:#07b} (SetConfig did not take)",
+                    c.pil.board_thrust_unit, c.pil.board_reversed_thrusters
+                ));
+            }
         }
         let clean = c.pil.board_rx_errors == 0
             && c.pil.board_rx_stale == 0
@@ -234,6 +275,51 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
                 c.pil.board_rx_stale,
                 DELAY.1 - DELAY.0
             ));
+        }
+    }
+}
+
+/// The real-chain scenario's thrust unit name and reversed-thruster mask, after checking that
+/// it is a real-chain mission as [`REAL_CHAIN`] says (kgf, tangent heading, time scale > 1,
+/// the real actuator chain); `None` (and a CI failure) otherwise.
+fn real_chain_scenario(ci: &mut Ci) -> Option<(&'static str, u8)> {
+    let path = ci.root.join(REAL_CHAIN);
+    let s = match host_sim::scenario::load_scenario(&path) {
+        Ok(s) => s,
+        Err(e) => {
+            ci.fail(format!("PIL real-chain: {REAL_CHAIN}: {e}"));
+            return None;
+        }
+    };
+    let cfg = s.config();
+    let mission = s.trajectory().mission();
+    let controller = s.controller().config();
+    let unit = controller.thrust_unit;
+    let mounting = controller.geometry.auv150_reversed();
+    let real = unit == controller_core::ThrustUnit::Kgf
+        && mission.heading == HeadingMode::Tangent
+        && mission.time_scale > 1.0
+        && !cfg.ideal_actuators;
+    match mounting {
+        Some(m) if real => {
+            println!(
+                "real-chain mission {REAL_CHAIN}: thrust unit {}, heading {}, time scale {}, ideal actuators {}, reversed-thruster mask {m:#07b}",
+                unit.as_str(),
+                mission.heading.as_str(),
+                mission.time_scale,
+                cfg.ideal_actuators
+            );
+            Some((unit.as_str(), m))
+        }
+        _ => {
+            ci.fail(format!(
+                "PIL real-chain: {REAL_CHAIN} must be a real-chain mission of the AUV-150 layout (kgf, tangent heading, time scale > 1, ideal_actuators = false); it has {}, {}, {}, ideal actuators {}, mounting {mounting:?}",
+                unit.as_str(),
+                mission.heading.as_str(),
+                mission.time_scale,
+                cfg.ideal_actuators
+            ));
+            None
         }
     }
 }

@@ -4,7 +4,10 @@
 #![allow(dead_code)]
 
 use auv_link::sign::{Direction, LinkKey, Signer};
-use auv_link::{encode, encode_signed, Command, Envelope, MissionSpec, Msg, StateFrame, MAX_FRAME};
+use auv_link::{
+    encode, encode_signed, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg, StateFrame,
+    MAX_FRAME,
+};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Table1Case, Trajectory};
 use firmware::board::{self, LinkBuffers};
@@ -35,11 +38,16 @@ pub fn supervisor() -> Supervisor {
     Supervisor::new(controller(), board_info(false))
 }
 
-/// The mission every test flies: the paper's 10 m circle.
-pub const CIRCLE: MissionSpec = MissionSpec::Circle {
-    radius: 10.0,
-    omega: 0.1,
-    depth: 5.0,
+/// The mission every test flies: the paper's 10 m circle, as the paper flies it (its heading,
+/// time scale 1).
+pub const CIRCLE: MissionPlan = MissionPlan {
+    path: MissionSpec::Circle {
+        radius: 10.0,
+        omega: 0.1,
+        depth: 5.0,
+    },
+    heading: Heading::Paper,
+    time_scale: 1.0,
 };
 
 /// A state frame on the circle at tick `k` (the vehicle exactly on its reference).

@@ -51,8 +51,8 @@ use auv_link::seq::SEQ_WINDOW;
 use auv_link::sign::{AuthError, Direction, LinkKey, Signer, MAX_TIMESTAMP};
 use auv_link::{
     decode_frame, encode, encode_signed, BoardStatus, Command, ConfigPatch, Envelope,
-    FailSafeReason, LinkError, MissionSpec, Msg, StateFrame, Telemetry, DEFAULT_STALE_PERIODS,
-    MAX_FRAME,
+    FailSafeReason, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
+    ThrustUnit, DEFAULT_STALE_PERIODS, MAX_FRAME,
 };
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Table1Case, Trajectory};
@@ -113,9 +113,13 @@ impl Bytes<'_> {
         self.at < self.data.len()
     }
     fn u8(&mut self) -> u8 {
-        let b = self.data.get(self.at).copied().unwrap_or(0);
+        let b = self.peek_u8();
         self.at += 1;
         b
+    }
+    /// The next byte, without taking it.
+    fn peek_u8(&self) -> u8 {
+        self.data.get(self.at).copied().unwrap_or(0)
     }
     fn u16(&mut self) -> u16 {
         u16::from_le_bytes([self.u8(), self.u8()])
@@ -352,7 +356,23 @@ fn state_frame(h: &Harness, input: &mut Bytes) -> StateFrame {
     s
 }
 
-fn mission(input: &mut Bytes) -> MissionSpec {
+/// A mission: [`path`]'s, with the tangent heading if bit 6 of its first byte is set and, if
+/// bit 5 is, a time scale from the input (else 1) — so byte 0 is the paper's circle as before.
+fn mission(input: &mut Bytes) -> MissionPlan {
+    let kind = input.peek_u8();
+    let path = path(input);
+    MissionPlan {
+        path,
+        heading: if kind & 0x40 != 0 {
+            Heading::Tangent
+        } else {
+            Heading::Paper
+        },
+        time_scale: if kind & 0x20 != 0 { input.f32() } else { 1.0 },
+    }
+}
+
+fn path(input: &mut Bytes) -> MissionSpec {
     let kind = input.u8();
     if kind & 0x80 == 0 {
         return MissionSpec::Circle {
@@ -407,6 +427,17 @@ fn patch(input: &mut Bytes) -> ConfigPatch {
             .then(|| pick(input, &[SUPPLY, 12.0, SUPPLY + 0.5, 0.0, f32::INFINITY])),
         stale_periods: (present & 16 != 0).then(|| input.u8()),
         lockstep: (present & 32 != 0).then(|| input.u8() & 1 == 1),
+        // Protocol 3's chain: any unit, any mask byte (a sixth thruster is refused); the
+        // priority stays unset (no bit left in `present`; tests/thruster_chain.rs covers it).
+        thrust_unit: (present & 64 != 0).then(|| {
+            if input.u8() & 1 == 0 {
+                ThrustUnit::Kgf
+            } else {
+                ThrustUnit::Newton
+            }
+        }),
+        reversed_thrusters: (present & 128 != 0).then(|| input.u8()),
+        priority: None,
     }
 }
 

@@ -13,7 +13,7 @@ use super::atomic::Pending;
 use super::plot::{
     figure, min_max, render, usable, Line, Panel, Stroke, C_DESIRED, C_LIMIT, C_WITH, C_WITHOUT,
 };
-use crate::record::{RunResult, Sample};
+use crate::record::{RunResult, Sample, THRUSTER_NAMES};
 
 const C_THRUSTERS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),
@@ -22,8 +22,6 @@ const C_THRUSTERS: [RGBColor; 5] = [
     RGBColor(148, 103, 189),
     RGBColor(140, 86, 75),
 ];
-/// Thruster order of `Sample::thrust` and `Sample::voltage`.
-const THRUSTER_NAMES: [&str; 5] = ["main", "vert fore", "vert aft", "horz fore", "horz aft"];
 
 fn series(run: &RunResult, f: impl Fn(&Sample) -> f64) -> Vec<(f64, f64)> {
     run.samples.iter().map(|s| (s.t, f(s))).collect()

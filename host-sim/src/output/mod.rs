@@ -23,7 +23,10 @@ pub mod report;
 pub use self::csv::{write_csv, CsvStream, CSV_COLUMNS};
 pub use self::dir::OutputDir;
 pub use self::figures::{plot_case, plot_case_with_limit, plot_names};
-pub use self::report::{report_markdown, table_markdown, table_text, write_report, ReportRow};
+pub use self::report::{
+    real_table_markdown, real_table_text, report_markdown, table_markdown, table_text,
+    write_report, RealRow, ReportRow,
+};
 
 /// The CSV file name of a run called `name`, with (`robust`) or without Δu:
 /// `{name}-with.csv` / `{name}-without.csv`.
@@ -31,21 +34,24 @@ pub fn csv_name(name: &str, robust: bool) -> String {
     format!("{name}-{}.csv", crate::record::du_suffix(robust))
 }
 
-/// Writes the plots of the report rows' runs (five per row, voltages against
-/// ±`voltage_limit`) and then `report.md` with the table, the plots, the `incomplete` outputs
-/// and `notes` into `dir` (the CSVs were streamed while the runs went). A plot that cannot be
-/// written is added to `incomplete` and the rest go on; the report's own failure is the error.
-/// Returns the report's path.
+/// Writes the plots of the report rows' runs and of `extra_plots` (five per run, voltages
+/// against ±`voltage_limit`) and then `report.md` with the table, `sections`, the plots, the
+/// `incomplete` outputs and `notes` into `dir` (the CSVs were streamed while the runs went). A
+/// plot that cannot be written is added to `incomplete` and the rest go on; the report's own
+/// failure is the error. Returns the report's path.
+#[allow(clippy::too_many_arguments)]
 pub fn write_plots_and_report(
     dir: &OutputDir,
     title: &str,
     rows: &[ReportRow],
+    sections: &str,
+    extra_plots: &[ReportRow],
     notes: &str,
     voltage_limit: f64,
     incomplete: &mut Vec<String>,
 ) -> Result<PathBuf> {
     let mut plots = Vec::new();
-    for row in rows {
+    for row in rows.iter().chain(extra_plots) {
         let written = plot_names(&row.with.name)
             .iter()
             .try_for_each(|name| dir.claim(name).map(|_| ()))
@@ -56,6 +62,6 @@ pub fn write_plots_and_report(
         }
     }
     let path = dir.claim("report.md")?;
-    let text = report_markdown(dir.path(), title, rows, &plots, notes, incomplete);
+    let text = report_markdown(dir.path(), title, rows, sections, &plots, notes, incomplete);
     atomic::write(&path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))
 }

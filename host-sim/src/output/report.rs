@@ -10,6 +10,7 @@ use controller_core::Table1Case;
 
 use super::atomic;
 use crate::paper;
+use crate::preflight::{Preflight, Verdict};
 use crate::record::{Metrics, RunResult};
 
 /// One row of a report table: a case, its run with Δu, optionally its run without Δu, and
@@ -253,7 +254,7 @@ pub fn write_report(
     notes: &str,
 ) -> Result<PathBuf> {
     let path = dir.join("report.md");
-    let s = report_markdown(dir, title, rows, plots, notes, &[]);
+    let s = report_markdown(dir, title, rows, "", plots, notes, &[]);
     fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
     atomic::write(&path, s.as_bytes()).with_context(|| format!("writing {}", path.display()))
 }
@@ -261,13 +262,15 @@ pub fn write_report(
 /// The text of `report.md` in `dir`: `# title`, a line on how to read the table, then the
 /// warnings — outputs that are `incomplete` (each line says which file and why), runs that
 /// were interrupted (the report is then **partial**), diverged, or had the controller in
-/// fail-safe (unexpectedly, or as the scenario expected) —, [`table_markdown`], each plot
-/// embedded as `![file](path)` (relative to `dir` when inside it) under its file name, and
-/// `notes` verbatim under "## Notes" (omitted if empty).
+/// fail-safe (unexpectedly, or as the scenario expected) —, [`table_markdown`], `sections`
+/// verbatim (Markdown with its own headings: the preflight verdicts, the real-vehicle table),
+/// each plot embedded as `![file](path)` (relative to `dir` when inside it) under its file
+/// name, and `notes` verbatim under "## Notes" (omitted if empty).
 pub fn report_markdown(
     dir: &Path,
     title: &str,
     rows: &[ReportRow],
+    sections: &str,
     plots: &[PathBuf],
     notes: &str,
     incomplete: &[String],
@@ -354,6 +357,13 @@ pub fn report_markdown(
         expected,
     );
     s.push_str(&table_markdown(rows));
+    if !sections.is_empty() {
+        s.push('\n');
+        s.push_str(sections);
+        if !sections.ends_with('\n') {
+            s.push('\n');
+        }
+    }
     if !plots.is_empty() {
         s.push_str("\n## Plots\n");
         for p in plots {
@@ -369,6 +379,133 @@ pub fn report_markdown(
         if !notes.ends_with('\n') {
             s.push('\n');
         }
+    }
+    s
+}
+
+/// One row of the real-vehicle table (docs/design.md §9): a run through the real actuator
+/// chain and the preflight check of its scenario.
+#[derive(Clone, Copy, Debug)]
+pub struct RealRow<'a> {
+    pub run: &'a RunResult,
+    pub preflight: &'a Preflight,
+}
+
+const REAL_HEADER: [&str; 10] = [
+    "mission",
+    "heading",
+    "time scale",
+    "max path (m)",
+    "rms path (m)",
+    "peak |V| (V)",
+    "saturated",
+    "within bound",
+    "preflight",
+    "outcome",
+];
+
+/// The preflight verdict in a table cell: `feasible`, `needs k ≥ 2.35`, `statically
+/// infeasible`, `infeasible`.
+pub fn verdict_cell(p: &Preflight) -> String {
+    match (p.verdict, p.smallest_time_scale) {
+        (Verdict::Feasible, _) => "feasible".to_string(),
+        (Verdict::NeedsTimeScale, Some(k)) => format!("needs k ≥ {k}"),
+        (Verdict::StaticallyInfeasible, _) => "statically infeasible".to_string(),
+        _ => "infeasible".to_string(),
+    }
+}
+
+fn real_cells(rows: &[RealRow]) -> Vec<Vec<String>> {
+    rows.iter()
+        .map(|r| {
+            let m = &r.run.metrics;
+            vec![
+                r.run.name.clone(),
+                r.preflight.heading.clone(),
+                format!("{}", r.preflight.time_scale),
+                fmt_err(m.max_path),
+                fmt_err(m.rms_path),
+                fmt_fixed(m.peak_voltage, 1),
+                format!("{} %", fmt_fixed(100.0 * m.saturated_fraction, 1)),
+                if crate::real::within_bound(r.run) {
+                    "yes"
+                } else {
+                    "NO"
+                }
+                .to_string(),
+                verdict_cell(r.preflight),
+                r.run.outcome.to_string(),
+            ]
+        })
+        .collect()
+}
+
+/// What the real-vehicle table's "within bound" column means.
+pub fn real_table_legend() -> String {
+    format!(
+        "within bound: completed with max path error ≤ {} m and a thruster saturated in ≤ {} % \
+         of the control periods (docs/design.md §9)",
+        crate::real::MAX_PATH_ERROR,
+        100.0 * crate::real::MAX_SATURATED_FRACTION
+    )
+}
+
+/// The real-vehicle table as Markdown: per run its mission, heading, time scale, max and rms
+/// path error, peak |V|, saturated fraction, whether it is within the bound, the preflight
+/// verdict and the outcome.
+pub fn real_table_markdown(rows: &[RealRow]) -> String {
+    let mut s = format!("| {} |\n|", REAL_HEADER.map(md_escape).join(" | "));
+    for i in 0..REAL_HEADER.len() {
+        s.push_str(if (2..8).contains(&i) {
+            " ---: |"
+        } else {
+            " --- |"
+        });
+    }
+    s.push('\n');
+    for r in real_cells(rows) {
+        let cells: Vec<String> = r.iter().map(|c| md_escape(c)).collect();
+        s.push_str(&format!("| {} |\n", cells.join(" | ")));
+    }
+    s
+}
+
+/// The same table as [`real_table_markdown`] for the terminal, columns aligned.
+pub fn real_table_text(rows: &[RealRow]) -> String {
+    let header: Vec<String> = REAL_HEADER.iter().map(|h| h.to_string()).collect();
+    let body = real_cells(rows);
+    let widths: Vec<usize> = (0..header.len())
+        .map(|i| {
+            std::iter::once(&header)
+                .chain(&body)
+                .map(|r| r[i].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect();
+    let line = |r: &[String]| {
+        let mut l = String::new();
+        for (i, c) in r.iter().enumerate() {
+            if i > 0 {
+                l.push_str("  ");
+            }
+            let pad = " ".repeat(widths[i].saturating_sub(c.chars().count()));
+            if (2..8).contains(&i) {
+                l.push_str(&pad);
+                l.push_str(c);
+            } else {
+                l.push_str(c);
+                l.push_str(&pad);
+            }
+        }
+        format!("{}\n", l.trim_end())
+    };
+    let mut s = line(&header);
+    s.push_str(&line(
+        &widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>(),
+    ));
+    for r in &body {
+        s.push_str(&line(r));
     }
     s
 }

@@ -5,7 +5,7 @@
 use controller_core::config::ConfigField;
 use controller_core::controller::{MAX_ANGULAR_RATE, MAX_LINEAR_SPEED, MAX_POSITION};
 use controller_core::model::{self, ParamVariation, VehicleParams, VARIED_PARAMETER_NAMES};
-use controller_core::{Controller, Trajectory, TrajectoryKind};
+use controller_core::{Controller, Mission, Trajectory};
 use controller_core::{Fault, Status};
 
 use crate::config::{CurrentModel, SimConfig, VariationProfile};
@@ -51,6 +51,9 @@ pub(super) fn controller(config: &SimConfig) -> Res<Controller> {
                 ..
             }) => "controller.pitch_limit_deg".to_string(),
             Some(ConfigField {
+                name: "priority", ..
+            }) => "controller.axis_priority".to_string(),
+            Some(ConfigField {
                 name: "params" | "uncertainty" | "geometry",
                 ..
             })
@@ -65,9 +68,10 @@ pub(super) fn controller(config: &SimConfig) -> Res<Controller> {
     })
 }
 
-/// The trajectory, built; its error under `trajectory.<field>`.
-pub(super) fn trajectory(kind: &TrajectoryKind) -> Res<Trajectory> {
-    Trajectory::new(*kind)
+/// The mission's trajectory, built; its error under `trajectory.<field>` (`trajectory.radius`,
+/// `trajectory.time_scale`, `trajectory.heading`).
+pub(super) fn trajectory(mission: &Mission) -> Res<Trajectory> {
+    Trajectory::new(*mission)
         .map_err(|e| invalid(format!("trajectory.{}", e.parameter()), e.to_string()))
 }
 

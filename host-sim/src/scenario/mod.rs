@@ -45,9 +45,12 @@
 //! depth_rate = 0.05           # helix (required), m/s, positive descends
 //! omega = 0.1                 # rad/s; default 0.1, lawn-mower 0.05
 //! depth = 5.0                 # m, positive down; default 5
+//! heading = "paper"           # "paper" | "tangent" (ψ_d along the course); default "paper"
+//! time_scale = 1.0            # k in [1, 100]: the reference is η_d(t/k); default 1
 //!
 //! [variation]                 # Table-3 parameter variation of the plant (not the controller)
 //! profile = "abs-sin"         # "none" | "constant" | "abs-sin" | "staircase" | "table3-staircase"
+//! trimmed = false             # true: payload ballasted to W = B (mass, inertia, CG shift act)
 //! omega = 0.1                 # abs-sin only, rad/s, default 0.1
 //! mass = 30.0                 # constant / abs-sin: Δ (abs-sin: the maximum); see below
 //! x_g = 0.05
@@ -90,6 +93,11 @@
 //! pitch_limit_deg = 80.0      # (0, 90)
 //! voltage_limit = 24.0        # V, > 0
 //! b_bound = "controlled-rows" # "controlled-rows" | "literal"
+//! thrust_unit = "kgf"         # "kgf" | "newton": the unit of Eqs 31–32; default "kgf"
+//! axis_priority = ["pitch", "depth", "yaw", "sway", "surge"]  # the five axes, highest first
+//! reversed_thrusters = ["vert fore", "vert aft", "horz fore", "horz aft"]  # strong side
+//!                             # against the reference axis (+x main, +z vertical, +y
+//!                             # horizontal); default: the core's (this list)
 //!
 //! [link_faults]               # processor in the loop only: tick ranges "A..B" (A included)
 //! drop = ["100..101"]         # state frames not sent
@@ -208,7 +216,7 @@ impl Scenario {
     /// trajectory.
     pub fn new(config: SimConfig) -> Result<Self, ScenarioError> {
         let controller = check::controller(&config)?;
-        let trajectory = check::trajectory(&config.trajectory)?;
+        let trajectory = check::trajectory(&config.mission())?;
         Self::assemble(config, controller, trajectory, true)
     }
 
@@ -223,14 +231,14 @@ impl Scenario {
         } else {
             check::controller(&config)?
         };
-        let trajectory = if config.trajectory == self.config.trajectory {
+        let trajectory = if config.mission() == self.config.mission() {
             self.trajectory
         } else {
-            check::trajectory(&config.trajectory)?
+            check::trajectory(&config.mission())?
         };
         // The mission's reference depends only on these (a Monte Carlo draw keeps them all).
         let same_mission = config.controller == self.config.controller
-            && config.trajectory == self.config.trajectory
+            && config.mission() == self.config.mission()
             && config.duration == self.config.duration;
         Self::assemble(config, controller, trajectory, !same_mission)
     }

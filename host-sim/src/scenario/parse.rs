@@ -4,8 +4,12 @@
 
 use std::fmt;
 
+use controller_core::allocator::{AxisPriority, AXIS_NAMES};
+use controller_core::effectiveness::ThrusterGeometry;
 use controller_core::model::{ParamVariation, VARIED_PARAMETERS, VARIED_PARAMETER_NAMES};
-use controller_core::{BBound, ControllerConfig, RobustLaw, Table1Case, TrajectoryKind};
+use controller_core::{
+    BBound, ControllerConfig, HeadingMode, RobustLaw, Table1Case, ThrustUnit, TrajectoryKind,
+};
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
@@ -16,6 +20,7 @@ use crate::config::{
     CurrentModel, LinkFaults, SensorNoise, SimConfig, TickRange, VariationProfile,
 };
 use crate::paper;
+use crate::record::THRUSTER_NAMES;
 
 /// Default `seed` of `[noise]` and of the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;
@@ -46,13 +51,36 @@ struct RawScenario {
     divergence_limit: Option<f64>,
     thruster_lag: Option<f64>,
     expect_faults: Option<bool>,
-    /// The core's own type: kind-specific keys, defaults and unknown keys are its serde form's.
-    trajectory: TrajectoryKind,
+    trajectory: RawTrajectory,
     variation: Option<RawVariation>,
     current: Option<RawCurrent>,
     noise: Option<RawNoise>,
     controller: Option<RawController>,
     link_faults: Option<RawLinkFaults>,
+}
+
+/// `[trajectory]`: the path is the core's own type (kind-specific keys, defaults and unknown
+/// keys are its serde form's), plus how the mission is flown: `heading` and `time_scale`.
+#[derive(Deserialize)]
+struct RawTrajectory {
+    heading: Option<HeadingName>,
+    time_scale: Option<f64>,
+    #[serde(flatten)]
+    path: TrajectoryKind,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum HeadingName {
+    Paper,
+    Tangent,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum ThrustUnitName {
+    Kgf,
+    Newton,
 }
 
 /// `[link_faults]`: tick ranges "A..B" (processor in the loop only).
@@ -94,6 +122,7 @@ type RawDelta = [Option<f64>; VARIED_PARAMETERS];
 /// `[variation]`: `profile`, `omega`, `steps` and the nine Δ keys.
 struct RawVariation {
     profile: ProfileName,
+    trimmed: Option<bool>,
     omega: Option<f64>,
     steps: Option<Vec<RawStep>>,
     delta: RawDelta,
@@ -139,10 +168,12 @@ impl<'de> Deserialize<'de> for RawVariation {
                 f.write_str("a [variation] table")
             }
             fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawVariation, A::Error> {
-                let (mut profile, mut omega, mut steps) = (None, None, None);
-                let delta = visit_delta_table(&mut map, "`profile`, `omega`, `steps`", |k, m| {
+                let (mut profile, mut omega, mut steps, mut trimmed) = (None, None, None, None);
+                let own = "`profile`, `trimmed`, `omega`, `steps`";
+                let delta = visit_delta_table(&mut map, own, |k, m| {
                     match k {
                         "profile" => profile = Some(m.next_value()?),
+                        "trimmed" => trimmed = Some(m.next_value()?),
                         "omega" => omega = Some(m.next_value()?),
                         "steps" => steps = Some(m.next_value()?),
                         _ => return Ok(false),
@@ -151,6 +182,7 @@ impl<'de> Deserialize<'de> for RawVariation {
                 })?;
                 Ok(RawVariation {
                     profile: profile.ok_or_else(|| de::Error::missing_field("profile"))?,
+                    trimmed,
                     omega,
                     steps,
                     delta,
@@ -259,6 +291,9 @@ struct RawController {
     pitch_limit_deg: Option<f64>,
     voltage_limit: Option<f64>,
     b_bound: Option<BBoundName>,
+    thrust_unit: Option<ThrustUnitName>,
+    axis_priority: Option<Vec<String>>,
+    reversed_thrusters: Option<Vec<String>>,
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -297,7 +332,16 @@ fn required<T: Copy>(key: &str, value: Option<T>, what: &str) -> Res<T> {
 
 fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
     let name = raw.name.unwrap_or_else(|| default_name.to_string());
-    let mut config = SimConfig::new(name, raw.trajectory);
+    let mut config = SimConfig::new(name, raw.trajectory.path);
+    if let Some(h) = raw.trajectory.heading {
+        config.heading = match h {
+            HeadingName::Paper => HeadingMode::Paper,
+            HeadingName::Tangent => HeadingMode::Tangent,
+        };
+    }
+    if let Some(k) = raw.trajectory.time_scale {
+        config.time_scale = to_f32("trajectory.time_scale", k)?;
+    }
     if let Some(case) = raw.table1_case {
         config.case = Some(Table1Case::from_name(&case).ok_or_else(|| {
             let names: Vec<&str> = Table1Case::ALL.iter().map(|c| c.name()).collect();
@@ -329,6 +373,7 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
     config.expect_faults = raw.expect_faults.unwrap_or(false);
     if let Some(raw) = raw.variation {
         config.variation = build_variation(&raw)?;
+        config.trimmed = raw.trimmed.unwrap_or(false);
     }
     if let Some(raw) = raw.current {
         config.current = build_current(&raw)?;
@@ -487,5 +532,89 @@ fn build_controller(raw: &RawController) -> Res<ControllerConfig> {
             BBoundName::Literal => BBound::Literal,
         };
     }
+    if let Some(u) = raw.thrust_unit {
+        c.thrust_unit = match u {
+            ThrustUnitName::Kgf => ThrustUnit::Kgf,
+            ThrustUnitName::Newton => ThrustUnit::Newton,
+        };
+    }
+    if let Some(order) = &raw.axis_priority {
+        c.priority = axis_priority(order)?;
+    }
+    if let Some(names) = &raw.reversed_thrusters {
+        c.geometry = ThrusterGeometry::auv150(reversed_mask(names)?);
+    }
     Ok(c)
+}
+
+/// `controller.reversed_thrusters`: the thrusters (by [`THRUSTER_NAMES`]) mounted with their
+/// strong (positive-thrust) side against their reference axis (+x main, +z vertical, +y
+/// horizontal), each at most once: the AUV-150 layout with those mounting signs
+/// ([`ThrusterGeometry::auv150`], docs/design.md §9).
+fn reversed_mask(names: &[String]) -> Res<u8> {
+    let key = "controller.reversed_thrusters";
+    let mut mask = 0u8;
+    for (i, name) in names.iter().enumerate() {
+        let t = THRUSTER_NAMES
+            .iter()
+            .position(|n| n == name)
+            .ok_or_else(|| {
+                invalid(
+                    format!("{key}[{i}]"),
+                    format!(
+                        "{name:?} is not a thruster: one of `{}`",
+                        THRUSTER_NAMES.join("`, `")
+                    ),
+                )
+            })?;
+        if mask & (1 << t) != 0 {
+            return Err(invalid(
+                format!("{key}[{i}]"),
+                format!("{name:?} is given twice"),
+            ));
+        }
+        mask |= 1 << t;
+    }
+    Ok(mask)
+}
+
+/// `controller.axis_priority`: the five actuated axes by name ([`AXIS_NAMES`] without roll),
+/// each once, highest first; equal weights (docs/design.md §9).
+fn axis_priority(order: &[String]) -> Res<AxisPriority> {
+    let key = "controller.axis_priority";
+    let actuated: Vec<&str> = AXIS_NAMES
+        .iter()
+        .copied()
+        .filter(|n| *n != "roll")
+        .collect();
+    let expected = || format!("each of `{}` once, highest first", actuated.join("`, `"));
+    if order.len() != actuated.len() {
+        return Err(invalid(
+            key,
+            format!("{} axes given, need {}", order.len(), expected()),
+        ));
+    }
+    let mut priority = AxisPriority {
+        rank: [0; 6],
+        ..AxisPriority::default()
+    };
+    for (i, name) in order.iter().enumerate() {
+        let axis = AXIS_NAMES
+            .iter()
+            .position(|n| n == name && *n != "roll")
+            .ok_or_else(|| {
+                invalid(
+                    format!("{key}[{i}]"),
+                    format!("{name:?} is not an actuated axis: need {}", expected()),
+                )
+            })?;
+        if priority.rank[axis] != 0 {
+            return Err(invalid(
+                format!("{key}[{i}]"),
+                format!("{name:?} is given twice: need {}", expected()),
+            ));
+        }
+        priority.rank[axis] = (order.len() - i) as u8;
+    }
+    Ok(priority)
 }

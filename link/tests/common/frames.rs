@@ -7,8 +7,8 @@
 #![allow(dead_code)]
 
 use auv_link::{
-    decode_frame, encode, Command, ConfigPatch, Envelope, FrameDecoder, LinkError, MissionSpec,
-    Msg, StateFrame, Telemetry, MAX_FRAME,
+    decode_frame, encode, Command, ConfigPatch, Envelope, FrameDecoder, LinkError, MissionPlan,
+    MissionSpec, Msg, StateFrame, Telemetry, MAX_FRAME,
 };
 
 /// What the decoder must report for `bytes`: each non-empty frame of at most `MAX_FRAME − 1`
@@ -134,7 +134,14 @@ pub fn same_command(a: &Command, b: &Command) -> bool {
         (Command::Arm, Command::Arm)
         | (Command::Disarm, Command::Disarm)
         | (Command::StopMission, Command::StopMission) => true,
-        (Command::StartMission(a), Command::StartMission(b)) => same_mission(a, b),
+        (Command::StartMission(a), Command::StartMission(b)) => {
+            let MissionPlan {
+                path,
+                heading,
+                time_scale,
+            } = a;
+            same_mission(path, &b.path) && *heading == b.heading && f(*time_scale, b.time_scale)
+        }
         (Command::SetConfig(a), Command::SetConfig(b)) => {
             let ConfigPatch {
                 rate_hz,
@@ -143,8 +150,19 @@ pub fn same_command(a: &Command, b: &Command) -> bool {
                 voltage_limit,
                 stale_periods,
                 lockstep,
+                thrust_unit,
+                reversed_thrusters,
+                priority,
             } = a;
-            *rate_hz == b.rate_hz
+            let same_priority = match (priority, &b.priority) {
+                (None, None) => true,
+                (Some(p), Some(q)) => p.rank == q.rank && fs(&p.weight, &q.weight),
+                _ => false,
+            };
+            same_priority
+                && *thrust_unit == b.thrust_unit
+                && *reversed_thrusters == b.reversed_thrusters
+                && *rate_hz == b.rate_hz
                 && *robust == b.robust
                 && of(*delta_max, b.delta_max)
                 && of(*voltage_limit, b.voltage_limit)
@@ -235,8 +253,12 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         rx_auth_errors,
         last_rx_seq,
         signing,
+        thrust_unit,
+        reversed_thrusters,
     } = a;
-    *tick == b.tick
+    *thrust_unit == b.thrust_unit
+        && *reversed_thrusters == b.reversed_thrusters
+        && *tick == b.tick
         && *status == b.status
         && fs(voltages, &b.voltages)
         && fs(thrusts, &b.thrusts)

@@ -3,7 +3,8 @@
 //! proves each kind of failure is visible.
 
 use auv_link::sign::{Direction, LinkKey, Signer, Verifier};
-use auv_link::{encode, encode_signed, Command, Envelope, FrameDecoder, MissionSpec, Msg};
+use auv_link::{encode, encode_signed, Command, ConfigPatch, Envelope, FrameDecoder, Msg};
+use auv_link::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
 use auv_link::{BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, MAX_FRAME};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
@@ -164,10 +165,14 @@ fn circle_state(k: u64) -> StateFrame {
     }
 }
 
-const MISSION: MissionSpec = MissionSpec::Circle {
-    radius: 10.0,
-    omega: 0.1,
-    depth: 5.0,
+const MISSION: MissionPlan = MissionPlan {
+    path: MissionSpec::Circle {
+        radius: 10.0,
+        omega: 0.1,
+        depth: 5.0,
+    },
+    heading: Heading::Paper,
+    time_scale: 1.0,
 };
 
 fn board_info(signing: bool) -> BoardInfo {
@@ -311,6 +316,89 @@ fn fail_safe_exercise() -> bool {
     ok && counted && lone_refused && repeat_dropped && fault_kept
 }
 
+/// Instructions `board::receive` spends on one frame (decode, then the supervisor's work).
+fn timed_frame(sup: &mut Supervisor, link: &mut LinkBuffers, host: &mut Host, msg: Msg) -> u32 {
+    let env = host.env(msg);
+    let mut buf = [0u8; MAX_FRAME];
+    let n = encode(&env, &mut buf).unwrap_or(0);
+    let t0 = SYST::get_current();
+    board::receive(sup, link, &buf[..n]);
+    let t1 = SYST::get_current();
+    elapsed(t0, t1) * INSTRUCTIONS_PER_TICK
+}
+
+/// The thruster chain and the mission settings of protocol 3 through real frames: a
+/// `SetConfig` of the thrust unit, mounting and priority is applied whole and reported in
+/// telemetry, refused while armed and with an invalid mask; a `StartMission` with the tangent
+/// heading and a time scale flies, one with a time scale below 1 is refused with its reason.
+/// Logs the instructions each costs the board.
+fn real_chain_exercise() -> bool {
+    let Ok(controller) = Controller::new(ControllerConfig::default()) else {
+        return false;
+    };
+    let mut sup = Supervisor::new(controller, board_info(false));
+    let mut link = LinkBuffers::new();
+    let mut host = Host { seq: 0 };
+    let (sup, link) = (&mut sup, &mut link);
+    let now = || 0u32;
+    let boot = sup.step(false, &now).telemetry;
+    let kgf_reported = boot.thrust_unit == ThrustUnit::Kgf
+        && boot.reversed_thrusters == controller_core::effectiveness::AUV150_REVERSED;
+    let chain = ConfigPatch {
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(0),
+        priority: Some(AxisPriority::from(
+            controller_core::allocator::AxisPriority::default(),
+        )),
+        ..ConfigPatch::EMPTY
+    };
+    let set_config = timed_frame(
+        sup,
+        link,
+        &mut host,
+        Msg::Command(Command::SetConfig(chain)),
+    );
+    let t = sup.step(false, &now).telemetry;
+    let applied =
+        t.thrust_unit == ThrustUnit::Newton && t.reversed_thrusters == 0 && t.refused_commands == 0;
+    let bad_mask = ConfigPatch {
+        reversed_thrusters: Some(1 << 5),
+        ..ConfigPatch::EMPTY
+    };
+    host.send(sup, link, Msg::Command(Command::SetConfig(bad_mask)), false);
+    let mask_refused = sup.last_refusal() == Some(Refusal::InvalidMounting);
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    host.send(sup, link, Msg::Command(Command::SetConfig(chain)), false);
+    let armed_refused = sup.last_refusal() == Some(Refusal::WhileArmed);
+    let slow = MissionPlan {
+        time_scale: 0.5,
+        ..MISSION
+    };
+    host.send(sup, link, Msg::Command(Command::StartMission(slow)), false);
+    let scale_refused = sup.last_refusal() == Some(Refusal::InvalidTimeScale);
+    let tangent = MissionPlan {
+        heading: Heading::Tangent,
+        time_scale: 2.0,
+        ..MISSION
+    };
+    let start = timed_frame(
+        sup,
+        link,
+        &mut host,
+        Msg::Command(Command::StartMission(tangent)),
+    );
+    let flying = sup.mode() == Mode::Running && sup.refused_commands() == 3;
+    info!(
+        "real chain: boot reports kgf and the default mounting {}, SetConfig newton/mounting/priority applied {}, invalid mask refused {}, refused while armed {}, time scale 0.5 refused {}, tangent mission at k = 2 running {}",
+        kgf_reported, applied, mask_refused, armed_refused, scale_refused, flying
+    );
+    info!(
+        "real chain instructions (a SetConfig of unit, mounting and priority; a StartMission, tangent at twice the time): set_config={} start_mission={}",
+        set_config, start
+    );
+    kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
+}
+
 /// A signed link: an unsigned frame and a replayed signed frame are refused, a signed one is
 /// taken; the telemetry says signing is on.
 fn signed_link_exercise() -> bool {
@@ -382,6 +470,8 @@ fn largest_telemetry() -> Envelope {
             rx_auth_errors: u32::MAX,
             last_rx_seq: u16::MAX,
             signing: true,
+            thrust_unit: ThrustUnit::Newton,
+            reversed_thrusters: u8::MAX,
         }),
     )
 }
@@ -511,7 +601,7 @@ pub fn run(mut syst: SYST) -> bool {
     let (golden_ok, max, mean) = golden_vectors();
     info!("update instructions: max={} mean={}", max, mean);
     let budget_ok = crate::cost::run(max);
-    let link_ok = fail_safe_exercise() && signed_link_exercise();
+    let link_ok = fail_safe_exercise() && signed_link_exercise() && real_chain_exercise();
     let signing_ok = signing_cost().is_some();
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());

@@ -1,0 +1,374 @@
+//! Issue 9, the real vehicle in the simulator: trim, the thrust unit of the real chain, the
+//! scenario keys, the preflight check against closed forms and against the flown outcome,
+//! and `host-sim check`'s exit codes. Runs are short (seconds of simulated time).
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use controller_core::kinematics::Attitude;
+use controller_core::model::{self, ParamVariation, VehicleParams, GRAVITY};
+use controller_core::{HeadingMode, ThrustUnit, TrajectoryKind};
+use host_sim::plant::{self, Plant, PlantState, PlantTerms};
+use host_sim::preflight::{self, Verdict, DEFAULT_MARGIN};
+use host_sim::real;
+use host_sim::scenario::{load_scenario, parse_scenario, Scenario, ScenarioError};
+use nalgebra::{Vector3, Vector6};
+
+fn scenarios_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios")
+}
+
+fn real_file(name: &str) -> PathBuf {
+    scenarios_dir().join("real").join(format!("{name}.toml"))
+}
+
+/// A small deterministic generator (no dependency on the draw order of a crate).
+struct Lcg(u64);
+impl Lcg {
+    fn next(&mut self) -> f64 {
+        self.0 = self
+            .0
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (self.0 >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn range(&mut self, a: f64, b: f64) -> f64 {
+        a + (b - a) * self.next()
+    }
+}
+
+#[test]
+fn trim_makes_gs_force_rows_vanish_and_keeps_its_moments() {
+    // Closed form (docs/design.md §9): W = B ⇒ g₁ = g₂ = g₃ = 0 for every attitude; the trim
+    // buoyancy acts at CO, so the moments are the untrimmed payload's.
+    let mut rng = Lcg(9);
+    for corner in [0u32, 1, 0b1_1111_1111, 0b0_0000_1111, 0b1_0101_0101] {
+        let bx = controller_core::uncertainty::ParamBox::table3();
+        let p = VehicleParams::auv150().with_variation(&bx.corner(corner));
+        let t = plant::trimmed(&p);
+        assert_eq!(t.mass, p.mass);
+        assert_eq!(t.r_g, p.r_g);
+        assert_eq!(t.inertia, p.inertia);
+        assert_eq!(t.weight(), t.buoyancy);
+        for _ in 0..200 {
+            let att = Attitude::from_euler(
+                rng.range(-1.2, 1.2),
+                rng.range(-1.2, 1.2),
+                rng.range(-3.1, 3.1),
+            );
+            let g = model::restoring(&t, &att);
+            let g0 = model::restoring(&p, &att);
+            assert!(
+                g.iter().take(3).all(|&f| f == 0.0),
+                "corner {corner}: forces {g}"
+            );
+            for (m, m0) in g.iter().zip(g0.iter()).skip(3) {
+                assert!(
+                    (m - m0).abs() <= 1e-9 * (1.0 + m0.abs()),
+                    "corner {corner}: moment {m} vs {m0}"
+                );
+            }
+        }
+    }
+    // The untrimmed payload weighs Δm g in g₃ (the check above is not vacuous).
+    let p = VehicleParams::auv150().with_variation(&ParamVariation::TABLE3_MAX);
+    let g = model::restoring(&p, &Attitude::from_euler(0.0, 0.0, 0.0));
+    assert!((g[2] + 30.0 * GRAVITY).abs() < 1e-9, "{}", g[2]);
+}
+
+#[test]
+fn required_force_inverts_the_plant() {
+    let mut rng = Lcg(17);
+    let p = VehicleParams::auv150().with_variation(&ParamVariation::TABLE3_MAX);
+    let plant = Plant::new(p, PlantTerms::default()).unwrap();
+    for _ in 0..200 {
+        let eta = Vector6::from_fn(|i, _| {
+            if i < 3 {
+                rng.range(-10.0, 10.0)
+            } else {
+                rng.range(-0.8, 0.8)
+            }
+        });
+        let nu = Vector6::from_fn(|_, _| rng.range(-1.5, 1.5));
+        let a = Vector6::from_fn(|_, _| rng.range(-0.5, 0.5));
+        let current = Vector3::new(rng.range(-0.5, 0.5), rng.range(-0.5, 0.5), 0.1);
+        let s = PlantState { eta, nu };
+        let tau = plant.required_force(&s, &a, &current);
+        let (_, nu_dot) = plant.derivative(&s, &tau, &current).unwrap();
+        assert!((nu_dot - a).amax() < 1e-9, "{nu_dot} vs {a}");
+    }
+}
+
+fn real(name: &str) -> Scenario {
+    load_scenario(&real_file(name)).unwrap_or_else(|e| panic!("{name}: {e}"))
+}
+
+#[test]
+fn the_real_chain_applies_the_commanded_wrench_in_the_configured_unit() {
+    // Regression: the real chain turned voltages into thrust with Eqs 31-32 read in newtons
+    // whatever the unit, so in kgf the plant got 1/9.81 of the allocated thrust. Where nothing
+    // saturates the allocator gives B₅⁻¹τ, so the applied wrench is the commanded one.
+    for unit in ["kgf", "newton"] {
+        let s = real("circular-10R")
+            .with(|c| {
+                c.duration = 2.0;
+                c.controller.thrust_unit = ThrustUnit::from_name(unit).unwrap();
+            })
+            .unwrap();
+        let run = host_sim::sil::run(&s);
+        let mut checked = 0;
+        // The last sample keeps the previous period's thrust (the run ends there).
+        let last = run.samples.len() - 1;
+        for smp in run.samples[..last].iter().filter(|x| x.saturated == 0) {
+            for r in [0usize, 1, 2, 4, 5] {
+                let (cmd, applied) = (smp.tau[r], smp.tau_applied[r]);
+                assert!(
+                    (cmd - applied).abs() <= 1e-3 * (1.0 + cmd.abs()),
+                    "{unit}, t = {}: row {r}: commanded {cmd}, applied {applied}",
+                    smp.t
+                );
+            }
+            checked += 1;
+        }
+        if unit == "kgf" {
+            assert!(checked > 150, "{checked} unsaturated periods");
+        }
+    }
+}
+
+#[test]
+fn scenario_keys_of_the_real_vehicle_are_read() {
+    let s = parse_scenario(
+        "[trajectory]\nkind = \"circle\"\nradius = 10\nheading = \"tangent\"\ntime_scale = 2\n\
+         [variation]\nprofile = \"constant\"\ntrimmed = true\n\
+         [controller]\nthrust_unit = \"newton\"\n\
+         axis_priority = [\"depth\", \"pitch\", \"sway\", \"yaw\", \"surge\"]\n\
+         reversed_thrusters = [\"vert fore\"]\n",
+    )
+    .unwrap();
+    let c = s.config();
+    assert_eq!(c.heading, HeadingMode::Tangent);
+    assert_eq!(c.time_scale, 2.0);
+    assert!(c.trimmed);
+    assert_eq!(c.controller.thrust_unit, ThrustUnit::Newton);
+    // X Y Z K M N ranks, highest 5.
+    assert_eq!(c.controller.priority.rank, [1, 3, 5, 0, 4, 2]);
+    assert_eq!(c.controller.geometry.auv150_reversed(), Some(0b0_0010));
+    assert_eq!(s.trajectory().mission().time_scale, 2.0);
+    // Defaults: the paper's heading, k = 1, untrimmed, kgf, the core's mounting.
+    let d = parse_scenario("[trajectory]\nkind = \"circle\"\nradius = 10\n").unwrap();
+    let c = d.config();
+    assert_eq!(c.heading, HeadingMode::Paper);
+    assert_eq!(c.time_scale, 1.0);
+    assert!(!c.trimmed);
+    assert_eq!(c.controller.thrust_unit, ThrustUnit::Kgf);
+    assert_eq!(c.controller, controller_core::ControllerConfig::default());
+}
+
+fn invalid_key(text: &str) -> String {
+    match parse_scenario(text) {
+        Err(ScenarioError::Invalid { key, .. }) => key,
+        other => panic!("expected an invalid value, got {other:?}"),
+    }
+}
+
+#[test]
+fn bad_real_vehicle_keys_are_named() {
+    let circle = "[trajectory]\nkind = \"circle\"\nradius = 10\n";
+    assert_eq!(
+        invalid_key(&format!("{circle}time_scale = 0.5\n")),
+        "trajectory.time_scale"
+    );
+    // A tangent mission too slow for a course (0.01 m/s) names the heading.
+    assert_eq!(
+        invalid_key("[trajectory]\nkind = \"circle\"\nradius = 0.1\nheading = \"tangent\"\n"),
+        "trajectory.heading"
+    );
+    let ctl = |extra: &str| format!("{circle}[controller]\n{extra}\n");
+    assert_eq!(
+        invalid_key(&ctl(
+            "axis_priority = [\"pitch\", \"depth\", \"yaw\", \"sway\"]"
+        )),
+        "controller.axis_priority"
+    );
+    assert_eq!(
+        invalid_key(&ctl(
+            "axis_priority = [\"pitch\", \"roll\", \"yaw\", \"sway\", \"surge\"]"
+        )),
+        "controller.axis_priority[1]"
+    );
+    assert_eq!(
+        invalid_key(&ctl("reversed_thrusters = [\"vert fore\", \"vert fore\"]")),
+        "controller.reversed_thrusters[1]"
+    );
+    assert_eq!(
+        invalid_key(&ctl("reversed_thrusters = [\"bow\"]")),
+        "controller.reversed_thrusters[0]"
+    );
+    for bad in [
+        format!("{circle}heading = \"sideways\"\n"),
+        ctl("thrust_unit = \"lbf\""),
+        format!("{circle}[variation]\nprofile = \"none\"\ntrimmed = 1\n"),
+    ] {
+        assert!(
+            matches!(parse_scenario(&bad), Err(ScenarioError::Toml(_))),
+            "{bad}"
+        );
+    }
+}
+
+#[test]
+fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
+    let compiled = real::real_scenarios().unwrap();
+    for ((file, _), s) in real::REAL_SCENARIOS.iter().zip(&compiled) {
+        let loaded = load_scenario(&scenarios_dir().join("real").join(file)).unwrap();
+        assert_eq!(loaded.config(), s.config(), "{file}");
+    }
+    for (case, s) in controller_core::Table1Case::ALL.iter().zip(&compiled) {
+        let c = s.config();
+        assert_eq!(c.trajectory, case.kind(), "{}", c.name);
+        assert_eq!(c.heading, HeadingMode::Tangent);
+        assert!(c.trimmed && !c.ideal_actuators);
+        assert_eq!(c.controller.thrust_unit, ThrustUnit::Kgf);
+        assert_eq!(c.variation, host_sim::paper::variation(*case));
+        // The whole 70 s path of the paper, at the mission's time scale.
+        assert!((c.duration - 70.0 * f64::from(c.time_scale)).abs() < 0.01);
+    }
+}
+
+#[test]
+fn the_static_demand_is_the_closed_form_of_weight_and_cg_moment() {
+    // Untrimmed Table-3 payload, level: the thrusters must hold ΔW = 30·9.81 N upward and the
+    // CG moment x_G W = 0.05·520·9.81 N m; the vertical pair pushing up shares them as
+    // T_fore = (ΔW + M/1.8)/2 = 218.0 N, beyond its 80 % envelope of 157.7 N.
+    let paper = host_sim::paper::scenario(controller_core::Table1Case::Circular10R, true).unwrap();
+    let p = preflight::check(&paper, DEFAULT_MARGIN).unwrap();
+    assert_eq!(p.verdict, Verdict::StaticallyInfeasible);
+    assert_eq!(p.smallest_time_scale, None);
+    let v = p.static_violation.as_ref().unwrap();
+    let dw = 30.0 * GRAVITY;
+    let moment = 0.05 * 520.0 * GRAVITY;
+    let fore = (dw + moment / 1.8) / 2.0;
+    assert_eq!(v.thruster, "vert fore");
+    assert!((v.demand - fore).abs() < 0.5, "{} vs {fore}", v.demand);
+    assert!(v.given_up.contains(&"depth".to_string()), "{v:?}");
+    // Trimmed, on the real vehicle's mounting (fore up, aft down), only the moment is left:
+    // ±M/3.6 on the pair, on their strong sides, for every corner and the whole circle.
+    let r = preflight::check(&real("circular-10R"), DEFAULT_MARGIN).unwrap();
+    assert_eq!(r.verdict, Verdict::Feasible);
+    for t in &r.thrusters[1..3] {
+        assert!((t.max - moment / 3.6).abs() < 0.5, "{t:?}");
+        assert!(t.min > -1.0, "{t:?}");
+    }
+}
+
+#[test]
+fn the_newton_reading_shrinks_every_envelope_and_grounds_the_real_circle() {
+    let kgf = real("circular-10R");
+    let newton = kgf
+        .with(|c| c.controller.thrust_unit = ThrustUnit::Newton)
+        .unwrap();
+    let (ek, en) = (kgf.controller().envelope(), newton.controller().envelope());
+    let pairs = ek.max.iter().zip(&en.max).chain(ek.min.iter().zip(&en.min));
+    for (k, n) in pairs {
+        assert!((k / n - 9.80665).abs() < 1e-3, "{k} vs {n}");
+    }
+    // 255 N m of CG moment against tunnels of 20 N: no speed helps.
+    let p = preflight::check(&newton, DEFAULT_MARGIN).unwrap();
+    assert_eq!(p.verdict, Verdict::StaticallyInfeasible, "{p}");
+}
+
+#[test]
+fn time_scale_cures_a_dynamic_infeasibility_and_the_proposal_is_tight() {
+    // The real figure-eight 40×40 at the paper's speed asks more than 80 % of the fore
+    // horizontal tunnel and of the main thruster; check proposes the smallest feasible scale.
+    let fast = real("figure-eight-40x40")
+        .with(|c| {
+            c.time_scale = 1.0;
+            c.duration = 70.0;
+        })
+        .unwrap();
+    let p = preflight::check(&fast, DEFAULT_MARGIN).unwrap();
+    assert_eq!(p.verdict, Verdict::NeedsTimeScale, "{p}");
+    let k = p.smallest_time_scale.unwrap();
+    assert!(k > 1.0 && k < 2.0, "{k}");
+    let at = |k: f64| {
+        let s = fast
+            .with(|c| {
+                c.time_scale = k as f32;
+                c.duration = 70.0 * k;
+            })
+            .unwrap();
+        preflight::check(&s, DEFAULT_MARGIN).unwrap().verdict
+    };
+    assert_eq!(at(k), Verdict::Feasible);
+    assert_eq!(at(k - 0.02), Verdict::NeedsTimeScale);
+}
+
+#[test]
+fn what_check_calls_feasible_flies_within_the_bound_and_static_infeasibility_does_not() {
+    // Short flights (20 s of each real mission, 8 s of each paper mission through the chain):
+    // the verdict of the shortened scenario against its flown outcome.
+    let real_missions = real::real_scenarios().unwrap();
+    for s in real_missions
+        .iter()
+        .filter(|s| {
+            s.config().trajectory
+                != TrajectoryKind::Circle {
+                    radius: 10.0,
+                    omega: 0.1,
+                    depth: 5.0,
+                }
+        })
+        .take(4)
+    {
+        let short = s.with(|c| c.duration = 20.0).unwrap();
+        let p = preflight::check(&short, DEFAULT_MARGIN).unwrap();
+        assert_eq!(p.verdict, Verdict::Feasible, "{p}");
+        let run = host_sim::sil::run(&short);
+        assert!(
+            real::within_bound(&run),
+            "{}: path {} m, saturated {}",
+            run.name,
+            run.metrics.max_path,
+            run.metrics.saturated_fraction
+        );
+    }
+    let chain = real::paper_real_chain_scenarios(&real_missions).unwrap();
+    for s in chain.iter().step_by(2) {
+        let short = s.with(|c| c.duration = 8.0).unwrap();
+        let p = preflight::check(&short, DEFAULT_MARGIN).unwrap();
+        assert_eq!(p.verdict, Verdict::StaticallyInfeasible, "{p}");
+        let run = host_sim::sil::run(&short);
+        assert!(!real::within_bound(&run), "{}: {:?}", run.name, run.metrics);
+    }
+}
+
+fn host_sim() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+}
+
+#[test]
+fn check_exits_0_feasible_1_infeasible_2_bad_input() {
+    let code = |args: &[&str]| host_sim().arg("check").args(args).output().unwrap();
+    let feasible = real_file("circular-10R");
+    let o = code(&["--scenario", feasible.to_str().unwrap()]);
+    assert_eq!(
+        o.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    assert!(String::from_utf8_lossy(&o.stdout).contains("FEASIBLE at time scale 1"));
+    let paper = scenarios_dir().join("circular-10R.toml");
+    let o = code(&["--scenario", paper.to_str().unwrap(), "--json"]);
+    assert_eq!(o.status.code(), Some(1));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["verdict"], "statically-infeasible");
+    assert_eq!(v["thrusters"].as_array().unwrap().len(), 5);
+    let o = code(&["--scenario", feasible.to_str().unwrap(), "--margin", "1.5"]);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--margin"));
+    let o = code(&["--scenario", "/nonexistent/x.toml"]);
+    assert_eq!(o.status.code(), Some(2));
+}
