@@ -214,27 +214,27 @@ fn time_scale_and_tangent_heading_match_the_path_at_t_over_k() {
             let t = tick as f64 / RATE as f64;
             let d = tr.sample(tick, RATE);
             let (p, z, z_dot) = path_f64(m.path, t / k);
-            for i in 0..2 {
-                let e0 = (d.eta[i] as f64 - p[i][0]).abs();
-                let e1 = (d.eta_dot[i] as f64 - p[i][1] / k).abs();
-                let e2 = (d.eta_ddot[i] as f64 - p[i][2] / (k * k)).abs();
+            for (i, p) in p.iter().enumerate() {
+                let e0 = (d.eta[i] as f64 - p[0]).abs();
+                let e1 = (d.eta_dot[i] as f64 - p[1] / k).abs();
+                let e2 = (d.eta_ddot[i] as f64 - p[2] / (k * k)).abs();
                 assert!(
-                    e0 <= pos_tol * (1.0 + p[i][0].abs()),
+                    e0 <= pos_tol * (1.0 + p[0].abs()),
                     "{name} t={t}: η[{i}] {} vs {}",
                     d.eta[i],
-                    p[i][0]
+                    p[0]
                 );
                 assert!(
                     e1 <= pos_tol,
                     "{name} t={t}: η̇[{i}] {} vs {}",
                     d.eta_dot[i],
-                    p[i][1] / k
+                    p[1] / k
                 );
                 assert!(
                     e2 <= pos_tol,
                     "{name} t={t}: η̈[{i}] {} vs {}",
                     d.eta_ddot[i],
-                    p[i][2] / (k * k)
+                    p[2] / (k * k)
                 );
                 worst[0] = worst[0].max(e0);
             }
