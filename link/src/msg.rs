@@ -378,6 +378,39 @@ pub struct Telemetry {
 }
 
 impl Telemetry {
+    /// The report of the longest encoding: every varint at its maximum, every f32 at its largest
+    /// magnitude, every `Option` `Some`. Its envelope with `seq = u16::MAX` is
+    /// [`Envelope::MAX_SIZE`] bytes and, signed, the longest frame, `MAX_FRAME` (the link's
+    /// tests check both); the board's self-test times its encoding as the worst case.
+    pub const LARGEST: Telemetry = Telemetry {
+        tick: u64::MAX,
+        status: BoardStatus::FailSafe(FailSafeReason::Overrun),
+        voltages: [f32::MAX; 5],
+        thrusts: [f32::MIN; 5],
+        tau: [f32::MAX; 6],
+        saturated: u8::MAX,
+        delta: f32::MAX,
+        delta_clamped: true,
+        w_norm: f32::MAX,
+        controller_fault: u8::MAX,
+        loop_overruns: u32::MAX,
+        worst_update_ticks: u32::MAX,
+        rx_frames: u32::MAX,
+        rx_errors: u32::MAX,
+        last_state_seq: u16::MAX,
+        latched: Some(FailSafeReason::Overrun),
+        refused_commands: u32::MAX,
+        last_refusal: Some(Refusal::ControllerConfig),
+        rx_stale: u32::MAX,
+        rx_auth_errors: u32::MAX,
+        last_rx_seq: u16::MAX,
+        signing: true,
+        thrust_unit: ThrustUnit::Newton,
+        reversed_thrusters: u8::MAX,
+    };
+}
+
+impl Telemetry {
     /// Worst-case postcard size of a `Telemetry` (bytes).
     pub const MAX_SIZE: usize = U64
         + BoardStatus::MAX_SIZE

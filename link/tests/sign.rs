@@ -8,9 +8,8 @@ use auv_link::sign::{
     AuthError, Direction, LinkKey, Signer, Verifier, MAC_LEN, SIGNATURE_LEN, TIMESTAMP_LEN,
 };
 use auv_link::{
-    decode_frame, decode_frame_signed, encode, encode_signed, BoardStatus, Command, Envelope,
-    FailSafeReason, FrameDecoder, LinkError, Msg, Refusal, StateFrame, Telemetry, ThrustUnit,
-    MAX_FRAME,
+    decode_frame, decode_frame_signed, encode, encode_signed, Command, Envelope, FrameDecoder,
+    LinkError, Msg, StateFrame, Telemetry, MAX_FRAME,
 };
 use frames::{crc16, stuff};
 use hmac::{Hmac, KeyInit, Mac};
@@ -61,35 +60,7 @@ fn a_signed_frame_is_the_documented_layout() {
 
 #[test]
 fn the_largest_signed_frame_is_max_frame() {
-    let env = Envelope::new(
-        u16::MAX,
-        Msg::Telemetry(Telemetry {
-            tick: u64::MAX,
-            status: BoardStatus::FailSafe(FailSafeReason::Overrun),
-            voltages: [f32::MAX; 5],
-            thrusts: [f32::MIN; 5],
-            tau: [f32::MAX; 6],
-            saturated: u8::MAX,
-            delta: f32::MAX,
-            delta_clamped: true,
-            w_norm: f32::MAX,
-            controller_fault: u8::MAX,
-            loop_overruns: u32::MAX,
-            worst_update_ticks: u32::MAX,
-            rx_frames: u32::MAX,
-            rx_errors: u32::MAX,
-            last_state_seq: u16::MAX,
-            latched: Some(FailSafeReason::Overrun),
-            refused_commands: u32::MAX,
-            last_refusal: Some(Refusal::ControllerConfig),
-            rx_stale: u32::MAX,
-            rx_auth_errors: u32::MAX,
-            last_rx_seq: u16::MAX,
-            signing: true,
-            thrust_unit: ThrustUnit::Newton,
-            reversed_thrusters: u8::MAX,
-        }),
-    );
+    let env = Envelope::new(u16::MAX, Msg::Telemetry(Telemetry::LARGEST));
     let mut signer = Signer::new(&key(), Direction::FromBoard);
     let wire = signed(&env, &mut signer);
     assert_eq!(wire.len(), MAX_FRAME);

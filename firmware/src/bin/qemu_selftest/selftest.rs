@@ -445,35 +445,7 @@ fn signed_link_exercise() -> bool {
 
 /// The largest telemetry frame the board sends.
 fn largest_telemetry() -> Envelope {
-    Envelope::new(
-        u16::MAX,
-        Msg::Telemetry(Telemetry {
-            tick: u64::MAX,
-            status: BoardStatus::FailSafe(FailSafeReason::Overrun),
-            voltages: [f32::MAX; 5],
-            thrusts: [f32::MIN; 5],
-            tau: [f32::MAX; 6],
-            saturated: u8::MAX,
-            delta: f32::MAX,
-            delta_clamped: true,
-            w_norm: f32::MAX,
-            controller_fault: u8::MAX,
-            loop_overruns: u32::MAX,
-            worst_update_ticks: u32::MAX,
-            rx_frames: u32::MAX,
-            rx_errors: u32::MAX,
-            last_state_seq: u16::MAX,
-            latched: Some(FailSafeReason::Overrun),
-            refused_commands: u32::MAX,
-            last_refusal: Some(Refusal::ControllerConfig),
-            rx_stale: u32::MAX,
-            rx_auth_errors: u32::MAX,
-            last_rx_seq: u16::MAX,
-            signing: true,
-            thrust_unit: ThrustUnit::Newton,
-            reversed_thrusters: u8::MAX,
-        }),
-    )
+    Envelope::new(u16::MAX, Msg::Telemetry(Telemetry::LARGEST))
 }
 
 /// Instructions to sign (encode) the largest telemetry frame and to receive (decode and
