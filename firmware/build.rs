@@ -15,7 +15,9 @@ use std::path::PathBuf;
 
 use auv_link::sign::LinkKey;
 use controller_core::kinematics::{self, Attitude};
-use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
+use controller_core::{
+    Controller, ControllerConfig, HeadingMode, Mission, Status, Table1Case, Trajectory,
+};
 
 // The images' table, shared with the library (bin names, memory maps).
 #[allow(dead_code)]
@@ -227,7 +229,19 @@ fn golden() -> String {
             for robust in [true, false] {
                 let c = if robust { &with } else { &without };
                 let o = c.update(*ticks, &eta, &nu, &tr);
-                push(&mut body, ci, *ticks, robust, &eta, &nu, &o);
+                push(&mut body, ci, *ticks, robust, false, &eta, &nu, &o);
+                n += 1;
+            }
+            // The tangent heading (ψ_d = the path's course: one atan2 and its derivatives)
+            // on the same inputs, at two of the four instants, Δu on.
+            if k == 1 || k == 2 {
+                let tangent = Trajectory::new(Mission {
+                    heading: HeadingMode::Tangent,
+                    ..Mission::paper(case.kind())
+                })
+                .expect("every Table-1 path is fast enough for the tangent heading");
+                let o = with.update(*ticks, &eta, &nu, &tangent);
+                push(&mut body, ci, *ticks, true, true, &eta, &nu, &o);
                 n += 1;
             }
         }
@@ -241,6 +255,7 @@ fn golden() -> String {
         0,
         0,
         true,
+        false,
         &eta,
         &nu,
         &with.update(0, &eta, &nu, &tr),
@@ -251,6 +266,7 @@ fn golden() -> String {
         0,
         0,
         true,
+        false,
         &eta,
         &nu,
         &with.update(0, &eta, &nu, &tr),
@@ -278,6 +294,7 @@ fn push(
     case: usize,
     ticks: u64,
     robust: bool,
+    tangent: bool,
     eta: &[f32; 6],
     nu: &[f32; 6],
     o: &controller_core::Output,
@@ -288,7 +305,7 @@ fn push(
     };
     writeln!(
         body,
-        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
+        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, tangent: {tangent}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
         arr(eta),
         arr(nu),
         arr(&o.voltage),

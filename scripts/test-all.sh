@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Every test of the workspace, set-up included (safe on a fresh machine):
-# host tests with both math backends of the core, the simulator and the closed loop, the
+# host tests with two math backends of the core (kernels, micromath), the simulator and the closed loop, the
 # firmware's host tests, and the firmware on the target (`cargo xtask firmware`, xtask/): every
 # image built, its memory map and sizes checked, the QEMU self-test (golden vectors,
 # instruction counts, fail-safe, snapshots, failure injection) and processor in the loop.
@@ -10,7 +10,7 @@ bash scripts/setup.sh
 # The STM32 image needs a link key: the public CI test key unless one is given.
 source scripts/ci-link-key.sh
 
-echo "== host tests (libm backend): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic, xtask"
+echo "== host tests (the kernels math backend, the default): controller-core, link, host-sim (plant, scenarios, CLI), closed loop, firmware logic, xtask"
 cargo test --workspace --profile host
 
 echo "== controller-core tests with the micromath backend"

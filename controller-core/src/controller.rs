@@ -13,7 +13,7 @@ use crate::allocator::Allocated;
 use crate::allocator::Allocator;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
-use crate::kinematics::{self, Attitude};
+use crate::kinematics::{Attitude, Kinematics};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
 use crate::model::{self, VehicleParams};
 use crate::thruster::{self, Actuation, Envelope, ThrusterMap};
@@ -396,12 +396,13 @@ impl Controller {
         if cos_theta_abs < self.cos_pitch_limit {
             return Err(Fault::PitchLimit);
         }
-        let eta_dot = kinematics::eta_dot(&att, &nu).map_err(|_| Fault::PitchLimit)?;
-        let jinv_jdot_nu = kinematics::jinv_jdot_nu(&att, &nu).map_err(|_| Fault::PitchLimit)?;
+        let kin = Kinematics::new(att).map_err(|_| Fault::PitchLimit)?;
+        let eta_dot = kin.eta_dot(&nu);
+        let jinv_jdot_nu = kin.jinv_jdot_nu(&nu);
         Ok(StepKinematics {
             eta,
             nu,
-            att,
+            kin,
             cos_theta_abs,
             eta_dot,
             jinv_jdot_nu,
@@ -463,7 +464,7 @@ impl Controller {
         let tau = law::body_force(
             &self.m_hat,
             &self.config.params,
-            &kin.att,
+            &kin.kin,
             &kin.nu,
             &u,
             &kin.jinv_jdot_nu,
@@ -550,7 +551,8 @@ impl Stage {
 pub struct StepKinematics {
     pub eta: Vector6<f32>,
     pub nu: Vector6<f32>,
-    pub att: Attitude<f32>,
+    /// R, sec θ, tan θ: formed once, used by every stage.
+    pub kin: Kinematics<f32>,
     pub cos_theta_abs: f32,
     pub eta_dot: Vector6<f32>,
     pub jinv_jdot_nu: Vector6<f32>,

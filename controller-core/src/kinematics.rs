@@ -99,9 +99,14 @@ pub fn rotation<T: RealField + Copy>(a: &Attitude<T>) -> Matrix3<T> {
 #[doc(alias = "Tzyx")]
 pub fn euler_rate_matrix<T: RealField + Copy>(a: &Attitude<T>) -> Result<Matrix3<T>, GimbalLock> {
     let sec = a.sec_theta()?;
-    let tth = a.stheta * sec;
+    Ok(t_matrix(a, sec, a.stheta * sec))
+}
+
+/// T(φ,θ) from sec θ and tan θ = sθ·sec θ.
+#[inline]
+fn t_matrix<T: RealField + Copy>(a: &Attitude<T>, sec: T, tth: T) -> Matrix3<T> {
     let (o, z) = (T::one(), T::zero());
-    Ok(Matrix3::new(
+    Matrix3::new(
         o,
         a.sphi * tth,
         a.cphi * tth,
@@ -111,7 +116,7 @@ pub fn euler_rate_matrix<T: RealField + Copy>(a: &Attitude<T>) -> Result<Matrix3
         z,
         a.sphi * sec,
         a.cphi * sec,
-    ))
+    )
 }
 
 /// T(φ,θ)⁻¹ = [[1, 0, −sθ], [0, cφ, cθ sφ], [0, −sφ, cθ cφ]]: ω = T⁻¹ [φ̇ θ̇ ψ̇]ᵀ. Defined for
@@ -156,23 +161,22 @@ pub fn eta_dot<T: RealField + Copy>(
     a: &Attitude<T>,
     nu: &Vector6<T>,
 ) -> Result<Vector6<T>, GimbalLock> {
-    let v = rotation(a) * nu.fixed_rows::<3>(0);
-    let e = euler_rate_matrix(a)? * nu.fixed_rows::<3>(3);
-    Ok(Vector6::new(v.x, v.y, v.z, e.x, e.y, e.z))
+    Ok(Kinematics::new(*a)?.eta_dot(nu))
 }
 
-/// Ṫ(φ,θ) along the motion, given the Euler rates (φ̇, θ̇).
-fn euler_rate_matrix_dot<T: RealField + Copy>(
+/// Ṫ(φ,θ) along the motion, given sec θ, tan θ and the Euler rates (φ̇, θ̇).
+#[inline]
+fn t_dot_matrix<T: RealField + Copy>(
     a: &Attitude<T>,
+    sec: T,
+    tth: T,
     phi_dot: T,
     theta_dot: T,
-) -> Result<Matrix3<T>, GimbalLock> {
-    let sec = a.sec_theta()?;
-    let tth = a.stheta * sec;
+) -> Matrix3<T> {
     let sec2 = sec * sec;
     let z = T::zero();
     let (sf, cf) = (a.sphi, a.cphi);
-    Ok(Matrix3::new(
+    Matrix3::new(
         z,
         cf * tth * phi_dot + sf * sec2 * theta_dot,
         -sf * tth * phi_dot + cf * sec2 * theta_dot,
@@ -182,7 +186,7 @@ fn euler_rate_matrix_dot<T: RealField + Copy>(
         z,
         cf * sec * phi_dot + sf * tth * sec * theta_dot,
         -sf * sec * phi_dot + cf * tth * sec * theta_dot,
-    ))
+    )
 }
 
 /// J̇(η, ν) = diag(Ṙ, Ṫ) with Ṙ = R S(ω) (Eq 3's J̇).
@@ -190,13 +194,14 @@ pub fn jacobian_dot<T: RealField + Copy>(
     a: &Attitude<T>,
     nu: &Vector6<T>,
 ) -> Result<Matrix6<T>, GimbalLock> {
+    let k = Kinematics::new(*a)?;
     let omega = Vector3::new(nu[3], nu[4], nu[5]);
-    let rates = euler_rate_matrix(a)? * omega;
+    let rates = k.euler_rates(&omega);
     let mut jd = Matrix6::zeros();
     jd.fixed_view_mut::<3, 3>(0, 0)
-        .copy_from(&(rotation(a) * crate::model::skew(&omega)));
+        .copy_from(&(k.r * skew(&omega)));
     jd.fixed_view_mut::<3, 3>(3, 3)
-        .copy_from(&euler_rate_matrix_dot(a, rates.x, rates.y)?);
+        .copy_from(&t_dot_matrix(a, k.sec, k.tan, rates.x, rates.y));
     Ok(jd)
 }
 
@@ -206,10 +211,94 @@ pub fn jinv_jdot_nu<T: RealField + Copy>(
     a: &Attitude<T>,
     nu: &Vector6<T>,
 ) -> Result<Vector6<T>, GimbalLock> {
-    let v = Vector3::new(nu[0], nu[1], nu[2]);
-    let omega = Vector3::new(nu[3], nu[4], nu[5]);
-    let rates = euler_rate_matrix(a)? * omega;
-    let lin = omega.cross(&v);
-    let ang = euler_rate_matrix_inv(a) * (euler_rate_matrix_dot(a, rates.x, rates.y)? * omega);
-    Ok(Vector6::new(lin.x, lin.y, lin.z, ang.x, ang.y, ang.z))
+    Ok(Kinematics::new(*a)?.jinv_jdot_nu(nu))
+}
+
+/// Skew-symmetric S(a) with S(a) b = a × b (Fossen's `Smtrx`).
+#[doc(alias = "Smtrx")]
+pub fn skew<T: RealField + Copy>(a: &Vector3<T>) -> Matrix3<T> {
+    let z = T::zero();
+    Matrix3::new(z, -a.z, a.y, a.z, z, -a.x, -a.y, a.x, z)
+}
+
+/// The kinematics of one attitude, formed once per step and shared by everything that needs
+/// them (docs/design.md §4, §16): R, sec θ and tan θ, with η̇ = Jν (Eq 2), J⁻¹J̇ν (Eq 3) and
+/// J⁻¹u as methods. T and T⁻¹ are applied to vectors directly (their zeros and ones cost
+/// nothing). Building it is the one place the gimbal-lock check runs.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Kinematics<T> {
+    /// The attitude's sines and cosines.
+    pub att: Attitude<T>,
+    /// R(φ,θ,ψ), body → earth.
+    pub r: Matrix3<T>,
+    /// sec θ.
+    pub sec: T,
+    /// tan θ.
+    pub tan: T,
+}
+
+impl<T: RealField + Copy> Kinematics<T> {
+    /// R, sec θ and tan θ of `att`; [`GimbalLock`] at θ = ±90°.
+    #[inline]
+    pub fn new(att: Attitude<T>) -> Result<Self, GimbalLock> {
+        let sec = att.sec_theta()?;
+        Ok(Kinematics {
+            att,
+            r: rotation(&att),
+            sec,
+            tan: att.stheta * sec,
+        })
+    }
+
+    /// T(φ,θ) ω: the Euler rates [φ̇ θ̇ ψ̇] of the body rates ω.
+    #[inline]
+    pub fn euler_rates(&self, omega: &Vector3<T>) -> Vector3<T> {
+        let a = &self.att;
+        let s = omega.y * a.sphi + omega.z * a.cphi;
+        Vector3::new(
+            omega.x + s * self.tan,
+            omega.y * a.cphi - omega.z * a.sphi,
+            s * self.sec,
+        )
+    }
+
+    /// T(φ,θ)⁻¹ x (defined for every attitude).
+    #[inline]
+    pub fn euler_rates_inv(&self, x: &Vector3<T>) -> Vector3<T> {
+        let a = &self.att;
+        Vector3::new(
+            x.x - a.stheta * x.z,
+            a.cphi * x.y + a.ctheta * a.sphi * x.z,
+            -a.sphi * x.y + a.ctheta * a.cphi * x.z,
+        )
+    }
+
+    /// η̇ = J(η) ν (Eq 2).
+    #[inline]
+    pub fn eta_dot(&self, nu: &Vector6<T>) -> Vector6<T> {
+        let v = self.r * Vector3::new(nu[0], nu[1], nu[2]);
+        let e = self.euler_rates(&Vector3::new(nu[3], nu[4], nu[5]));
+        Vector6::new(v.x, v.y, v.z, e.x, e.y, e.z)
+    }
+
+    /// J(η)⁻¹ u = [Rᵀ u₁; T⁻¹ u₂] (Eq 3).
+    #[inline]
+    pub fn jinv_mul(&self, u: &Vector6<T>) -> Vector6<T> {
+        let v = self.r.tr_mul(&Vector3::new(u[0], u[1], u[2]));
+        let e = self.euler_rates_inv(&Vector3::new(u[3], u[4], u[5]));
+        Vector6::new(v[0], v[1], v[2], e.x, e.y, e.z)
+    }
+
+    /// J⁻¹ J̇ ν in closed form (docs/design.md §4): [ω × v; T⁻¹ Ṫ ω]. This is the term of
+    /// Eq (3) (ν̇ = J⁻¹(η̈ − J̇ν)) that the inversion-free law needs.
+    #[inline]
+    pub fn jinv_jdot_nu(&self, nu: &Vector6<T>) -> Vector6<T> {
+        let v = Vector3::new(nu[0], nu[1], nu[2]);
+        let omega = Vector3::new(nu[3], nu[4], nu[5]);
+        let rates = self.euler_rates(&omega);
+        let lin = omega.cross(&v);
+        let t_dot = t_dot_matrix(&self.att, self.sec, self.tan, rates.x, rates.y);
+        let ang = self.euler_rates_inv(&(t_dot * omega));
+        Vector6::new(lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
+    }
 }

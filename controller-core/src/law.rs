@@ -10,7 +10,7 @@
 
 use nalgebra::{Matrix6, RealField, Vector6};
 
-use crate::kinematics::{self, Attitude};
+use crate::kinematics::Kinematics;
 use crate::model::{self, VehicleParams};
 
 /// Indices of the controlled axes in η: x, y, z, θ, ψ.
@@ -189,18 +189,20 @@ pub fn uncertainty_bound(c: &DeltaConstants, x: &DeltaInputs) -> f32 {
 /// This is Eq (7), τ̄ = b̂⁻¹(u + f̂), mapped to the body by τ = Jᵀτ̄: with b̂⁻¹ = M̄̂ and
 /// f̂ = b̂Ĥ the products collapse and no matrix is inverted at run time (a test keeps the
 /// literal Eq 7 route and this one in agreement). `jinv_jdot_nu` is
-/// [`kinematics::jinv_jdot_nu`], passed in because δ(e,t) needs its norm too.
+/// [`Kinematics::jinv_jdot_nu`], passed in because δ(e,t) needs its norm too; `kin` is the
+/// step's one kinematics value. C(ν)ν and D(ν)ν are formed as vectors
+/// ([`model::coriolis_force`], [`model::damping_force`]).
 pub fn body_force<T: RealField + Copy>(
     m_hat: &Matrix6<T>,
     params: &VehicleParams<T>,
-    att: &Attitude<T>,
+    kin: &Kinematics<T>,
     nu: &Vector6<T>,
     u: &Vector6<T>,
     jinv_jdot_nu: &Vector6<T>,
 ) -> Vector6<T> {
-    let accel = kinematics::jacobian_inv(att) * u - jinv_jdot_nu;
+    let accel = kin.jinv_mul(u) - jinv_jdot_nu;
     m_hat * accel
-        + model::coriolis(m_hat, nu) * nu
-        + model::damping(params, nu) * nu
-        + model::restoring(params, att)
+        + model::coriolis_force(m_hat, nu)
+        + model::damping_force(params, nu)
+        + model::restoring(params, &kin.att)
 }

@@ -13,6 +13,7 @@ pub mod kinematics;
 pub mod law;
 pub mod math;
 pub mod model;
+pub mod phase;
 pub mod thruster;
 pub mod trajectory;
 pub mod uncertainty;

@@ -3,20 +3,20 @@
 //! Every transcendental call of the f32 law goes through this module so that one cargo feature
 //! decides what runs on the board:
 //!
-//! * default — [`libm`]: correctly rounded to an ulp or two; its `sinf`, `cosf` and `cbrtf`
-//!   evaluate in f64 (soft-float calls on the Cortex-M4F) and its `sqrtf` is a software loop
-//!   there;
-//! * feature `kernels` — the core's own f32-only [`kernels`]: sin/cos within 0.82 ulp over
-//!   every f32, cbrt within 0.51 ulp, atan2 within 1.5 ulp, and the FPU's `vsqrt.f32` (exact);
-//!   no f64 anywhere;
+//! * default — the core's own f32-only [`kernels`]: sin/cos within 0.82 ulp over every f32,
+//!   cbrt within 0.51 ulp, atan2 within 1.5 ulp, and the FPU's `vsqrt.f32` (exact); no f64
+//!   anywhere, so nothing on the control step is a soft-float call on the Cortex-M4F
+//!   (docs/design.md §17, the board default on evidence: accuracy, Table 1, instruction counts);
+//! * feature `libm-math` — [`libm`]: correctly rounded to an ulp or two; its `sinf`, `cosf` and
+//!   `cbrtf` evaluate in f64 (soft-float calls on the Cortex-M4F) and its `sqrtf` is a software
+//!   loop there (kept to measure against);
 //! * feature `micromath` — micromath's fast approximations for `sin`, `cos`, `sqrt` and
 //!   `atan2` (the product design names micromath). Measured here (`tests/math_backend.rs`):
 //!   sin/cos absolute error ≈ 1e-3, `sqrt` relative error up to ≈ 6 % (√2 → 1.5).
 //!
-//! If several are enabled (features add up in a workspace), micromath wins over kernels, and
-//! kernels over libm. Making the kernels the default is one line: `default = ["kernels"]` in
-//! `controller-core/Cargo.toml`. `cbrt` is the kernels' with `kernels` and libm's otherwise
-//! (micromath has no `cbrt`); `floor` is always libm (exact, integer operations).
+//! If several are enabled (features add up in a workspace), micromath wins over libm, and libm
+//! over the kernels. `cbrt` is libm's with `libm-math` and the kernels' otherwise (micromath
+//! has no `cbrt`); `floor` is always libm (exact, integer operations).
 //!
 //! Call these functions by path (`math::sqrt(x)`), never as methods: a method call `x.sqrt()`
 //! resolves to std on the host and to a trait method on the target, which is exactly the
@@ -29,10 +29,10 @@ pub mod kernels;
 /// Name of the backend compiled in, for logs and benchmarks.
 pub const BACKEND: &str = if cfg!(feature = "micromath") {
     "micromath"
-} else if cfg!(feature = "kernels") {
-    "kernels"
-} else {
+} else if cfg!(feature = "libm-math") {
     "libm"
+} else {
+    "kernels"
 };
 
 /// sin(x).
@@ -42,11 +42,11 @@ pub fn sin(x: f32) -> f32 {
     {
         micromath::F32(x).sin().0
     }
-    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    #[cfg(not(any(feature = "micromath", feature = "libm-math")))]
     {
         kernels::sin(x)
     }
-    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
+    #[cfg(all(feature = "libm-math", not(feature = "micromath")))]
     {
         libm::sinf(x)
     }
@@ -59,11 +59,11 @@ pub fn cos(x: f32) -> f32 {
     {
         micromath::F32(x).cos().0
     }
-    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    #[cfg(not(any(feature = "micromath", feature = "libm-math")))]
     {
         kernels::cos(x)
     }
-    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
+    #[cfg(all(feature = "libm-math", not(feature = "micromath")))]
     {
         libm::cosf(x)
     }
@@ -72,11 +72,11 @@ pub fn cos(x: f32) -> f32 {
 /// (sin x, cos x) (the kernels reduce x once for both).
 #[inline]
 pub fn sin_cos(x: f32) -> (f32, f32) {
-    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    #[cfg(not(any(feature = "micromath", feature = "libm-math")))]
     {
         kernels::sin_cos(x)
     }
-    #[cfg(not(all(feature = "kernels", not(feature = "micromath"))))]
+    #[cfg(any(feature = "micromath", feature = "libm-math"))]
     {
         (sin(x), cos(x))
     }
@@ -90,11 +90,11 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     {
         micromath::F32(y).atan2(micromath::F32(x)).0
     }
-    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    #[cfg(not(any(feature = "micromath", feature = "libm-math")))]
     {
         kernels::atan2(y, x)
     }
-    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
+    #[cfg(all(feature = "libm-math", not(feature = "micromath")))]
     {
         libm::atan2f(y, x)
     }
@@ -107,11 +107,11 @@ pub fn sqrt(x: f32) -> f32 {
     {
         micromath::F32(x).sqrt().0
     }
-    #[cfg(all(feature = "kernels", not(feature = "micromath")))]
+    #[cfg(not(any(feature = "micromath", feature = "libm-math")))]
     {
         kernels::sqrt(x)
     }
-    #[cfg(not(any(feature = "micromath", feature = "kernels")))]
+    #[cfg(all(feature = "libm-math", not(feature = "micromath")))]
     {
         libm::sqrtf(x)
     }
@@ -126,14 +126,14 @@ pub fn exact_sqrt(x: f32) -> f32 {
     libm::sqrtf(x)
 }
 
-/// ∛x (the kernels' with `kernels`, libm's otherwise).
+/// ∛x (libm's with `libm-math`, the kernels' otherwise).
 #[inline]
 pub fn cbrt(x: f32) -> f32 {
-    #[cfg(feature = "kernels")]
+    #[cfg(not(feature = "libm-math"))]
     {
         kernels::cbrt(x)
     }
-    #[cfg(not(feature = "kernels"))]
+    #[cfg(feature = "libm-math")]
     {
         libm::cbrtf(x)
     }
@@ -168,28 +168,29 @@ pub fn wrap_pi(x: f32) -> f32 {
     }
 }
 
-/// Reduces the phase ω·t, with t = `ticks` / `rate_hz` seconds, to [0, 2π] (up to one rounding
-/// either side; callers wrap before sin/cos) in f64 before it
-/// becomes f32 (docs/design.md §8, "Time"): an f32 `t` would lose a millisecond per tick after a few
-/// hours, and ω·t in f32 loses the phase itself. Fixed work (one floor, no loop).
+/// (sin θ, cos θ) of θ = 2π·`phase`/2³², a phase in 2⁻³² turns ([`crate::phase`]): the
+/// kernels reduce it by integer arithmetic (θ exact modulo 2π); libm and micromath take it as
+/// [`turns_to_radians`].
 #[inline]
-pub fn phase(omega: f32, ticks: u64, rate_hz: u32) -> f32 {
-    phase_f64(omega as f64, ticks, rate_hz)
+pub fn sin_cos_turns(phase: u32) -> (f32, f32) {
+    #[cfg(not(any(feature = "micromath", feature = "libm-math")))]
+    {
+        kernels::sin_cos_turns(phase)
+    }
+    #[cfg(any(feature = "micromath", feature = "libm-math"))]
+    {
+        sin_cos(turns_to_radians(phase))
+    }
 }
 
-/// [`phase`] for a frequency given in f64 (a mission's ω/k, docs/design.md §6: the time scale
-/// divides the frequency once, at configuration time, not the time on every tick).
+/// A phase in 2⁻³² turns as an angle in (−π, π] (rad): the phase read as a signed turn
+/// fraction, one rounding to f32.
 #[inline]
-pub fn phase_f64(omega: f64, ticks: u64, rate_hz: u32) -> f32 {
-    let t = ticks as f64 / rate_hz as f64;
-    let p = omega * t;
-    let r = p - core::f64::consts::TAU * libm::floor(p / core::f64::consts::TAU);
-    r as f32
-}
-
-/// Seconds since mission start as f64 (for terms linear in t, such as the lawn-mower's surge
-/// advance or the helix depth rate, which must not be computed from an f32 time).
-#[inline]
-pub fn seconds(ticks: u64, rate_hz: u32) -> f64 {
-    ticks as f64 / rate_hz as f64
+pub fn turns_to_radians(phase: u32) -> f32 {
+    const RAD_PER_UNIT: f32 = TAU / 4_294_967_296.0;
+    if phase == 1 << 31 {
+        PI
+    } else {
+        (phase as i32) as f32 * RAD_PER_UNIT
+    }
 }

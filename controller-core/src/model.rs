@@ -222,12 +222,7 @@ impl ParamVariation<f64> {
     }
 }
 
-/// Skew-symmetric matrix S(a) with S(a) b = a × b (Fossen's `Smtrx`).
-#[doc(alias = "Smtrx")]
-pub fn skew<T: RealField + Copy>(a: &Vector3<T>) -> Matrix3<T> {
-    let z = T::zero();
-    Matrix3::new(z, -a.z, a.y, a.z, z, -a.x, -a.y, a.x, z)
-}
+pub use crate::kinematics::skew;
 
 /// Rigid-body inertia M_RB = [[m I₃, −m S(r_G)], [m S(r_G), diag(I_x, I_y, I_z)]]
 /// (docs/design.md §2; Eq 1's M_RB).
@@ -274,6 +269,24 @@ pub fn coriolis<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Matrix6
     c.fixed_view_mut::<3, 3>(3, 0).copy_from(&(-sa));
     c.fixed_view_mut::<3, 3>(3, 3).copy_from(&(-sb));
     c
+}
+
+/// C(ν)ν without forming C (the force the law and the plant need): with [a; b] = Mν,
+/// C(ν)ν = [ω × a; v × a + ω × b] ([`coriolis`] times ν; docs/design.md §2).
+pub fn coriolis_force<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Vector6<T> {
+    let ab = m * nu;
+    let a = Vector3::new(ab[0], ab[1], ab[2]);
+    let b = Vector3::new(ab[3], ab[4], ab[5]);
+    let v = Vector3::new(nu[0], nu[1], nu[2]);
+    let w = Vector3::new(nu[3], nu[4], nu[5]);
+    let lin = w.cross(&a);
+    let ang = v.cross(&a) + w.cross(&b);
+    Vector6::new(lin.x, lin.y, lin.z, ang.x, ang.y, ang.z)
+}
+
+/// D(ν)ν without forming D: d_i |ν_i| ν_i per axis ([`damping`] times ν).
+pub fn damping_force<T: RealField + Copy>(p: &VehicleParams<T>, nu: &Vector6<T>) -> Vector6<T> {
+    Vector6::from_fn(|i, _| p.damping[i] * nu[i].abs() * nu[i])
 }
 
 /// Quadratic damping D(ν) = diag(120|u|, 1224|v|, 1224|w|, d_p|p|, 2731|q|, 2731|r|) (Eq 1,

@@ -26,11 +26,17 @@
 //! * All derivatives are analytic (term-by-term derivatives of the truncated series).
 //!
 //! **Time and precision** (docs/design.md §8): time is the integer tick count; no f32 `t` is ever
-//! formed. For each base frequency one phase θ = ω·t is reduced modulo 2π in f64
-//! ([`math::phase`]); harmonics use n·θ (n an integer, so n·θ ≡ nωt mod 2π), wrapped to (−π, π]
-//! before the f32 `sin`/`cos`. Terms linear in t (lawn-mower surge advance, helix depth rate)
-//! use [`math::seconds`] in f64 and are rounded to f32 once, at the end. Positions that grow
-//! with t (lawn-mower x_d, helix z_d) are still f32 in the result, so they lose resolution as
+//! formed, and no f64 arithmetic runs per sample (docs/design.md §16). The tick count is split
+//! once into whole seconds and a fraction ([`MissionTime`]); each base frequency turns it into a
+//! phase in 2⁻³² turns by integer arithmetic ([`Frequency::phase`], exact to 3·2⁻³² turns at
+//! any mission time); harmonics are n·θ as a wrapping integer product, so they are exact too.
+//! One `sin_cos_turns` gives (sin θ, cos θ), the double-angle formulas (sin 2θ, cos 2θ), and the
+//! heading series takes sin nθ, cos nθ for n = 3, 5, 7, 9 from the angle-addition recurrence:
+//! one call per sample (two for the figure-eight's half phase) instead of one per harmonic.
+//! Terms linear in t (lawn-mower surge advance, helix depth rate) use
+//! [`MissionTime::linear`], the rate split into f32 parts at configuration so that rate·t is
+//! rounded once. Positions that
+//! grow with t (lawn-mower x_d, helix z_d) are f32 in the result, so they lose resolution as
 //! they grow (≈ 8 mm at 90 km); see §8 "Position".
 //!
 //! **Heading** ψ_d is returned wrapped to (−π, π]. For the circle and helix ψ_d = ωt grows
@@ -48,6 +54,7 @@ use core::fmt;
 use nalgebra::Vector6;
 
 use crate::math;
+use crate::phase::{Frequency, LinearRate, MissionTime};
 
 /// Desired state at one instant (earth frame, components [x y z φ θ ψ]).
 ///
@@ -420,13 +427,16 @@ pub struct Trajectory {
     mission: Mission,
     /// ω/k (rad/s), for the amplitudes.
     omega: f32,
-    /// ω/k in f64, for the phases (docs/design.md §16).
-    omega_f64: f64,
+    /// ω/k as a turn rate, for θ (docs/design.md §16).
+    theta: Frequency,
+    /// ω/2k, the figure-eight's half phase (zero otherwise).
+    half: Frequency,
     /// The linear rate over k: the lawn-mower's advance 0.25/k (per unit scale, m/s) or the
     /// helix's depth rate ż/k (m/s); zero otherwise.
     rate: f32,
-    /// `rate` in f64, for the positions that grow with t.
-    rate_f64: f64,
+    /// The linear position rate for the positions that grow with t
+    /// ([`MissionTime::linear`]): the lawn-mower's 0.25·s/k (m/s) or the helix's ż/k.
+    position_rate: LinearRate,
     /// `[a_n, a_n nω, a_n n²ω²]` for the odd harmonics (zero for circle/helix).
     psi: [[f32; 3]; ODD_TERMS],
     /// K_d of Assumption 1.
@@ -435,13 +445,36 @@ pub struct Trajectory {
     min_speed: f32,
 }
 
-/// The phases a sample needs: θ = (ω/k)·t and, for the figure-eight, the half phase, both
-/// reduced in f64; t (s) for the terms linear in time.
+/// The phases a sample needs, in 2⁻³² turns: θ = (ω/k)·t and, for the figure-eight, the half
+/// phase; the first two harmonics of θ; the mission time for the terms linear in time.
 #[derive(Clone, Copy)]
 struct Phases {
-    theta: f32,
-    half: f32,
-    t: f64,
+    half: u32,
+    h: Harmonics,
+    time: MissionTime,
+}
+
+/// (sin θ, cos θ) from one exact-phase `sin_cos_turns`, and (sin 2θ, cos 2θ) from them by the
+/// double-angle formulas: what the paths (x_d, y_d) and the heading series share.
+#[derive(Clone, Copy)]
+struct Harmonics {
+    s1: f32,
+    c1: f32,
+    s2: f32,
+    c2: f32,
+}
+
+impl Harmonics {
+    #[inline]
+    fn of(theta: u32) -> Harmonics {
+        let (s1, c1) = math::sin_cos_turns(theta);
+        Harmonics {
+            s1,
+            c1,
+            s2: 2.0 * s1 * c1,
+            c2: (c1 - s1) * (c1 + s1),
+        }
+    }
 }
 
 /// The horizontal path and its first three derivatives, and z_d, ż_d.
@@ -586,6 +619,14 @@ impl Trajectory {
         let omega_f64 = omega as f64 / k;
         let rate_f64 = rate as f64 / k;
         let omega = omega_f64 as f32;
+        let position_rate = match mission.path {
+            TrajectoryKind::LawnMower { scale, .. } => LinearRate::new(rate_f64 * scale as f64),
+            _ => LinearRate::new(rate_f64),
+        };
+        let half = match mission.path {
+            TrajectoryKind::FigureEight { .. } => Frequency::from_rad_per_s(0.5 * omega_f64),
+            _ => Frequency::default(),
+        };
         let psi = match mission.path {
             TrajectoryKind::FigureEight { .. } => series_coefficients(Series::Triangle, omega),
             TrajectoryKind::LawnMower { .. } => series_coefficients(Series::Trapezoid, omega),
@@ -594,9 +635,10 @@ impl Trajectory {
         let mut t = Self {
             mission,
             omega,
-            omega_f64,
+            theta: Frequency::from_rad_per_s(omega_f64),
+            half,
             rate: rate_f64 as f32,
-            rate_f64,
+            position_rate,
             psi,
             accel_bound: 0.0,
             min_speed: 0.0,
@@ -678,17 +720,18 @@ impl Trajectory {
         for j in 0..TANGENT_BOUND_SAMPLES {
             // One period: the figure-eight's y has the half phase (period 4π in θ), the
             // lawn-mower's derivatives have period 2π in θ.
-            let a = core::f32::consts::TAU * j as f32 / TANGENT_BOUND_SAMPLES as f32;
+            let a = j.wrapping_mul(u32::MAX / TANGENT_BOUND_SAMPLES + 1);
+            let time = MissionTime::new(0, 1);
             let ph = match self.mission.path {
                 TrajectoryKind::FigureEight { .. } => Phases {
-                    theta: math::wrap_pi(2.0 * a),
                     half: a,
-                    t: 0.0,
+                    h: Harmonics::of(a.wrapping_mul(2)),
+                    time,
                 },
                 _ => Phases {
-                    theta: a,
-                    half: 0.0,
-                    t: 0.0,
+                    half: 0,
+                    h: Harmonics::of(a),
+                    time,
                 },
             };
             let (_, _, accel) = tangent(&self.planar(&ph));
@@ -762,8 +805,8 @@ impl Trajectory {
 
     /// η_d, η̇_d, η̈_d at t = `ticks` / `rate_hz` seconds since mission start.
     ///
-    /// Phases are reduced in f64 from the tick count (see the module doc), so the result at
-    /// 100 h is as accurate as at 1 s. `rate_hz == 0` has no meaningful time: it returns the
+    /// Phases come from the tick count in integer arithmetic (see the module doc), so the
+    /// result at 100 h is as accurate as at 1 s. `rate_hz == 0` has no meaningful time: it returns the
     /// t = 0 sample. Never panics; every component is finite for every `ticks` and `rate_hz`
     /// (for absurd t the lawn-mower x_d and helix z_d are huge but finite).
     pub fn sample(&self, ticks: u64, rate_hz: u32) -> Desired {
@@ -772,7 +815,13 @@ impl Trajectory {
         } else {
             (ticks, rate_hz)
         };
-        let ph = self.phases(ticks, rate_hz);
+        let time = MissionTime::new(ticks, rate_hz);
+        let theta = self.theta.phase(&time);
+        let ph = Phases {
+            half: self.half.phase(&time),
+            h: Harmonics::of(theta),
+            time,
+        };
         let p = self.planar(&ph);
         let mut eta = Vector6::<f32>::zeros();
         let mut eta_dot = Vector6::<f32>::zeros();
@@ -788,9 +837,9 @@ impl Trajectory {
         let (psi, rate, accel) = match (self.mission.heading, self.mission.path) {
             (HeadingMode::Tangent, _) => tangent(&p),
             (HeadingMode::Paper, TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. }) => {
-                (math::wrap_pi(ph.theta), self.omega, 0.0)
+                (math::turns_to_radians(theta), self.omega, 0.0)
             }
-            (HeadingMode::Paper, _) => self.heading_series(ph.theta),
+            (HeadingMode::Paper, _) => self.heading_series(&ph.h),
         };
         eta[5] = psi;
         eta_dot[5] = rate;
@@ -802,34 +851,19 @@ impl Trajectory {
         }
     }
 
-    /// The phases of tick `ticks` (`rate_hz` ≥ 1): only those the path uses.
-    fn phases(&self, ticks: u64, rate_hz: u32) -> Phases {
-        let theta = math::phase_f64(self.omega_f64, ticks, rate_hz);
-        let (half, t) = match self.mission.path {
-            TrajectoryKind::FigureEight { .. } => {
-                (math::phase_f64(0.5 * self.omega_f64, ticks, rate_hz), 0.0)
-            }
-            TrajectoryKind::LawnMower { .. } | TrajectoryKind::Helix { .. } => {
-                (0.0, math::seconds(ticks, rate_hz))
-            }
-            TrajectoryKind::Circle { .. } => (0.0, 0.0),
-        };
-        Phases { theta, half, t }
-    }
-
     /// The path at the given phases: x_d, y_d and three derivatives each, z_d and ż_d
     /// (analytic; every frequency and rate is already over the time scale).
     fn planar(&self, ph: &Phases) -> Planar {
         let omega = self.omega;
         match self.mission.path {
             TrajectoryKind::Circle { radius, depth, .. } => {
-                let mut p = circle(radius, omega, ph.theta);
+                let mut p = circle(radius, omega, &ph.h);
                 p.z = depth;
                 p
             }
             TrajectoryKind::Helix { radius, depth, .. } => {
-                let mut p = circle(radius, omega, ph.theta);
-                p.z = (depth as f64 + self.rate_f64 * ph.t) as f32;
+                let mut p = circle(radius, omega, &ph.h);
+                p.z = ph.time.linear(&self.position_rate, depth);
                 p.z_dot = self.rate;
                 p
             }
@@ -837,8 +871,8 @@ impl Trajectory {
                 amplitude, depth, ..
             } => {
                 let half = 0.5 * omega;
-                let (s1, c1) = harmonic(1, ph.theta);
-                let (sh, ch) = harmonic(1, ph.half);
+                let (s1, c1) = (ph.h.s1, ph.h.c1);
+                let (sh, ch) = math::sin_cos_turns(ph.half);
                 Planar {
                     x: amplitude * s1,
                     y: amplitude * ch,
@@ -858,13 +892,12 @@ impl Trajectory {
                 }
             }
             TrajectoryKind::LawnMower { scale, depth, .. } => {
-                let (s1, c1) = harmonic(1, ph.theta);
-                let (s2, c2) = harmonic(2, ph.theta);
+                let Harmonics { s1, c1, s2, c2 } = ph.h;
                 let two = 2.0 * omega;
                 let wave = 2.5 * scale * s2;
                 let amp_y = 15.0 * scale;
                 Planar {
-                    x: (self.rate_f64 * scale as f64 * ph.t + wave as f64) as f32,
+                    x: ph.time.linear(&self.position_rate, wave),
                     y: amp_y * c1,
                     z: depth,
                     z_dot: 0.0,
@@ -882,13 +915,23 @@ impl Trajectory {
     }
 
     /// ψ_d, ψ̇_d, ψ̈_d from the precomputed odd-harmonic coefficients (fixed five terms).
-    fn heading_series(&self, theta: f32) -> (f32, f32, f32) {
+    ///
+    /// sin nθ and cos nθ for n = 3, 5, 7, 9 come from the angle-addition recurrence
+    /// sin (n+2)θ = sin nθ cos 2θ + cos nθ sin 2θ, cos (n+2)θ = cos nθ cos 2θ − sin nθ sin 2θ,
+    /// from the sample's [`Harmonics`] (one `sin_cos_turns` for the path and the series
+    /// together, instead of one call per harmonic). Four steps of the recurrence add a few
+    /// ulps (tests/trajectory.rs measures the series against f64).
+    fn heading_series(&self, h: &Harmonics) -> (f32, f32, f32) {
+        let (s2, c2) = (h.s2, h.c2);
+        let (mut s, mut co) = (h.s1, h.c1);
         let (mut psi, mut rate, mut accel) = (0.0f32, 0.0f32, 0.0f32);
-        for (i, c) in self.psi.iter().enumerate() {
-            let (s, co) = harmonic(2 * i as u32 + 1, theta);
+        for c in &self.psi {
             psi += c[0] * s;
             rate += c[1] * co;
             accel -= c[2] * s;
+            let next = (s * c2 + co * s2, co * c2 - s * s2);
+            s = next.0;
+            co = next.1;
         }
         (math::wrap_pi(psi), rate, accel)
     }
@@ -913,8 +956,8 @@ fn tangent(p: &Planar) -> (f32, f32, f32) {
 }
 
 /// Circle part shared by the circle and the helix: x, y and their derivatives (z left 0).
-fn circle(radius: f32, omega: f32, theta: f32) -> Planar {
-    let (s, c) = harmonic(1, theta);
+fn circle(radius: f32, omega: f32, h: &Harmonics) -> Planar {
+    let (s, c) = (h.s1, h.c1);
     Planar {
         x: radius * s,
         y: radius * c,
@@ -929,13 +972,6 @@ fn circle(radius: f32, omega: f32, theta: f32) -> Planar {
             ],
         ],
     }
-}
-
-/// (sin nθ, cos nθ) with n·θ wrapped to (−π, π] first (θ is a reduced phase; n·θ ≡ nωt mod 2π
-/// because n is an integer).
-#[inline]
-fn harmonic(n: u32, theta: f32) -> (f32, f32) {
-    math::sin_cos(math::wrap_pi(n as f32 * theta))
 }
 
 /// √s rounded up: the correctly rounded root (every backend: this is configuration time), one

@@ -1,6 +1,6 @@
 //! Kinematics of Eqs (2)–(3) against identities and finite differences.
 
-use controller_core::kinematics::{self, Attitude, GimbalLock};
+use controller_core::kinematics::{self, Attitude, GimbalLock, Kinematics};
 use nalgebra::{Matrix3, Matrix6, Vector6};
 use proptest::prelude::*;
 
@@ -52,6 +52,22 @@ proptest! {
         // Central difference error O(h²·J⃛) plus rounding O(ε/h): ≈ 1e-9 at θ ≤ 1.4 rad,
         // where sec²θ ≈ 35.
         prop_assert!((fd - jd).amax() < 1e-6 * (1.0 + jd.amax()), "fd {fd} vs {jd}");
+    }
+
+    /// The step's kinematics value applies J, J⁻¹ and T as the matrices do.
+    #[test]
+    fn kinematics_value_applies_the_matrices(
+        (phi, theta, psi) in attitude_strategy(),
+        x in prop::array::uniform6(-2.0f64..2.0),
+    ) {
+        let x = Vector6::from(x);
+        let a = Attitude::from_euler(phi, theta, psi);
+        let k = Kinematics::new(a).unwrap();
+        let j = kinematics::jacobian(&a).unwrap();
+        prop_assert!((k.eta_dot(&x) - j * x).amax() < 1e-9 * (1.0 + (j * x).amax()));
+        let jinv = kinematics::jacobian_inv(&a);
+        prop_assert!((k.jinv_mul(&x) - jinv * x).amax() < 1e-12 * (1.0 + x.amax()));
+        prop_assert!((k.jinv_mul(&k.eta_dot(&x)) - x).amax() < 1e-9 * (1.0 + x.amax()));
     }
 
     /// J⁻¹J̇ν in closed form ([ω × v; T⁻¹Ṫω]) equals the matrix product J⁻¹·(J̇ν).

@@ -70,12 +70,3 @@ fn wrap_pi_lands_in_the_half_open_interval_and_preserves_the_angle() {
     assert_eq!(math::wrap_pi(std::f32::consts::PI), std::f32::consts::PI);
     assert!(math::wrap_pi(f32::NAN).is_nan());
 }
-
-#[test]
-fn phase_reduction_is_exact_to_f64_after_a_year_of_ticks() {
-    // 0.1 rad/s for a year at 100 Hz: ω·t ≈ 3.2e6 rad. f32 t would be off by seconds.
-    let ticks = 365 * 24 * 3600 * 100u64;
-    let p = math::phase(0.1, ticks, 100) as f64;
-    let exact = (0.1f32 as f64 * ticks as f64 / 100.0).rem_euclid(std::f64::consts::TAU);
-    assert!((p - exact).abs() < 1e-6, "{p} vs {exact}");
-}

@@ -136,6 +136,19 @@ proptest! {
         prop_assert!((cnu.fixed_rows::<3>(3) - bottom).amax() < 1e-9);
     }
 
+    /// The vector forms C(ν)ν and D(ν)ν (what the law and the plant use) equal the matrices
+    /// times ν.
+    #[test]
+    fn force_vectors_equal_the_matrices_times_nu(nu in nu_strategy(), s in 0.0f64..1.0) {
+        let p = VehicleParams::auv150().with_variation(&ParamVariation::TABLE3_MAX.scaled(s));
+        for m in [model::mass_matrix(&p), model::rigid_body_mass(&p), model::added_mass(&p)] {
+            let want = model::coriolis(&m, &nu) * nu;
+            prop_assert!((model::coriolis_force(&m, &nu) - want).amax() < 1e-9 * (1.0 + want.amax()));
+        }
+        let want = model::damping(&p, &nu) * nu;
+        prop_assert!((model::damping_force(&p, &nu) - want).amax() < 1e-9 * (1.0 + want.amax()));
+    }
+
     /// Damping dissipates: νᵀD(ν)ν ≥ 0.
     #[test]
     fn damping_dissipates(nu in nu_strategy()) {

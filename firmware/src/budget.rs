@@ -34,23 +34,25 @@ impl StepBudget {
 /// Every backend's budgets: the measured maxima are the `stage …: max=` and `update
 /// instructions: max=` lines of `firmware/snapshots/selftest-<backend>.log`.
 pub const BUDGETS: [StepBudget; 3] = [
-    StepBudget {
-        backend: "libm",
-        update: 40_000,
-        // kinematics, trajectory, law, allocation, voltage maps
-        stages: [8_800, 22_000, 1_200, 1_000, 8_000],
-    },
-    // Allocation 100 → 1 000 and the totals with it: issue 9's saturation-aware allocator
-    // (block solves and envelope clamps, ≈ 890 instructions) replaced the bare B₅⁻¹τ.
-    StepBudget {
-        backend: "micromath",
-        update: 13_000,
-        stages: [700, 2_200, 900, 1_000, 8_000],
-    },
+    // The boards' backend. `update` ≤ 4 000 is the target of issue 11 (the step near its
+    // physical limit), not measured-plus-headroom: a change that crosses it is a decision.
     StepBudget {
         backend: "kernels",
-        update: 6_400,
-        stages: [560, 2_500, 850, 1_000, 1_250],
+        update: 4_000,
+        // kinematics, trajectory, law, allocation, voltage maps
+        stages: [560, 520, 760, 1_000, 1_250],
+    },
+    // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
+    StepBudget {
+        backend: "libm",
+        update: 25_000,
+        stages: [8_400, 6_200, 1_000, 1_000, 8_000],
+    },
+    // micromath takes the kernels' cbrt (it has none), so its maps cost the kernels'.
+    StepBudget {
+        backend: "micromath",
+        update: 4_200,
+        stages: [500, 460, 780, 1_000, 1_250],
     },
 ];
 

@@ -25,15 +25,18 @@ pub const RAM_BUDGET: u64 = 32 * 1024;
 /// The controller-core math backend an image is built with.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
 pub enum Backend {
-    /// libm (the boards' default).
+    /// The core's own f32 kernels (the boards' default).
+    Kernels,
+    /// libm's f32 functions (`--features libm-math`).
     Libm,
     /// micromath's fast approximations (`--features micromath`).
     Micromath,
-    /// The core's own f32 kernels (`--features kernels`).
-    Kernels,
 }
 
 impl Backend {
+    /// The boards' backend: the core's math without a feature.
+    pub const DEFAULT: Backend = Backend::Kernels;
+
     /// The name `controller_core::math::BACKEND` gives it.
     pub fn name(self) -> &'static str {
         match self {
@@ -46,9 +49,9 @@ impl Backend {
     /// The firmware feature that selects it (none for the default).
     fn feature(self) -> Option<&'static str> {
         match self {
-            Backend::Libm => None,
+            Backend::Kernels => None,
+            Backend::Libm => Some("libm-math"),
             Backend::Micromath => Some("micromath"),
-            Backend::Kernels => Some("kernels"),
         }
     }
 }
@@ -61,32 +64,32 @@ pub struct Variant {
 }
 
 impl Variant {
-    pub const QEMU: Variant = Variant::libm(Image::Qemu);
+    pub const QEMU: Variant = Variant::default_backend(Image::Qemu);
     pub const SELFTEST: [Variant; 3] = [
-        Variant::libm(Image::QemuSelftest),
+        Variant::default_backend(Image::QemuSelftest),
+        Variant {
+            image: Image::QemuSelftest,
+            backend: Backend::Libm,
+        },
         Variant {
             image: Image::QemuSelftest,
             backend: Backend::Micromath,
         },
-        Variant {
-            image: Image::QemuSelftest,
-            backend: Backend::Kernels,
-        },
     ];
-    /// Every image with the board default (libm), and the self-test with the other backends
-    /// too.
+    /// Every image with the board default (the kernels), and the self-test with the other
+    /// backends too.
     pub const ALL: [Variant; 5] = [
-        Variant::libm(Image::Qemu),
+        Variant::default_backend(Image::Qemu),
         Variant::SELFTEST[0],
         Variant::SELFTEST[1],
         Variant::SELFTEST[2],
-        Variant::libm(Image::Stm32f405),
+        Variant::default_backend(Image::Stm32f405),
     ];
 
-    const fn libm(image: Image) -> Variant {
+    const fn default_backend(image: Image) -> Variant {
         Variant {
             image,
-            backend: Backend::Libm,
+            backend: Backend::DEFAULT,
         }
     }
 
@@ -110,9 +113,10 @@ impl Built {
 }
 
 /// Builds `variants`: one `cargo build` per board feature and backend, with a `--bin` for each
-/// image. The libm images stay where cargo puts them (`target/thumbv7em-none-eabihf/release/`,
-/// what `cargo fw` and `host-sim pil` use); the other backends' self-tests are built first and
-/// copied to `target/xtask/` so that the libm build after them leaves the default ELFs in place.
+/// image. The default backend's images stay where cargo puts them
+/// (`target/thumbv7em-none-eabihf/release/`, what `cargo fw` and `host-sim pil` use); the other
+/// backends' self-tests are built first and copied to `target/xtask/` so that the default build
+/// after them leaves the default ELFs in place.
 pub fn build(ci: &mut Ci, variants: &[Variant]) -> Built {
     ci.step("building the images");
     let mut groups: BTreeMap<(Backend, &str), Vec<Image>> = BTreeMap::new();
@@ -123,7 +127,7 @@ pub fn build(ci: &mut Ci, variants: &[Variant]) -> Built {
             .push(v.image);
     }
     let mut elfs = Vec::new();
-    // The other backends first (see above): reverse order of the backends, libm last.
+    // The other backends first (see above): reverse order of the backends, the default last.
     for ((backend, board), images) in groups.into_iter().rev() {
         let mut features = board.to_string();
         if let Some(f) = backend.feature() {
@@ -161,7 +165,7 @@ pub fn build(ci: &mut Ci, variants: &[Variant]) -> Built {
         for image in images {
             let elf = ci.target_dir.join(TARGET).join("release").join(image.bin());
             let variant = Variant { image, backend };
-            if backend == Backend::Libm {
+            if backend == Backend::DEFAULT {
                 elfs.push((variant, elf));
                 continue;
             }

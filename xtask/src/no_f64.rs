@@ -7,8 +7,7 @@
 //!
 //! For each routine found, the report names the chain of calls from `update` and, from the
 //! ELF's DWARF, the functions inlined at the call site (with LTO most of the core is inlined
-//! into `update`), e.g. `__aeabi_ul2d ← controller_core::math::phase ← …::Trajectory::sample ←
-//! …::Controller::update`.
+//! into `update`), e.g. `__aeabi_dmul ← libm::math::rem_pio2f ← libm::math::sinf ← …::Controller::update`.
 
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -19,10 +18,10 @@ use crate::callgraph::{CallGraph, InlineFrames};
 use crate::ci::Ci;
 use crate::images::{Built, Variant};
 
-/// Whether a soft-float f64 routine reachable from `update` fails the firmware CI. False until
-/// issue 11 part B takes the f64 out of the per-tick path (the trajectory's phase reduction,
-/// libm's sinf/cosf/cbrtf): then set it to true, and it stays true.
-pub const FATAL: bool = false;
+/// Whether a soft-float f64 routine reachable from `update` fails the firmware CI: it does. The
+/// trajectory's phases are integer arithmetic and the default math backend is the core's f32
+/// kernels, so the flying images have none (docs/design.md §16).
+pub const FATAL: bool = true;
 
 /// The demangled name of the control step, the root of the check.
 pub const ROOT: &str = "controller_core::controller::Controller::update";

@@ -58,7 +58,7 @@ pub fn run(ci: &mut Ci, built: &Built) {
         check_stage_budgets(ci, backend, &run.log);
         check_signing_budget(ci, backend, &run.log);
         compare_log(ci, backend, &run.log);
-        if v.backend == Backend::Libm {
+        if v.backend == Backend::DEFAULT {
             inject_failures(ci, elf);
         }
     }

@@ -129,7 +129,9 @@ pub fn stages(
     let mut update = Stat::default();
     let mut per_case = [[0u32; STAGES + 1]; Table1Case::ALL.len()];
     for g in golden {
-        let tr = Trajectory::table1(Table1Case::ALL[g.case]);
+        let Some(tr) = g.trajectory() else {
+            continue;
+        };
         let c = if g.robust { with } else { without };
         let Some((counts, total)) = step_counts(counter, c, &tr, g) else {
             continue;

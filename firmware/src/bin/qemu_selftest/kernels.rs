@@ -1,12 +1,13 @@
 //! The math kernels on the target: the same bits as on the host (vectors from `build.rs`), and
 //! each kernel's instructions per call beside libm's f32 functions (which evaluate sin, cos and
-//! cbrt in soft-float f64 here, and sqrt in software), the backend's `sin_cos`, and the f64
-//! phase reduction of today's trajectories.
+//! cbrt in soft-float f64 here, and sqrt in software), the backend's `sin_cos`, and the
+//! trajectory's integer phase.
 
 use core::f32::consts::{FRAC_PI_4, PI};
 use core::hint::black_box;
 
 use controller_core::math::{self, kernels};
+use controller_core::phase::{Frequency, MissionTime};
 use defmt::{error, info};
 
 use crate::cost::Counter;
@@ -148,10 +149,12 @@ pub fn run(counter: &Counter) -> bool {
         kernels::sqrt,
     );
     report(counter, "sqrtf (libm)", "[0.01, 1e4]", &s, libm::sqrtf);
-    // Today's trajectory phase: ω·t reduced modulo 2π in f64, then rounded to f32.
+    // The trajectory's phase: mission time split by integer division, then ω·t modulo one
+    // turn in fixed point (controller_core::phase).
     let ticks: [u64; 4] = [1_234, 86_400 * 100, 1 << 33, 6_999];
-    report(counter, "phase (math, f64)", "4 tick counts", &ticks, |k| {
-        math::phase(0.1, k, 100)
+    let frequency = Frequency::from_rad_per_s(0.1);
+    report(counter, "phase (integer)", "4 tick counts", &ticks, |k| {
+        frequency.phase(&MissionTime::new(k, 100))
     });
     report(
         counter,

@@ -7,7 +7,9 @@ use auv_link::{encode, encode_signed, Command, ConfigPatch, Envelope, FrameDecod
 use auv_link::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
 use auv_link::{BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, MAX_FRAME};
 use controller_core::kinematics::{self, Attitude};
-use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
+use controller_core::{
+    Controller, ControllerConfig, HeadingMode, Mission, Status, Table1Case, Trajectory,
+};
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use defmt::{error, info};
@@ -26,6 +28,8 @@ pub struct Golden {
     pub case: usize,
     pub ticks: u64,
     pub robust: bool,
+    /// The mission flies the tangent heading (the Table-1 case's path, ψ_d its course).
+    pub tangent: bool,
     pub eta: [f32; 6],
     pub nu: [f32; 6],
     pub voltage: [f32; 5],
@@ -33,6 +37,23 @@ pub struct Golden {
     pub delta: f32,
     pub w_norm: f32,
     pub status: u8,
+}
+
+impl Golden {
+    /// The mission this vector samples: its Table-1 case, with the tangent heading when
+    /// `tangent` (as build.rs made it); `None` if the target refuses it.
+    pub fn trajectory(&self) -> Option<Trajectory> {
+        let case = *Table1Case::ALL.get(self.case)?;
+        if self.tangent {
+            Trajectory::new(Mission {
+                heading: HeadingMode::Tangent,
+                ..Mission::paper(case.kind())
+            })
+            .ok()
+        } else {
+            Some(Trajectory::table1(case))
+        }
+    }
 }
 
 /// Target and host agree when the difference is within a few f32 roundings of the larger
@@ -82,7 +103,11 @@ fn golden_vectors() -> (bool, u32, u32) {
     let mut worst_ulps = 0u32;
     let (mut max_ticks, mut sum_ticks, mut timed) = (0u32, 0u64, 0u32);
     for (i, g) in GOLDEN.iter().enumerate() {
-        let tr = Trajectory::table1(Table1Case::ALL[g.case]);
+        let Some(tr) = g.trajectory() else {
+            ok = false;
+            error!("golden vector {}: the target refuses its mission", i);
+            continue;
+        };
         let c = if g.robust { &with } else { &without };
         let t0 = SYST::get_current();
         let o = c.update(g.ticks, &g.eta, &g.nu, &tr);
