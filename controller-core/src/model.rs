@@ -93,8 +93,14 @@ impl<T: RealField + Copy> VehicleParams<T> {
 
     /// Converts the parameter set to another scalar type (e.g. the f64 defaults to the
     /// controller's f32).
+    ///
+    /// The buoyancy is carried as the net weight W − B, not as B: W = m g is formed in `U`,
+    /// and B = W − (W − B), so a neutrally buoyant vehicle stays exactly neutral. Casting B
+    /// itself would leave the rounding difference of m·g in f32 and of B (one ulp of ≈ 4 800 N,
+    /// 0.5 mN) as a spurious heave force in every step, the largest f32 error in τ
+    /// (tests/precision.rs).
     pub fn cast<U: RealField + Copy>(&self, f: impl Fn(T) -> U) -> VehicleParams<U> {
-        VehicleParams {
+        let mut out = VehicleParams {
             mass: f(self.mass),
             r_g: self.r_g.map(&f),
             inertia: self.inertia.map(&f),
@@ -105,7 +111,9 @@ impl<T: RealField + Copy> VehicleParams<T> {
             z_b_roll: f(self.z_b_roll),
             z_b_pitch: f(self.z_b_pitch),
             gravity: f(self.gravity),
-        }
+        };
+        out.buoyancy = out.weight() - f(self.weight() - self.buoyancy);
+        out
     }
 
     /// Weight W = m g (N).
