@@ -66,14 +66,22 @@ impl Default for PlantTerms {
     }
 }
 
-/// The plant at one set of parameters, for one integration step: M and its factorisation are
-/// formed once per step.
+/// The plant at one set of parameters: M = M_RB + M_A and its Cholesky factor are formed when
+/// the parameters are set ([`Plant::new`], [`Plant::set_params`]) and reused by every
+/// derivative until they change.
+///
+/// **Choice** (docs/design.md §2): a simulation keeps one `Plant` and hands it the parameters of
+/// every step; M is refactorised only when they differ from the last ones (`==` on every
+/// field), so a constant or staircase profile factorises once per value, not once per step.
+#[derive(Clone, Debug)]
 pub struct Plant {
     params: VehicleParams<f64>,
     m_rb: Matrix6<f64>,
-    m_a: Matrix6<f64>,
+    /// The diagonal of M_A (Eq 1's added mass is diagonal, `model::added_mass`).
+    m_a: Vector6<f64>,
     m_chol: nalgebra::Cholesky<f64, nalgebra::U6>,
     terms: PlantTerms,
+    factorisations: u64,
 }
 
 /// The plant cannot go on.
@@ -102,20 +110,73 @@ impl std::fmt::Display for PlantError {
     }
 }
 
+/// M_RB, the diagonal of M_A, and the Cholesky factor of M = M_RB + M_A for `params`.
+type MassParts = (
+    Matrix6<f64>,
+    Vector6<f64>,
+    nalgebra::Cholesky<f64, nalgebra::U6>,
+);
+
+fn mass_parts(params: &VehicleParams<f64>) -> Result<MassParts, PlantError> {
+    let m_rb = model::rigid_body_mass(params);
+    let m_a = model::added_mass(params);
+    let m_chol = (m_rb + m_a)
+        .cholesky()
+        .ok_or(PlantError::MassNotPositiveDefinite)?;
+    Ok((m_rb, m_a.diagonal(), m_chol))
+}
+
+/// C(ν) ν of `controller_core::model::coriolis` (Kirchhoff form) without forming the matrix:
+/// with [a₁; a₂] = M ν (`m_nu`) and ν = [v; ω], C(ν) ν = [ω × a₁; v × a₁ + ω × a₂].
+fn coriolis_force(m_nu: &Vector6<f64>, nu: &Vector6<f64>) -> Vector6<f64> {
+    let a1 = Vector3::new(m_nu[0], m_nu[1], m_nu[2]);
+    let a2 = Vector3::new(m_nu[3], m_nu[4], m_nu[5]);
+    let v = Vector3::new(nu[0], nu[1], nu[2]);
+    let omega = Vector3::new(nu[3], nu[4], nu[5]);
+    let f = omega.cross(&a1);
+    let m = v.cross(&a1) + omega.cross(&a2);
+    Vector6::new(f.x, f.y, f.z, m.x, m.y, m.z)
+}
+
+/// D(ν) ν of `controller_core::model::damping` without forming the matrix: dᵢ |νᵢ| νᵢ.
+fn damping_force(p: &VehicleParams<f64>, nu: &Vector6<f64>) -> Vector6<f64> {
+    Vector6::from_fn(|i, _| p.damping[i] * nu[i].abs() * nu[i])
+}
+
 impl Plant {
     pub fn new(params: VehicleParams<f64>, terms: PlantTerms) -> Result<Self, PlantError> {
-        let m_rb = model::rigid_body_mass(&params);
-        let m_a = model::added_mass(&params);
-        let m_chol = (m_rb + m_a)
-            .cholesky()
-            .ok_or(PlantError::MassNotPositiveDefinite)?;
+        let (m_rb, m_a, m_chol) = mass_parts(&params)?;
         Ok(Plant {
             params,
             m_rb,
             m_a,
             m_chol,
             terms,
+            factorisations: 1,
         })
+    }
+
+    /// Sets the parameters for the next steps. M is formed and factorised again only if
+    /// `params` differ from the current ones; on an error the plant keeps its old parameters.
+    pub fn set_params(&mut self, params: VehicleParams<f64>) -> Result<(), PlantError> {
+        if params == self.params {
+            return Ok(());
+        }
+        let (m_rb, m_a, m_chol) = mass_parts(&params)?;
+        *self = Plant {
+            params,
+            m_rb,
+            m_a,
+            m_chol,
+            terms: self.terms,
+            factorisations: self.factorisations + 1,
+        };
+        Ok(())
+    }
+
+    /// How many times M has been formed and factorised since [`Plant::new`] (1 after it).
+    pub fn factorisations(&self) -> u64 {
+        self.factorisations
     }
 
     pub fn params(&self) -> &VehicleParams<f64> {
@@ -124,10 +185,15 @@ impl Plant {
 
     /// M = M_RB + M_A.
     pub fn mass_matrix(&self) -> Matrix6<f64> {
-        self.m_rb + self.m_a
+        self.m_rb + Matrix6::from_diagonal(&self.m_a)
     }
 
-    /// (η̇, ν̇) of Eqs (1)–(2) under body force `tau` and earth-fixed current `current`.
+    /// (η̇, ν̇) of Eqs (1)–(2) under body force `tau` and earth-fixed current `current`:
+    ///
+    /// ν̇ = M⁻¹ (τ − C_RB(ν) ν − C_A(ν_r) ν_r + M_A ν̇_c − D(ν_r) ν_r − g(η)).
+    ///
+    /// R is built once and serves η̇ = J ν and ν_c = [Rᵀ v_c; 0]; C ν and D ν are formed as
+    /// vectors ([`coriolis_force`], [`damping_force`]) and M⁻¹ is the cached factor's solve.
     pub fn derivative(
         &self,
         s: &PlantState,
@@ -135,19 +201,30 @@ impl Plant {
         current: &Vector3<f64>,
     ) -> Result<(Vector6<f64>, Vector6<f64>), PlantError> {
         let att = Attitude::from_eta(&s.eta);
-        let eta_dot = kinematics::eta_dot(&att, &s.nu)?;
+        let r = kinematics::rotation(&att);
+        let v = Vector3::new(s.nu[0], s.nu[1], s.nu[2]);
         let omega = Vector3::new(s.nu[3], s.nu[4], s.nu[5]);
-        let vc_body = kinematics::rotation(&att).transpose() * current;
+        let p_dot = r * v;
+        let theta_dot = kinematics::euler_rate_matrix(&att)? * omega;
+        let eta_dot = Vector6::new(
+            p_dot.x,
+            p_dot.y,
+            p_dot.z,
+            theta_dot.x,
+            theta_dot.y,
+            theta_dot.z,
+        );
+        let vc_body = r.transpose() * current;
         let nu_c = Vector6::new(vc_body.x, vc_body.y, vc_body.z, 0.0, 0.0, 0.0);
         let dvc = -omega.cross(&vc_body);
         let nu_c_dot = Vector6::new(dvc.x, dvc.y, dvc.z, 0.0, 0.0, 0.0);
         let nu_r = s.nu - nu_c;
         let mut rhs = tau
-            - model::coriolis(&self.m_rb, &s.nu) * s.nu
-            - model::coriolis(&self.m_a, &nu_r) * nu_r
-            + self.m_a * nu_c_dot;
+            - coriolis_force(&(self.m_rb * s.nu), &s.nu)
+            - coriolis_force(&self.m_a.component_mul(&nu_r), &nu_r)
+            + self.m_a.component_mul(&nu_c_dot);
         if self.terms.damping {
-            rhs -= model::damping(&self.params, &nu_r) * nu_r;
+            rhs -= damping_force(&self.params, &nu_r);
         }
         if self.terms.restoring {
             rhs -= model::restoring(&self.params, &att);
@@ -175,12 +252,12 @@ impl Plant {
         let dvc = -omega.cross(&vc_body);
         let nu_c_dot = Vector6::new(dvc.x, dvc.y, dvc.z, 0.0, 0.0, 0.0);
         let nu_r = s.nu - nu_c;
-        let mut tau = (self.m_rb + self.m_a) * nu_dot
-            + model::coriolis(&self.m_rb, &s.nu) * s.nu
-            + model::coriolis(&self.m_a, &nu_r) * nu_r
-            - self.m_a * nu_c_dot;
+        let mut tau = self.mass_matrix() * nu_dot
+            + coriolis_force(&(self.m_rb * s.nu), &s.nu)
+            + coriolis_force(&self.m_a.component_mul(&nu_r), &nu_r)
+            - self.m_a.component_mul(&nu_c_dot);
         if self.terms.damping {
-            tau += model::damping(&self.params, &nu_r) * nu_r;
+            tau += damping_force(&self.params, &nu_r);
         }
         if self.terms.restoring {
             tau += model::restoring(&self.params, &att);

@@ -213,6 +213,27 @@ pub fn run_observed(
     source: &mut dyn ControlSource,
     observer: &mut dyn Observer,
 ) -> RunResult {
+    run_recorded(scenario, source, observer, Recording::Plot)
+}
+
+/// What a run keeps of its samples besides the metrics and the fault counts (which are
+/// accumulated from every sample either way, as is what the observer sees).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Recording {
+    /// The plot series ([`crate::decimate`]) in [`RunResult::samples`].
+    Plot,
+    /// No samples: [`RunResult::samples`] is empty. For runs nobody plots (Monte Carlo): the
+    /// [`RunResult::summary`] is the same as with [`Recording::Plot`].
+    MetricsOnly,
+}
+
+/// [`run_observed`], keeping what `recording` says.
+pub fn run_recorded(
+    scenario: &Scenario,
+    source: &mut dyn ControlSource,
+    observer: &mut dyn Observer,
+    recording: Recording,
+) -> RunResult {
     let cfg = scenario.config();
     let controller = scenario.controller();
     let trajectory = scenario.trajectory();
@@ -233,15 +254,19 @@ pub fn run_observed(
     let mut noise_rng = rand::rngs::StdRng::seed_from_u64(cfg.noise.as_ref().map_or(0, |n| n.seed));
     let lag_alpha = cfg.thruster_lag.map(|tl| 1.0 - (-h / tl).exp());
     let mut thrust_applied: Option<[f64; THRUSTERS]> = None;
+    // One plant for the run: M is refactorised only when the parameters change.
+    let mut plant: Option<Plant> = None;
 
-    let mut plot = Decimator::new(steps + 1);
+    let mut plot = (recording == Recording::Plot).then(|| Decimator::new(steps + 1));
     let mut metrics = metrics::Accumulator::default();
     let mut faults = FaultCounts::default();
     let mut record = |s: Sample| {
         metrics.push(&s);
         faults.record(&s);
         observer.sample(&s);
-        plot.push(&s);
+        if let Some(plot) = &mut plot {
+            plot.push(&s);
+        }
     };
     let mut outcome = Outcome::Completed;
 
@@ -356,8 +381,11 @@ pub fn run_observed(
             if cfg.trimmed {
                 params = crate::plant::trimmed(&params);
             }
-            let stepped = Plant::new(params, PlantTerms::default())
-                .and_then(|plant| plant.rk4_step(&state, &tau, &current.v, h));
+            let stepped = match &mut plant {
+                Some(p) => p.set_params(params).map(|()| &*p),
+                None => Plant::new(params, PlantTerms::default()).map(|p| &*plant.insert(p)),
+            }
+            .and_then(|p| p.rk4_step(&state, &tau, &current.v, h));
             match stepped {
                 Ok(s) => state = s,
                 Err(e) => {
@@ -387,6 +415,7 @@ pub fn run_observed(
         outcome,
         faults,
         faults_expected: cfg.expect_faults,
-        samples: plot.finish(),
+        samples: plot.map_or_else(Vec::new, Decimator::finish),
+        plant_factorisations: plant.map_or(0, |p| p.factorisations()),
     }
 }
