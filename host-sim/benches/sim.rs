@@ -24,6 +24,13 @@ fn bench(c: &mut Criterion) {
             plant.rk4_step(black_box(&s), black_box(&tau), black_box(&current), 0.001)
         })
     });
+    let plant = Plant::new(params, PlantTerms::default()).unwrap();
+    c.bench_function("plant RK4 step (M cached)", |b| {
+        b.iter(|| plant.rk4_step(black_box(&s), black_box(&tau), black_box(&current), 0.001))
+    });
+    c.bench_function("plant derivative", |b| {
+        b.iter(|| plant.derivative(black_box(&s), black_box(&tau), black_box(&current)))
+    });
     let scenario = paper::scenario(Table1Case::LawnMower30x15, true).expect("the paper's case");
     let mut group = c.benchmark_group("mission");
     group.sample_size(20);

@@ -23,7 +23,7 @@ use nalgebra::{Vector3, Vector6};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::config::CurrentModel;
+use crate::config::{CurrentModel, VariationProfile};
 use crate::decimate::Decimator;
 use crate::interrupt;
 use crate::metrics;
@@ -254,8 +254,20 @@ pub fn run_recorded(
     let mut noise_rng = rand::rngs::StdRng::seed_from_u64(cfg.noise.as_ref().map_or(0, |n| n.seed));
     let lag_alpha = cfg.thruster_lag.map(|tl| 1.0 - (-h / tl).exp());
     let mut thrust_applied: Option<[f64; THRUSTERS]> = None;
-    // One plant for the run: M is refactorised only when the parameters change.
+    // One plant for the run: M is refactorised only when the parameters change, and a
+    // profile that does not vary in time is not evaluated again.
     let mut plant: Option<Plant> = None;
+    let params_at = |ts: f64| {
+        let params = nominal.with_variation(&cfg.variation.at(ts));
+        match cfg.trimmed {
+            true => crate::plant::trimmed(&params),
+            false => params,
+        }
+    };
+    let params_fixed = matches!(
+        cfg.variation,
+        VariationProfile::None | VariationProfile::Constant(_)
+    );
 
     let mut plot = (recording == Recording::Plot).then(|| Decimator::new(steps + 1));
     let mut metrics = metrics::Accumulator::default();
@@ -362,28 +374,30 @@ pub fn run_recorded(
         }
 
         // 3.–4. Lag, wrench, integrate.
+        let wrench = |thrust: &[f64; THRUSTERS]| {
+            alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(*thrust)
+        };
         let mut applied = thrust_applied.unwrap_or(target);
         let mut first_applied = None;
+        // Without lag the thrust, so the wrench, is the target's all period.
+        let mut tau = wrench(&target);
         for j in 0..substeps {
             if let Some(alpha) = lag_alpha {
                 for i in 0..THRUSTERS {
                     applied[i] += alpha * (target[i] - applied[i]);
                 }
+                tau = wrench(&applied);
             } else {
                 applied = target;
             }
             if first_applied.is_none() {
                 first_applied = Some(applied);
             }
-            let tau = alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(applied);
             let ts = t + j as f64 * h;
-            let mut params = nominal.with_variation(&cfg.variation.at(ts));
-            if cfg.trimmed {
-                params = crate::plant::trimmed(&params);
-            }
             let stepped = match &mut plant {
-                Some(p) => p.set_params(params).map(|()| &*p),
-                None => Plant::new(params, PlantTerms::default()).map(|p| &*plant.insert(p)),
+                Some(p) if params_fixed => Ok(&*p),
+                Some(p) => p.set_params(params_at(ts)).map(|()| &*p),
+                None => Plant::new(params_at(ts), PlantTerms::default()).map(|p| &*plant.insert(p)),
             }
             .and_then(|p| p.rk4_step(&state, &tau, &current.v, h));
             match stepped {
