@@ -70,7 +70,7 @@ impl Default for PlantTerms {
 /// the parameters are set ([`Plant::new`], [`Plant::set_params`]) and reused by every
 /// derivative until they change.
 ///
-/// **Choice** (docs/design.md §2): a simulation keeps one `Plant` and hands it the parameters of
+/// **Choice 80** (docs/design.md §2): a simulation keeps one `Plant` and hands it the parameters of
 /// every step; M is refactorised only when they differ from the last ones (`==` on every
 /// field), so a constant or staircase profile factorises once per value, not once per step.
 #[derive(Clone, Debug)]
@@ -162,7 +162,7 @@ fn sin_cos_small(d: f64) -> (f64, f64) {
 /// δ = the difference of the angles ([`sin_cos_small`]); an angle that moved more than
 /// [`NEAR_ANGLE`] is evaluated afresh.
 ///
-/// **Choice** (docs/design.md §2): an RK4 stage moves the angles by at most h/2·|rate| or
+/// **Choice 81** (docs/design.md §2): an RK4 stage moves the angles by at most h/2·|rate| or
 /// h·|rate| (below 10⁻³ rad for 1 rad/s at the 1 ms step), so the stages' sines and cosines
 /// follow from the step's by two products and a sum each, within a few ulps of libm's (the
 /// plant tests bound the difference), for three libm `sin_cos` calls per stage.

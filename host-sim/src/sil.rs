@@ -9,7 +9,9 @@
 //!    configured for), to thrust; a controller fault means every thruster off (0 N);
 //! 3. optional first-order thruster lag, then τ_applied = B·thrust;
 //! 4. RK4 substeps with τ held, the plant's parameters (trimmed if the scenario says so,
-//!    [`crate::plant::trimmed`]) and the current evaluated per substep.
+//!    [`crate::plant::trimmed`]) and the current evaluated per substep; one plant for the
+//!    run, whose M is formed again only when the parameters change (Choice 80,
+//!    [`Plant::set_params`]).
 //!
 //! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
 //! run with a reason; every sample recorded until then is kept.
@@ -222,8 +224,9 @@ pub fn run_observed(
 pub enum Recording {
     /// The plot series ([`crate::decimate`]) in [`RunResult::samples`].
     Plot,
-    /// No samples: [`RunResult::samples`] is empty. For runs nobody plots (Monte Carlo): the
-    /// [`RunResult::summary`] is the same as with [`Recording::Plot`].
+    /// No samples: [`RunResult::samples`] is empty. For runs nobody plots: **Choice 82**
+    /// (docs/design.md §2), Monte Carlo records this way. The [`RunResult::summary`] is the
+    /// same as with [`Recording::Plot`].
     MetricsOnly,
 }
 
