@@ -282,7 +282,12 @@ pub fn coriolis<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Matrix6
 /// C(ν)ν without forming C (the force the law and the plant need): with [a; b] = Mν,
 /// C(ν)ν = [ω × a; v × a + ω × b] ([`coriolis`] times ν; docs/design.md §2).
 pub fn coriolis_force<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Vector6<T> {
-    let ab = m * nu;
+    coriolis_force_of(&(m * nu), nu)
+}
+
+/// [`coriolis_force`] from a precomputed Mν (`ab`), for callers that form Mν their own way
+/// (the plant's diagonal M_A).
+pub fn coriolis_force_of<T: RealField + Copy>(ab: &Vector6<T>, nu: &Vector6<T>) -> Vector6<T> {
     let a = Vector3::new(ab[0], ab[1], ab[2]);
     let b = Vector3::new(ab[3], ab[4], ab[5]);
     let v = Vector3::new(nu[0], nu[1], nu[2]);

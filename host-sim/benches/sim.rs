@@ -24,6 +24,23 @@ fn bench(c: &mut Criterion) {
             plant.rk4_step(black_box(&s), black_box(&tau), black_box(&current), 0.001)
         })
     });
+    let plant = Plant::new(params, PlantTerms::default()).unwrap();
+    c.bench_function("plant RK4 step (M cached)", |b| {
+        b.iter(|| plant.rk4_step(black_box(&s), black_box(&tau), black_box(&current), 0.001))
+    });
+    c.bench_function("plant derivative", |b| {
+        b.iter(|| plant.derivative(black_box(&s), black_box(&tau), black_box(&current)))
+    });
+    // Choice 80: ν̇ from the cached M⁻¹ against the solve with M's Cholesky factor.
+    let m = controller_core::model::mass_matrix(&params);
+    let chol = m.cholesky().unwrap();
+    let m_inv = chol.inverse();
+    c.bench_function("nu_dot: Cholesky solve", |b| {
+        b.iter(|| chol.solve(black_box(&tau)))
+    });
+    c.bench_function("nu_dot: M⁻¹ product", |b| {
+        b.iter(|| m_inv * black_box(tau))
+    });
     let scenario = paper::scenario(Table1Case::LawnMower30x15, true).expect("the paper's case");
     let mut group = c.benchmark_group("mission");
     group.sample_size(20);

@@ -26,7 +26,7 @@ use crate::interrupt;
 use crate::progress::duration_text;
 use crate::record::Metrics;
 use crate::scenario::{Scenario, ScenarioError};
-use crate::sil::{self, LocalController, Observer};
+use crate::sil::{self, LocalController, Observer, Recording};
 
 /// Most runs of one Monte Carlo without the explicit override (`--allow-long-run`).
 pub const MAX_RUNS: usize = 10_000;
@@ -125,7 +125,13 @@ fn percentile(sorted: &[f64], p: f64) -> f64 {
 pub fn estimate(base: &Scenario, opts: &MonteCarloOptions) -> Result<String, ScenarioError> {
     let short = base.with(|c| c.duration = c.duration.min(CALIBRATION_SECONDS))?;
     let t0 = Instant::now();
-    sil::run(&short);
+    // Timed as the runs go: metrics only.
+    sil::run_recorded(
+        &short,
+        &mut LocalController::new(&short),
+        &mut (),
+        Recording::MetricsOnly,
+    );
     let wall = t0.elapsed().as_secs_f64();
     let plant_steps = |s: &Scenario| (s.steps() * s.substeps() as u64).max(1) as f64;
     let per_step = wall / plant_steps(&short);
@@ -145,7 +151,8 @@ pub fn estimate(base: &Scenario, opts: &MonteCarloOptions) -> Result<String, Sce
 }
 
 /// Runs `opts.runs` draws around `base` in parallel (the controller is `base`'s, built once);
-/// each run's samples go to an `observer()` (progress).
+/// each run's samples go to an `observer()` (progress) and are not kept
+/// ([`Recording::MetricsOnly`]: the summary needs the metrics and fault counts only).
 pub fn run<O: Observer>(
     base: &Scenario,
     opts: &MonteCarloOptions,
@@ -167,10 +174,11 @@ pub fn run<O: Observer>(
                     cfg.current = CurrentModel::Constant(d.current);
                 }
             })?;
-            let r = sil::run_observed(
+            let r = sil::run_recorded(
                 &scenario,
                 &mut LocalController::new(&scenario),
                 &mut observer(),
+                Recording::MetricsOnly,
             );
             if r.interrupted() {
                 return Ok(None);

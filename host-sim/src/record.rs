@@ -214,6 +214,10 @@ pub struct RunResult {
     /// [`crate::decimate`]). The CSV has every period (it is written as the run goes).
     #[serde(skip)]
     pub samples: Vec<Sample>,
+    /// How many times the plant formed and factorised M(p) ([`crate::plant::Plant::set_params`]):
+    /// once per distinct parameter set the run met, not once per step.
+    #[serde(skip)]
+    pub plant_factorisations: u64,
 }
 
 /// A run as the commands report it in JSON (`--json`): `{"case": name, "robust", the

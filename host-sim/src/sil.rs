@@ -9,7 +9,9 @@
 //!    configured for), to thrust; a controller fault means every thruster off (0 N);
 //! 3. optional first-order thruster lag, then τ_applied = B·thrust;
 //! 4. RK4 substeps with τ held, the plant's parameters (trimmed if the scenario says so,
-//!    [`crate::plant::trimmed`]) and the current evaluated per substep.
+//!    [`crate::plant::trimmed`]) and the current evaluated per substep; one plant for the
+//!    run, whose M is formed again only when the parameters change (Choice 80,
+//!    [`Plant::set_params`]).
 //!
 //! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
 //! run with a reason; every sample recorded until then is kept.
@@ -23,7 +25,7 @@ use nalgebra::{Vector3, Vector6};
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-use crate::config::CurrentModel;
+use crate::config::{CurrentModel, VariationProfile};
 use crate::decimate::Decimator;
 use crate::interrupt;
 use crate::metrics;
@@ -213,6 +215,28 @@ pub fn run_observed(
     source: &mut dyn ControlSource,
     observer: &mut dyn Observer,
 ) -> RunResult {
+    run_recorded(scenario, source, observer, Recording::Plot)
+}
+
+/// What a run keeps of its samples besides the metrics and the fault counts (which are
+/// accumulated from every sample either way, as is what the observer sees).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Recording {
+    /// The plot series ([`crate::decimate`]) in [`RunResult::samples`].
+    Plot,
+    /// No samples: [`RunResult::samples`] is empty. For runs nobody plots: **Choice 82**
+    /// (docs/design.md §2), Monte Carlo records this way. The [`RunResult::summary`] is the
+    /// same as with [`Recording::Plot`].
+    MetricsOnly,
+}
+
+/// [`run_observed`], keeping what `recording` says.
+pub fn run_recorded(
+    scenario: &Scenario,
+    source: &mut dyn ControlSource,
+    observer: &mut dyn Observer,
+    recording: Recording,
+) -> RunResult {
     let cfg = scenario.config();
     let controller = scenario.controller();
     let trajectory = scenario.trajectory();
@@ -233,15 +257,31 @@ pub fn run_observed(
     let mut noise_rng = rand::rngs::StdRng::seed_from_u64(cfg.noise.as_ref().map_or(0, |n| n.seed));
     let lag_alpha = cfg.thruster_lag.map(|tl| 1.0 - (-h / tl).exp());
     let mut thrust_applied: Option<[f64; THRUSTERS]> = None;
+    // One plant for the run: M is refactorised only when the parameters change, and a
+    // profile that does not vary in time is not evaluated again.
+    let mut plant: Option<Plant> = None;
+    let params_at = |ts: f64| {
+        let params = nominal.with_variation(&cfg.variation.at(ts));
+        match cfg.trimmed {
+            true => crate::plant::trimmed(&params),
+            false => params,
+        }
+    };
+    let params_fixed = matches!(
+        cfg.variation,
+        VariationProfile::None | VariationProfile::Constant(_)
+    );
 
-    let mut plot = Decimator::new(steps + 1);
+    let mut plot = (recording == Recording::Plot).then(|| Decimator::new(steps + 1));
     let mut metrics = metrics::Accumulator::default();
     let mut faults = FaultCounts::default();
     let mut record = |s: Sample| {
         metrics.push(&s);
         faults.record(&s);
         observer.sample(&s);
-        plot.push(&s);
+        if let Some(plot) = &mut plot {
+            plot.push(&s);
+        }
     };
     let mut outcome = Outcome::Completed;
 
@@ -337,27 +377,32 @@ pub fn run_observed(
         }
 
         // 3.–4. Lag, wrench, integrate.
+        let wrench = |thrust: &[f64; THRUSTERS]| {
+            alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(*thrust)
+        };
         let mut applied = thrust_applied.unwrap_or(target);
         let mut first_applied = None;
+        // Without lag the thrust, so the wrench, is the target's all period.
+        let mut tau = wrench(&target);
         for j in 0..substeps {
             if let Some(alpha) = lag_alpha {
                 for i in 0..THRUSTERS {
                     applied[i] += alpha * (target[i] - applied[i]);
                 }
+                tau = wrench(&applied);
             } else {
                 applied = target;
             }
             if first_applied.is_none() {
                 first_applied = Some(applied);
             }
-            let tau = alloc_b * nalgebra::SVector::<f64, THRUSTERS>::from(applied);
             let ts = t + j as f64 * h;
-            let mut params = nominal.with_variation(&cfg.variation.at(ts));
-            if cfg.trimmed {
-                params = crate::plant::trimmed(&params);
+            let stepped = match &mut plant {
+                Some(p) if params_fixed => Ok(&*p),
+                Some(p) => p.set_params(params_at(ts)).map(|()| &*p),
+                None => Plant::new(params_at(ts), PlantTerms::default()).map(|p| &*plant.insert(p)),
             }
-            let stepped = Plant::new(params, PlantTerms::default())
-                .and_then(|plant| plant.rk4_step(&state, &tau, &current.v, h));
+            .and_then(|p| p.rk4_step(&state, &tau, &current.v, h));
             match stepped {
                 Ok(s) => state = s,
                 Err(e) => {
@@ -387,6 +432,7 @@ pub fn run_observed(
         outcome,
         faults,
         faults_expected: cfg.expect_faults,
-        samples: plot.finish(),
+        samples: plot.map_or_else(Vec::new, Decimator::finish),
+        plant_factorisations: plant.map_or(0, |p| p.factorisations()),
     }
 }
