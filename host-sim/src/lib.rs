@@ -16,7 +16,8 @@
 //! | [`paper`] | the paper's Table 1: cases, profiles, its numbers, notes, the twelve runs |
 //! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale |
 //! | [`real`] | the real vehicle's six missions (`scenarios/real/`) and the paper's through the real chain |
-//! | [`pil`] | processor in the loop: the firmware in QEMU flies the plant; PIL vs SIL |
+//! | [`pil`] | processor and hardware in the loop: the firmware in QEMU or on a board flies the plant; PIL/HIL vs SIL |
+//! | [`transport`] | the byte transport under the board link: TCP socket or serial port |
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box |
 //! | [`output`] | CSV, plots, report |
 //! | [`cli`] | the `host-sim` commands |
@@ -38,3 +39,4 @@ pub mod real;
 pub mod record;
 pub mod scenario;
 pub mod sil;
+pub mod transport;

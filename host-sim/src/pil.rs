@@ -26,9 +26,20 @@
 //! the board drops (off its mission clock). Once the link is healthy again the simulator
 //! re-arms it (disarm, arm, and start the mission again where it is, since disarming drops it)
 //! and it must resume. Every fail-safe entry and exit is recorded.
+//!
+//! Hardware in the loop (`host-sim hil`) is the same runner over another byte transport
+//! ([`crate::transport`]): a serial device instead of QEMU's socket ([`BoardInTheLoop::over_serial`]).
+//! It paces the run one of two ways ([`Pacing`], docs/design.md §21): lock-step, exactly the
+//! protocol above; or real time, where the board runs on its own timer (`lockstep = false`)
+//! and the host sends each state frame at its wall-clock period and flies the plant on the
+//! newest telemetry it has when the next period is due ([`RealTimeStats`]).
+//!
+//! Every wait is bounded: no valid telemetry for the reply timeout (10 s for PIL,
+//! `hil --reply-timeout`) ends the run with a message that says whether the board sent
+//! nothing (not powered, not wired, wrong port) or only bytes that did not decode (a wrong
+//! baud rate or key); a link that closes or a port that goes away ends it at once.
 
-use std::io::{Read, Write};
-use std::net::{TcpListener, TcpStream};
+use std::net::TcpListener;
 use std::os::unix::process::CommandExt;
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
@@ -49,6 +60,162 @@ use crate::config::LinkFaults;
 use crate::record::{ControlStatus, RunResult, RunSummary};
 use crate::scenario::Scenario;
 use crate::sil::{ControlOut, ControlSource};
+use crate::transport::{Serial, Transport};
+
+/// How long PIL waits for valid telemetry before it gives up on QEMU (an idle QEMU under
+/// `-icount` on a loaded host is slow; the board itself answers every period).
+pub const PIL_REPLY_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// The longest single read: the runner checks its deadlines at least this often.
+const READ_SLICE: Duration = Duration::from_millis(100);
+
+/// How the runner paces the board (docs/design.md §21).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "lowercase")]
+pub enum Pacing {
+    /// The board runs one period per state frame, on the frame's tick (PIL's protocol): the
+    /// result does not depend on either side's speed and equals SIL bit for bit.
+    #[default]
+    Lockstep,
+    /// The board runs on its own timer (`SetConfig { lockstep: false }`); the host sends each
+    /// state frame at its wall-clock period and applies the newest telemetry it has when the
+    /// next period is due.
+    Realtime,
+}
+
+impl Pacing {
+    /// `"lockstep"` or `"realtime"` (the flag's and the JSON's value).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Pacing::Lockstep => "lockstep",
+            Pacing::Realtime => "realtime",
+        }
+    }
+}
+
+/// The timing of a real-time run ([`Pacing::Realtime`]): what the board's own clock and the
+/// link did to the loop. Times in seconds of the host's monotonic clock.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct RealTimeStats {
+    /// Control periods the host ran.
+    pub periods: u64,
+    /// State frames whose telemetry (the board's output computed from that frame,
+    /// `last_state_seq`) had not arrived when the next period was due: the plant flew that
+    /// period on an older state's output.
+    pub late_frames: u64,
+    /// Periods the host itself began more than a whole period late (it fell behind the wall
+    /// clock: a loaded desktop).
+    pub host_missed_periods: u64,
+    /// Board periods without telemetry: gaps in the telemetry's tick numbers.
+    pub board_missed_periods: u64,
+    /// Reply latency, state frame sent → its telemetry received: mean, 99th percentile, max.
+    pub latency_mean: f64,
+    pub latency_p99: f64,
+    pub latency_max: f64,
+    /// Replies the latency is taken over.
+    pub latency_samples: u64,
+    /// Interval between consecutive telemetry frames: mean, and its jitter (RMS and largest
+    /// deviation from the nominal period).
+    pub reply_interval_mean: f64,
+    pub reply_jitter_rms: f64,
+    pub reply_jitter_max: f64,
+}
+
+/// The real-time pacer and its accumulators.
+struct RealTime {
+    period: Duration,
+    /// The wall-clock time of period 0 (set on the first period).
+    origin: Option<Instant>,
+    /// The last state frames sent (sequence number, when), not yet answered.
+    sent: std::collections::VecDeque<(u16, Instant)>,
+    latencies: Vec<f64>,
+    last_arrival: Option<Instant>,
+    intervals: Vec<f64>,
+    stats: RealTimeStats,
+}
+
+impl RealTime {
+    fn new(rate_hz: u32) -> Self {
+        RealTime {
+            period: Duration::from_secs_f64(1.0 / f64::from(rate_hz.max(1))),
+            origin: None,
+            sent: std::collections::VecDeque::new(),
+            latencies: Vec::new(),
+            last_arrival: None,
+            intervals: Vec::new(),
+            stats: RealTimeStats::default(),
+        }
+    }
+
+    /// When period `k` is due.
+    fn due(&mut self, k: u64) -> Instant {
+        let origin = *self.origin.get_or_insert_with(Instant::now);
+        origin + self.period.mul_f64(k as f64)
+    }
+
+    /// Sleeps until period `k` is due; counts it missed if the host is a period late.
+    fn pace(&mut self, k: u64) {
+        let due = self.due(k);
+        let now = Instant::now();
+        if now < due {
+            std::thread::sleep(due - now);
+        } else if now - due > self.period {
+            self.stats.host_missed_periods += 1;
+        }
+        self.stats.periods += 1;
+    }
+
+    /// State frame `seq` was sent now.
+    fn sent(&mut self, seq: u16) {
+        // A reply more than 16 periods late counts as none.
+        if self.sent.len() == 16 {
+            self.sent.pop_front();
+        }
+        self.sent.push_back((seq, Instant::now()));
+    }
+
+    /// Telemetry computed from state frame `seq` arrived at `at`: the first such reply gives
+    /// that frame's latency (a late one too).
+    fn answered(&mut self, seq: u16, at: Instant) {
+        if let Some(i) = self.sent.iter().position(|&(s, _)| s == seq) {
+            let (_, sent) = self.sent[i];
+            self.latencies.push((at - sent).as_secs_f64());
+            // Older frames are answered by this one or never.
+            self.sent.drain(..=i);
+        }
+    }
+
+    /// A telemetry frame arrived at `at`.
+    fn arrived(&mut self, at: Instant) {
+        if let Some(last) = self.last_arrival.replace(at) {
+            self.intervals.push((at - last).as_secs_f64());
+        }
+    }
+
+    /// The figures, from the samples.
+    fn finish(&mut self) -> RealTimeStats {
+        let mut s = std::mem::take(&mut self.stats);
+        let mut l = std::mem::take(&mut self.latencies);
+        l.sort_by(f64::total_cmp);
+        s.latency_samples = l.len() as u64;
+        if !l.is_empty() {
+            s.latency_mean = l.iter().sum::<f64>() / l.len() as f64;
+            // Nearest rank.
+            let rank = ((0.99 * l.len() as f64).ceil() as usize).clamp(1, l.len());
+            s.latency_p99 = l[rank - 1];
+            s.latency_max = l[l.len() - 1];
+        }
+        let iv = std::mem::take(&mut self.intervals);
+        if !iv.is_empty() {
+            let nominal = self.period.as_secs_f64();
+            s.reply_interval_mean = iv.iter().sum::<f64>() / iv.len() as f64;
+            s.reply_jitter_rms =
+                (iv.iter().map(|d| (d - nominal).powi(2)).sum::<f64>() / iv.len() as f64).sqrt();
+            s.reply_jitter_max = iv.iter().map(|d| (d - nominal).abs()).fold(0.0, f64::max);
+        }
+        s
+    }
+}
 
 /// Largest |PIL − SIL| of the max path error (m) that a fault-free PIL run may show: 1 mm.
 /// PIL equals SIL bit for bit today (the same f32 core, the same state frames); this is the
@@ -114,6 +281,19 @@ pub struct PilStats {
     pub board_thrust_unit: Option<String>,
     #[serde(default)]
     pub board_reversed_thrusters: Option<u8>,
+    /// The longest `update` in the board's own timer unit (QEMU: SysTick counts of
+    /// `INSTRUCTIONS_PER_TICK` instructions; the STM32: CPU cycles at 168 MHz).
+    #[serde(default)]
+    pub worst_update_board_ticks: u64,
+    /// What carried the link: `"tcp"` (PIL) or the serial port and its baud rate.
+    #[serde(default)]
+    pub link: String,
+    /// How the run was paced.
+    #[serde(default)]
+    pub pacing: Pacing,
+    /// The timing of a real-time run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub realtime: Option<RealTimeStats>,
 }
 
 impl FailSafeEventKind {
@@ -126,11 +306,13 @@ impl FailSafeEventKind {
     }
 }
 
-/// What a comparison is of: always `"pil"` (processor in the loop against SIL).
+/// What a comparison is of: `"pil"` (processor in the loop, QEMU on a socket) or `"hil"`
+/// (the board on a serial port), against SIL.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Mode {
     Pil,
+    Hil,
 }
 
 /// One PIL run compared with SIL: an entry of `host-sim pil --json`'s `cases` (read it back
@@ -151,11 +333,11 @@ pub struct PilComparison {
 }
 
 impl PilComparison {
-    /// The comparison of a PIL run with the SIL run of the same scenario.
-    pub fn new(pil_run: &RunResult, sil_run: &RunResult, stats: PilStats) -> Self {
+    /// The comparison of a PIL (or HIL: `mode`) run with the SIL run of the same scenario.
+    pub fn new(pil_run: &RunResult, sil_run: &RunResult, stats: PilStats, mode: Mode) -> Self {
         PilComparison {
             run: pil_run.summary(),
-            mode: Mode::Pil,
+            mode,
             sil_max_path: sil_run.metrics.max_path,
             pil_minus_sil_max_path: pil_run.metrics.max_path - sil_run.metrics.max_path,
             pil: stats,
@@ -169,10 +351,24 @@ impl PilComparison {
     }
 }
 
-/// The firmware in QEMU, on a socket.
+/// A board in the loop: the firmware in QEMU on a socket (PIL), or a board on a serial port
+/// (HIL; the board may be QEMU's on a pty).
 pub struct BoardInTheLoop {
-    child: Child,
-    stream: TcpStream,
+    /// QEMU, when this runner started it (ended with the run).
+    child: Option<Child>,
+    stream: Box<dyn Transport>,
+    pacing: Pacing,
+    /// Real-time pacing's clock and figures.
+    rt: Option<RealTime>,
+    /// No valid telemetry for this long ends the run.
+    reply_timeout: Duration,
+    /// When valid telemetry last arrived, and what came since (bytes, refused frames).
+    heard: Instant,
+    noise_bytes: u64,
+    noise_refused: u64,
+    read_timeout: Duration,
+    /// The newest telemetry (real time: what the thrusters apply when a reply is late).
+    latest: Option<Telemetry>,
     decoder: FrameDecoder,
     /// Signing on: signs every frame sent.
     signer: Option<Signer>,
@@ -194,7 +390,8 @@ pub struct BoardInTheLoop {
     needs_rearm: bool,
     t0: Instant,
     pub stats: PilStats,
-    log_path: PathBuf,
+    /// Where to look when the link fails (QEMU's log, or the serial port).
+    context: String,
 }
 
 impl BoardInTheLoop {
@@ -213,37 +410,17 @@ impl BoardInTheLoop {
         key: Option<&LinkKey>,
     ) -> Result<Self, String> {
         check_flying_image(elf)?;
-        let c = scenario.controller().config();
-        // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
-        let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
-            "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
-        })?;
-        let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
-        let log_err = log.try_clone().map_err(|e| e.to_string())?;
-        let mut qemu = Command::new("bash");
-        qemu
-            // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
-            // under `timeout`, two processes down).
-            .process_group(0)
-            .arg(runner)
-            .arg(elf);
-        if let Some(k) = key {
-            // The QEMU image's provisioning (firmware::qemu::link_key); visible to this
-            // machine's process list, which is acceptable for a simulator's key.
-            let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
-            qemu.arg("-append").arg(format!("link-key={hex}"));
-        }
-        let child = qemu
-            .env("QEMU_SERIAL", format!("tcp:127.0.0.1:{port},nodelay=on"))
-            .env("QEMU_TIMEOUT", "3600")
-            .stdin(Stdio::null())
-            .stdout(Stdio::from(log))
-            .stderr(Stdio::from(log_err))
-            .spawn()
-            .map_err(|e| format!("starting QEMU through {}: {e}", runner.display()))?;
+        let mut child = spawn_qemu(
+            elf,
+            runner,
+            &format!("tcp:127.0.0.1:{port},nodelay=on"),
+            Pacing::Lockstep,
+            log,
+            key,
+        )?;
         listener.set_nonblocking(true).map_err(|e| e.to_string())?;
         let deadline = Instant::now() + Duration::from_secs(30);
         let stream = loop {
@@ -251,6 +428,7 @@ impl BoardInTheLoop {
                 Ok((s, _)) => break s,
                 Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
                     if Instant::now() > deadline {
+                        stop_group(&mut child);
                         return Err(format!(
                             "QEMU did not connect its UART within 30 s (see {})",
                             log_path.display()
@@ -258,17 +436,85 @@ impl BoardInTheLoop {
                     }
                     std::thread::sleep(Duration::from_millis(20));
                 }
-                Err(e) => return Err(format!("accepting QEMU's UART: {e}")),
+                Err(e) => {
+                    stop_group(&mut child);
+                    return Err(format!("accepting QEMU's UART: {e}"));
+                }
             }
         };
         stream.set_nonblocking(false).map_err(|e| e.to_string())?;
         stream.set_nodelay(true).map_err(|e| e.to_string())?;
-        stream
-            .set_read_timeout(Some(Duration::from_secs(10)))
-            .map_err(|e| e.to_string())?;
+        Self::connect(
+            Box::new(stream),
+            Some(child),
+            "tcp".to_string(),
+            format!("see {}", log_path.display()),
+            scenario,
+            faults,
+            Pacing::Lockstep,
+            PIL_REPLY_TIMEOUT,
+            key,
+        )
+    }
+
+    /// Hardware in the loop: the board on the serial device `port` at `baud` (a USB-serial
+    /// adapter, or QEMU's `-serial pty`), configured and armed as [`BoardInTheLoop::start`]
+    /// does, paced by `pacing`. No valid telemetry for `reply_timeout` ends the set-up or the
+    /// run with a message that says what came instead.
+    pub fn over_serial(
+        port: &str,
+        baud: u32,
+        scenario: &Scenario,
+        faults: LinkFaults,
+        pacing: Pacing,
+        reply_timeout: Duration,
+        key: Option<&LinkKey>,
+    ) -> Result<Self, String> {
+        let serial = Serial::open(port, baud)?;
+        Self::connect(
+            Box::new(serial),
+            None,
+            format!("{port} at {baud} baud"),
+            format!("serial port {port} at {baud} baud"),
+            scenario,
+            faults,
+            pacing,
+            reply_timeout,
+            key,
+        )
+    }
+
+    /// The set-up over an open transport (module docs): the first telemetry, then disarm,
+    /// the configuration and arming, until the board reports itself armed.
+    #[allow(clippy::too_many_arguments)]
+    fn connect(
+        stream: Box<dyn Transport>,
+        child: Option<Child>,
+        link: String,
+        context: String,
+        scenario: &Scenario,
+        faults: LinkFaults,
+        pacing: Pacing,
+        reply_timeout: Duration,
+        key: Option<&LinkKey>,
+    ) -> Result<Self, String> {
+        let c = scenario.controller().config();
+        // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
+        let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
+            "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
+        })?;
+        let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let mut b = BoardInTheLoop {
             child,
             stream,
+            pacing,
+            rt: (pacing == Pacing::Realtime).then(|| RealTime::new(c.rate_hz)),
+            reply_timeout,
+            heard: Instant::now(),
+            noise_bytes: 0,
+            noise_refused: 0,
+            read_timeout: Duration::ZERO,
+            latest: None,
             decoder: match key {
                 Some(k) => FrameDecoder::signed(Verifier::new(k, Direction::FromBoard)),
                 None => FrameDecoder::new(),
@@ -289,9 +535,11 @@ impl BoardInTheLoop {
             t0: Instant::now(),
             stats: PilStats {
                 signed: key.is_some(),
+                link,
+                pacing,
                 ..PilStats::default()
             },
-            log_path: log_path.to_path_buf(),
+            context,
         };
         // Continue the board's numbering: a board that already heard a runner (this one
         // restarted) drops frames numbered at or before its last (auv_link::seq).
@@ -300,19 +548,25 @@ impl BoardInTheLoop {
             b.seq = first.last_rx_seq.wrapping_add(1);
         }
         let refused_before = first.refused_commands;
+        // A board that flew before (a bench board between runs) may still be armed, and
+        // refuses a configuration while armed: disarm it first (a fresh board is disarmed
+        // already; disarming is never refused).
+        b.send(Msg::Command(LinkCommand::Disarm))?;
         b.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
             rate_hz: Some(c.rate_hz),
             robust: Some(c.robust),
             delta_max: Some(c.delta_max),
             voltage_limit: Some(c.voltage_limit),
             stale_periods: Some(DEFAULT_STALE_PERIODS),
-            lockstep: Some(true),
+            lockstep: Some(pacing == Pacing::Lockstep),
             thrust_unit: Some(thrust_unit),
             reversed_thrusters: Some(mounting),
             priority: Some(c.priority.into()),
         })))?;
+        let arm_seq = b.seq;
         b.send(Msg::Command(LinkCommand::Arm))?;
-        // Wait until the board reports itself armed: the configuration and arming took.
+        // Wait until the board reports itself armed after it took the arming (an earlier
+        // frame of a board that was armed before says nothing of this set-up).
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
             let t = b.next_telemetry()?;
@@ -322,7 +576,7 @@ impl BoardInTheLoop {
                     t.last_refusal.map_or("(no reason)", |r| r.as_str())
                 ));
             }
-            if t.status == BoardStatus::Armed {
+            if t.status == BoardStatus::Armed && t.last_rx_seq == arm_seq {
                 if t.reversed_thrusters != mounting {
                     return Err(format!(
                         "the board flies thruster mounting {:#07b}, not the scenario's {mounting:#07b}",
@@ -330,6 +584,7 @@ impl BoardInTheLoop {
                     ));
                 }
                 b.check_unit(&t)?;
+                b.latest = Some(t);
                 break;
             }
             if Instant::now() > deadline {
@@ -378,34 +633,90 @@ impl BoardInTheLoop {
     }
 
     fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
-        self.stream.write_all(bytes).map_err(|e| {
+        self.stream
+            .write_frame(bytes)
+            .map_err(|e| self.lost(&e, "write"))
+    }
+
+    /// The message for a link that failed under a read or a write.
+    fn lost(&self, e: &std::io::Error, op: &str) -> String {
+        use std::io::ErrorKind;
+        match e.kind() {
+            ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => {
+                format!(
+                    "the board's link went away ({e}): the port was unplugged, the board lost power, or its emulator ended ({})",
+                    self.context
+                )
+            }
+            _ => format!("board link {op} failed: {e} ({})", self.context),
+        }
+    }
+
+    /// Why no valid telemetry came for the reply timeout.
+    fn silence(&self) -> String {
+        let t = self.reply_timeout.as_secs_f64();
+        if self.noise_bytes == 0 {
             format!(
-                "board link write failed: {e} (see {})",
-                self.log_path.display()
+                "no telemetry from the board for {t:.1} s: it sent nothing ({}); is it powered, flashed with its flying image and wired (its TX to this end's RX, a common ground), and is this the right port?",
+                self.context
             )
-        })
+        } else {
+            format!(
+                "no valid telemetry from the board for {t:.1} s: {} bytes came, and {} frames that did not decode ({}); a wrong baud rate (--baud; the STM32 board's is 460800), a wrong or missing link key (--link-key-file), or another device on this port",
+                self.noise_bytes, self.noise_refused, self.context
+            )
+        }
     }
 
     /// The next telemetry frame from the board (frames of other kinds are ignored).
     fn next_telemetry(&mut self) -> Result<Telemetry, String> {
+        loop {
+            if let Some(t) = self.poll_telemetry(None)? {
+                return Ok(t);
+            }
+        }
+    }
+
+    /// The next telemetry frame, or `None` once `until` has passed without one. No valid
+    /// telemetry for the reply timeout is an error ([`BoardInTheLoop::silence`]), whatever
+    /// `until` says.
+    fn poll_telemetry(&mut self, until: Option<Instant>) -> Result<Option<Telemetry>, String> {
         let mut chunk = [0u8; 512];
         loop {
             if let Some(t) = self.pending.pop_front() {
                 self.stats.telemetry_frames += 1;
-                return Ok(t);
+                self.heard = Instant::now();
+                self.noise_bytes = 0;
+                self.noise_refused = 0;
+                if let Some(rt) = &mut self.rt {
+                    rt.arrived(self.heard);
+                }
+                return Ok(Some(t));
             }
-            let n = self.stream.read(&mut chunk).map_err(|e| {
-                format!(
-                    "board link read failed: {e} (see {})",
-                    self.log_path.display()
-                )
-            })?;
-            if n == 0 {
-                return Err(format!(
-                    "QEMU closed the link (see {})",
-                    self.log_path.display()
-                ));
+            let now = Instant::now();
+            let silent_until = self.heard + self.reply_timeout;
+            if now >= silent_until {
+                return Err(self.silence());
             }
+            let mut wait = READ_SLICE.min(silent_until - now);
+            if let Some(u) = until {
+                if now >= u {
+                    return Ok(None);
+                }
+                wait = wait.min(u - now);
+            }
+            let wait = wait.max(Duration::from_millis(1));
+            if wait != self.read_timeout {
+                self.stream
+                    .set_read_timeout(wait)
+                    .map_err(|e| self.lost(&e, "set-up"))?;
+                self.read_timeout = wait;
+            }
+            let n = self
+                .stream
+                .read_some(&mut chunk)
+                .map_err(|e| self.lost(&e, "read"))?;
+            self.noise_bytes += n as u64;
             for &b in &chunk[..n] {
                 match self.decoder.push(b) {
                     None => {}
@@ -425,19 +736,102 @@ impl BoardInTheLoop {
                         ));
                     }
                     // Undecodable, badly signed, out of sequence, or not telemetry.
-                    Some(_) => self.stats.telemetry_refused += 1,
+                    Some(_) => {
+                        self.stats.telemetry_refused += 1;
+                        self.noise_refused += 1;
+                    }
                 }
             }
         }
     }
 
+    /// Appends this period's state frame to `out` — `frame`, or with a delay fault the one
+    /// from `delay_ticks` earlier, with a corruption fault a byte flipped — and returns the
+    /// sequence number the board's answer will name (none for a frame the board will refuse
+    /// or drop).
+    fn encode_state(
+        &mut self,
+        frame: StateFrame,
+        corrupt: bool,
+        delayed: bool,
+        out: &mut Vec<u8>,
+    ) -> Result<Option<u16>, String> {
+        let mut buf = [0u8; MAX_FRAME];
+        let sent = if delayed {
+            let i = self
+                .history
+                .len()
+                .saturating_sub(1 + self.faults.delay_ticks as usize);
+            self.history[i]
+        } else {
+            frame
+        };
+        // A corrupted frame is refused, and a delayed one holds an old state that the board
+        // drops as off its mission clock: neither is answered.
+        let expect = (!corrupt && !delayed).then_some(self.seq);
+        let n = self.encode(Msg::State(sent), &mut buf)?;
+        if corrupt {
+            buf[n / 2] ^= 0x5A;
+        }
+        out.extend_from_slice(&buf[..n]);
+        self.stats.state_frames_sent += 1;
+        Ok(expect)
+    }
+
     /// The telemetry of the board's next control period (later than any seen before).
     fn next_period(&mut self) -> Result<Telemetry, String> {
         loop {
-            let t = self.next_telemetry()?;
-            if self.last_tick.is_none_or(|last| t.tick > last) {
-                self.last_tick = Some(t.tick);
+            if let Some(t) = self.poll_period(None)? {
                 return Ok(t);
+            }
+        }
+    }
+
+    /// [`BoardInTheLoop::next_period`], or `None` once `until` has passed; in real time,
+    /// counts the board's periods missing between two telemetry frames.
+    fn poll_period(&mut self, until: Option<Instant>) -> Result<Option<Telemetry>, String> {
+        loop {
+            let Some(t) = self.poll_telemetry(until)? else {
+                return Ok(None);
+            };
+            if self.last_tick.is_none_or(|last| t.tick > last) {
+                if let (Some(rt), Some(last)) = (&mut self.rt, self.last_tick) {
+                    rt.stats.board_missed_periods += t.tick - last - 1;
+                }
+                self.last_tick = Some(t.tick);
+                self.latest = Some(t);
+                return Ok(Some(t));
+            }
+        }
+    }
+
+    /// Real time: the board's output for state frame `expect_seq` if it arrives before
+    /// period `k + 1` is due, else the newest output the board sent (a late frame: the
+    /// thrusters hold what the board last commanded, as they would on the vehicle).
+    fn realtime_reply(&mut self, k: u64, expect_seq: Option<u16>) -> Result<Telemetry, String> {
+        let due = match &mut self.rt {
+            Some(rt) => rt.due(k + 1),
+            None => Instant::now(),
+        };
+        loop {
+            match self.poll_period(Some(due))? {
+                Some(t) => {
+                    let heard = self.heard;
+                    if let Some(rt) = &mut self.rt {
+                        rt.answered(t.last_state_seq, heard);
+                    }
+                    if expect_seq.is_some_and(|seq| t.last_state_seq == seq) {
+                        return Ok(t);
+                    }
+                }
+                None => {
+                    if let (Some(rt), Some(_)) = (&mut self.rt, expect_seq) {
+                        rt.stats.late_frames += 1;
+                    }
+                    return self
+                        .latest
+                        .ok_or_else(|| "no telemetry from the board yet".to_string());
+                }
             }
         }
     }
@@ -471,24 +865,23 @@ impl BoardInTheLoop {
         self.stats.board_loop_overruns = t.loop_overruns;
         self.stats.board_thrust_unit = Some(unit_name(t.thrust_unit).to_string());
         self.stats.board_reversed_thrusters = Some(t.reversed_thrusters);
+        self.stats.worst_update_board_ticks = u64::from(t.worst_update_ticks);
         self.stats.worst_update_instructions =
             t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
     }
 
     fn stop_qemu(&mut self) {
-        // SIGTERM to the whole process group (bash runner, timeout, QEMU, defmt-print).
-        let _ = Command::new("kill")
-            .arg("-TERM")
-            .arg("--")
-            .arg(format!("-{}", self.child.id()))
-            .status();
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        if let Some(child) = &mut self.child {
+            stop_group(child);
+        }
     }
 
-    /// Ends the QEMU process and returns the figures.
+    /// Ends the QEMU process (if this runner started one) and returns the figures.
     pub fn finish(mut self) -> PilStats {
         self.stop_qemu();
+        if let Some(rt) = &mut self.rt {
+            self.stats.realtime = Some(rt.finish());
+        }
         let wall = self.t0.elapsed().as_secs_f64();
         self.stats.wall_seconds = wall;
         self.stats.frames_per_second = if wall > 0.0 {
@@ -508,6 +901,9 @@ impl Drop for BoardInTheLoop {
 
 impl ControlSource for BoardInTheLoop {
     fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
+        if let Some(rt) = &mut self.rt {
+            rt.pace(k);
+        }
         let frame = StateFrame {
             t_ticks: k,
             eta: *eta,
@@ -525,7 +921,14 @@ impl ControlSource for BoardInTheLoop {
         let mut expect_seq = None;
         let mut out = Vec::with_capacity(4 * MAX_FRAME);
         let mut buf = [0u8; MAX_FRAME];
+        // Lock-step: commands, then the state frame (a mission's first state frame sets its
+        // clock; an earlier one is not on it). Real time: the state first, so that a mission
+        // (re)started in this period has a state when the board's next period comes.
+        let state_first = self.pacing == Pacing::Realtime;
         if !silent {
+            if state_first && !dropped {
+                expect_seq = self.encode_state(frame, corrupt, delayed, &mut out)?;
+            }
             if self.needs_rearm && healthy {
                 // Recovery: the link is good again; re-arm (the fail-safe latches until
                 // then) and start the mission again, since disarming dropped it. Its first
@@ -549,41 +952,28 @@ impl ControlSource for BoardInTheLoop {
                 out.extend_from_slice(&buf[..n]);
                 self.started = true;
             }
-            if !dropped {
-                let sent = if delayed {
-                    let i = self
-                        .history
-                        .len()
-                        .saturating_sub(1 + self.faults.delay_ticks as usize);
-                    self.history[i]
-                } else {
-                    frame
-                };
-                // A corrupted frame is refused, and a delayed one holds an old state that the
-                // board drops as off its mission clock: neither is answered.
-                if !corrupt && !delayed {
-                    expect_seq = Some(self.seq);
-                }
-                let n = self.encode(Msg::State(sent), &mut buf)?;
-                if corrupt {
-                    buf[n / 2] ^= 0x5A;
-                }
-                out.extend_from_slice(&buf[..n]);
-                self.stats.state_frames_sent += 1;
+            if !state_first && !dropped {
+                expect_seq = self.encode_state(frame, corrupt, delayed, &mut out)?;
             }
         }
         if !out.is_empty() {
             self.write(&out)?;
         }
-        // The board's answer to this frame; if it timed out before the frame arrived (host
-        // slower than the board's virtual clock), that timeout period is skipped. Without a
-        // valid frame the answer is the board's next (timed-out) period.
-        let t = loop {
-            let t = self.next_period()?;
-            match expect_seq {
-                Some(seq) if t.last_state_seq != seq => continue,
-                _ => break t,
-            }
+        if let (Some(rt), Some(seq)) = (&mut self.rt, expect_seq) {
+            rt.sent(seq);
+        }
+        let t = match self.pacing {
+            // The board's answer to this frame; if it timed out before the frame arrived
+            // (host slower than the board's virtual clock), that timeout period is skipped.
+            // Without a valid frame the answer is the board's next (timed-out) period.
+            Pacing::Lockstep => loop {
+                let t = self.next_period()?;
+                match expect_seq {
+                    Some(seq) if t.last_state_seq != seq => continue,
+                    _ => break t,
+                }
+            },
+            Pacing::Realtime => self.realtime_reply(k, expect_seq)?,
         };
         self.note_status(&t, k);
         self.check_unit(&t)?;
@@ -610,6 +1000,130 @@ fn on_off(b: bool) -> &'static str {
     } else {
         "off"
     }
+}
+
+/// Starts the QEMU flying image through `runner` (`scripts/qemu-run.sh`) in its own process
+/// group, with UART0 on `serial` (QEMU's `-serial` argument: `tcp:…` for PIL, `pty` for HIL)
+/// and its log (stdout and stderr) into `log`. Lock-step runs under `-icount shift=0` (the
+/// runner's default: update timings are instruction counts); real time without `-icount`, so
+/// that QEMU's SysTick follows the wall clock (`QEMU_ICOUNT=off`).
+pub fn spawn_qemu(
+    elf: &Path,
+    runner: &Path,
+    serial: &str,
+    pacing: Pacing,
+    log: std::fs::File,
+    key: Option<&LinkKey>,
+) -> Result<Child, String> {
+    let log_err = log.try_clone().map_err(|e| e.to_string())?;
+    let mut qemu = Command::new("bash");
+    qemu
+        // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
+        // under `timeout`, two processes down).
+        .process_group(0)
+        .arg(runner)
+        .arg(elf);
+    if let Some(k) = key {
+        // The QEMU image's provisioning (firmware::qemu::link_key); visible to this
+        // machine's process list, which is acceptable for a simulator's key.
+        let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
+        qemu.arg("-append").arg(format!("link-key={hex}"));
+    }
+    if pacing == Pacing::Realtime {
+        qemu.env("QEMU_ICOUNT", "off");
+    }
+    qemu.env("QEMU_SERIAL", serial)
+        .env("QEMU_TIMEOUT", "3600")
+        .stdin(Stdio::null())
+        .stdout(Stdio::from(log))
+        .stderr(Stdio::from(log_err))
+        .spawn()
+        .map_err(|e| format!("starting QEMU through {}: {e}", runner.display()))
+}
+
+/// Ends a process group started by [`spawn_qemu`] (bash runner, timeout, QEMU, defmt-print)
+/// and reaps its leader.
+pub fn stop_group(child: &mut Child) {
+    let _ = Command::new("kill")
+        .arg("-TERM")
+        .arg("--")
+        .arg(format!("-{}", child.id()))
+        .status();
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
+/// The QEMU flying image with its UART0 on a pseudo-terminal (`-serial pty`): a real tty that
+/// `host-sim hil --port` opens as it would a USB-serial adapter (the CI's HIL without
+/// hardware). Ends QEMU when dropped.
+pub struct QemuPty {
+    child: Child,
+    /// The pty's device (`/dev/pts/N`).
+    pub port: PathBuf,
+}
+
+/// The runner's line on stderr naming the pty: `qemu-run: UART0 on pty /dev/pts/N (link)`
+/// (scripts/qemu-run.sh; QEMU's own line goes to its stdout, the defmt stream).
+const PTY_LINE: &str = "UART0 on pty ";
+
+impl QemuPty {
+    /// Starts `elf` through `runner` with `QEMU_SERIAL=pty`, its log into `log_path`
+    /// (created), and waits (at most 30 s) for the runner to name the pty in it.
+    pub fn start(
+        elf: &Path,
+        runner: &Path,
+        log_path: &Path,
+        pacing: Pacing,
+        key: Option<&LinkKey>,
+    ) -> Result<Self, String> {
+        check_flying_image(elf)?;
+        let log = std::fs::File::create(log_path)
+            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
+        let child = spawn_qemu(elf, runner, "pty", pacing, log, key)?;
+        let mut q = QemuPty {
+            child,
+            port: PathBuf::new(),
+        };
+        let deadline = Instant::now() + Duration::from_secs(30);
+        loop {
+            let text = std::fs::read_to_string(log_path).unwrap_or_default();
+            if let Some(port) = pty_of_log(&text) {
+                q.port = port;
+                return Ok(q);
+            }
+            if let Ok(Some(status)) = q.child.try_wait() {
+                return Err(format!(
+                    "QEMU ended ({status}) before naming its pty (see {})",
+                    log_path.display()
+                ));
+            }
+            if Instant::now() > deadline {
+                return Err(format!(
+                    "QEMU did not name its pty within 30 s (see {})",
+                    log_path.display()
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// Ends QEMU now (the board's port goes away).
+    pub fn kill(&mut self) {
+        stop_group(&mut self.child);
+    }
+}
+
+impl Drop for QemuPty {
+    fn drop(&mut self) {
+        stop_group(&mut self.child);
+    }
+}
+
+/// The pty QEMU's log names ([`PTY_LINE`]), if it does yet.
+pub fn pty_of_log(log: &str) -> Option<PathBuf> {
+    let rest = &log[log.find(PTY_LINE)? + PTY_LINE.len()..];
+    let path = rest.split_whitespace().next()?;
+    path.starts_with("/dev/").then(|| PathBuf::from(path))
 }
 
 /// MAVLink 2's signing time: 10 µs units since 2015-01-01 00:00 UTC (1 420 070 400 s after the
