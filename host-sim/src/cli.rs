@@ -860,7 +860,8 @@ pub fn hil(args: &HilArgs, stdout: &mut dyn Write) -> Result<Exit> {
 /// The runs of `pil` and `hil`: each scenario in SIL, then with the board `start` connects,
 /// compared; the report, and how the command ended. A run that loses its board keeps what it
 /// recorded (its CSV, its row in the report, marked diverged with the reason) and is named on
-/// stderr.
+/// stderr (**Choice 72**); a real-time run is compared with SIL but need not agree with it
+/// (**Choice 69**; docs/design.md §21).
 fn fly(
     args: &LoopArgs,
     scenarios: &[Scenario],

@@ -95,6 +95,12 @@ impl Pacing {
 
 /// The timing of a real-time run ([`Pacing::Realtime`]): what the board's own clock and the
 /// link did to the loop. Times in seconds of the host's monotonic clock.
+///
+/// **Choice 67** (docs/design.md §21): latency from a state frame sent to the first
+/// telemetry naming it (a reply more than 16 frames late counts as none), p99 by nearest
+/// rank; jitter as the RMS and the largest deviation of the telemetry interval from the
+/// period; board missed = gaps in the telemetry's ticks; host missed = periods begun more
+/// than a period late.
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct RealTimeStats {
     /// Control periods the host ran.
@@ -486,6 +492,10 @@ impl BoardInTheLoop {
 
     /// The set-up over an open transport (module docs): the first telemetry, then disarm,
     /// the configuration and arming, until the board reports itself armed.
+    ///
+    /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
+    /// from a run before, and refuses a configuration while armed), and take `Armed` only
+    /// from telemetry whose `last_rx_seq` is the `Arm`'s.
     #[allow(clippy::too_many_arguments)]
     fn connect(
         stream: Box<dyn Transport>,
@@ -641,7 +651,13 @@ impl BoardInTheLoop {
     /// The message for a link that failed under a read or a write.
     fn lost(&self, e: &std::io::Error, op: &str) -> String {
         use std::io::ErrorKind;
+        // EIO: a tty whose other end (a pty's master, a USB adapter) is gone.
+        const EIO: i32 = 5;
         match e.kind() {
+            _ if e.raw_os_error() == Some(EIO) => format!(
+                "the board's link went away ({e}): the port was unplugged, the board lost power, or its emulator ended ({})",
+                self.context
+            ),
             ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => {
                 format!(
                     "the board's link went away ({e}): the port was unplugged, the board lost power, or its emulator ended ({})",
@@ -679,7 +695,8 @@ impl BoardInTheLoop {
 
     /// The next telemetry frame, or `None` once `until` has passed without one. No valid
     /// telemetry for the reply timeout is an error ([`BoardInTheLoop::silence`]), whatever
-    /// `until` says.
+    /// `until` says (**Choice 64**, docs/design.md §21: every wait bounded, silence told from
+    /// noise).
     fn poll_telemetry(&mut self, until: Option<Instant>) -> Result<Option<Telemetry>, String> {
         let mut chunk = [0u8; 512];
         loop {
@@ -808,6 +825,7 @@ impl BoardInTheLoop {
     /// Real time: the board's output for state frame `expect_seq` if it arrives before
     /// period `k + 1` is due, else the newest output the board sent (a late frame: the
     /// thrusters hold what the board last commanded, as they would on the vehicle).
+    /// **Choice 66**, docs/design.md §21.
     fn realtime_reply(&mut self, k: u64, expect_seq: Option<u16>) -> Result<Telemetry, String> {
         let due = match &mut self.rt {
             Some(rt) => rt.due(k + 1),
@@ -923,7 +941,8 @@ impl ControlSource for BoardInTheLoop {
         let mut buf = [0u8; MAX_FRAME];
         // Lock-step: commands, then the state frame (a mission's first state frame sets its
         // clock; an earlier one is not on it). Real time: the state first, so that a mission
-        // (re)started in this period has a state when the board's next period comes.
+        // (re)started in this period has a state when the board's next period comes
+        // (Choice 68, docs/design.md §21).
         let state_first = self.pacing == Pacing::Realtime;
         if !silent {
             if state_first && !dropped {
@@ -1056,6 +1075,10 @@ pub fn stop_group(child: &mut Child) {
 /// The QEMU flying image with its UART0 on a pseudo-terminal (`-serial pty`): a real tty that
 /// `host-sim hil --port` opens as it would a USB-serial adapter (the CI's HIL without
 /// hardware). Ends QEMU when dropped.
+///
+/// **Choice 70** (docs/design.md §21): the runner makes the pty with `-chardev pty,path=…`
+/// and names it on stderr, since QEMU prints its own `char device redirected to` line on
+/// stdout, into the defmt stream; real time runs QEMU without `-icount`.
 pub struct QemuPty {
     child: Child,
     /// The pty's device (`/dev/pts/N`).

@@ -12,6 +12,8 @@ use std::net::TcpStream;
 use std::time::Duration;
 
 /// What the runner needs from a byte transport.
+///
+/// **Choice 62** (docs/design.md §21): one runner over this seam, not a runner per transport.
 pub trait Transport: Send {
     /// Up to `buf.len()` bytes, waiting at most the read timeout for the first: `Ok(0)` when
     /// nothing came in that time. A closed link is `Err` ([`io::ErrorKind::UnexpectedEof`]).
@@ -62,6 +64,9 @@ pub struct Serial {
 impl Serial {
     /// Opens `path` at `baud` (8N1, no flow control) in raw mode — no echo, no line editing,
     /// which a pseudo-terminal would otherwise apply (the board's frames would come back).
+    ///
+    /// **Choice 63**: 8N1, no flow control, raw, exclusive (serialport's default), both
+    /// buffers cleared; the caller's default baud is the STM32's 460 800.
     pub fn open(path: &str, baud: u32) -> Result<Serial, String> {
         if !std::path::Path::new(path).exists() {
             return Err(format!(
