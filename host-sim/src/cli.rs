@@ -995,24 +995,9 @@ fn pil_notes(cases: &[PilComparison]) -> String {
         .filter_map(|c| c.pil.realtime.as_ref().map(|r| (c, r)))
         .collect();
     if !realtime.is_empty() {
-        notes += "\n### Real-time pacing (docs/design.md §21)\n\n\
-                  | case | periods | late frames | host missed | board missed | latency mean / p99 / max (ms) | \
-                  reply interval (ms) | jitter RMS / max (ms) |\n|---|---|---|---|---|---|---|---|\n";
+        notes += "\n### Real-time pacing (docs/design.md §21)\n\n";
         for (c, r) in realtime {
-            notes += &format!(
-                "| {} | {} | {} | {} | {} | {:.2} / {:.2} / {:.2} | {:.2} | {:.2} / {:.2} |\n",
-                c.run.name,
-                r.periods,
-                r.late_frames,
-                r.host_missed_periods,
-                r.board_missed_periods,
-                1e3 * r.latency_mean,
-                1e3 * r.latency_p99,
-                1e3 * r.latency_max,
-                1e3 * r.reply_interval_mean,
-                1e3 * r.reply_jitter_rms,
-                1e3 * r.reply_jitter_max,
-            );
+            notes += &format!("- {}: {r}\n", c.run.name);
         }
     }
     notes

@@ -127,6 +127,27 @@ pub struct RealTimeStats {
     pub reply_jitter_max: f64,
 }
 
+impl std::fmt::Display for RealTimeStats {
+    /// One line: the counts, then latency, interval and jitter in ms.
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} periods, {} late frames, host missed {}, board missed {}; latency mean {:.2} / p99 {:.2} / max {:.2} ms over {} replies; reply interval {:.2} ms, jitter RMS {:.2} / max {:.2} ms",
+            self.periods,
+            self.late_frames,
+            self.host_missed_periods,
+            self.board_missed_periods,
+            1e3 * self.latency_mean,
+            1e3 * self.latency_p99,
+            1e3 * self.latency_max,
+            self.latency_samples,
+            1e3 * self.reply_interval_mean,
+            1e3 * self.reply_jitter_rms,
+            1e3 * self.reply_jitter_max,
+        )
+    }
+}
+
 /// The real-time pacer and its accumulators.
 struct RealTime {
     period: Duration,
@@ -191,8 +212,12 @@ impl RealTime {
         }
     }
 
-    /// A telemetry frame arrived at `at`.
+    /// A telemetry frame arrived at `at`. The intervals count from the first period on
+    /// (the set-up's frames come at the board's default rate).
     fn arrived(&mut self, at: Instant) {
+        if self.origin.is_none() {
+            return;
+        }
         if let Some(last) = self.last_arrival.replace(at) {
             self.intervals.push((at - last).as_secs_f64());
         }
@@ -653,18 +678,18 @@ impl BoardInTheLoop {
         use std::io::ErrorKind;
         // EIO: a tty whose other end (a pty's master, a USB adapter) is gone.
         const EIO: i32 = 5;
-        match e.kind() {
-            _ if e.raw_os_error() == Some(EIO) => format!(
+        let gone = e.raw_os_error() == Some(EIO)
+            || matches!(
+                e.kind(),
+                ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset
+            );
+        if gone {
+            format!(
                 "the board's link went away ({e}): the port was unplugged, the board lost power, or its emulator ended ({})",
                 self.context
-            ),
-            ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset => {
-                format!(
-                    "the board's link went away ({e}): the port was unplugged, the board lost power, or its emulator ended ({})",
-                    self.context
-                )
-            }
-            _ => format!("board link {op} failed: {e} ({})", self.context),
+            )
+        } else {
+            format!("board link {op} failed: {e} ({})", self.context)
         }
     }
 
@@ -824,9 +849,28 @@ impl BoardInTheLoop {
 
     /// Real time: the board's output for state frame `expect_seq` if it arrives before
     /// period `k + 1` is due, else the newest output the board sent (a late frame: the
-    /// thrusters hold what the board last commanded, as they would on the vehicle).
+    /// thrusters hold what the board last commanded, as they would on the vehicle). Period 0
+    /// waits for its answer, and the run's wall clock starts then.
     /// **Choice 66**, docs/design.md §21.
     fn realtime_reply(&mut self, k: u64, expect_seq: Option<u16>) -> Result<Telemetry, String> {
+        if k == 0 {
+            // The mission starts with the board's answer to its first state frame (bounded by
+            // the reply timeout): the wall clock of the run counts from there, so period 0
+            // does not fly on a reply from before the mission ran.
+            loop {
+                let t = self.next_period()?;
+                let heard = self.heard;
+                if let Some(rt) = &mut self.rt {
+                    rt.answered(t.last_state_seq, heard);
+                }
+                if expect_seq.is_none_or(|seq| t.last_state_seq == seq) {
+                    if let Some(rt) = &mut self.rt {
+                        rt.origin = Some(heard);
+                    }
+                    return Ok(t);
+                }
+            }
+        }
         let due = match &mut self.rt {
             Some(rt) => rt.due(k + 1),
             None => Instant::now(),

@@ -140,20 +140,9 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
                 if let Some(c) = report(ci, "real time", &o) {
                     match &c.pil.realtime {
                         Some(r) if r.periods > 0 && c.pil.telemetry_frames > 0 => println!(
-                            "real time over {}: {:.0} frames/s, {} periods, {} late, host missed {}, board missed {}, latency mean {:.2} / p99 {:.2} / max {:.2} ms over {} replies, reply interval {:.2} ms, jitter RMS {:.2} / max {:.2} ms; max path {:.3} m (SIL {:.3} m), {} fail-safe events, exit {}",
+                            "real time over {}: {:.0} frames/s, {r}; max path {:.3} m (SIL {:.3} m), {} fail-safe events, exit {}",
                             c.pil.link,
                             c.pil.frames_per_second,
-                            r.periods,
-                            r.late_frames,
-                            r.host_missed_periods,
-                            r.board_missed_periods,
-                            1e3 * r.latency_mean,
-                            1e3 * r.latency_p99,
-                            1e3 * r.latency_max,
-                            r.latency_samples,
-                            1e3 * r.reply_interval_mean,
-                            1e3 * r.reply_jitter_rms,
-                            1e3 * r.reply_jitter_max,
                             c.run.metrics.max_path,
                             c.sil_max_path,
                             c.pil.failsafe_events.len(),
