@@ -855,8 +855,13 @@ impl BoardInTheLoop {
     fn realtime_reply(&mut self, k: u64, expect_seq: Option<u16>) -> Result<Telemetry, String> {
         if k == 0 {
             // The mission starts with the board's answer to its first state frame (bounded by
-            // the reply timeout): the wall clock of the run counts from there, so period 0
-            // does not fly on a reply from before the mission ran.
+            // the reply timeout), so period 0 does not fly on a reply from before the mission
+            // ran. The board sends telemetry just after its period boundary: the run's clock
+            // starts half a period after that answer, so that the host's periods fall between
+            // the board's — a frame then waits half a period for the board, and its answer
+            // has half a period to come back. (Started on the answer itself, every frame
+            // arrived just after a boundary and was answered just after the next period was
+            // due: every frame late.) The clocks drift apart over a run; the figures show it.
             loop {
                 let t = self.next_period()?;
                 let heard = self.heard;
@@ -865,7 +870,7 @@ impl BoardInTheLoop {
                 }
                 if expect_seq.is_none_or(|seq| t.last_state_seq == seq) {
                     if let Some(rt) = &mut self.rt {
-                        rt.origin = Some(heard);
+                        rt.origin = Some(heard + rt.period / 2);
                     }
                     return Ok(t);
                 }
