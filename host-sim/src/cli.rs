@@ -8,6 +8,7 @@
 //! host-sim table1 [--json] [--out DIR]
 //! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
 //! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
+//! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
 //! ```
@@ -18,7 +19,7 @@
 //! each mission, one line each, and put it in the report; they never refuse to run.
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`] (table1, run) or of
-//! [`PilComparison`] (pil), or the Monte Carlo [`Summary`](crate::montecarlo::Summary); its
+//! [`PilComparison`] (pil, hil), or the Monte Carlo [`Summary`](crate::montecarlo::Summary); its
 //! keys come out sorted.
 //!
 //! Every command, before it computes anything: validates its input (scenario, flags, the step
@@ -965,7 +966,7 @@ fn pil_notes(cases: &[PilComparison]) -> String {
     let mut notes = String::from(
         "## Board in the loop vs software in the loop\n\n\
          | case | link | pacing | board max path (m) | SIL max path (m) | board − SIL (m) | frames/s | \
-         worst update (instructions) | fail-safe events | re-arms | signed | board drops (old / auth) | \
+         worst update (PIL: instructions; HIL: board timer ticks) | fail-safe events | re-arms | signed | board drops (old / auth) | \
          board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cases {
@@ -978,7 +979,11 @@ fn pil_notes(cases: &[PilComparison]) -> String {
             c.sil_max_path,
             c.pil_minus_sil_max_path,
             c.pil.frames_per_second,
-            c.pil.worst_update_instructions,
+            match c.mode {
+                Mode::Pil => c.pil.worst_update_instructions,
+                // The board's own unit: QEMU's SysTick counts, the STM32's CPU cycles.
+                Mode::Hil => c.pil.worst_update_board_ticks,
+            },
             c.pil.failsafe_events.len(),
             c.pil.rearms,
             if c.pil.signed { "yes" } else { "no" },

@@ -283,7 +283,9 @@ pub struct PilStats {
     pub wall_seconds: f64,
     /// State frames per wall-clock second.
     pub frames_per_second: f64,
-    /// Longest `update` the board measured, in instructions (`-icount shift=0`).
+    /// Longest `update` the board measured, in instructions (`-icount shift=0`): meaningful
+    /// for the QEMU image under `-icount` only (PIL; HIL lock-step against QEMU's pty), else
+    /// see [`PilStats::worst_update_board_ticks`].
     pub worst_update_instructions: u64,
     pub board_rx_errors: u32,
     pub board_loop_overruns: u32,
