@@ -17,6 +17,8 @@
 //! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale |
 //! | [`real`] | the real vehicle's six missions (`scenarios/real/`) and the paper's through the real chain |
 //! | [`pil`] | processor and hardware in the loop: the firmware in QEMU or on a board flies the plant; PIL/HIL vs SIL |
+//! | [`pacing`] | lock-step or real time, and a real-time run's timing figures |
+//! | [`qemu`] | the QEMU image as a board in the loop: on a socket or a pty |
 //! | [`transport`] | the byte transport under the board link: TCP socket or serial port |
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box |
 //! | [`output`] | CSV, plots, report |
@@ -30,11 +32,13 @@ pub mod link;
 pub mod metrics;
 pub mod montecarlo;
 pub mod output;
+pub mod pacing;
 pub mod paper;
 pub mod pil;
 pub mod plant;
 pub mod preflight;
 pub mod progress;
+pub mod qemu;
 pub mod real;
 pub mod record;
 pub mod scenario;

@@ -17,7 +17,9 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-use host_sim::pil::{Mode, Pacing, PilComparison, QemuPty};
+use host_sim::pacing::Pacing;
+use host_sim::pil::{Mode, PilComparison};
+use host_sim::qemu::QemuPty;
 use host_sim::record::Cases;
 
 use crate::ci::Ci;
