@@ -3,18 +3,38 @@
 # decodes its defmt log. Exit status: QEMU's (semihosting exit code), 124 on timeout (a hang).
 #
 #   QEMU_TIMEOUT   seconds before a run counts as hung (default 120)
-#   QEMU_SERIAL    QEMU -serial argument for UART0, the navigation link (default: none)
+#   QEMU_SERIAL    QEMU -serial argument for UART0, the navigation link (default: none);
+#                  `pty` puts it on a pseudo-terminal, named on stderr as
+#                  `qemu-run: UART0 on pty /dev/pts/N`: `host-sim hil --port` opens it (QEMU's
+#                  own `char device redirected to` line goes to stdout, into defmt-print)
+#   QEMU_PTY_LINK  with QEMU_SERIAL=pty: a symlink QEMU makes to the pty (default: a fresh
+#                  name under /tmp); it is removed when QEMU ends
+#   QEMU_ICOUNT    QEMU -icount argument (default shift=0: 1 instruction = 1 ns, deterministic
+#                  timings); `off` runs without it, so that the board's SysTick follows the
+#                  wall clock (`host-sim hil --pacing realtime` against QEMU)
 set -uo pipefail
 elf="$1"
 shift
+icount=(-icount "${QEMU_ICOUNT:-shift=0}")
+if [ "${QEMU_ICOUNT:-}" = off ]; then icount=(); fi
+serial=(-serial "${QEMU_SERIAL:-none}")
+if [ "${QEMU_SERIAL:-}" = pty ]; then
+  link="${QEMU_PTY_LINK:-$(mktemp -u /tmp/qemu-uart0.XXXXXX)}"
+  serial=(-chardev "pty,id=uart0,path=$link" -serial chardev:uart0)
+  # Name the pty on stderr once QEMU has made it (at most 30 s).
+  (for _ in $(seq 300); do
+     if [ -L "$link" ]; then echo "qemu-run: UART0 on pty $(readlink "$link") ($link)" >&2; exit 0; fi
+     sleep 0.1
+   done) &
+fi
 command -v qemu-system-arm >/dev/null || { echo "qemu-system-arm not found (see .ci/run)" >&2; exit 127; }
 command -v defmt-print >/dev/null || { echo "defmt-print not found: cargo install defmt-print --locked" >&2; exit 127; }
 # --foreground: stay in the caller's process group, so that stopping the runner stops QEMU.
 timeout --foreground "${QEMU_TIMEOUT:-120}" qemu-system-arm \
   -machine mps2-an386 -cpu cortex-m4 \
-  -nographic -monitor none -serial "${QEMU_SERIAL:-none}" \
+  -nographic -monitor none "${serial[@]}" \
   -semihosting-config enable=on,target=native \
-  -icount shift=0 \
+  "${icount[@]}" \
   -kernel "$elf" "$@" \
   | defmt-print -e "$elf"
 status=("${PIPESTATUS[@]}")

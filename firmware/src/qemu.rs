@@ -8,6 +8,14 @@
 //!   (see [`crate::qemu_clock`]).
 //! - Thrusters: the board has no PWM; [`MemPwm`] channels keep the commanded duty in RAM (they
 //!   implement `SetDutyCycle` like a real timer channel would).
+//! - Receive buffering: UART0 holds one received byte and raises no interrupt this board
+//!   uses, so while the loop waits for its period ([`QemuBoard::wait_period`]) it drains the
+//!   UART into a RAM queue ([`CmsdkUart::poll_rx`]), as the STM32's USART interrupt does into
+//!   its SPSC queue; the loop's reads take that queue first. Without it a free-running board
+//!   (`host-sim hil --pacing realtime`) read only the bytes that came while it pumped at the
+//!   start of a period — a few dozen — and fell further behind every period. Lock-step never
+//!   waits there (it polls the link itself), so PIL is unchanged. (Choice 71,
+//!   docs/design.md §21.)
 //! - No watchdog.
 //! - Configuration at boot: QEMU's semihosting command line (`-append "…"`, see
 //!   [`command_line`]); the flying image takes its link key from it ([`link_key`]), the
@@ -101,16 +109,22 @@ const BAUDDIV: usize = 0x10;
 const STATE_TX_FULL: u32 = 1 << 0;
 const STATE_RX_FULL: u32 = 1 << 1;
 
-/// CMSDK APB UART as an `embedded_io` serial port.
+/// CMSDK APB UART as an `embedded_io` serial port, with a software receive queue.
 pub struct CmsdkUart {
     base: usize,
+    /// Bytes taken from the UART while the loop waited ([`CmsdkUart::poll_rx`]), in order,
+    /// before any still in the UART. As large as the STM32's receive queue.
+    rx: heapless::Deque<u8, { crate::serial::RX_CAPACITY }>,
 }
 
 impl CmsdkUart {
     /// # Safety
     /// `base` must be the address of a CMSDK UART owned by nobody else.
     unsafe fn new(base: usize, baud: u32) -> Self {
-        let u = CmsdkUart { base };
+        let u = CmsdkUart {
+            base,
+            rx: heapless::Deque::new(),
+        };
         // SAFETY: registers of a UART the caller gives us exclusive use of.
         unsafe {
             write_volatile((base + BAUDDIV) as *mut u32, CORE_HZ / baud);
@@ -123,6 +137,14 @@ impl CmsdkUart {
         // SAFETY: a register of our UART.
         unsafe { read_volatile((self.base + off) as *const u32) }
     }
+
+    /// Moves every byte the UART holds into the receive queue (while it has room: a full
+    /// queue leaves the rest in the UART, as flow control would).
+    pub fn poll_rx(&mut self) {
+        while !self.rx.is_full() && self.reg(STATE) & STATE_RX_FULL != 0 {
+            let _ = self.rx.push_back(self.reg(DATA) as u8);
+        }
+    }
 }
 
 impl ErrorType for CmsdkUart {
@@ -131,7 +153,7 @@ impl ErrorType for CmsdkUart {
 
 impl ReadReady for CmsdkUart {
     fn read_ready(&mut self) -> Result<bool, Infallible> {
-        Ok(self.reg(STATE) & STATE_RX_FULL != 0)
+        Ok(!self.rx.is_empty() || self.reg(STATE) & STATE_RX_FULL != 0)
     }
 }
 
@@ -141,8 +163,20 @@ impl Read for CmsdkUart {
         if buf.is_empty() {
             return Ok(0);
         }
-        while self.reg(STATE) & STATE_RX_FULL == 0 {}
         let mut n = 0;
+        while n < buf.len() {
+            match self.rx.pop_front() {
+                Some(b) => {
+                    buf[n] = b;
+                    n += 1;
+                }
+                None => break,
+            }
+        }
+        if n > 0 {
+            return Ok(n);
+        }
+        while self.reg(STATE) & STATE_RX_FULL == 0 {}
         while n < buf.len() && self.reg(STATE) & STATE_RX_FULL != 0 {
             buf[n] = self.reg(DATA) as u8;
             n += 1;
@@ -258,10 +292,13 @@ impl Board for QemuBoard {
     /// which feeds UART0's bytes, waiting for its lock (PIL's arming handshake, which runs on
     /// these periods, then timed out on an idle host). The boundary is seen at most that many
     /// cycles late; what the loop does with it does not change.
+    ///
+    /// Between two reads of the flag it drains UART0 into its receive queue (module docs).
     fn wait_period(&mut self) -> bool {
         let overrun = self.period_elapsed();
         if !overrun {
             while !self.period_elapsed() {
+                self.uart.poll_rx();
                 cortex_m::asm::delay(WAIT_POLL_CYCLES);
             }
         }

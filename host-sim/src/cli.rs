@@ -8,6 +8,7 @@
 //! host-sim table1 [--json] [--out DIR]
 //! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
 //! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
+//! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
 //! ```
@@ -18,7 +19,7 @@
 //! each mission, one line each, and put it in the report; they never refuse to run.
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`] (table1, run) or of
-//! [`PilComparison`] (pil), or the Monte Carlo [`Summary`](crate::montecarlo::Summary); its
+//! [`PilComparison`] (pil, hil), or the Monte Carlo [`Summary`](crate::montecarlo::Summary); its
 //! keys come out sorted.
 //!
 //! Every command, before it computes anything: validates its input (scenario, flags, the step
@@ -58,7 +59,7 @@ use crate::interrupt;
 use crate::montecarlo::{self, MonteCarloOptions, MAX_RUNS};
 use crate::output::{self, atomic, CsvStream, OutputDir, RealRow, ReportRow};
 use crate::paper;
-use crate::pil::{BoardInTheLoop, PilComparison};
+use crate::pil::{BoardInTheLoop, Mode, Pacing, PilComparison};
 use crate::preflight::{self, Preflight, DEFAULT_MARGIN};
 use crate::progress::Progress;
 use crate::real;
@@ -166,10 +167,9 @@ pub struct CheckArgs {
     pub margin: f64,
 }
 
-/// `pil`: processor in the loop. The firmware ELF in QEMU flies the simulated vehicle over a
-/// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).
+/// What `pil` and `hil` share: the missions, the link faults and key, the outputs.
 #[derive(Args, Clone, Debug, PartialEq)]
-pub struct PilArgs {
+pub struct LoopArgs {
     #[arg(long, conflicts_with = "table1")]
     pub scenario: Option<PathBuf>,
     /// The six Table-1 missions (with Δu).
@@ -177,15 +177,9 @@ pub struct PilArgs {
     pub table1: bool,
     #[arg(long)]
     pub json: bool,
-    #[arg(long, default_value = "runs/pil")]
-    pub out: PathBuf,
-    /// Firmware ELF: the QEMU flying image [default:
-    /// target/thumbv7em-none-eabihf/release/firmware-qemu].
-    #[arg(long)]
-    pub elf: Option<PathBuf>,
     /// Sign the link with this key file (`#` comment lines, then 64 hex digits; e.g.
-    /// firmware/ci-test-link-key.hex): the board is started with it, and both ends refuse
-    /// unsigned frames. Without it the link is unsigned.
+    /// firmware/ci-test-link-key.hex): both ends refuse unsigned frames (`pil` starts the
+    /// board with it; a real board has its own compiled in). Without it the link is unsigned.
     #[arg(long)]
     pub link_key_file: Option<PathBuf>,
     /// Override the scenario's duration (s); the scenario's limits apply to it.
@@ -208,6 +202,49 @@ pub struct PilArgs {
     /// Run beyond the step cap (see `run --help`).
     #[arg(long)]
     pub allow_long_run: bool,
+}
+
+/// `pil`: processor in the loop. The firmware ELF in QEMU flies the simulated vehicle over a
+/// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct PilArgs {
+    #[command(flatten)]
+    pub common: LoopArgs,
+    #[arg(long, default_value = "runs/pil")]
+    pub out: PathBuf,
+    /// Firmware ELF: the QEMU flying image [default:
+    /// target/thumbv7em-none-eabihf/release/firmware-qemu].
+    #[arg(long)]
+    pub elf: Option<PathBuf>,
+}
+
+/// The STM32 board's link baud rate (firmware/src/stm32f405.rs), `hil`'s default.
+pub const DEFAULT_HIL_BAUD: u32 = 460_800;
+
+/// `hil`'s default reply timeout (s): a board answers every period (10 ms at 100 Hz).
+pub const DEFAULT_HIL_REPLY_TIMEOUT: f64 = 5.0;
+
+/// `hil`: hardware in the loop. The board on a serial port (a USB-serial adapter, or QEMU's
+/// `-serial pty`) flies the simulated vehicle; compared with SIL. Link faults as `pil`.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct HilArgs {
+    /// The serial device of the board's link (e.g. /dev/ttyUSB0, or QEMU's /dev/pts/N).
+    #[arg(long)]
+    pub port: String,
+    /// Baud rate (8N1, no flow control); the STM32 board's is 460800.
+    #[arg(long, default_value_t = DEFAULT_HIL_BAUD)]
+    pub baud: u32,
+    /// lockstep: the board runs a period per state frame (as PIL; equals SIL); realtime: the
+    /// board runs on its own timer and the host flies the plant in wall-clock time.
+    #[arg(long, value_enum, default_value_t = Pacing::Lockstep)]
+    pub pacing: Pacing,
+    /// Seconds without valid telemetry after which the run stops (a silent or garbled link).
+    #[arg(long, default_value_t = DEFAULT_HIL_REPLY_TIMEOUT)]
+    pub reply_timeout: f64,
+    #[command(flatten)]
+    pub common: LoopArgs,
+    #[arg(long, default_value = "runs/hil")]
+    pub out: PathBuf,
 }
 
 /// `monte-carlo`: draws the Table-3 parameters uniformly in their box, runs in parallel,
@@ -676,9 +713,10 @@ fn workspace_root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
 }
 
-/// `pil`. Exits 1 if a run diverged, or if a run without link faults differs from SIL by more
-/// than [`PIL_SIL_TOLERANCE`](crate::pil::PIL_SIL_TOLERANCE).
-pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
+/// The scenarios of a `pil` or `hil` run: the flags override the duration and add to each
+/// scenario's [link_faults]; every check of the scenario (duration, step cap) applies to the
+/// result.
+fn loop_scenarios(args: &LoopArgs) -> Result<Vec<Scenario>> {
     let base: Vec<Scenario> = match (&args.scenario, args.table1) {
         (Some(p), false) => vec![load(p, args.allow_long_run)?],
         (None, true) => Table1Case::ALL
@@ -687,8 +725,6 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
             .collect::<Result<_, _>>()?,
         _ => bail!("give --scenario FILE or --table1"),
     };
-    // The flags override the duration and add to the scenario's [link_faults]; every check of
-    // the scenario (duration, step cap) applies to the result.
     let mut scenarios = Vec::with_capacity(base.len());
     for s in &base {
         let changed = s.with(|c| {
@@ -712,6 +748,32 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
             None => s.config().name.clone(),
         })?);
     }
+    Ok(scenarios)
+}
+
+/// The link key of `--link-key-file`, if given.
+fn link_key(args: &LoopArgs) -> Result<Option<auv_link::sign::LinkKey>> {
+    let Some(p) = &args.link_key_file else {
+        return Ok(None);
+    };
+    let text = std::fs::read_to_string(p)
+        .with_context(|| format!("reading the link key file {}", p.display()))?;
+    Ok(Some(
+        auv_link::sign::LinkKey::from_key_file(&text)
+            .map_err(|e| anyhow!("{}: {e}", p.display()))?,
+    ))
+}
+
+/// A board connected for one scenario, and the log of its emulator (kept whatever happens).
+struct Started {
+    board: BoardInTheLoop,
+    log: Option<(atomic::Pending, PathBuf)>,
+}
+
+/// `pil`. Exits 1 if a run diverged, or if a run without link faults differs from SIL by more
+/// than [`PIL_SIL_TOLERANCE`](crate::pil::PIL_SIL_TOLERANCE).
+pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    let scenarios = loop_scenarios(&args.common)?;
     let root = workspace_root();
     let elf = args
         .elf
@@ -719,68 +781,148 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .unwrap_or_else(|| crate::pil::default_elf(&root));
     crate::pil::check_flying_image(&elf).map_err(|e| anyhow!(e))?;
     let runner = root.join("scripts/qemu-run.sh");
-    let key = match &args.link_key_file {
-        None => None,
-        Some(p) => {
-            let text = std::fs::read_to_string(p)
-                .with_context(|| format!("reading the link key file {}", p.display()))?;
-            Some(
-                auv_link::sign::LinkKey::from_key_file(&text)
-                    .map_err(|e| anyhow!("{}: {e}", p.display()))?,
-            )
-        }
-    };
+    let key = link_key(&args.common)?;
     let dir = OutputDir::prepare(&args.out)?;
-    // Each scenario runs twice: SIL, then PIL.
-    let progress = Progress::start("PIL", 2 * periods(&scenarios), !args.json);
+    fly(
+        &args.common,
+        &scenarios,
+        &dir,
+        Mode::Pil,
+        stdout,
+        |s: &Scenario, dir: &OutputDir| {
+            let cfg = s.config();
+            let log_path = dir.claim(&format!("{}-qemu.log", cfg.name))?;
+            let (log, log_file) = atomic::Pending::create(&log_path)
+                .with_context(|| format!("writing {}", log_path.display()))?;
+            match BoardInTheLoop::start(
+                &elf,
+                &runner,
+                s,
+                cfg.link_faults.clone(),
+                log_file,
+                &log_path,
+                key.as_ref(),
+            ) {
+                Ok(board) => Ok(Started {
+                    board,
+                    log: Some((log, log_path)),
+                }),
+                Err(e) => {
+                    // Keep QEMU's log: it says why.
+                    let _ = log.commit();
+                    bail!("{}: {e}", cfg.name);
+                }
+            }
+        },
+    )
+}
+
+/// `hil`. Exits 1 if a run diverged or lost its board, or if a lock-step run without link
+/// faults differs from SIL by more than [`PIL_SIL_TOLERANCE`](crate::pil::PIL_SIL_TOLERANCE);
+/// 2 if the port cannot be opened or the board never answers the set-up.
+pub fn hil(args: &HilArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    if !(args.reply_timeout.is_finite() && args.reply_timeout > 0.0 && args.reply_timeout <= 3600.0)
+    {
+        bail!(
+            "--reply-timeout must be a time in (0, 3600] s, got {}",
+            args.reply_timeout
+        );
+    }
+    if args.baud == 0 {
+        bail!("--baud must be a positive baud rate");
+    }
+    let scenarios = loop_scenarios(&args.common)?;
+    let key = link_key(&args.common)?;
+    let dir = OutputDir::prepare(&args.out)?;
+    let timeout = std::time::Duration::from_secs_f64(args.reply_timeout);
+    fly(
+        &args.common,
+        &scenarios,
+        &dir,
+        Mode::Hil,
+        stdout,
+        |s: &Scenario, _: &OutputDir| {
+            let cfg = s.config();
+            BoardInTheLoop::over_serial(
+                &args.port,
+                args.baud,
+                s,
+                cfg.link_faults.clone(),
+                args.pacing,
+                timeout,
+                key.as_ref(),
+            )
+            .map(|board| Started { board, log: None })
+            .map_err(|e| anyhow!("{}: {e}", cfg.name))
+        },
+    )
+}
+
+/// The runs of `pil` and `hil`: each scenario in SIL, then with the board `start` connects,
+/// compared; the report, and how the command ended. A run that loses its board keeps what it
+/// recorded (its CSV, its row in the report, marked diverged with the reason) and is named on
+/// stderr (**Choice 72**); a real-time run is compared with SIL but need not agree with it
+/// (**Choice 69**; docs/design.md §21).
+fn fly(
+    args: &LoopArgs,
+    scenarios: &[Scenario],
+    dir: &OutputDir,
+    mode: Mode,
+    stdout: &mut dyn Write,
+    mut start: impl FnMut(&Scenario, &OutputDir) -> Result<Started>,
+) -> Result<Exit> {
+    let (name, title) = match mode {
+        Mode::Pil => ("PIL", "AUV-150 processor in the loop (firmware in QEMU)"),
+        Mode::Hil => (
+            "HIL",
+            "AUV-150 hardware in the loop (board on a serial port)",
+        ),
+    };
+    // Each scenario runs twice: SIL, then on the board.
+    let progress = Progress::start(name, 2 * periods(scenarios), !args.json);
     let incomplete = Incomplete::default();
     let mut cases = Vec::new();
     let mut runs = Vec::new();
     let mut failed = false;
-    for s in &scenarios {
+    for s in scenarios {
         if interrupt::requested() {
             break;
         }
         let cfg = s.config();
         let sil_run = sil::run_observed(s, &mut LocalController::new(s), &mut progress.observer());
-        let log_path = dir.claim(&format!("{}-qemu.log", cfg.name))?;
-        let (log, log_file) = atomic::Pending::create(&log_path)
-            .with_context(|| format!("writing {}", log_path.display()))?;
-        let started = BoardInTheLoop::start(
-            &elf,
-            &runner,
-            s,
-            cfg.link_faults.clone(),
-            log_file,
-            &log_path,
-            key.as_ref(),
-        );
-        let mut board = match started {
-            Ok(b) => b,
-            Err(e) => {
-                // Keep QEMU's log: it says why.
-                let _ = log.commit();
-                bail!("{}: {e}", cfg.name);
-            }
-        };
-        let pil_run = run_into(&dir, s, &mut board, &progress, &incomplete);
+        let Started { mut board, log } = start(s, dir)?;
+        let board_run = run_into(dir, s, &mut board, &progress, &incomplete);
         let stats = board.finish();
-        if let Err(e) = log.commit() {
-            incomplete.push(format!("{} was not written: {e}", log_path.display()));
+        if let Some((log, log_path)) = log {
+            if let Err(e) = log.commit() {
+                incomplete.push(format!("{} was not written: {e}", log_path.display()));
+            }
         }
-        let c = PilComparison::new(&pil_run, &sil_run, stats);
-        let interrupted = sil_run.interrupted() || pil_run.interrupted();
-        failed |= pil_run.diverged() || (cfg.link_faults.is_empty() && !interrupted && !c.agrees());
+        if let Some(d) = board_run.summary().diverged {
+            eprintln!(
+                "host-sim: error: {name} {}: stopped at t = {:.2} s: {} (what was recorded is kept in {})",
+                cfg.name,
+                d.t,
+                d.reason,
+                dir.path().display()
+            );
+        }
+        let c = PilComparison::new(&board_run, &sil_run, stats, mode);
+        let interrupted = sil_run.interrupted() || board_run.interrupted();
+        // Real time does not repeat SIL (the board's clock, the link's latency): compared,
+        // not required to agree.
+        let must_agree = c.pil.pacing == Pacing::Lockstep && cfg.link_faults.is_empty();
+        failed |= board_run.diverged() || (must_agree && !interrupted && !c.agrees());
         cases.push(c);
-        runs.push(pil_run);
+        runs.push(board_run);
     }
     progress.finish();
     let notes = pil_notes(&cases);
     let rows: Vec<ReportRow> = runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
     let report = output::write_plots_and_report(
-        &dir,
-        "AUV-150 processor in the loop (firmware in QEMU)",
+        dir,
+        title,
         &rows,
         "",
         &[],
@@ -819,23 +961,29 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     Ok(exit)
 }
 
-/// The report's PIL-vs-SIL section.
+/// The report's PIL-vs-SIL section (HIL's too), and the timing of real-time runs.
 fn pil_notes(cases: &[PilComparison]) -> String {
     let mut notes = String::from(
-        "## Processor in the loop vs software in the loop\n\n\
-         | case | PIL max path (m) | SIL max path (m) | PIL − SIL (m) | frames/s | worst update \
-         (instructions) | fail-safe events | re-arms | signed | board drops (old / auth) | \
-         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
+        "## Board in the loop vs software in the loop\n\n\
+         | case | link | pacing | board max path (m) | SIL max path (m) | board − SIL (m) | frames/s | \
+         worst update (PIL: instructions; HIL: board timer ticks) | fail-safe events | re-arms | signed | board drops (old / auth) | \
+         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cases {
         notes += &format!(
-            "| {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
+            "| {} | {} | {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
             c.run.name,
+            c.pil.link,
+            c.pil.pacing.as_str(),
             c.run.metrics.max_path,
             c.sil_max_path,
             c.pil_minus_sil_max_path,
             c.pil.frames_per_second,
-            c.pil.worst_update_instructions,
+            match c.mode {
+                Mode::Pil => c.pil.worst_update_instructions,
+                // The board's own unit: QEMU's SysTick counts, the STM32's CPU cycles.
+                Mode::Hil => c.pil.worst_update_board_ticks,
+            },
             c.pil.failsafe_events.len(),
             c.pil.rearms,
             if c.pil.signed { "yes" } else { "no" },
@@ -846,6 +994,16 @@ fn pil_notes(cases: &[PilComparison]) -> String {
                 None => c.pil.board_refused_commands.to_string(),
             },
         );
+    }
+    let realtime: Vec<_> = cases
+        .iter()
+        .filter_map(|c| c.pil.realtime.as_ref().map(|r| (c, r)))
+        .collect();
+    if !realtime.is_empty() {
+        notes += "\n### Real-time pacing (docs/design.md §21)\n\n";
+        for (c, r) in realtime {
+            notes += &format!("- {}: {r}\n", c.run.name);
+        }
     }
     notes
 }

@@ -16,7 +16,10 @@
 //! | [`paper`] | the paper's Table 1: cases, profiles, its numbers, notes, the twelve runs |
 //! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale |
 //! | [`real`] | the real vehicle's six missions (`scenarios/real/`) and the paper's through the real chain |
-//! | [`pil`] | processor in the loop: the firmware in QEMU flies the plant; PIL vs SIL |
+//! | [`pil`] | processor and hardware in the loop: the firmware in QEMU or on a board flies the plant; PIL/HIL vs SIL |
+//! | [`pacing`] | lock-step or real time, and a real-time run's timing figures |
+//! | [`qemu`] | the QEMU image as a board in the loop: on a socket or a pty |
+//! | [`transport`] | the byte transport under the board link: TCP socket or serial port |
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box |
 //! | [`output`] | CSV, plots, report |
 //! | [`cli`] | the `host-sim` commands |
@@ -29,12 +32,15 @@ pub mod link;
 pub mod metrics;
 pub mod montecarlo;
 pub mod output;
+pub mod pacing;
 pub mod paper;
 pub mod pil;
 pub mod plant;
 pub mod preflight;
 pub mod progress;
+pub mod qemu;
 pub mod real;
 pub mod record;
 pub mod scenario;
 pub mod sil;
+pub mod transport;

@@ -8,7 +8,7 @@
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cli::{self, CheckArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args};
+use host_sim::cli::{self, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args};
 
 #[derive(Parser)]
 #[command(
@@ -30,6 +30,10 @@ enum Command {
     /// Processor in the loop: the firmware ELF in QEMU flies the simulated vehicle over a
     /// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).
     Pil(PilArgs),
+    /// Hardware in the loop: the board on a serial port (USB-serial adapter, or QEMU's
+    /// `-serial pty`) flies the simulated vehicle, lock-stepped or in real time; compared
+    /// with SIL. Link faults as `pil`.
+    Hil(HilArgs),
     /// Preflight: can the real thrusters fly this scenario (every corner of the parameter box,
     /// the board's allocator, a margin of the envelope), and if not, at what time scale?
     /// Simulates nothing. Exit 0 feasible, 1 infeasible, 2 bad input.
@@ -51,6 +55,7 @@ fn main() -> ExitCode {
         Command::Table1(args) => cli::table1(&args, stdout),
         Command::Run(args) => cli::run(&args, stdout),
         Command::Pil(args) => cli::pil(&args, stdout),
+        Command::Hil(args) => cli::hil(&args, stdout),
         Command::MonteCarlo(args) => cli::monte_carlo(&args, stdout),
         Command::Check(args) => cli::check(&args, stdout),
     };

@@ -26,12 +26,22 @@
 //! the board drops (off its mission clock). Once the link is healthy again the simulator
 //! re-arms it (disarm, arm, and start the mission again where it is, since disarming drops it)
 //! and it must resume. Every fail-safe entry and exit is recorded.
+//!
+//! Hardware in the loop (`host-sim hil`) is the same runner over another byte transport
+//! ([`crate::transport`]): a serial device instead of QEMU's socket ([`BoardInTheLoop::over_serial`]).
+//! It paces the run one of two ways ([`Pacing`], docs/design.md §21): lock-step, exactly the
+//! protocol above; or real time, where the board runs on its own timer (`lockstep = false`)
+//! and the host sends each state frame at its wall-clock period and flies the plant on the
+//! newest telemetry it has when the next period is due ([`RealTimeStats`]).
+//!
+//! Every wait is bounded: no valid telemetry for the reply timeout (10 s for PIL,
+//! `hil --reply-timeout`) ends the run with a message that says whether the board sent
+//! nothing (not powered, not wired, wrong port) or only bytes that did not decode (a wrong
+//! baud rate or key); a link that closes or a port that goes away ends it at once.
 
-use std::io::{Read, Write};
-use std::net::{TcpListener, TcpStream};
-use std::os::unix::process::CommandExt;
+use std::net::TcpListener;
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::Child;
 use std::time::{Duration, Instant};
 
 use auv_link::seq::SeqCheck;
@@ -46,9 +56,20 @@ use serde::{Deserialize, Serialize};
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 
 use crate::config::LinkFaults;
+use crate::pacing::RealTime;
+pub use crate::pacing::{Pacing, RealTimeStats};
+use crate::qemu::{spawn_qemu, stop_group};
 use crate::record::{ControlStatus, RunResult, RunSummary};
 use crate::scenario::Scenario;
 use crate::sil::{ControlOut, ControlSource};
+use crate::transport::{Serial, Transport};
+
+/// How long PIL waits for valid telemetry before it gives up on QEMU (an idle QEMU under
+/// `-icount` on a loaded host is slow; the board itself answers every period).
+pub const PIL_REPLY_TIMEOUT: Duration = Duration::from_secs(10);
+
+/// The longest single read: the runner checks its deadlines at least this often.
+const READ_SLICE: Duration = Duration::from_millis(100);
 
 /// Largest |PIL − SIL| of the max path error (m) that a fault-free PIL run may show: 1 mm.
 /// PIL equals SIL bit for bit today (the same f32 core, the same state frames); this is the
@@ -85,7 +106,9 @@ pub struct PilStats {
     pub wall_seconds: f64,
     /// State frames per wall-clock second.
     pub frames_per_second: f64,
-    /// Longest `update` the board measured, in instructions (`-icount shift=0`).
+    /// Longest `update` the board measured, in instructions (`-icount shift=0`): meaningful
+    /// for the QEMU image under `-icount` only (PIL; HIL lock-step against QEMU's pty), else
+    /// see [`PilStats::worst_update_board_ticks`].
     pub worst_update_instructions: u64,
     pub board_rx_errors: u32,
     pub board_loop_overruns: u32,
@@ -114,6 +137,19 @@ pub struct PilStats {
     pub board_thrust_unit: Option<String>,
     #[serde(default)]
     pub board_reversed_thrusters: Option<u8>,
+    /// The longest `update` in the board's own timer unit (QEMU: SysTick counts of
+    /// `INSTRUCTIONS_PER_TICK` instructions; the STM32: CPU cycles at 168 MHz).
+    #[serde(default)]
+    pub worst_update_board_ticks: u64,
+    /// What carried the link: `"tcp"` (PIL) or the serial port and its baud rate.
+    #[serde(default)]
+    pub link: String,
+    /// How the run was paced.
+    #[serde(default)]
+    pub pacing: Pacing,
+    /// The timing of a real-time run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub realtime: Option<RealTimeStats>,
 }
 
 impl FailSafeEventKind {
@@ -126,11 +162,13 @@ impl FailSafeEventKind {
     }
 }
 
-/// What a comparison is of: always `"pil"` (processor in the loop against SIL).
+/// What a comparison is of: `"pil"` (processor in the loop, QEMU on a socket) or `"hil"`
+/// (the board on a serial port), against SIL.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Mode {
     Pil,
+    Hil,
 }
 
 /// One PIL run compared with SIL: an entry of `host-sim pil --json`'s `cases` (read it back
@@ -151,11 +189,11 @@ pub struct PilComparison {
 }
 
 impl PilComparison {
-    /// The comparison of a PIL run with the SIL run of the same scenario.
-    pub fn new(pil_run: &RunResult, sil_run: &RunResult, stats: PilStats) -> Self {
+    /// The comparison of a PIL (or HIL: `mode`) run with the SIL run of the same scenario.
+    pub fn new(pil_run: &RunResult, sil_run: &RunResult, stats: PilStats, mode: Mode) -> Self {
         PilComparison {
             run: pil_run.summary(),
-            mode: Mode::Pil,
+            mode,
             sil_max_path: sil_run.metrics.max_path,
             pil_minus_sil_max_path: pil_run.metrics.max_path - sil_run.metrics.max_path,
             pil: stats,
@@ -169,10 +207,24 @@ impl PilComparison {
     }
 }
 
-/// The firmware in QEMU, on a socket.
+/// A board in the loop: the firmware in QEMU on a socket (PIL), or a board on a serial port
+/// (HIL; the board may be QEMU's on a pty).
 pub struct BoardInTheLoop {
-    child: Child,
-    stream: TcpStream,
+    /// QEMU, when this runner started it (ended with the run).
+    child: Option<Child>,
+    stream: Box<dyn Transport>,
+    pacing: Pacing,
+    /// Real-time pacing's clock and figures.
+    rt: Option<RealTime>,
+    /// No valid telemetry for this long ends the run.
+    reply_timeout: Duration,
+    /// When valid telemetry last arrived, and what came since (bytes, refused frames).
+    heard: Instant,
+    noise_bytes: u64,
+    noise_refused: u64,
+    read_timeout: Duration,
+    /// The newest telemetry (real time: what the thrusters apply when a reply is late).
+    latest: Option<Telemetry>,
     decoder: FrameDecoder,
     /// Signing on: signs every frame sent.
     signer: Option<Signer>,
@@ -194,7 +246,8 @@ pub struct BoardInTheLoop {
     needs_rearm: bool,
     t0: Instant,
     pub stats: PilStats,
-    log_path: PathBuf,
+    /// Where to look when the link fails (QEMU's log, or the serial port).
+    context: String,
 }
 
 impl BoardInTheLoop {
@@ -213,37 +266,17 @@ impl BoardInTheLoop {
         key: Option<&LinkKey>,
     ) -> Result<Self, String> {
         check_flying_image(elf)?;
-        let c = scenario.controller().config();
-        // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
-        let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
-            "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
-        })?;
-        let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let listener = TcpListener::bind("127.0.0.1:0")
             .map_err(|e| format!("binding a loopback port: {e}"))?;
         let port = listener.local_addr().map_err(|e| e.to_string())?.port();
-        let log_err = log.try_clone().map_err(|e| e.to_string())?;
-        let mut qemu = Command::new("bash");
-        qemu
-            // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
-            // under `timeout`, two processes down).
-            .process_group(0)
-            .arg(runner)
-            .arg(elf);
-        if let Some(k) = key {
-            // The QEMU image's provisioning (firmware::qemu::link_key); visible to this
-            // machine's process list, which is acceptable for a simulator's key.
-            let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
-            qemu.arg("-append").arg(format!("link-key={hex}"));
-        }
-        let child = qemu
-            .env("QEMU_SERIAL", format!("tcp:127.0.0.1:{port},nodelay=on"))
-            .env("QEMU_TIMEOUT", "3600")
-            .stdin(Stdio::null())
-            .stdout(Stdio::from(log))
-            .stderr(Stdio::from(log_err))
-            .spawn()
-            .map_err(|e| format!("starting QEMU through {}: {e}", runner.display()))?;
+        let mut child = spawn_qemu(
+            elf,
+            runner,
+            &format!("tcp:127.0.0.1:{port},nodelay=on"),
+            Pacing::Lockstep,
+            log,
+            key,
+        )?;
         listener.set_nonblocking(true).map_err(|e| e.to_string())?;
         let deadline = Instant::now() + Duration::from_secs(30);
         let stream = loop {
@@ -251,6 +284,7 @@ impl BoardInTheLoop {
                 Ok((s, _)) => break s,
                 Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
                     if Instant::now() > deadline {
+                        stop_group(&mut child);
                         return Err(format!(
                             "QEMU did not connect its UART within 30 s (see {})",
                             log_path.display()
@@ -258,17 +292,89 @@ impl BoardInTheLoop {
                     }
                     std::thread::sleep(Duration::from_millis(20));
                 }
-                Err(e) => return Err(format!("accepting QEMU's UART: {e}")),
+                Err(e) => {
+                    stop_group(&mut child);
+                    return Err(format!("accepting QEMU's UART: {e}"));
+                }
             }
         };
         stream.set_nonblocking(false).map_err(|e| e.to_string())?;
         stream.set_nodelay(true).map_err(|e| e.to_string())?;
-        stream
-            .set_read_timeout(Some(Duration::from_secs(10)))
-            .map_err(|e| e.to_string())?;
+        Self::connect(
+            Box::new(stream),
+            Some(child),
+            "tcp".to_string(),
+            format!("see {}", log_path.display()),
+            scenario,
+            faults,
+            Pacing::Lockstep,
+            PIL_REPLY_TIMEOUT,
+            key,
+        )
+    }
+
+    /// Hardware in the loop: the board on the serial device `port` at `baud` (a USB-serial
+    /// adapter, or QEMU's `-serial pty`), configured and armed as [`BoardInTheLoop::start`]
+    /// does, paced by `pacing`. No valid telemetry for `reply_timeout` ends the set-up or the
+    /// run with a message that says what came instead.
+    pub fn over_serial(
+        port: &str,
+        baud: u32,
+        scenario: &Scenario,
+        faults: LinkFaults,
+        pacing: Pacing,
+        reply_timeout: Duration,
+        key: Option<&LinkKey>,
+    ) -> Result<Self, String> {
+        let serial = Serial::open(port, baud)?;
+        Self::connect(
+            Box::new(serial),
+            None,
+            format!("{port} at {baud} baud"),
+            format!("serial port {port} at {baud} baud"),
+            scenario,
+            faults,
+            pacing,
+            reply_timeout,
+            key,
+        )
+    }
+
+    /// The set-up over an open transport (module docs): the first telemetry, then disarm,
+    /// the configuration and arming, until the board reports itself armed.
+    ///
+    /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
+    /// from a run before, and refuses a configuration while armed), and take `Armed` only
+    /// from telemetry whose `last_rx_seq` is the `Arm`'s.
+    #[allow(clippy::too_many_arguments)]
+    fn connect(
+        stream: Box<dyn Transport>,
+        child: Option<Child>,
+        link: String,
+        context: String,
+        scenario: &Scenario,
+        faults: LinkFaults,
+        pacing: Pacing,
+        reply_timeout: Duration,
+        key: Option<&LinkKey>,
+    ) -> Result<Self, String> {
+        let c = scenario.controller().config();
+        // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
+        let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
+            "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
+        })?;
+        let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let mut b = BoardInTheLoop {
             child,
             stream,
+            pacing,
+            rt: (pacing == Pacing::Realtime).then(|| RealTime::new(c.rate_hz)),
+            reply_timeout,
+            heard: Instant::now(),
+            noise_bytes: 0,
+            noise_refused: 0,
+            read_timeout: Duration::ZERO,
+            latest: None,
             decoder: match key {
                 Some(k) => FrameDecoder::signed(Verifier::new(k, Direction::FromBoard)),
                 None => FrameDecoder::new(),
@@ -289,9 +395,11 @@ impl BoardInTheLoop {
             t0: Instant::now(),
             stats: PilStats {
                 signed: key.is_some(),
+                link,
+                pacing,
                 ..PilStats::default()
             },
-            log_path: log_path.to_path_buf(),
+            context,
         };
         // Continue the board's numbering: a board that already heard a runner (this one
         // restarted) drops frames numbered at or before its last (auv_link::seq).
@@ -300,19 +408,25 @@ impl BoardInTheLoop {
             b.seq = first.last_rx_seq.wrapping_add(1);
         }
         let refused_before = first.refused_commands;
+        // A board that flew before (a bench board between runs) may still be armed, and
+        // refuses a configuration while armed: disarm it first (a fresh board is disarmed
+        // already; disarming is never refused).
+        b.send(Msg::Command(LinkCommand::Disarm))?;
         b.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
             rate_hz: Some(c.rate_hz),
             robust: Some(c.robust),
             delta_max: Some(c.delta_max),
             voltage_limit: Some(c.voltage_limit),
             stale_periods: Some(DEFAULT_STALE_PERIODS),
-            lockstep: Some(true),
+            lockstep: Some(pacing == Pacing::Lockstep),
             thrust_unit: Some(thrust_unit),
             reversed_thrusters: Some(mounting),
             priority: Some(c.priority.into()),
         })))?;
+        let arm_seq = b.seq;
         b.send(Msg::Command(LinkCommand::Arm))?;
-        // Wait until the board reports itself armed: the configuration and arming took.
+        // Wait until the board reports itself armed after it took the arming (an earlier
+        // frame of a board that was armed before says nothing of this set-up).
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
             let t = b.next_telemetry()?;
@@ -322,7 +436,7 @@ impl BoardInTheLoop {
                     t.last_refusal.map_or("(no reason)", |r| r.as_str())
                 ));
             }
-            if t.status == BoardStatus::Armed {
+            if t.status == BoardStatus::Armed && t.last_rx_seq == arm_seq {
                 if t.reversed_thrusters != mounting {
                     return Err(format!(
                         "the board flies thruster mounting {:#07b}, not the scenario's {mounting:#07b}",
@@ -330,6 +444,7 @@ impl BoardInTheLoop {
                     ));
                 }
                 b.check_unit(&t)?;
+                b.latest = Some(t);
                 break;
             }
             if Instant::now() > deadline {
@@ -378,34 +493,97 @@ impl BoardInTheLoop {
     }
 
     fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
-        self.stream.write_all(bytes).map_err(|e| {
+        self.stream
+            .write_frame(bytes)
+            .map_err(|e| self.lost(&e, "write"))
+    }
+
+    /// The message for a link that failed under a read or a write.
+    fn lost(&self, e: &std::io::Error, op: &str) -> String {
+        use std::io::ErrorKind;
+        // EIO: a tty whose other end (a pty's master, a USB adapter) is gone.
+        const EIO: i32 = 5;
+        let gone = e.raw_os_error() == Some(EIO)
+            || matches!(
+                e.kind(),
+                ErrorKind::UnexpectedEof | ErrorKind::BrokenPipe | ErrorKind::ConnectionReset
+            );
+        if gone {
             format!(
-                "board link write failed: {e} (see {})",
-                self.log_path.display()
+                "the board's link went away ({e}): the port was unplugged, the board lost power, or its emulator ended ({})",
+                self.context
             )
-        })
+        } else {
+            format!("board link {op} failed: {e} ({})", self.context)
+        }
+    }
+
+    /// Why no valid telemetry came for the reply timeout.
+    fn silence(&self) -> String {
+        let t = self.reply_timeout.as_secs_f64();
+        if self.noise_bytes == 0 {
+            format!(
+                "no telemetry from the board for {t:.1} s: it sent nothing ({}); is it powered, flashed with its flying image and wired (its TX to this end's RX, a common ground), and is this the right port?",
+                self.context
+            )
+        } else {
+            format!(
+                "no valid telemetry from the board for {t:.1} s: {} bytes came, and {} frames that did not decode ({}); a wrong baud rate (--baud; the STM32 board's is 460800), a wrong or missing link key (--link-key-file), or another device on this port",
+                self.noise_bytes, self.noise_refused, self.context
+            )
+        }
     }
 
     /// The next telemetry frame from the board (frames of other kinds are ignored).
     fn next_telemetry(&mut self) -> Result<Telemetry, String> {
+        loop {
+            if let Some(t) = self.poll_telemetry(None)? {
+                return Ok(t);
+            }
+        }
+    }
+
+    /// The next telemetry frame, or `None` once `until` has passed without one. No valid
+    /// telemetry for the reply timeout is an error ([`BoardInTheLoop::silence`]), whatever
+    /// `until` says (**Choice 64**, docs/design.md §21: every wait bounded, silence told from
+    /// noise).
+    fn poll_telemetry(&mut self, until: Option<Instant>) -> Result<Option<Telemetry>, String> {
         let mut chunk = [0u8; 512];
         loop {
             if let Some(t) = self.pending.pop_front() {
                 self.stats.telemetry_frames += 1;
-                return Ok(t);
+                self.heard = Instant::now();
+                self.noise_bytes = 0;
+                self.noise_refused = 0;
+                if let Some(rt) = &mut self.rt {
+                    rt.arrived(self.heard);
+                }
+                return Ok(Some(t));
             }
-            let n = self.stream.read(&mut chunk).map_err(|e| {
-                format!(
-                    "board link read failed: {e} (see {})",
-                    self.log_path.display()
-                )
-            })?;
-            if n == 0 {
-                return Err(format!(
-                    "QEMU closed the link (see {})",
-                    self.log_path.display()
-                ));
+            let now = Instant::now();
+            let silent_until = self.heard + self.reply_timeout;
+            if now >= silent_until {
+                return Err(self.silence());
             }
+            let mut wait = READ_SLICE.min(silent_until - now);
+            if let Some(u) = until {
+                if now >= u {
+                    return Ok(None);
+                }
+                wait = wait.min(u - now);
+            }
+            let wait = wait.max(Duration::from_millis(1));
+            if wait != self.read_timeout {
+                self.stream
+                    .set_read_timeout(wait)
+                    .map_err(|e| self.lost(&e, "set-up"))?;
+                self.read_timeout = wait;
+            }
+            let n = self
+                .stream
+                .read_some(&mut chunk)
+                .map_err(|e| self.lost(&e, "read"))?;
+            self.noise_bytes += n as u64;
             for &b in &chunk[..n] {
                 match self.decoder.push(b) {
                     None => {}
@@ -425,19 +603,127 @@ impl BoardInTheLoop {
                         ));
                     }
                     // Undecodable, badly signed, out of sequence, or not telemetry.
-                    Some(_) => self.stats.telemetry_refused += 1,
+                    Some(_) => {
+                        self.stats.telemetry_refused += 1;
+                        self.noise_refused += 1;
+                    }
                 }
             }
         }
     }
 
+    /// Appends this period's state frame to `out` — `frame`, or with a delay fault the one
+    /// from `delay_ticks` earlier, with a corruption fault a byte flipped — and returns the
+    /// sequence number the board's answer will name (none for a frame the board will refuse
+    /// or drop).
+    fn encode_state(
+        &mut self,
+        frame: StateFrame,
+        corrupt: bool,
+        delayed: bool,
+        out: &mut Vec<u8>,
+    ) -> Result<Option<u16>, String> {
+        let mut buf = [0u8; MAX_FRAME];
+        let sent = if delayed {
+            let i = self
+                .history
+                .len()
+                .saturating_sub(1 + self.faults.delay_ticks as usize);
+            self.history[i]
+        } else {
+            frame
+        };
+        // A corrupted frame is refused, and a delayed one holds an old state that the board
+        // drops as off its mission clock: neither is answered.
+        let expect = (!corrupt && !delayed).then_some(self.seq);
+        let n = self.encode(Msg::State(sent), &mut buf)?;
+        if corrupt {
+            buf[n / 2] ^= 0x5A;
+        }
+        out.extend_from_slice(&buf[..n]);
+        self.stats.state_frames_sent += 1;
+        Ok(expect)
+    }
+
     /// The telemetry of the board's next control period (later than any seen before).
     fn next_period(&mut self) -> Result<Telemetry, String> {
         loop {
-            let t = self.next_telemetry()?;
-            if self.last_tick.is_none_or(|last| t.tick > last) {
-                self.last_tick = Some(t.tick);
+            if let Some(t) = self.poll_period(None)? {
                 return Ok(t);
+            }
+        }
+    }
+
+    /// [`BoardInTheLoop::next_period`], or `None` once `until` has passed; in real time,
+    /// counts the board's periods missing between two telemetry frames.
+    fn poll_period(&mut self, until: Option<Instant>) -> Result<Option<Telemetry>, String> {
+        loop {
+            let Some(t) = self.poll_telemetry(until)? else {
+                return Ok(None);
+            };
+            if self.last_tick.is_none_or(|last| t.tick > last) {
+                if let (Some(rt), Some(last)) = (&mut self.rt, self.last_tick) {
+                    rt.stats.board_missed_periods += t.tick - last - 1;
+                }
+                self.last_tick = Some(t.tick);
+                self.latest = Some(t);
+                return Ok(Some(t));
+            }
+        }
+    }
+
+    /// Real time: the board's output for state frame `expect_seq` if it arrives before
+    /// period `k + 1` is due, else the newest output the board sent (a late frame: the
+    /// thrusters hold what the board last commanded, as they would on the vehicle). Period 0
+    /// waits for its answer, and the run's wall clock starts then.
+    /// **Choice 66**, docs/design.md §21.
+    fn realtime_reply(&mut self, k: u64, expect_seq: Option<u16>) -> Result<Telemetry, String> {
+        if k == 0 {
+            // The mission starts with the board's answer to its first state frame (bounded by
+            // the reply timeout), so period 0 does not fly on a reply from before the mission
+            // ran. The board sends telemetry just after its period boundary: the run's clock
+            // starts half a period after that answer, so that the host's periods fall between
+            // the board's — a frame then waits half a period for the board, and its answer
+            // has half a period to come back. (Started on the answer itself, every frame
+            // arrived just after a boundary and was answered just after the next period was
+            // due: every frame late.) The clocks drift apart over a run; the figures show it.
+            loop {
+                let t = self.next_period()?;
+                let heard = self.heard;
+                if let Some(rt) = &mut self.rt {
+                    rt.answered(t.last_state_seq, heard);
+                }
+                if expect_seq.is_none_or(|seq| t.last_state_seq == seq) {
+                    if let Some(rt) = &mut self.rt {
+                        rt.origin = Some(heard + rt.period / 2);
+                    }
+                    return Ok(t);
+                }
+            }
+        }
+        let due = match &mut self.rt {
+            Some(rt) => rt.due(k + 1),
+            None => Instant::now(),
+        };
+        loop {
+            match self.poll_period(Some(due))? {
+                Some(t) => {
+                    let heard = self.heard;
+                    if let Some(rt) = &mut self.rt {
+                        rt.answered(t.last_state_seq, heard);
+                    }
+                    if expect_seq.is_some_and(|seq| t.last_state_seq == seq) {
+                        return Ok(t);
+                    }
+                }
+                None => {
+                    if let (Some(rt), Some(_)) = (&mut self.rt, expect_seq) {
+                        rt.stats.late_frames += 1;
+                    }
+                    return self
+                        .latest
+                        .ok_or_else(|| "no telemetry from the board yet".to_string());
+                }
             }
         }
     }
@@ -471,24 +757,23 @@ impl BoardInTheLoop {
         self.stats.board_loop_overruns = t.loop_overruns;
         self.stats.board_thrust_unit = Some(unit_name(t.thrust_unit).to_string());
         self.stats.board_reversed_thrusters = Some(t.reversed_thrusters);
+        self.stats.worst_update_board_ticks = u64::from(t.worst_update_ticks);
         self.stats.worst_update_instructions =
             t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
     }
 
     fn stop_qemu(&mut self) {
-        // SIGTERM to the whole process group (bash runner, timeout, QEMU, defmt-print).
-        let _ = Command::new("kill")
-            .arg("-TERM")
-            .arg("--")
-            .arg(format!("-{}", self.child.id()))
-            .status();
-        let _ = self.child.kill();
-        let _ = self.child.wait();
+        if let Some(child) = &mut self.child {
+            stop_group(child);
+        }
     }
 
-    /// Ends the QEMU process and returns the figures.
+    /// Ends the QEMU process (if this runner started one) and returns the figures.
     pub fn finish(mut self) -> PilStats {
         self.stop_qemu();
+        if let Some(rt) = &mut self.rt {
+            self.stats.realtime = Some(rt.finish());
+        }
         let wall = self.t0.elapsed().as_secs_f64();
         self.stats.wall_seconds = wall;
         self.stats.frames_per_second = if wall > 0.0 {
@@ -508,6 +793,9 @@ impl Drop for BoardInTheLoop {
 
 impl ControlSource for BoardInTheLoop {
     fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
+        if let Some(rt) = &mut self.rt {
+            rt.pace(k);
+        }
         let frame = StateFrame {
             t_ticks: k,
             eta: *eta,
@@ -525,7 +813,15 @@ impl ControlSource for BoardInTheLoop {
         let mut expect_seq = None;
         let mut out = Vec::with_capacity(4 * MAX_FRAME);
         let mut buf = [0u8; MAX_FRAME];
+        // Lock-step: commands, then the state frame (a mission's first state frame sets its
+        // clock; an earlier one is not on it). Real time: the state first, so that a mission
+        // (re)started in this period has a state when the board's next period comes
+        // (Choice 68, docs/design.md §21).
+        let state_first = self.pacing == Pacing::Realtime;
         if !silent {
+            if state_first && !dropped {
+                expect_seq = self.encode_state(frame, corrupt, delayed, &mut out)?;
+            }
             if self.needs_rearm && healthy {
                 // Recovery: the link is good again; re-arm (the fail-safe latches until
                 // then) and start the mission again, since disarming dropped it. Its first
@@ -549,41 +845,28 @@ impl ControlSource for BoardInTheLoop {
                 out.extend_from_slice(&buf[..n]);
                 self.started = true;
             }
-            if !dropped {
-                let sent = if delayed {
-                    let i = self
-                        .history
-                        .len()
-                        .saturating_sub(1 + self.faults.delay_ticks as usize);
-                    self.history[i]
-                } else {
-                    frame
-                };
-                // A corrupted frame is refused, and a delayed one holds an old state that the
-                // board drops as off its mission clock: neither is answered.
-                if !corrupt && !delayed {
-                    expect_seq = Some(self.seq);
-                }
-                let n = self.encode(Msg::State(sent), &mut buf)?;
-                if corrupt {
-                    buf[n / 2] ^= 0x5A;
-                }
-                out.extend_from_slice(&buf[..n]);
-                self.stats.state_frames_sent += 1;
+            if !state_first && !dropped {
+                expect_seq = self.encode_state(frame, corrupt, delayed, &mut out)?;
             }
         }
         if !out.is_empty() {
             self.write(&out)?;
         }
-        // The board's answer to this frame; if it timed out before the frame arrived (host
-        // slower than the board's virtual clock), that timeout period is skipped. Without a
-        // valid frame the answer is the board's next (timed-out) period.
-        let t = loop {
-            let t = self.next_period()?;
-            match expect_seq {
-                Some(seq) if t.last_state_seq != seq => continue,
-                _ => break t,
-            }
+        if let (Some(rt), Some(seq)) = (&mut self.rt, expect_seq) {
+            rt.sent(seq);
+        }
+        let t = match self.pacing {
+            // The board's answer to this frame; if it timed out before the frame arrived
+            // (host slower than the board's virtual clock), that timeout period is skipped.
+            // Without a valid frame the answer is the board's next (timed-out) period.
+            Pacing::Lockstep => loop {
+                let t = self.next_period()?;
+                match expect_seq {
+                    Some(seq) if t.last_state_seq != seq => continue,
+                    _ => break t,
+                }
+            },
+            Pacing::Realtime => self.realtime_reply(k, expect_seq)?,
         };
         self.note_status(&t, k);
         self.check_unit(&t)?;

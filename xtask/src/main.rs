@@ -13,7 +13,9 @@
 //!                                  injection (a wrong answer, a panic, a HardFault, a hang)
 //! cargo xtask pil                  processor in the loop: a short mission must equal SIL bit
 //!                                  for bit; the link-fault case must enter and leave fail-safe
-//!                                  at its exact ticks
+//!                                  at its exact ticks; hardware in the loop over QEMU's pty
+//!                                  (xtask/src/hil.rs): lock-step equals SIL, real-time
+//!                                  figures, the port going away mid-mission
 //! ```
 //!
 //! `--bless` rewrites the snapshots from this run instead of comparing (review the diff, then
@@ -26,6 +28,7 @@
 
 mod callgraph;
 mod ci;
+mod hil;
 mod images;
 mod no_f64;
 mod pil;
@@ -69,7 +72,7 @@ enum Task {
         #[arg(long)]
         bless: bool,
     },
-    /// Processor in the loop: PIL = SIL, and the link-fault case.
+    /// Processor in the loop: PIL = SIL, and the link-fault case; HIL over QEMU's pty.
     Pil,
 }
 

@@ -60,6 +60,7 @@ pub fn run(ci: &mut Ci, built: &Built) {
     let host_sim = ci.target_dir.join(HOST_PROFILE).join("host-sim");
     let elf = elf.to_path_buf();
     pil_checks(ci, &host_sim, &elf);
+    crate::hil::checks(ci, &host_sim, &elf);
 }
 
 /// Both PIL checks. Runs the release `host-sim` binary with `--json` and reads its report into

@@ -1,0 +1,231 @@
+//! Hardware in the loop without hardware: the QEMU flying image with its UART0 on a
+//! pseudo-terminal (`scripts/qemu-run.sh` with `QEMU_SERIAL=pty`, [`QemuPty`]), flown by
+//! `host-sim hil --port /dev/pts/N` through the same serial path a USB-serial adapter takes.
+//! Three checks:
+//!
+//! 1. lock-step over the pty must equal SIL bit for bit (as PIL over TCP does), with a clean
+//!    link at both ends;
+//! 2. real time over the pty (QEMU without `-icount`, so the board's SysTick follows the wall
+//!    clock): the run's timing figures are reported — frames/s, late frames, latency, jitter,
+//!    missed periods — and must be present; they are not held to a bound (they measure this
+//!    machine's load as much as the loop);
+//! 3. the board's port goes away mid-mission (QEMU killed): `hil` must end within
+//!    [`LOST_BOUND_S`] with a message, a non-zero exit, and the partial run kept (its CSV and
+//!    its JSON case, marked as stopped early).
+
+use std::path::Path;
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+use host_sim::pacing::Pacing;
+use host_sim::pil::{Mode, PilComparison};
+use host_sim::qemu::QemuPty;
+use host_sim::record::Cases;
+
+use crate::ci::Ci;
+
+/// The mission HIL flies (workspace-relative), and for how long (s): 500 periods.
+const SCENARIO: &str = "host-sim/scenarios/lawn-mower-20x10.toml";
+const SECONDS: &str = "5";
+/// The mission flown when the port goes away: long enough to be cut short.
+const LONG_SECONDS: &str = "60";
+/// The most `hil` may take to notice a port that went away (s); it notices at its next read.
+const LOST_BOUND_S: u64 = 30;
+
+pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
+    ci.step(
+        "hardware in the loop over QEMU's pty: lock-step equals SIL, real-time figures, the port going away mid-mission",
+    );
+    let runner = ci.root.join("scripts/qemu-run.sh");
+    let scratch = ci.scratch();
+    let hil = |ci: &mut Ci,
+               name: &str,
+               pacing: Pacing,
+               seconds: &str|
+     -> Option<(QemuPty, Command, std::path::PathBuf)> {
+        let log = scratch.join(format!("hil-{name}-qemu.log"));
+        let board = match QemuPty::start(elf, &runner, &log, pacing, None) {
+            Ok(b) => b,
+            Err(e) => {
+                ci.fail(format!("HIL {name}: {e}"));
+                return None;
+            }
+        };
+        let out = scratch.join(format!("hil-{name}"));
+        let _ = std::fs::remove_dir_all(&out);
+        let mut cmd = Command::new(host_sim);
+        cmd.current_dir(&ci.root)
+            .arg("hil")
+            .arg("--port")
+            .arg(&board.port)
+            .args(["--pacing", pacing.as_str()])
+            .args([
+                "--scenario",
+                SCENARIO,
+                "--duration",
+                seconds,
+                "--json",
+                "--out",
+            ])
+            .arg(&out);
+        println!(
+            "{} hil --port {} --pacing {} --scenario {SCENARIO} --duration {seconds}",
+            ci.rel(host_sim),
+            board.port.display(),
+            pacing.as_str()
+        );
+        Some((board, cmd, out))
+    };
+    let report = |ci: &mut Ci,
+                  name: &str,
+                  output: &std::process::Output|
+     -> Option<PilComparison> {
+        match serde_json::from_slice::<Cases<PilComparison>>(&output.stdout) {
+            Ok(r) if r.cases.len() == 1 => r.cases.into_iter().next(),
+            other => {
+                ci.fail(format!(
+                    "HIL {name}: host-sim exited {} without a one-case JSON report ({:?}); its messages:\n{}",
+                    output.status,
+                    other.err(),
+                    String::from_utf8_lossy(&output.stderr)
+                ));
+                None
+            }
+        }
+    };
+
+    // 1. Lock-step over the pty: the PIL protocol on a tty; must equal SIL bit for bit.
+    if let Some((board, mut cmd, _)) = hil(ci, "lockstep", Pacing::Lockstep, SECONDS) {
+        let output = cmd.output();
+        drop(board);
+        match output {
+            Err(e) => ci.fail(format!("HIL lock-step: running host-sim: {e}")),
+            Ok(o) => {
+                if let Some(c) = report(ci, "lock-step", &o) {
+                    println!(
+                        "lock-step over {}: HIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s",
+                        c.pil.link, c.run.metrics.max_path, c.sil_max_path, c.pil.frames_per_second
+                    );
+                    let clean = c.pil.board_rx_errors == 0
+                        && c.pil.board_rx_stale == 0
+                        && c.pil.board_refused_commands == 0
+                        && c.pil.telemetry_refused == 0;
+                    if !o.status.success()
+                        || c.mode != Mode::Hil
+                        || !c.agrees()
+                        || c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits()
+                        || !clean
+                    {
+                        ci.fail(format!(
+                            "HIL lock-step over the pty: exit {}, max path {} m against SIL's {} m (must be bit for bit), board rx errors {}, dropped {}, refused {}, telemetry refused {}; the serial path must carry exactly what the socket does (raw mode: no echo, no line editing)",
+                            o.status,
+                            c.run.metrics.max_path,
+                            c.sil_max_path,
+                            c.pil.board_rx_errors,
+                            c.pil.board_rx_stale,
+                            c.pil.board_refused_commands,
+                            c.pil.telemetry_refused
+                        ));
+                    }
+                }
+            }
+        }
+    }
+
+    // 2. Real time over the pty: figures, reported.
+    if let Some((board, mut cmd, _)) = hil(ci, "realtime", Pacing::Realtime, SECONDS) {
+        let output = cmd.output();
+        drop(board);
+        match output {
+            Err(e) => ci.fail(format!("HIL real time: running host-sim: {e}")),
+            Ok(o) => {
+                if let Some(c) = report(ci, "real time", &o) {
+                    match &c.pil.realtime {
+                        Some(r) if r.periods > 0 && c.pil.telemetry_frames > 0 => println!(
+                            "real time over {}: {:.0} frames/s, {r}; max path {:.3} m (SIL {:.3} m), {} fail-safe events, exit {}",
+                            c.pil.link,
+                            c.pil.frames_per_second,
+                            c.run.metrics.max_path,
+                            c.sil_max_path,
+                            c.pil.failsafe_events.len(),
+                            o.status
+                        ),
+                        other => ci.fail(format!(
+                            "HIL real time: no timing figures in the report ({other:?}, {} telemetry frames)",
+                            c.pil.telemetry_frames
+                        )),
+                    }
+                }
+            }
+        }
+    }
+
+    // 3. The port goes away mid-mission.
+    if let Some((mut board, mut cmd, out)) = hil(ci, "lost", Pacing::Lockstep, LONG_SECONDS) {
+        let child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn();
+        let mut child = match child {
+            Ok(c) => c,
+            Err(e) => {
+                ci.fail(format!("HIL port lost: running host-sim: {e}"));
+                return;
+            }
+        };
+        // Let the mission fly a while (its CSV grows), then end QEMU.
+        std::thread::sleep(Duration::from_secs(3));
+        board.kill();
+        let killed = Instant::now();
+        let deadline = killed + Duration::from_secs(LOST_BOUND_S);
+        let ended = loop {
+            match child.try_wait() {
+                Ok(Some(_)) => break true,
+                Ok(None) if Instant::now() < deadline => {
+                    std::thread::sleep(Duration::from_millis(50))
+                }
+                _ => break false,
+            }
+        };
+        if !ended {
+            let _ = child.kill();
+            let _ = child.wait();
+            ci.fail(format!(
+                "HIL port lost: host-sim was still running {LOST_BOUND_S} s after QEMU (its port) ended: a hang"
+            ));
+            return;
+        }
+        let noticed = killed.elapsed().as_secs_f64();
+        let o = match child.wait_with_output() {
+            Ok(o) => o,
+            Err(e) => {
+                ci.fail(format!("HIL port lost: host-sim's output: {e}"));
+                return;
+            }
+        };
+        let err = String::from_utf8_lossy(&o.stderr);
+        let message = err
+            .lines()
+            .find(|l| l.contains("link went away"))
+            .map(str::to_string);
+        let csv_rows = std::fs::read_dir(&out)
+            .into_iter()
+            .flatten()
+            .flatten()
+            .filter(|e| e.path().extension().is_some_and(|x| x == "csv"))
+            .filter_map(|e| std::fs::read_to_string(e.path()).ok())
+            .map(|t| t.lines().count().saturating_sub(1))
+            .max()
+            .unwrap_or(0);
+        let stopped = report(ci, "port lost", &o).and_then(|c| c.run.diverged);
+        println!(
+            "port lost: host-sim ended {noticed:.2} s after QEMU, exit {}, {csv_rows} CSV rows kept, run stopped at {:?}; message: {}",
+            o.status,
+            stopped.as_ref().map(|d| d.t),
+            message.as_deref().unwrap_or("(none)")
+        );
+        if o.status.success() || message.is_none() || csv_rows == 0 || stopped.is_none() {
+            ci.fail(format!(
+                "HIL port lost: expected a non-zero exit, a `link went away` message, the partial CSV and a JSON case marked stopped early; got exit {}, message {message:?}, {csv_rows} CSV rows, stopped {stopped:?}; stderr:\n{err}",
+                o.status
+            ));
+        }
+    }
+}
