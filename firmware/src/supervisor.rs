@@ -490,7 +490,16 @@ impl Supervisor {
             (true, Some(l), _, _) => BoardStatus::FailSafe(l.reason),
             (true, None, None, _) => BoardStatus::Armed,
             (true, None, Some(_), _) if overrun => self.latch(FailSafeReason::Overrun, 0),
-            (true, None, Some(_), None) => self.latch(FailSafeReason::StaleState, 0),
+            // A mission still waiting for its first state frame: StartMission and that frame
+            // may straddle a period edge, so the mission gets the same `stale_periods` grace
+            // as a state that stops arriving (thrusters off meanwhile), then latches.
+            (true, None, Some((_, start)), None) => {
+                if self.tick.wrapping_sub(start) > u64::from(self.stale_periods) {
+                    self.latch(FailSafeReason::StaleState, 0)
+                } else {
+                    BoardStatus::Running
+                }
+            }
             (true, None, Some(_), Some(_)) if stale => self.latch(FailSafeReason::StaleState, 0),
             (true, None, Some((traj, start)), Some(s)) => {
                 // Mission time: the board's own ticks since StartMission; in lock-step the

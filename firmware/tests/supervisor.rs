@@ -475,9 +475,34 @@ fn start_mission_in_lockstep_drops_the_state_held_from_before() {
     let (mut s, mut h) = lockstep();
     assert!(taken(&mut s, &mut h, 5_000));
     h.command(&mut s, Command::StartMission(CIRCLE));
-    // No state on the mission's clock yet: the first period fails safe, it does not fly
-    // the mission at tick 5000.
+    // No state on the mission's clock yet: the board does not fly the mission at tick 5000.
+    // It waits `stale_periods` periods (2) with the thrusters off, then fails safe.
+    for _ in 0..=2 {
+        let st = s.step(false, NOW);
+        assert_eq!(st.telemetry.status, BoardStatus::Running);
+        assert_eq!(st.voltages, [0.0; 5]);
+    }
     assert_eq!(status(&mut s), STALE);
+}
+
+/// Regression (issue 12, seen once in four CI runs of the real-chain PIL): `StartMission` and
+/// the mission's first state frame can reach the board either side of a period edge. The
+/// supervisor latched a stale-state fail-safe in that period, at t = 0; the mission now gets
+/// the same `stale_periods` grace as a state that stops arriving.
+#[test]
+fn start_mission_and_its_first_state_may_straddle_a_period() {
+    let (mut s, mut h) = lockstep();
+    h.command(&mut s, Command::StartMission(CIRCLE));
+    let idle = s.step(false, NOW);
+    assert_eq!(idle.telemetry.status, BoardStatus::Running);
+    assert_eq!(idle.voltages, [0.0; 5]);
+    let ctl = s.controller().clone();
+    let traj = controller_core::Trajectory::table1(controller_core::Table1Case::Circular10R);
+    let f = state(0);
+    assert!(taken(&mut s, &mut h, 0));
+    let flying = s.step(false, NOW);
+    assert_eq!(flying.telemetry.status, BoardStatus::Running);
+    assert_eq!(flying.voltages, ctl.update(0, &f.eta, &f.nu, &traj).voltage);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -173,6 +173,9 @@ struct Model {
     periods_since_state: Option<u64>,
     /// Lock-step mission clock: the last accepted tick, and periods since.
     clock: Option<(u64, u64)>,
+    /// Periods run since the mission started (a mission waits `stale_periods` for its first
+    /// state).
+    mission_periods: u64,
 }
 
 impl Model {
@@ -188,12 +191,19 @@ impl Model {
             last_timestamp: None,
             periods_since_state: None,
             clock: None,
+            mission_periods: 0,
         }
     }
 
     fn fresh(&self) -> bool {
         self.periods_since_state
             .is_some_and(|n| n <= u64::from(self.stale_periods))
+    }
+
+    /// A mission that has had no state yet, still within its `stale_periods` grace: running,
+    /// thrusters off.
+    fn waiting(&self) -> bool {
+        self.periods_since_state.is_none() && self.mission_periods <= u64::from(self.stale_periods)
     }
 }
 
@@ -685,6 +695,7 @@ impl Harness {
                         "StartMission accepted: {m:?}"
                     );
                     m.mission = true;
+                    m.mission_periods = 0;
                     m.clock = None;
                     if m.lockstep {
                         m.periods_since_state = None;
@@ -732,8 +743,9 @@ impl Harness {
         }
         let on = step.voltages.iter().any(|v| *v != 0.0);
         let m = self.model;
-        let may_fly = m.armed && m.mission && m.latched.is_none() && !overrun && m.fresh();
-        if on || t.status == BoardStatus::Running {
+        let may_run = m.armed && m.mission && m.latched.is_none() && !overrun;
+        let may_fly = may_run && m.fresh();
+        if on {
             assert!(
                 may_fly,
                 "thrusters on {:?}, {t:?}, model {m:?}",
@@ -741,6 +753,12 @@ impl Harness {
             );
             assert_eq!(t.status, BoardStatus::Running);
             self.stats.periods_on += 1;
+        } else if t.status == BoardStatus::Running {
+            // Running with the thrusters off: a mission waiting for its first state.
+            assert!(
+                may_fly || (may_run && m.waiting()),
+                "running, {t:?}, model {m:?}"
+            );
         }
         match m.latched {
             Some(r) => {
@@ -758,7 +776,7 @@ impl Harness {
                     assert!(m.armed && m.mission, "fail-safe without a mission: {m:?}");
                     let want = if overrun {
                         FailSafeReason::Overrun
-                    } else if !m.fresh() {
+                    } else if !m.fresh() && !m.waiting() {
                         FailSafeReason::StaleState
                     } else {
                         FailSafeReason::ControllerFault
@@ -797,6 +815,7 @@ impl Harness {
         }
         let m = &mut self.model;
         m.periods_since_state = m.periods_since_state.map(|n| n + 1);
+        m.mission_periods += 1;
         m.clock = m.clock.map(|(t, n)| (t, n + 1));
         t
     }
