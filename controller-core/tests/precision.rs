@@ -60,6 +60,18 @@ fn relative_error(tau: &[f32; 6], reference: &Vector6<f64>) -> f64 {
     diff / scale
 }
 
+/// The controller without Δu, built once (`Controller::new` takes the bounds over the box).
+fn controller() -> &'static Controller {
+    static C: std::sync::OnceLock<Controller> = std::sync::OnceLock::new();
+    C.get_or_init(|| {
+        Controller::new(ControllerConfig {
+            robust: false,
+            ..ControllerConfig::default()
+        })
+        .expect("defaults without Δu")
+    })
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(3000))]
     /// Within 1e-6 of ‖τ‖∞ (relative) for states near every Table-1 mission: offsets up to
@@ -71,8 +83,8 @@ proptest! {
         d_eta in prop::array::uniform6(-1.0f32..1.0),
         d_nu in prop::array::uniform6(-1.0f32..1.0),
     ) {
-        let cfg = ControllerConfig { robust: false, ..ControllerConfig::default() };
-        let c = Controller::new(cfg.clone()).unwrap();
+        let c = controller();
+        let cfg = *c.config();
         let tr = Trajectory::table1(Table1Case::ALL[case]);
         let d = tr.sample(ticks, 100);
         let mut eta: [f32; 6] = d.eta.into();
@@ -116,11 +128,8 @@ fn f32_parameters_keep_the_net_weight() {
 /// The figure the note quotes: the worst relative error over a deterministic sweep.
 #[test]
 fn report_tau_error_over_the_missions() {
-    let cfg = ControllerConfig {
-        robust: false,
-        ..ControllerConfig::default()
-    };
-    let c = Controller::new(cfg.clone()).unwrap();
+    let c = controller();
+    let cfg = *c.config();
     let mut worst = 0.0f64;
     for case in Table1Case::ALL {
         let tr = Trajectory::table1(case);
