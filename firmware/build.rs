@@ -229,7 +229,13 @@ fn golden() -> String {
             for robust in [true, false] {
                 let c = if robust { &with } else { &without };
                 let o = c.update(*ticks, &eta, &nu, &tr);
-                push(&mut body, ci, *ticks, robust, false, &eta, &nu, &o);
+                let id = Id {
+                    case: ci,
+                    ticks: *ticks,
+                    robust,
+                    tangent: false,
+                };
+                push(&mut body, id, &eta, &nu, &o);
                 n += 1;
             }
             // The tangent heading (ψ_d = the path's course: one atan2 and its derivatives)
@@ -241,21 +247,30 @@ fn golden() -> String {
                 })
                 .expect("every Table-1 path is fast enough for the tangent heading");
                 let o = with.update(*ticks, &eta, &nu, &tangent);
-                push(&mut body, ci, *ticks, true, true, &eta, &nu, &o);
+                let id = Id {
+                    case: ci,
+                    ticks: *ticks,
+                    robust: true,
+                    tangent: true,
+                };
+                push(&mut body, id, &eta, &nu, &o);
                 n += 1;
             }
         }
     }
     // Faults: pitch beyond the limit, and a NaN.
+    let fault = || Id {
+        case: 0,
+        ticks: 0,
+        robust: true,
+        tangent: false,
+    };
     let tr = Trajectory::table1(Table1Case::Circular10R);
     let eta = [0.0, 10.0, 5.0, 0.0, 1.5, 0.0];
     let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 0.1];
     push(
         &mut body,
-        0,
-        0,
-        true,
-        false,
+        fault(),
         &eta,
         &nu,
         &with.update(0, &eta, &nu, &tr),
@@ -263,10 +278,7 @@ fn golden() -> String {
     let eta = [0.0, 10.0, f32::NAN, 0.0, 0.0, 0.0];
     push(
         &mut body,
-        0,
-        0,
-        true,
-        false,
+        fault(),
         &eta,
         &nu,
         &with.update(0, &eta, &nu, &tr),
@@ -289,16 +301,22 @@ fn arr(a: &[f32]) -> String {
     format!("[{}]", items.join(", "))
 }
 
-fn push(
-    body: &mut String,
+/// Which vector: its Table-1 case, tick, Δu on or off, and whether the mission flies the
+/// tangent heading (the self-test's `Golden` fields of the same names).
+struct Id {
     case: usize,
     ticks: u64,
     robust: bool,
     tangent: bool,
-    eta: &[f32; 6],
-    nu: &[f32; 6],
-    o: &controller_core::Output,
-) {
+}
+
+fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller_core::Output) {
+    let Id {
+        case,
+        ticks,
+        robust,
+        tangent,
+    } = id;
     let status = match o.status {
         Status::Ok => 0,
         Status::Fault(_) => 1,
