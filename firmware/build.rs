@@ -234,6 +234,7 @@ fn golden() -> String {
                     ticks: *ticks,
                     robust,
                     tangent: false,
+                    helix: None,
                 };
                 push(&mut body, id, &eta, &nu, &o);
                 n += 1;
@@ -252,9 +253,29 @@ fn golden() -> String {
                     ticks: *ticks,
                     robust: true,
                     tangent: true,
+                    helix: None,
                 };
                 push(&mut body, id, &eta, &nu, &o);
                 n += 1;
+            }
+            // The helix (the fourth path kind: the circle's radius, a descent rate, so z_d
+            // grows with t) at the circle's inputs, Δu on and off.
+            if ci == 0 && (k == 1 || k == 3) {
+                let helix = (10.0, 0.05);
+                let tr = Trajectory::helix(helix.0, helix.1).expect("a valid helix");
+                for robust in [true, false] {
+                    let c = if robust { &with } else { &without };
+                    let o = c.update(*ticks, &eta, &nu, &tr);
+                    let id = Id {
+                        case: ci,
+                        ticks: *ticks,
+                        robust,
+                        tangent: false,
+                        helix: Some(helix),
+                    };
+                    push(&mut body, id, &eta, &nu, &o);
+                    n += 1;
+                }
             }
         }
     }
@@ -264,6 +285,7 @@ fn golden() -> String {
         ticks: 0,
         robust: true,
         tangent: false,
+        helix: None,
     };
     let tr = Trajectory::table1(Table1Case::Circular10R);
     let eta = [0.0, 10.0, 5.0, 0.0, 1.5, 0.0];
@@ -308,6 +330,8 @@ struct Id {
     ticks: u64,
     robust: bool,
     tangent: bool,
+    /// A helix (radius, depth rate) flown instead of the case's path.
+    helix: Option<(f32, f32)>,
 }
 
 fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller_core::Output) {
@@ -316,14 +340,19 @@ fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller
         ticks,
         robust,
         tangent,
+        helix,
     } = id;
+    let helix = match helix {
+        Some((r, rate)) => format!("Some(({}, {}))", f(r), f(rate)),
+        None => "None".to_string(),
+    };
     let status = match o.status {
         Status::Ok => 0,
         Status::Fault(_) => 1,
     };
     writeln!(
         body,
-        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, tangent: {tangent}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
+        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, tangent: {tangent}, helix: {helix}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
         arr(eta),
         arr(nu),
         arr(&o.voltage),

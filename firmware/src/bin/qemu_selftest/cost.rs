@@ -136,12 +136,19 @@ pub fn stages(
         let Some((counts, total)) = step_counts(counter, c, &tr, g) else {
             continue;
         };
+        // The per-mission rows are the Table-1 paths (either heading); the helix counts in
+        // the per-stage maxima below only.
+        let row = g.helix.is_none().then_some(g.case);
         for (i, &n) in counts.iter().enumerate() {
             stage[i].add(n);
-            per_case[g.case][i] = per_case[g.case][i].max(n);
+            if let Some(r) = row {
+                per_case[r][i] = per_case[r][i].max(n);
+            }
         }
         update.add(total);
-        per_case[g.case][STAGES] = per_case[g.case][STAGES].max(total);
+        if let Some(r) = row {
+            per_case[r][STAGES] = per_case[r][STAGES].max(total);
+        }
     }
     info!(
         "step cost per call (instructions, the largest over each mission's golden vectors), stages {=[?]}:",

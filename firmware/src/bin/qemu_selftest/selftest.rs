@@ -30,6 +30,8 @@ pub struct Golden {
     pub robust: bool,
     /// The mission flies the tangent heading (the Table-1 case's path, ψ_d its course).
     pub tangent: bool,
+    /// A helix (radius, depth rate) flown instead of the case's path.
+    pub helix: Option<(f32, f32)>,
     pub eta: [f32; 6],
     pub nu: [f32; 6],
     pub voltage: [f32; 5],
@@ -41,10 +43,12 @@ pub struct Golden {
 
 impl Golden {
     /// The mission this vector samples: its Table-1 case, with the tangent heading when
-    /// `tangent` (as build.rs made it); `None` if the target refuses it.
+    /// `tangent`, or the helix (as build.rs made it); `None` if the target refuses it.
     pub fn trajectory(&self) -> Option<Trajectory> {
         let case = *Table1Case::ALL.get(self.case)?;
-        if self.tangent {
+        if let Some((radius, rate)) = self.helix {
+            Trajectory::helix(radius, rate).ok()
+        } else if self.tangent {
             Trajectory::new(Mission {
                 heading: HeadingMode::Tangent,
                 ..Mission::paper(case.kind())
