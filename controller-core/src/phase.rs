@@ -32,8 +32,6 @@ pub struct Frequency {
     frac_q64: u64,
     /// ⌊ν⌋, whole turns per second.
     whole: u32,
-    /// frac(ν) in 2⁻³² turns per second.
-    frac_q32: u32,
 }
 
 impl Frequency {
@@ -58,7 +56,6 @@ impl Frequency {
             } else {
                 whole as u32
             },
-            frac_q32: (frac_q64 >> 32) as u32,
         }
     }
 
@@ -66,10 +63,12 @@ impl Frequency {
     #[inline]
     pub fn phase(&self, t: &MissionTime) -> u32 {
         let seconds = (t.seconds.wrapping_mul(self.frac_q64) >> 32) as u32;
+        // frac(ν) in 2⁻³² turns/s: the high half of frac_q64.
+        let frac_q32 = self.frac_q64 >> 32;
         let fraction = t
             .fraction
             .wrapping_mul(self.whole)
-            .wrapping_add(((t.fraction as u64 * self.frac_q32 as u64) >> 32) as u32);
+            .wrapping_add(((t.fraction as u64 * frac_q32) >> 32) as u32);
         seconds.wrapping_add(fraction)
     }
 }
@@ -157,7 +156,8 @@ impl MissionTime {
         let rest = rate.hi * q_lo
             + rate.mid * q_hi
             + (rate.mid * q_lo + rate.lo * (q_hi + q_lo))
-            + (rate.sum * frac + offset);
+            // hi + mid is the rate rounded to f32, exactly: enough for the fraction of a second.
+            + ((rate.hi + rate.mid) * frac + offset);
         big + rest
     }
 }
@@ -170,8 +170,6 @@ pub struct LinearRate {
     hi: f32,
     mid: f32,
     lo: f32,
-    /// The rate in f32 (for the fraction of a second, where one rounding is enough).
-    sum: f32,
 }
 
 impl LinearRate {
@@ -183,12 +181,6 @@ impl LinearRate {
             hi,
             mid: sum - hi,
             lo: (rate - sum as f64) as f32,
-            sum,
         }
-    }
-
-    /// The rate in f32.
-    pub fn rate(&self) -> f32 {
-        self.sum
     }
 }
