@@ -14,6 +14,10 @@
 /// The target every image is built for (a Cortex-M4F with its single-precision FPU).
 pub const TARGET: &str = "thumbv7em-none-eabihf";
 
+/// The symbol the STM32 emulator build's substitutions bring into an image
+/// (`stm32f405::emulator`): the emulator image must have it, the flight image must not.
+pub const EMULATOR_SYMBOL: &str = "AUV150_EMULATOR_SUBSTITUTIONS";
+
 /// Prefix of every image marker; see [`Image::marker`].
 const MARKER_PREFIX: &[u8] = b"auv150-image:";
 
@@ -28,11 +32,20 @@ pub enum Image {
     QemuSelftest,
     /// The STM32F405 thruster board (flash with probe-rs).
     Stm32f405,
+    /// The STM32F405 board code under QEMU's `netduinoplus2`, with what QEMU does not model
+    /// substituted (`stm32f405::emulator`): CI's hardware in the loop over a pty. Not a flight
+    /// image.
+    Stm32f405Emulator,
 }
 
 impl Image {
     /// Every image, in build order.
-    pub const ALL: [Image; 3] = [Image::Qemu, Image::QemuSelftest, Image::Stm32f405];
+    pub const ALL: [Image; 4] = [
+        Image::Qemu,
+        Image::QemuSelftest,
+        Image::Stm32f405,
+        Image::Stm32f405Emulator,
+    ];
 
     /// The binary's name: `--bin NAME`, and the ELF's file name under
     /// `target/thumbv7em-none-eabihf/<profile>/`.
@@ -41,6 +54,7 @@ impl Image {
             Image::Qemu => "firmware-qemu",
             Image::QemuSelftest => "firmware-qemu-selftest",
             Image::Stm32f405 => "firmware-stm32f405",
+            Image::Stm32f405Emulator => "firmware-stm32f405-emulator",
         }
     }
 
@@ -49,6 +63,7 @@ impl Image {
         match self {
             Image::Qemu | Image::QemuSelftest => "qemu",
             Image::Stm32f405 => "stm32f405",
+            Image::Stm32f405Emulator => "stm32f405-emulator",
         }
     }
 
@@ -56,8 +71,25 @@ impl Image {
     pub const fn memory_map(self) -> &'static str {
         match self {
             Image::Qemu | Image::QemuSelftest => "memory-qemu.x",
-            Image::Stm32f405 => "memory-stm32f405.x",
+            // netduinoplus2 has the STM32F405's flash and SRAM where the chip has them.
+            Image::Stm32f405 | Image::Stm32f405Emulator => "memory-stm32f405.x",
         }
+    }
+
+    /// The QEMU machine the image runs on (`scripts/qemu-run.sh` picks it by the image's
+    /// marker), or `None` for the real board's image, which does not run under QEMU (it waits
+    /// for a crystal QEMU's STM32F405 does not have).
+    pub const fn qemu_machine(self) -> Option<&'static str> {
+        match self {
+            Image::Qemu | Image::QemuSelftest => Some("mps2-an386"),
+            Image::Stm32f405Emulator => Some("netduinoplus2"),
+            Image::Stm32f405 => None,
+        }
+    }
+
+    /// A flying image that runs under QEMU: one `host-sim pil` and `host-sim hil` can start.
+    pub const fn flies_in_qemu(self) -> bool {
+        matches!(self, Image::Qemu | Image::Stm32f405Emulator)
     }
 
     /// The bytes that identify this image inside its ELF: `auv150-image:<bin>;` (the `;` keeps
@@ -67,6 +99,7 @@ impl Image {
             Image::Qemu => b"auv150-image:firmware-qemu;",
             Image::QemuSelftest => b"auv150-image:firmware-qemu-selftest;",
             Image::Stm32f405 => b"auv150-image:firmware-stm32f405;",
+            Image::Stm32f405Emulator => b"auv150-image:firmware-stm32f405-emulator;",
         }
     }
 

@@ -29,5 +29,11 @@ pub mod rt;
 #[cfg(all(target_os = "none", feature = "qemu"))]
 pub mod qemu;
 
+#[cfg(all(
+    target_os = "none",
+    any(feature = "qemu", feature = "stm32f405-emulator")
+))]
+pub mod semihosting;
+
 #[cfg(all(target_os = "none", feature = "stm32f405"))]
 pub mod stm32f405;

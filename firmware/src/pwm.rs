@@ -38,3 +38,70 @@ pub fn set_voltage<P: SetDutyCycle>(pwm: &mut P, v: f32, v_supply: f32) -> Resul
 pub fn set_neutral<P: SetDutyCycle>(pwm: &mut P) -> Result<(), P::Error> {
     pwm.set_duty_cycle_fraction(1, 2)
 }
+
+/// A PWM channel that keeps its duty in RAM: the thrusters of a board whose timers are not
+/// there — QEMU's `mps2-an386` has no timer PWM, and QEMU's STM32F405 does not model TIM1 or
+/// TIM8 (the `stm32f405` emulator build). It behaves as a timer channel does towards
+/// `embedded_hal::pwm::SetDutyCycle`: a duty above the maximum is clamped to it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct MemPwm {
+    duty: u16,
+    max: u16,
+}
+
+impl MemPwm {
+    /// A channel of `max` counts of full duty, at neutral (half of `max`).
+    pub const fn neutral(max: u16) -> Self {
+        MemPwm { duty: max / 2, max }
+    }
+
+    /// The duty last set (counts of [`SetDutyCycle::max_duty_cycle`]).
+    pub const fn duty(&self) -> u16 {
+        self.duty
+    }
+}
+
+impl embedded_hal::pwm::ErrorType for MemPwm {
+    type Error = core::convert::Infallible;
+}
+
+impl SetDutyCycle for MemPwm {
+    fn max_duty_cycle(&self) -> u16 {
+        self.max
+    }
+
+    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Self::Error> {
+        self.duty = duty.min(self.max);
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_ram_channel_maps_the_supply_range_onto_its_counts() {
+        // d = (V + V_s) / (2 V_s): −V_s → 0, 0 → half, +V_s → full, beyond → clamped.
+        let mut ch = MemPwm::neutral(8400);
+        assert_eq!(ch.duty(), 4200);
+        for (v, want) in [
+            (-24.0, 0),
+            (0.0, 4200),
+            (12.0, 6300),
+            (24.0, 8400),
+            (99.0, 8400),
+        ] {
+            let Ok(()) = set_voltage(&mut ch, v, 24.0);
+            assert_eq!(ch.duty(), want, "{v} V");
+        }
+        let Ok(()) = set_voltage(&mut ch, f32::NAN, 24.0);
+        assert_eq!(ch.duty(), 4200, "a non-finite voltage gives neutral");
+        let Ok(()) = ch.set_duty_cycle(u16::MAX);
+        assert_eq!(
+            ch.duty(),
+            8400,
+            "a duty above the maximum is clamped, as a timer's is"
+        );
+    }
+}

@@ -18,7 +18,8 @@
 //!   docs/design.md §21.)
 //! - No watchdog.
 //! - Configuration at boot: QEMU's semihosting command line (`-append "…"`, see
-//!   [`command_line`]); the flying image takes its link key from it ([`link_key`]), the
+//!   [`crate::semihosting::command_line`]); the flying image takes its link key from it
+//!   ([`crate::semihosting::link_key`]), the
 //!   self-test its failure injections.
 
 use core::cell::Cell;
@@ -27,79 +28,15 @@ use core::ptr::{read_volatile, write_volatile};
 
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
-use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
 use embedded_io::{ErrorType, Read, ReadReady, Write};
 
 use crate::board::Board;
+pub use crate::pwm::MemPwm;
 use crate::qemu_clock::CORE_HZ;
+pub use crate::semihosting::halt;
 
 /// Nominal H-bridge supply (V).
 pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
-
-/// Ends the program: QEMU exits with `code` (0 = success) through semihosting. Without a
-/// semihosting host (a real board), the core resets instead.
-pub fn halt(code: i32) -> ! {
-    let status = if code == 0 {
-        cortex_m_semihosting::debug::EXIT_SUCCESS
-    } else {
-        cortex_m_semihosting::debug::EXIT_FAILURE
-    };
-    cortex_m_semihosting::debug::exit(status);
-    cortex_m::peripheral::SCB::sys_reset()
-}
-
-/// Room for the semihosting command line: QEMU passes the ELF's path, then `-append`'s text.
-pub const CMDLINE_LEN: usize = 512;
-
-/// The semihosting command line (`qemu-run.sh ELF -append "…"`), into `buf`; `None` if QEMU
-/// refused it (it does when the line does not fit).
-pub fn command_line(buf: &mut [u8; CMDLINE_LEN]) -> Option<&[u8]> {
-    let mut block = [buf.as_mut_ptr() as usize, buf.len()];
-    // SAFETY: SYS_GET_CMDLINE writes at most `block[1]` bytes into `buf` and the length back
-    // into `block[1]`.
-    let r = unsafe {
-        cortex_m_semihosting::syscall1(
-            cortex_m_semihosting::nr::GET_CMDLINE,
-            block.as_mut_ptr() as usize,
-        )
-    };
-    if r != 0 {
-        return None;
-    }
-    let n = block[1].min(buf.len());
-    Some(&buf[..n])
-}
-
-/// The word of the command line that provisions the link key: `link-key=` and 64 hex digits.
-pub const LINK_KEY_ARG: &str = "link-key=";
-
-/// Why the command line's key was not taken.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum KeyArgError {
-    /// The command line could not be read (longer than [`CMDLINE_LEN`]?).
-    Unreadable,
-    /// `link-key=` is followed by something that is not a key.
-    Malformed(auv_link::sign::KeyError),
-}
-
-/// The QEMU image's link key: `link-key=<64 hex digits>` on the semihosting command line
-/// (`host-sim pil --link-key-file` passes it), the QEMU analogue of a key in the board's flash
-/// configuration; it never crosses the link. `Ok(None)`: no key given, signing off.
-pub fn link_key() -> Result<Option<auv_link::sign::LinkKey>, KeyArgError> {
-    let mut buf = [0u8; CMDLINE_LEN];
-    let cmd = command_line(&mut buf).ok_or(KeyArgError::Unreadable)?;
-    let Some(word) = cmd
-        .split(|&b| b == b' ')
-        .find_map(|w| w.strip_prefix(LINK_KEY_ARG.as_bytes()))
-    else {
-        return Ok(None);
-    };
-    let text = core::str::from_utf8(word)
-        .map_err(|_| KeyArgError::Malformed(auv_link::sign::KeyError::NotHex { at: 0 }))?;
-    auv_link::sign::LinkKey::from_hex(text)
-        .map(Some)
-        .map_err(KeyArgError::Malformed)
-}
 
 const UART0: usize = 0x4000_4000;
 const DATA: usize = 0x00;
@@ -200,31 +137,12 @@ impl Write for CmsdkUart {
     }
 }
 
-/// A PWM channel that keeps its duty in RAM (QEMU has no timer PWM on this machine).
-pub struct MemPwm {
-    pub duty: u16,
-}
-
 /// Cycles between two reads of SysTick's flag while waiting for a period (40 µs at 25 MHz, 0.4 %
 /// of a 10 ms period).
 pub const WAIT_POLL_CYCLES: u32 = 1000;
 
 /// Counts of full duty: 10-bit resolution, like a 24 kHz timer channel at 25 MHz.
 pub const MAX_DUTY: u16 = 1000;
-
-impl PwmErrorType for MemPwm {
-    type Error = Infallible;
-}
-
-impl SetDutyCycle for MemPwm {
-    fn max_duty_cycle(&self) -> u16 {
-        MAX_DUTY
-    }
-    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
-        self.duty = duty.min(MAX_DUTY);
-        Ok(())
-    }
-}
 
 pub struct QemuBoard {
     syst: SYST,
@@ -245,13 +163,7 @@ impl QemuBoard {
         let mut b = QemuBoard {
             syst,
             uart,
-            thrusters: [
-                MemPwm { duty: MAX_DUTY / 2 },
-                MemPwm { duty: MAX_DUTY / 2 },
-                MemPwm { duty: MAX_DUTY / 2 },
-                MemPwm { duty: MAX_DUTY / 2 },
-                MemPwm { duty: MAX_DUTY / 2 },
-            ],
+            thrusters: [MemPwm::neutral(MAX_DUTY); 5],
             reload: 0,
             last_cvr: Cell::new(0),
             ticks: Cell::new(0),

@@ -51,3 +51,49 @@ fn every_memory_map_exists_and_none_sits_at_the_root_as_memory_x() {
     // The linker searches the working directory first: a root memory.x would shadow them.
     assert!(!root.join("memory.x").exists());
 }
+
+/// The runner picks the QEMU machine by the image's marker (scripts/qemu-run.sh): its table
+/// must say what `Image::qemu_machine` says, and refuse the images that do not run in QEMU.
+#[test]
+fn the_runner_runs_each_image_on_its_machine() {
+    let runner = std::fs::read_to_string(manifest_dir().join("../scripts/qemu-run.sh")).unwrap();
+    let arm = |bin: &str| {
+        runner
+            .lines()
+            .map(str::trim_start)
+            .find(|l| l.starts_with(&format!("{bin})")))
+            .map(str::to_string)
+    };
+    let default = arm("*").expect("a default arm");
+    for image in Image::ALL {
+        let line = arm(image.bin());
+        match image.qemu_machine() {
+            Some(machine) => {
+                let line = line.unwrap_or_else(|| default.clone());
+                assert!(
+                    line.contains(&format!("machine={machine} ")),
+                    "{}: the runner's `{line}` must run it on {machine}",
+                    image.bin()
+                );
+            }
+            None => {
+                let line =
+                    line.unwrap_or_else(|| panic!("{}: the runner must refuse it", image.bin()));
+                assert!(!line.contains("machine="), "{}: {line}", image.bin());
+                assert!(
+                    runner.contains("does not run under QEMU"),
+                    "the refusal says why"
+                );
+            }
+        }
+    }
+    // The marker the runner greps for is the images' marker.
+    let prefix = std::str::from_utf8(Image::Qemu.marker())
+        .unwrap()
+        .trim_end_matches(&(Image::Qemu.bin().to_owned() + ";"));
+    assert!(
+        runner.contains(&format!("'{prefix}[a-z0-9-]*;'")),
+        "{prefix}"
+    );
+    assert!(runner.contains(&format!("bin=${{marker#{prefix}}}")));
+}

@@ -218,7 +218,7 @@ pub struct PilArgs {
     pub elf: Option<PathBuf>,
 }
 
-/// The STM32 board's link baud rate (firmware/src/stm32f405.rs), `hil`'s default.
+/// The STM32 board's link baud rate (firmware/src/stm32f405/mod.rs), `hil`'s default.
 pub const DEFAULT_HIL_BAUD: u32 = 460_800;
 
 /// `hil`'s default reply timeout (s): a board answers every period (10 ms at 100 Hz).

@@ -929,18 +929,22 @@ pub fn check_flying_image(elf: &Path) -> Result<(), String> {
             Image::Qemu.bin()
         )
     })?;
+    let flying: Vec<&str> = Image::ALL
+        .iter()
+        .filter(|i| i.flies_in_qemu())
+        .map(|i| i.bin())
+        .collect();
+    let flying = flying.join("` or `");
     match Image::of_elf(&bytes) {
-        Some(Image::Qemu) => Ok(()),
+        Some(image) if image.flies_in_qemu() => Ok(()),
         Some(other) => Err(format!(
-            "{} is the `{}` image, not the QEMU flying image `{}` that PIL flies (see --elf)",
+            "{} is the `{}` image, not a flying image that runs in QEMU (`{flying}`) as the board in the loop (see --elf)",
             elf.display(),
             other.bin(),
-            Image::Qemu.bin()
         )),
         None => Err(format!(
-            "{} is not an AUV-150 firmware image (no image marker; built before the images were binaries?); PIL flies `{}`",
+            "{} is not an AUV-150 firmware image (no image marker; built before the images were binaries?); the board in the loop is `{flying}`",
             elf.display(),
-            Image::Qemu.bin()
         )),
     }
 }

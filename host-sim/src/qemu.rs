@@ -35,7 +35,7 @@ pub fn spawn_qemu(
         .arg(runner)
         .arg(elf);
     if let Some(k) = key {
-        // The QEMU image's provisioning (firmware::qemu::link_key); visible to this
+        // The QEMU image's provisioning (firmware::semihosting::link_key); visible to this
         // machine's process list, which is acceptable for a simulator's key.
         let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
         qemu.arg("-append").arg(format!("link-key={hex}"));
@@ -78,8 +78,9 @@ pub struct QemuPty {
 }
 
 /// The runner's line on stderr naming the pty: `qemu-run: UART0 on pty /dev/pts/N (link)`
-/// (scripts/qemu-run.sh; QEMU's own line goes to its stdout, the defmt stream).
-const PTY_LINE: &str = "UART0 on pty ";
+/// (`USART2` on the STM32 emulator's machine; scripts/qemu-run.sh; QEMU's own line goes to its
+/// stdout, the defmt stream).
+const PTY_LINE: (&str, &str) = ("qemu-run: ", " on pty ");
 
 impl QemuPty {
     /// Starts `elf` through `runner` with `QEMU_SERIAL=pty`, its log into `log_path`
@@ -136,9 +137,11 @@ impl Drop for QemuPty {
 
 /// The pty QEMU's log names ([`PTY_LINE`]), if it does yet.
 pub fn pty_of_log(log: &str) -> Option<PathBuf> {
-    let rest = &log[log.find(PTY_LINE)? + PTY_LINE.len()..];
-    let path = rest.split_whitespace().next()?;
-    path.starts_with("/dev/").then(|| PathBuf::from(path))
+    log.lines().find_map(|line| {
+        let (_uart, rest) = line.strip_prefix(PTY_LINE.0)?.split_once(PTY_LINE.1)?;
+        let path = rest.split_whitespace().next()?;
+        path.starts_with("/dev/").then(|| PathBuf::from(path))
+    })
 }
 
 #[cfg(test)]
@@ -154,5 +157,9 @@ mod tests {
             None
         );
         assert_eq!(pty_of_log("qemu-run: UART0 on pty "), None);
+        // The STM32 emulator's link is USART2.
+        let log = "qemu-run: USART2 on pty /dev/pts/12 (/tmp/qemu-uart0.y)\n";
+        assert_eq!(pty_of_log(log), Some(PathBuf::from("/dev/pts/12")));
+        assert_eq!(pty_of_log("INFO tick 3: UART0 on pty /dev/pts/1"), None);
     }
 }

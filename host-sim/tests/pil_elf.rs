@@ -1,5 +1,7 @@
-//! `pil` flies only the QEMU flying image: the self-test image (which runs its checks and
-//! exits) and anything without an image marker are refused with a message that says why.
+//! `pil` flies only a flying image that runs in QEMU — the QEMU image, or the STM32 board code's
+//! emulator build: the self-test image (which runs its checks and exits), the STM32 flight
+//! image (which waits for a crystal QEMU does not have) and anything without an image marker
+//! are refused with a message that says why.
 
 use std::path::PathBuf;
 
@@ -19,14 +21,19 @@ fn fake_elf(name: &str, marker: Option<Image>) -> PathBuf {
 }
 
 #[test]
-fn only_the_qemu_flying_image_is_flown() {
+fn only_flying_images_that_run_in_qemu_are_flown() {
     let flying = fake_elf("flying", Some(Image::Qemu));
     assert_eq!(check_flying_image(&flying), Ok(()));
+    let emulator = fake_elf("emulator", Some(Image::Stm32f405Emulator));
+    assert_eq!(check_flying_image(&emulator), Ok(()));
 
     let selftest = fake_elf("selftest", Some(Image::QemuSelftest));
     let err = check_flying_image(&selftest).unwrap_err();
     assert!(err.contains("firmware-qemu-selftest"), "{err}");
-    assert!(err.contains("firmware-qemu` that PIL flies"), "{err}");
+    assert!(
+        err.contains("(`firmware-qemu` or `firmware-stm32f405-emulator`)"),
+        "{err}"
+    );
 
     let stm32 = fake_elf("stm32", Some(Image::Stm32f405));
     assert!(check_flying_image(&stm32)
@@ -43,7 +50,7 @@ fn only_the_qemu_flying_image_is_flown() {
         .unwrap_err()
         .contains("--bin firmware-qemu"));
 
-    for p in [flying, selftest, stm32, unmarked] {
+    for p in [flying, emulator, selftest, stm32, unmarked] {
         let _ = std::fs::remove_file(p);
     }
 }

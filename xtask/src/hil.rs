@@ -1,7 +1,9 @@
-//! Hardware in the loop without hardware: the QEMU flying image with its UART0 on a
+//! Hardware in the loop without hardware: a flying image with its link UART on a
 //! pseudo-terminal (`scripts/qemu-run.sh` with `QEMU_SERIAL=pty`, [`QemuPty`]), flown by
 //! `host-sim hil --port /dev/pts/N` through the same serial path a USB-serial adapter takes.
-//! Three checks:
+//! Two boards ([`Board`]): the QEMU image on mps2-an386 (UART0, unsigned) and the STM32F405
+//! board code's emulator build on netduinoplus2 (USART2 and its interrupt, signed; see
+//! `firmware/src/stm32f405/emulator.rs`). Checks 1 and 2 run on both, 3 on the first:
 //!
 //! 1. lock-step over the pty must equal SIL bit for bit (as PIL over TCP does), with a clean
 //!    link at both ends;
@@ -17,6 +19,7 @@ use std::path::Path;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
+use auv_link::sign::LinkKey;
 use host_sim::pacing::Pacing;
 use host_sim::pil::{Mode, PilComparison};
 use host_sim::qemu::QemuPty;
@@ -32,32 +35,58 @@ const LONG_SECONDS: &str = "60";
 /// The most `hil` may take to notice a port that went away (s); it notices at its next read.
 const LOST_BOUND_S: u64 = 30;
 
-pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
+/// A board HIL flies: its ELF, a name for the logs and messages, and the link key both ends
+/// are provisioned with (`None`: unsigned).
+pub struct Board<'a> {
+    pub name: &'a str,
+    pub elf: &'a Path,
+    pub key_file: Option<&'a Path>,
+}
+
+pub fn checks(ci: &mut Ci, host_sim: &Path, boards: &[Board]) {
     ci.step(
-        "hardware in the loop over QEMU's pty: lock-step equals SIL, real-time figures, the port going away mid-mission",
+        "hardware in the loop over QEMU's pty (the QEMU image; the STM32 board code, emulated): lock-step equals SIL, real-time figures, the port going away mid-mission",
     );
+    for (i, board) in boards.iter().enumerate() {
+        checks_of(ci, host_sim, board, i == 0);
+    }
+}
+
+/// Checks 1 and 2 on `board`, and 3 if `port_lost`.
+fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
     let runner = ci.root.join("scripts/qemu-run.sh");
     let scratch = ci.scratch();
+    let elf = board.elf;
+    let key = match board.key_file.map(read_key).transpose() {
+        Ok(k) => k,
+        Err(e) => {
+            ci.fail(format!("HIL {}: {e}", board.name));
+            return;
+        }
+    };
+    let who = board.name;
     let hil = |ci: &mut Ci,
-               name: &str,
+               what: &str,
                pacing: Pacing,
                seconds: &str|
      -> Option<(QemuPty, Command, std::path::PathBuf)> {
-        let log = scratch.join(format!("hil-{name}-qemu.log"));
-        let board = match QemuPty::start(elf, &runner, &log, pacing, None) {
-            Ok(b) => b,
+        let name = format!("{} {what}", board.name);
+        let slug = format!("{}-{what}", board.name);
+        let log = scratch.join(format!("hil-{slug}-qemu.log"));
+        let qemu = match QemuPty::start(elf, &runner, &log, pacing, key.as_ref()) {
+            Ok(q) => q,
             Err(e) => {
                 ci.fail(format!("HIL {name}: {e}"));
                 return None;
             }
         };
-        let out = scratch.join(format!("hil-{name}"));
+        let out = scratch.join(format!("hil-{slug}"));
         let _ = std::fs::remove_dir_all(&out);
         let mut cmd = Command::new(host_sim);
         cmd.current_dir(&ci.root)
             .arg("hil")
             .arg("--port")
-            .arg(&board.port)
+            .arg(&qemu.port)
             .args(["--pacing", pacing.as_str()])
             .args([
                 "--scenario",
@@ -68,13 +97,21 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
                 "--out",
             ])
             .arg(&out);
+        if let Some(k) = board.key_file {
+            cmd.arg("--link-key-file").arg(k);
+        }
         println!(
-            "{} hil --port {} --pacing {} --scenario {SCENARIO} --duration {seconds}",
+            "{name}: {} hil --port {} --pacing {} --scenario {SCENARIO} --duration {seconds}{}",
             ci.rel(host_sim),
-            board.port.display(),
-            pacing.as_str()
+            qemu.port.display(),
+            pacing.as_str(),
+            if board.key_file.is_some() {
+                " --link-key-file …"
+            } else {
+                ""
+            }
         );
-        Some((board, cmd, out))
+        Some((qemu, cmd, out))
     };
     let report = |ci: &mut Ci,
                   name: &str,
@@ -95,15 +132,15 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     };
 
     // 1. Lock-step over the pty: the PIL protocol on a tty; must equal SIL bit for bit.
-    if let Some((board, mut cmd, _)) = hil(ci, "lockstep", Pacing::Lockstep, SECONDS) {
+    if let Some((qemu, mut cmd, _)) = hil(ci, "lockstep", Pacing::Lockstep, SECONDS) {
         let output = cmd.output();
-        drop(board);
+        drop(qemu);
         match output {
-            Err(e) => ci.fail(format!("HIL lock-step: running host-sim: {e}")),
+            Err(e) => ci.fail(format!("HIL {who} lock-step: running host-sim: {e}")),
             Ok(o) => {
-                if let Some(c) = report(ci, "lock-step", &o) {
+                if let Some(c) = report(ci, &format!("{who} lock-step"), &o) {
                     println!(
-                        "lock-step over {}: HIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s",
+                        "{who} lock-step over {}: HIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s",
                         c.pil.link, c.run.metrics.max_path, c.sil_max_path, c.pil.frames_per_second
                     );
                     let clean = c.pil.board_rx_errors == 0
@@ -115,16 +152,19 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
                         || !c.agrees()
                         || c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits()
                         || !clean
+                        || c.pil.signed != board.key_file.is_some()
                     {
                         ci.fail(format!(
-                            "HIL lock-step over the pty: exit {}, max path {} m against SIL's {} m (must be bit for bit), board rx errors {}, dropped {}, refused {}, telemetry refused {}; the serial path must carry exactly what the socket does (raw mode: no echo, no line editing)",
+                            "HIL lock-step over the pty: exit {}, max path {} m against SIL's {} m (must be bit for bit), board rx errors {}, dropped {}, refused {}, telemetry refused {}, signed {} (expected {}); the serial path must carry exactly what the socket does (raw mode: no echo, no line editing)",
                             o.status,
                             c.run.metrics.max_path,
                             c.sil_max_path,
                             c.pil.board_rx_errors,
                             c.pil.board_rx_stale,
                             c.pil.board_refused_commands,
-                            c.pil.telemetry_refused
+                            c.pil.telemetry_refused,
+                            c.pil.signed,
+                            board.key_file.is_some()
                         ));
                     }
                 }
@@ -133,16 +173,16 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     }
 
     // 2. Real time over the pty: figures, reported.
-    if let Some((board, mut cmd, _)) = hil(ci, "realtime", Pacing::Realtime, SECONDS) {
+    if let Some((qemu, mut cmd, _)) = hil(ci, "realtime", Pacing::Realtime, SECONDS) {
         let output = cmd.output();
-        drop(board);
+        drop(qemu);
         match output {
-            Err(e) => ci.fail(format!("HIL real time: running host-sim: {e}")),
+            Err(e) => ci.fail(format!("HIL {who} real time: running host-sim: {e}")),
             Ok(o) => {
-                if let Some(c) = report(ci, "real time", &o) {
+                if let Some(c) = report(ci, &format!("{who} real time"), &o) {
                     match &c.pil.realtime {
                         Some(r) if r.periods > 0 && c.pil.telemetry_frames > 0 => println!(
-                            "real time over {}: {:.0} frames/s, {r}; max path {:.3} m (SIL {:.3} m), {} fail-safe events, exit {}",
+                            "{who} real time over {}: {:.0} frames/s, {r}; max path {:.3} m (SIL {:.3} m), {} fail-safe events, exit {}",
                             c.pil.link,
                             c.pil.frames_per_second,
                             c.run.metrics.max_path,
@@ -160,19 +200,22 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
         }
     }
 
-    // 3. The port goes away mid-mission.
-    if let Some((mut board, mut cmd, out)) = hil(ci, "lost", Pacing::Lockstep, LONG_SECONDS) {
+    // 3. The port goes away mid-mission (host-sim's side of the port: one board suffices).
+    if !port_lost {
+        return;
+    }
+    if let Some((mut qemu, mut cmd, out)) = hil(ci, "lost", Pacing::Lockstep, LONG_SECONDS) {
         let child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn();
         let mut child = match child {
             Ok(c) => c,
             Err(e) => {
-                ci.fail(format!("HIL port lost: running host-sim: {e}"));
+                ci.fail(format!("HIL {who} port lost: running host-sim: {e}"));
                 return;
             }
         };
         // Let the mission fly a while (its CSV grows), then end QEMU.
         std::thread::sleep(Duration::from_secs(3));
-        board.kill();
+        qemu.kill();
         let killed = Instant::now();
         let deadline = killed + Duration::from_secs(LOST_BOUND_S);
         let ended = loop {
@@ -196,7 +239,7 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
         let o = match child.wait_with_output() {
             Ok(o) => o,
             Err(e) => {
-                ci.fail(format!("HIL port lost: host-sim's output: {e}"));
+                ci.fail(format!("HIL {who} port lost: host-sim's output: {e}"));
                 return;
             }
         };
@@ -214,9 +257,9 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
             .map(|t| t.lines().count().saturating_sub(1))
             .max()
             .unwrap_or(0);
-        let stopped = report(ci, "port lost", &o).and_then(|c| c.run.diverged);
+        let stopped = report(ci, &format!("{who} port lost"), &o).and_then(|c| c.run.diverged);
         println!(
-            "port lost: host-sim ended {noticed:.2} s after QEMU, exit {}, {csv_rows} CSV rows kept, run stopped at {:?}; message: {}",
+            "{who} port lost: host-sim ended {noticed:.2} s after QEMU, exit {}, {csv_rows} CSV rows kept, run stopped at {:?}; message: {}",
             o.status,
             stopped.as_ref().map(|d| d.t),
             message.as_deref().unwrap_or("(none)")
@@ -228,4 +271,10 @@ pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
             ));
         }
     }
+}
+
+/// The link key in a key file (firmware/README.md, "Link key"), for QEMU's command line.
+fn read_key(path: &Path) -> Result<LinkKey, String> {
+    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    LinkKey::from_key_file(&text).map_err(|e| format!("{}: {e}", path.display()))
 }

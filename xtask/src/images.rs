@@ -5,7 +5,7 @@
 use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 
-use firmware::image::{Image, TARGET};
+use firmware::image::{Image, EMULATOR_SYMBOL, TARGET};
 use object::{Object, ObjectSection, ObjectSymbol};
 
 use crate::ci::Ci;
@@ -65,6 +65,7 @@ pub struct Variant {
 
 impl Variant {
     pub const QEMU: Variant = Variant::default_backend(Image::Qemu);
+    pub const EMULATOR: Variant = Variant::default_backend(Image::Stm32f405Emulator);
     pub const SELFTEST: [Variant; 3] = [
         Variant::default_backend(Image::QemuSelftest),
         Variant {
@@ -78,12 +79,13 @@ impl Variant {
     ];
     /// Every image with the board default (the kernels), and the self-test with the other
     /// backends too.
-    pub const ALL: [Variant; 5] = [
+    pub const ALL: [Variant; 6] = [
         Variant::default_backend(Image::Qemu),
         Variant::SELFTEST[0],
         Variant::SELFTEST[1],
         Variant::SELFTEST[2],
         Variant::default_backend(Image::Stm32f405),
+        Variant::EMULATOR,
     ];
 
     const fn default_backend(image: Image) -> Variant {
@@ -191,8 +193,9 @@ fn expected_map(image: Image) -> (u64, u64) {
     match image {
         // mps2-an386: code at 0x0000_0000, 4 MiB of SRAM at 0x2000_0000.
         Image::Qemu | Image::QemuSelftest => (0x0000_0004, 0x2040_0000),
-        // STM32F405 (RM0090): flash at 0x0800_0000, 128 KiB of SRAM1+SRAM2 at 0x2000_0000.
-        Image::Stm32f405 => (0x0800_0004, 0x2002_0000),
+        // STM32F405 (RM0090): flash at 0x0800_0000, 128 KiB of SRAM1+SRAM2 at 0x2000_0000;
+        // QEMU's netduinoplus2 maps them there too.
+        Image::Stm32f405 | Image::Stm32f405Emulator => (0x0800_0004, 0x2002_0000),
     }
 }
 
@@ -202,6 +205,8 @@ struct ElfFacts {
     sizes: Sizes,
     reset_vector: Option<u64>,
     stack_top: Option<u64>,
+    /// It carries the STM32 emulator build's substitutions ([`EMULATOR_SYMBOL`]).
+    emulated: bool,
 }
 
 fn read_elf(path: &Path) -> Result<ElfFacts, String> {
@@ -233,6 +238,7 @@ fn read_elf(path: &Path) -> Result<ElfFacts, String> {
         sizes,
         reset_vector: symbol("__RESET_VECTOR"),
         stack_top: symbol("_stack_start"),
+        emulated: symbol(EMULATOR_SYMBOL).is_some(),
     })
 }
 
@@ -277,6 +283,14 @@ pub fn check(ci: &mut Ci, built: &Built) {
                 "{label}: the ELF's image marker says {:?}, not {:?} (firmware::image; does its main call Image::embed?)",
                 facts.image, v.image
             ));
+        }
+        let emulator = v.image == Image::Stm32f405Emulator;
+        if facts.emulated != emulator {
+            ci.fail(if emulator {
+                format!("{label}: no {EMULATOR_SYMBOL} symbol; does it call Stm32Board::init_emulated? (without the symbol the flight image's check below proves nothing)")
+            } else {
+                format!("{label} carries the STM32 emulator build's substitutions ({EMULATOR_SYMBOL}: no clock tree, thrusters in RAM); only firmware-stm32f405-emulator may")
+            });
         }
         let (reset, stack) = expected_map(v.image);
         if facts.reset_vector != Some(reset) || facts.stack_top != Some(stack) {

@@ -107,7 +107,7 @@ fn main() -> ExitCode {
             selftest::run(&mut ci, &built);
         }
         Task::Pil => {
-            let built = images::build(&mut ci, &[Variant::QEMU]);
+            let built = images::build(&mut ci, &[Variant::QEMU, Variant::EMULATOR]);
             pil::run(&mut ci, &built);
         }
     }

@@ -60,7 +60,21 @@ pub fn run(ci: &mut Ci, built: &Built) {
     let host_sim = ci.target_dir.join(HOST_PROFILE).join("host-sim");
     let elf = elf.to_path_buf();
     pil_checks(ci, &host_sim, &elf);
-    crate::hil::checks(ci, &host_sim, &elf);
+    let key = ci.root.join(CI_TEST_KEY);
+    let mut boards = vec![crate::hil::Board {
+        name: "qemu",
+        elf: &elf,
+        key_file: None,
+    }];
+    match built.elf(Variant::EMULATOR) {
+        Some(emulator) => boards.push(crate::hil::Board {
+            name: "stm32-emulator",
+            elf: emulator,
+            key_file: Some(&key),
+        }),
+        None => ci.fail("HIL: no STM32 emulator image (its build failed, see above)"),
+    }
+    crate::hil::checks(ci, &host_sim, &boards);
 }
 
 /// Both PIL checks. Runs the release `host-sim` binary with `--json` and reads its report into

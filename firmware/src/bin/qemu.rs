@@ -8,24 +8,12 @@
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::image::Image;
-use firmware::qemu::{self, halt, KeyArgError, QemuBoard};
+use firmware::qemu::{halt, QemuBoard};
+use firmware::semihosting::link_key_or_halt;
 
 #[entry]
 fn main() -> ! {
-    let key = match qemu::link_key() {
-        Ok(key) => key,
-        Err(KeyArgError::Unreadable) => {
-            defmt::error!("semihosting command line unreadable: no link key, not flying");
-            halt(1)
-        }
-        Err(KeyArgError::Malformed(_)) => {
-            defmt::error!(
-                "{=str} is not followed by 64 hexadecimal digits: not flying",
-                qemu::LINK_KEY_ARG
-            );
-            halt(1)
-        }
-    };
+    let key = link_key_or_halt();
     firmware::rt::fly_image(Image::Qemu, halt, key, |cp, rate_hz| {
         QemuBoard::init(cp.SYST, rate_hz)
     })

@@ -15,8 +15,8 @@ use cortex_m::peripheral::SYST;
 use defmt::{error, info};
 use firmware::board::{self, LinkBuffers};
 use firmware::pwm;
-use firmware::qemu::CMDLINE_LEN;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+use firmware::semihosting::CMDLINE_LEN;
 use firmware::supervisor::{BoardInfo, Mode, Supervisor};
 
 use crate::stack;
@@ -555,7 +555,7 @@ fn contains(hay: &[u8], needle: &[u8]) -> bool {
 /// makes the self-test fail in that way.
 fn inject_faults() -> bool {
     let mut buf = [0u8; CMDLINE_LEN];
-    let Some(cmd) = firmware::qemu::command_line(&mut buf) else {
+    let Some(cmd) = firmware::semihosting::command_line(&mut buf) else {
         // Say so: CI's injections would otherwise pass for a self-test that cannot fail.
         defmt::warn!(
             "semihosting command line unreadable (longer than {} bytes?): no failure injection",

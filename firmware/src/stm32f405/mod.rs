@@ -71,24 +71,27 @@
 //! way at full line rate); it can land inside a timed `Controller::update` and lengthen the
 //! measured ticks by that much.
 
-use core::cell::RefCell;
 use core::convert::Infallible;
 
-use cortex_m::interrupt::Mutex;
 use cortex_m::peripheral::syst::SystClkSource;
-use cortex_m::peripheral::{DWT, NVIC, SYST};
+use cortex_m::peripheral::{DWT, SYST};
 use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
-use embedded_io::{ErrorType, Read, ReadReady, Write};
+use stm32f4xx_hal::gpio::{PA10, PA11, PA2, PA3, PA8, PA9, PC6};
 use stm32f4xx_hal::pac;
 use stm32f4xx_hal::prelude::*;
-use stm32f4xx_hal::rcc::Config as ClockConfig;
+use stm32f4xx_hal::rcc::{Config as ClockConfig, Rcc};
 use stm32f4xx_hal::serial::config::StopBits;
-use stm32f4xx_hal::serial::{Config as SerialConfig, Event as SerialEvent, Serial};
+use stm32f4xx_hal::serial::{Config as SerialConfig, Serial};
 use stm32f4xx_hal::timer::{ErasedChannel, PwmHzManager};
 
 use crate::board::Board;
 use crate::pwm;
-use crate::serial::{self, IrqSide, LineError, LoopSide, RxFlags, RxQueue, TxQueue};
+
+mod usart2;
+pub use usart2::{on_usart2_interrupt, Usart2Link};
+
+#[cfg(feature = "stm32f405-emulator")]
+pub mod emulator;
 
 /// HSE crystal frequency (Hz). **Assumption: an 8 MHz crystal.**
 pub const HSE_HZ: u32 = 8_000_000;
@@ -100,6 +103,9 @@ pub const PCLK1_HZ: u32 = 42_000_000;
 pub const PCLK2_HZ: u32 = 84_000_000;
 /// Thruster PWM frequency (Hz).
 pub const PWM_HZ: u32 = 20_000;
+/// Counts of one PWM period, the channels' full duty: the advanced timers' clock (2 × PCLK2 =
+/// 168 MHz) over [`PWM_HZ`], no prescaler.
+pub const PWM_COUNTS: u16 = (2 * PCLK2_HZ / PWM_HZ) as u16;
 /// Navigation-link baud rate (8N1).
 pub const LINK_BAUD: u32 = 460_800;
 /// H-bridge supply voltage V_s (V): nominal, not measured. The duty for a commanded voltage
@@ -135,6 +141,67 @@ pub enum Thruster {
     Tim8(ErasedChannel<pac::TIM8>),
 }
 
+/// The board's five thruster outputs, as [`Stm32Board`] drives them: the real timers
+/// ([`AdvancedTimers`]) or, in the emulator build, RAM channels
+/// ([`emulator::EmulatedTimers`](crate::stm32f405)).
+pub trait ThrusterOutputs {
+    /// One channel.
+    type Channel: SetDutyCycle;
+    /// The five channels, order [main, vert fore, vert aft, horz fore, horz aft].
+    fn channels(&mut self) -> &mut [Self::Channel; 5];
+}
+
+/// The thruster outputs of the real board: TIM1 CH1–CH4 and TIM8 CH1 (pin map above), the
+/// timers held so nothing else can reconfigure them.
+pub struct AdvancedTimers {
+    channels: [Thruster; 5],
+    _tim1: PwmHzManager<pac::TIM1>,
+    _tim8: PwmHzManager<pac::TIM8>,
+}
+
+impl AdvancedTimers {
+    /// Starts both timers at [`PWM_HZ`], sets every channel to neutral, waits until the timers
+    /// have loaded it, and only then enables the outputs.
+    fn init(
+        tim1: pac::TIM1,
+        tim8: pac::TIM8,
+        (pa8, pa9, pa10, pa11, pc6): (PA8, PA9, PA10, PA11, PC6),
+        rcc: &mut Rcc,
+    ) -> Self {
+        // The timers run from here on, every channel output still disabled.
+        let (tim1, (t1c1, t1c2, t1c3, t1c4)) = tim1.pwm_hz(PWM_HZ.Hz(), rcc);
+        let (tim8, (t8c1, ..)) = tim8.pwm_hz(PWM_HZ.Hz(), rcc);
+        let mut channels = [
+            Thruster::Tim1(t1c1.with(pa8).erase()),
+            Thruster::Tim1(t1c2.with(pa9).erase()),
+            Thruster::Tim1(t1c3.with(pa10).erase()),
+            Thruster::Tim1(t1c4.with(pa11).erase()),
+            Thruster::Tim8(t8c1.with(pc6).erase()),
+        ];
+        for t in channels.iter_mut() {
+            let Ok(()) = pwm::set_neutral(t);
+        }
+        // The compare registers are preloaded: the neutral duty takes effect at the next update
+        // event. Two PWM periods make sure it has before any output is enabled.
+        cortex_m::asm::delay(2 * SYSCLK_HZ / PWM_HZ);
+        for t in channels.iter_mut() {
+            t.enable();
+        }
+        AdvancedTimers {
+            channels,
+            _tim1: tim1,
+            _tim8: tim8,
+        }
+    }
+}
+
+impl ThrusterOutputs for AdvancedTimers {
+    type Channel = Thruster;
+    fn channels(&mut self) -> &mut [Thruster; 5] {
+        &mut self.channels
+    }
+}
+
 impl Thruster {
     fn enable(&mut self) {
         match self {
@@ -165,150 +232,21 @@ impl SetDutyCycle for Thruster {
 }
 
 // ---------------------------------------------------------------------------------------------
-// Navigation link: USART2, interrupt driven through the two queues of `crate::serial`
-// ---------------------------------------------------------------------------------------------
-
-/// The interrupt's end of the queues, put here by [`Stm32Board::init`] before it unmasks the
-/// interrupt. Only [`on_usart2_interrupt`] and the diagnostics use it, each in a critical
-/// section.
-static IRQ_SIDE: Mutex<RefCell<Option<IrqSide<'static>>>> = Mutex::new(RefCell::new(None));
-
-fn usart2() -> &'static pac::usart1::RegisterBlock {
-    // SAFETY: USART2's register block is always mapped. `Usart2Link` owns the peripheral; the
-    // interrupt only reads SR/DR, writes DR and clears TXEIE, the main side only sets TXEIE
-    // (in a critical section) and reads SR — see `on_usart2_interrupt` and `Usart2Link::write`.
-    unsafe { &*pac::USART2::ptr() }
-}
-
-/// The body of the `USART2` interrupt handler (the STM32 image binds it: `#[interrupt] fn
-/// USART2()`): moves a received byte, with its status flags, into the receive queue, and the
-/// next queued byte into the data register.
-pub fn on_usart2_interrupt() {
-    let u = usart2();
-    let sr = u.sr().read();
-    let flags = RxFlags {
-        byte: sr.rxne().bit_is_set(),
-        damaged: sr.fe().bit_is_set() || sr.nf().bit_is_set() || sr.pe().bit_is_set(),
-        overrun: sr.ore().bit_is_set(),
-    };
-    // Reading DR after SR clears RXNE and the error flags (ORE would otherwise keep the
-    // interrupt pending).
-    let received =
-        (flags.byte || flags.damaged || flags.overrun).then(|| u.dr().read().dr().bits() as u8);
-    let send = sr.txe().bit_is_set() && u.cr1().read().txeie().bit_is_set();
-    let next = cortex_m::interrupt::free(|cs| {
-        let mut guard = IRQ_SIDE.borrow(cs).try_borrow_mut().ok()?;
-        let side = guard.as_mut()?;
-        if let Some(b) = received {
-            side.received(flags, b);
-        }
-        if send {
-            side.next_tx()
-        } else {
-            None
-        }
-    });
-    if send {
-        match next {
-            Some(b) => {
-                u.dr().write(|w| w.dr().set(b as u16));
-            }
-            // Nothing left: stop the TXE interrupt until `write` queues more.
-            None => {
-                u.cr1().modify(|_, w| w.txeie().clear_bit());
-            }
-        }
-    }
-}
-
-/// The navigation link on USART2 (PA2 TX, PA3 RX), 460800 8N1, as an `embedded_io` port: the
-/// loop's end of the [`crate::serial`] queues (see [`LoopSide`] for how reads and writes
-/// behave).
-///
-/// A line error (overrun, framing, noise, parity) or a byte dropped on a full queue comes out of
-/// [`Read::read`] as a [`LineError`] at the place in the stream where it happened; the control
-/// loop then resynchronises the frame decoder ([`crate::board::pump`]). The counts are in
-/// [`Usart2Link::rx_line_errors`] and [`Usart2Link::rx_dropped`].
-pub struct Usart2Link {
-    queues: LoopSide<'static>,
-    _serial: Serial<pac::USART2, u8>,
-}
-
-// Diagnostics (for logs or a debugger); the control loop itself does not need them.
-impl Usart2Link {
-    /// Receive line errors so far (overrun, framing, noise, parity).
-    pub fn rx_line_errors(&self) -> u32 {
-        irq_side(|s| s.line_errors())
-    }
-
-    /// Received bytes dropped because the receive queue was full (the loop stalled > 11 ms).
-    pub fn rx_dropped(&self) -> u32 {
-        irq_side(|s| s.dropped())
-    }
-}
-
-fn irq_side(f: impl FnOnce(&IrqSide<'static>) -> u32) -> u32 {
-    cortex_m::interrupt::free(|cs| {
-        IRQ_SIDE
-            .borrow(cs)
-            .try_borrow()
-            .ok()
-            .and_then(|s| s.as_ref().map(f))
-            .unwrap_or(0)
-    })
-}
-
-impl ErrorType for Usart2Link {
-    type Error = LineError;
-}
-
-impl ReadReady for Usart2Link {
-    fn read_ready(&mut self) -> Result<bool, LineError> {
-        self.queues.read_ready()
-    }
-}
-
-impl Read for Usart2Link {
-    fn read(&mut self, buf: &mut [u8]) -> Result<usize, LineError> {
-        self.queues.read(buf)
-    }
-}
-
-impl Write for Usart2Link {
-    fn write(&mut self, buf: &[u8]) -> Result<usize, LineError> {
-        // The interrupt drains the queue (TXEIE is on whenever it holds bytes).
-        let n = self.queues.write(buf)?;
-        // The interrupt clears TXEIE (read-modify-write of CR1): set it where it cannot
-        // interleave.
-        cortex_m::interrupt::free(|_| usart2().cr1().modify(|_, w| w.txeie().set_bit()));
-        Ok(n)
-    }
-
-    fn flush(&mut self) -> Result<(), LineError> {
-        self.queues.flush()?;
-        while usart2().sr().read().tc().bit_is_clear() {}
-        Ok(())
-    }
-}
-
-// ---------------------------------------------------------------------------------------------
 // The board
 // ---------------------------------------------------------------------------------------------
 
-/// The STM32F405 thruster board. See the module docs for clocks, pins and the safe state.
-pub struct Stm32Board {
-    thrusters: [Thruster; 5],
+/// The STM32F405 thruster board, with its thruster outputs `T` (the real timers; the emulator
+/// build's RAM channels). See the module docs for clocks, pins and the safe state.
+pub struct Stm32Board<T: ThrusterOutputs = AdvancedTimers> {
+    thrusters: T,
     link: Usart2Link,
     syst: SYST,
     iwdg: pac::IWDG,
     rate_hz: u32,
-    // Held so nothing else can reconfigure them.
-    _pwm_tim1: PwmHzManager<pac::TIM1>,
-    _pwm_tim8: PwmHzManager<pac::TIM8>,
     _dwt: DWT,
 }
 
-impl Stm32Board {
+impl Stm32Board<AdvancedTimers> {
     /// Brings the board up: clocks, thruster PWM at neutral, the link, the period timer at
     /// [`DEFAULT_RATE_HZ`], the cycle counter and, last, the watchdog — from then on the caller
     /// must call [`Board::feed_watchdog`] (the control loop does, once per period) at least
@@ -322,18 +260,8 @@ impl Stm32Board {
     /// Takes the device peripherals (`stm32f4xx_hal::pac::Peripherals::take()`): **call it
     /// once**. A second call, or a call after anything else took them, panics.
     pub fn init(cp: cortex_m::Peripherals) -> Self {
-        let mut cp = cp;
         let dp = pac::Peripherals::take().expect("device peripherals already taken");
-
-        // Halting the core in a debugger disables the thruster outputs and pauses the IWDG.
-        dp.DBGMCU.apb2_fz().modify(|_, w| {
-            w.dbg_tim1_stop().set_bit();
-            w.dbg_tim8_stop().set_bit()
-        });
-        dp.DBGMCU
-            .apb1_fz()
-            .modify(|_, w| w.dbg_iwdg_stop().set_bit());
-
+        stop_in_debug(&dp.DBGMCU);
         let mut rcc = dp.RCC.freeze(
             ClockConfig::hse(HSE_HZ.Hz())
                 .sysclk(SYSCLK_HZ.Hz())
@@ -347,56 +275,50 @@ impl Stm32Board {
             rcc.clocks.pclk1().raw(),
             rcc.clocks.pclk2().raw()
         );
-
         let gpioa = dp.GPIOA.split(&mut rcc);
         let gpioc = dp.GPIOC.split(&mut rcc);
+        let pwm_pins = (gpioa.pa8, gpioa.pa9, gpioa.pa10, gpioa.pa11, gpioc.pc6);
+        let thrusters = AdvancedTimers::init(dp.TIM1, dp.TIM8, pwm_pins, &mut rcc);
+        let link_pins = (gpioa.pa2, gpioa.pa3);
+        Stm32Board::assemble(cp, dp.USART2, link_pins, dp.IWDG, &mut rcc, thrusters)
+    }
+}
 
-        // Thrusters: the timers run from here on, every channel output still disabled.
-        let (pwm_tim1, (t1c1, t1c2, t1c3, t1c4)) = dp.TIM1.pwm_hz(PWM_HZ.Hz(), &mut rcc);
-        let (pwm_tim8, (t8c1, ..)) = dp.TIM8.pwm_hz(PWM_HZ.Hz(), &mut rcc);
-        let mut thrusters = [
-            Thruster::Tim1(t1c1.with(gpioa.pa8).erase()),
-            Thruster::Tim1(t1c2.with(gpioa.pa9).erase()),
-            Thruster::Tim1(t1c3.with(gpioa.pa10).erase()),
-            Thruster::Tim1(t1c4.with(gpioa.pa11).erase()),
-            Thruster::Tim8(t8c1.with(gpioc.pc6).erase()),
-        ];
-        for t in thrusters.iter_mut() {
-            let Ok(()) = pwm::set_neutral(t);
-        }
-        // The compare registers are preloaded: the neutral duty takes effect at the next update
-        // event. Two PWM periods make sure it has before any output is enabled.
-        cortex_m::asm::delay(2 * SYSCLK_HZ / PWM_HZ);
-        for t in thrusters.iter_mut() {
-            t.enable();
-        }
+/// Halting the core in a debugger disables the thruster outputs and pauses the IWDG (module
+/// docs, *Safe state*).
+fn stop_in_debug(dbgmcu: &pac::DBGMCU) {
+    dbgmcu.apb2_fz().modify(|_, w| {
+        w.dbg_tim1_stop().set_bit();
+        w.dbg_tim8_stop().set_bit()
+    });
+    dbgmcu.apb1_fz().modify(|_, w| w.dbg_iwdg_stop().set_bit());
+}
 
-        // Navigation link.
-        let mut serial: Serial<pac::USART2, u8> = Serial::new(
-            dp.USART2,
-            (gpioa.pa2, gpioa.pa3),
+impl<T: ThrusterOutputs> Stm32Board<T> {
+    /// What every build of the board does once its clocks and thrusters are up: the link on
+    /// USART2 (PA2/PA3, AF7) with its interrupt, the cycle counter for `now()`, and last the
+    /// period timer and the watchdog.
+    fn assemble(
+        cp: cortex_m::Peripherals,
+        usart2: pac::USART2,
+        pins: (PA2, PA3),
+        iwdg: pac::IWDG,
+        rcc: &mut Rcc,
+        thrusters: T,
+    ) -> Self {
+        let mut cp = cp;
+        let serial: Serial<pac::USART2, u8> = Serial::new(
+            usart2,
+            pins,
             SerialConfig::default()
                 .baudrate(LINK_BAUD.bps())
                 .wordlength_8()
                 .parity_none()
                 .stopbits(StopBits::STOP1),
-            &mut rcc,
+            rcc,
         )
         .expect("USART2 460800 8N1 from PCLK1");
-        // The queues live for the rest of the program; `init` runs once (a second call would
-        // already have failed to take the peripherals above).
-        let rx = cortex_m::singleton!(: RxQueue = RxQueue::new()).expect("init runs once");
-        let tx = cortex_m::singleton!(: TxQueue = TxQueue::new()).expect("init runs once");
-        let (irq_side, loop_side) = serial::split(rx, tx);
-        cortex_m::interrupt::free(|cs| IRQ_SIDE.borrow(cs).replace(Some(irq_side)));
-        serial.listen(SerialEvent::RxNotEmpty);
-        // SAFETY: the handler only touches USART2 and its end of the queues; unmasking it
-        // cannot break a critical section (none is active here).
-        unsafe { NVIC::unmask(pac::Interrupt::USART2) };
-        let link = Usart2Link {
-            queues: loop_side,
-            _serial: serial,
-        };
+        let link = Usart2Link::new(serial);
 
         // Cycle counter for `now()`.
         cp.DCB.enable_trace();
@@ -406,10 +328,8 @@ impl Stm32Board {
             thrusters,
             link,
             syst: cp.SYST,
-            iwdg: dp.IWDG,
+            iwdg,
             rate_hz: DEFAULT_RATE_HZ,
-            _pwm_tim1: pwm_tim1,
-            _pwm_tim8: pwm_tim8,
             _dwt: cp.DWT,
         };
 
@@ -419,7 +339,7 @@ impl Stm32Board {
         defmt::info!(
             "stm32f405: PWM {} Hz ({} counts), link {} baud, rate {} Hz, watchdog {} ms",
             PWM_HZ,
-            board.thrusters[0].max_duty_cycle(),
+            board.thrusters.channels()[0].max_duty_cycle(),
             LINK_BAUD,
             board.rate_hz,
             watchdog_timeout_ms(board.rate_hz)
@@ -447,16 +367,16 @@ fn watchdog_timeout_ms(rate_hz: u32) -> u32 {
     (4000 / rate_hz.max(1)).clamp(WATCHDOG_MIN_MS, 4096)
 }
 
-impl Board for Stm32Board {
-    type Thruster = Thruster;
+impl<T: ThrusterOutputs> Board for Stm32Board<T> {
+    type Thruster = T::Channel;
     type Link = Usart2Link;
 
     fn supply_voltage(&self) -> f32 {
         SUPPLY_VOLTAGE
     }
 
-    fn thrusters(&mut self) -> &mut [Thruster; 5] {
-        &mut self.thrusters
+    fn thrusters(&mut self) -> &mut [T::Channel; 5] {
+        self.thrusters.channels()
     }
 
     fn link(&mut self) -> &mut Usart2Link {
