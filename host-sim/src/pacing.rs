@@ -85,11 +85,38 @@ impl std::fmt::Display for RealTimeStats {
     }
 }
 
+/// Telemetry frames the host listens to once the board is armed at the mission's rate, before
+/// a real-time mission starts, to find the board's period phase ([`board_edge`]).
+pub(crate) const PHASE_FRAMES: usize = 8;
+
+/// One of the board's period boundaries as the host sees it, from the arrival times of
+/// telemetry the board sends once per period, just after each boundary. A frame is only ever
+/// delayed (by the board's work, the link, a host that read it late), so the boundary is the
+/// arrival after which the others come soonest: the one whose phase, modulo `period`, the
+/// others follow by the least in total — robust to a few frames delayed by a large part of a
+/// period, and to phases that straddle a boundary. (A frame delayed by nearly a whole period
+/// reads as one that came just before its boundary; the set-up's frames, read as they come,
+/// are not.) `None` without arrivals. **Choice 78**,
+/// docs/design.md §21.
+pub(crate) fn board_edge(arrivals: &[Instant], period: Duration) -> Option<Instant> {
+    let (&first, _) = arrivals.split_first()?;
+    let p = period.as_nanos().max(1);
+    let phases: Vec<u128> = arrivals
+        .iter()
+        .map(|a| a.saturating_duration_since(first).as_nanos() % p)
+        .collect();
+    let lag = |c: u128| -> u128 { phases.iter().map(|&ph| (ph + p - c) % p).sum() };
+    let best = phases.iter().copied().min_by_key(|&c| lag(c))?;
+    Some(first + Duration::from_nanos(best as u64))
+}
+
 /// The real-time pacer and its accumulators.
 pub(crate) struct RealTime {
     pub(crate) period: Duration,
     /// The wall-clock time of period 0 (set on the first period).
     pub(crate) origin: Option<Instant>,
+    /// One of the board's period boundaries ([`board_edge`]), if the set-up found it.
+    pub(crate) edge: Option<Instant>,
     /// The last state frames sent (sequence number, when), not yet answered.
     pub(crate) sent: std::collections::VecDeque<(u16, Instant)>,
     pub(crate) latencies: Vec<f64>,
@@ -103,12 +130,29 @@ impl RealTime {
         RealTime {
             period: Duration::from_secs_f64(1.0 / f64::from(rate_hz.max(1))),
             origin: None,
+            edge: None,
             sent: std::collections::VecDeque::new(),
             latencies: Vec::new(),
             last_arrival: None,
             intervals: Vec::new(),
             stats: RealTimeStats::default(),
         }
+    }
+
+    /// The run's clock, from the board's answer to the first state frame at `answer`: half a
+    /// period after the board's boundary that answer followed, so that the host's periods fall
+    /// between the board's (Choice 66). The boundary is the set-up's [`board_edge`] carried
+    /// forward, or, without one, the answer itself (which is late by whatever delayed it).
+    pub(crate) fn origin_after(&self, answer: Instant) -> Instant {
+        let boundary = match self.edge {
+            Some(edge) if answer >= edge => {
+                let p = self.period.as_nanos().max(1);
+                let since = (answer - edge).as_nanos() % p;
+                answer - Duration::from_nanos(since as u64)
+            }
+            _ => answer,
+        };
+        boundary + self.period / 2
     }
 
     /// When period `k` is due.
@@ -188,6 +232,52 @@ impl RealTime {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Boundaries every 10 ms from a known instant; frames delayed by 0.25 ms at best, some by
+    /// several ms (one by more than half a period, one by more than a whole one), the first of
+    /// them late; then a set whose phases straddle a boundary: the boundary found is the
+    /// least-delayed arrival's, and the clock starts half a period after the boundary before
+    /// a late answer.
+    #[test]
+    fn the_board_boundary_is_the_least_delayed_arrival() {
+        let p = Duration::from_millis(10);
+        let e0 = Instant::now();
+        let ms = |x: f64| Duration::from_secs_f64(x * 1e-3);
+        let arrivals_of = |delays: &[f64]| -> Vec<Instant> {
+            delays
+                .iter()
+                .enumerate()
+                .map(|(i, &d)| e0 + p * i as u32 + ms(d))
+                .collect()
+        };
+        let phase_of = |edge: Instant| (edge - e0).as_nanos() % p.as_nanos();
+        let arrivals = arrivals_of(&[4.6, 0.4, 0.25, 6.0, 0.3, 12.0, 0.5, 0.35]);
+        let edge = board_edge(&arrivals, p).unwrap();
+        assert_eq!(phase_of(edge), ms(0.25).as_nanos());
+        // Relative to the first arrival (0.4 ms late) the best is 9.85 ms on: across the wrap.
+        let straddling = arrivals_of(&[0.4, 0.25, 0.3, 3.0]);
+        assert_eq!(
+            phase_of(board_edge(&straddling, p).unwrap()),
+            ms(0.25).as_nanos()
+        );
+        assert_eq!(board_edge(&[], p), None);
+        // One arrival is its own boundary.
+        assert_eq!(board_edge(&arrivals[1..2], p), Some(arrivals[1]));
+
+        let mut rt = RealTime::new(100);
+        // Without a boundary: half a period after the answer.
+        let answer = e0 + p * 20 + ms(4.6);
+        assert_eq!(rt.origin_after(answer), answer + ms(5.0));
+        // With it: half a period after the boundary the answer followed (e0 + 200.25 ms).
+        rt.edge = Some(edge);
+        let origin = rt.origin_after(answer);
+        let want = e0 + p * 20 + ms(0.25) + ms(5.0);
+        assert!(
+            origin.max(want) - origin.min(want) < Duration::from_nanos(2),
+            "{:?}",
+            origin.max(want) - origin.min(want)
+        );
+    }
 
     /// The figures from samples whose answers are worked by hand: intervals 10, 12, 8 ms
     /// against a 10 ms period deviate by 0, +2, −2 ms (RMS √(8/3) ms, largest 2 ms); latencies

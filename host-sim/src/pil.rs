@@ -56,7 +56,7 @@ use serde::{Deserialize, Serialize};
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 
 use crate::config::LinkFaults;
-use crate::pacing::RealTime;
+use crate::pacing::{board_edge, RealTime, PHASE_FRAMES};
 pub use crate::pacing::{Pacing, RealTimeStats};
 use crate::qemu::{spawn_qemu, stop_group};
 use crate::record::{ControlStatus, RunResult, RunSummary};
@@ -451,6 +451,18 @@ impl BoardInTheLoop {
                 return Err(format!("board did not arm (status {:?})", t.status));
             }
         }
+        if b.rt.is_some() {
+            // Real time: the board's period phase, from the frames it sends armed at the
+            // mission's rate (Choice 78).
+            let mut arrivals = Vec::with_capacity(PHASE_FRAMES);
+            for _ in 0..PHASE_FRAMES {
+                b.latest = Some(b.next_telemetry()?);
+                arrivals.push(b.heard);
+            }
+            if let Some(rt) = &mut b.rt {
+                rt.edge = board_edge(&arrivals, rt.period);
+            }
+        }
         b.t0 = Instant::now();
         Ok(b)
     }
@@ -682,11 +694,14 @@ impl BoardInTheLoop {
             // The mission starts with the board's answer to its first state frame (bounded by
             // the reply timeout), so period 0 does not fly on a reply from before the mission
             // ran. The board sends telemetry just after its period boundary: the run's clock
-            // starts half a period after that answer, so that the host's periods fall between
-            // the board's — a frame then waits half a period for the board, and its answer
-            // has half a period to come back. (Started on the answer itself, every frame
-            // arrived just after a boundary and was answered just after the next period was
-            // due: every frame late.) The clocks drift apart over a run; the figures show it.
+            // starts half a period after the boundary that answer followed, so that the host's
+            // periods fall between the board's — a frame then waits half a period for the
+            // board, and its answer has half a period to come back. (Started on the answer
+            // itself, every frame arrived just after a boundary and was answered just after
+            // the next period was due: every frame late.) The boundary is the set-up's
+            // estimate (Choice 78), not the answer's arrival: a first answer delayed by a few
+            // ms put every later frame just after the board's boundary. The clocks drift
+            // apart over a run; the figures show it.
             loop {
                 let t = self.next_period()?;
                 let heard = self.heard;
@@ -695,7 +710,7 @@ impl BoardInTheLoop {
                 }
                 if expect_seq.is_none_or(|seq| t.last_state_seq == seq) {
                     if let Some(rt) = &mut self.rt {
-                        rt.origin = Some(heard + rt.period / 2);
+                        rt.origin = Some(rt.origin_after(heard));
                     }
                     return Ok(t);
                 }
