@@ -8,10 +8,12 @@
 //! exist and how to tell their ELFs apart) and [`qemu_clock`] (QEMU's instruction counts).
 //!
 //! Target only (`thumbv7em-none-eabihf`): `rt` (boot, the flying loop, fault reports) and one
-//! module per board, each behind its feature — `qemu` (mps2-an386) and `stm32f405`. The
-//! features only add a board (and its crates); they can be combined. The images themselves are
-//! the binaries in `src/bin/`: `firmware-qemu`, `firmware-qemu-selftest`,
-//! `firmware-stm32f405` (see firmware/README.md).
+//! module per board, each behind its feature — `qemu` (mps2-an386) and `stm32f405`, whose
+//! `emulator` build (feature `stm32f405-emulator`) runs the STM32 board code under QEMU's
+//! netduinoplus2 — and `semihosting` (exit and boot configuration under QEMU). The features
+//! only add a board (and its crates); they can be combined. The images themselves are the
+//! binaries in `src/bin/`: `firmware-qemu`, `firmware-qemu-selftest`, `firmware-stm32f405`,
+//! `firmware-stm32f405-emulator` (see firmware/README.md).
 #![cfg_attr(not(test), no_std)]
 
 pub mod board;

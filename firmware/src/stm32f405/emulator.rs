@@ -19,7 +19,7 @@
 //!    clock is 168 MHz, [`SYSCLK_HZ`](super::SYSCLK_HZ), so the control period is the board's.
 //! 2. **Thruster PWM.** TIM1/TIM8 are not modelled (a duty written there reads back 0), so the
 //!    five outputs are [`MemPwm`] channels with the real timers' resolution,
-//!    [`PWM_COUNTS`](super::PWM_COUNTS) = 8400: the voltage → duty path is the same, the duty
+//!    [`PWM_COUNTS`] = 8400: the voltage → duty path is the same, the duty
 //!    stays in RAM.
 //! 3. **Logs and the end of the program.** defmt goes over semihosting (QEMU's stdout, decoded
 //!    by `defmt-print`) instead of RTT, and `halt` exits QEMU with the code through

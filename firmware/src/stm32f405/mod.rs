@@ -1,7 +1,9 @@
 //! Board: STM32F405 (Cortex-M4F at 168 MHz), e.g. STM32F405RGT6, with stm32f4xx-hal 0.23.
 //!
 //! Built only for `target_os = "none"` with `--features stm32f405`; the image is the
-//! `firmware-stm32f405` binary.
+//! `firmware-stm32f405` binary. The same code, with what QEMU does not model substituted, is
+//! the `firmware-stm32f405-emulator` image for QEMU's netduinoplus2 ([`emulator`], feature
+//! `stm32f405-emulator`; not a flight image).
 //!
 //! # Clocks
 //!
@@ -27,7 +29,8 @@
 //! available with this map; PA9/PA10 are USART1's usual pins, USART1 is not used.
 //!
 //! - **PWM**: [`PWM_HZ`] = 20 kHz, edge-aligned PWM mode 1 on the two advanced timers (168 MHz
-//!   timer clock, no prescaler: 8400 counts per period, [`Thruster::max_duty_cycle`] = 8400).
+//!   timer clock, no prescaler: [`PWM_COUNTS`] = 8400 counts per period,
+//!   [`Thruster::max_duty_cycle`] = 8400).
 //!   Duty d gives a mean H-bridge voltage (2d − 1)·V_s (locked anti-phase, see
 //!   [`crate::pwm`]); **neutral is 50 %**. `init` sets all five channels to neutral and
 //!   lets the timers load it before it enables any output.
@@ -142,8 +145,7 @@ pub enum Thruster {
 }
 
 /// The board's five thruster outputs, as [`Stm32Board`] drives them: the real timers
-/// ([`AdvancedTimers`]) or, in the emulator build, RAM channels
-/// ([`emulator::EmulatedTimers`](crate::stm32f405)).
+/// ([`AdvancedTimers`]) or, in the emulator build, RAM channels (`emulator::EmulatedTimers`).
 pub trait ThrusterOutputs {
     /// One channel.
     type Channel: SetDutyCycle;
