@@ -27,4 +27,9 @@ fn USART2() {
     stm32f405::on_usart2_interrupt();
 }
 
+#[cortex_m_rt::exception]
+fn SysTick() {
+    stm32f405::on_systick_interrupt();
+}
+
 firmware::fault_handlers!(halt);

@@ -45,7 +45,10 @@
 //!   blocking the loop for a frame time (~87 µs per byte).
 //! - **Period timer**: SysTick on the 168 MHz core clock (HCLK/8 = 21 MHz below 11 Hz, where
 //!   the 24-bit reload would overflow). The period is 1/hz to within one count for hz ≥ 2;
-//!   1 Hz is clamped to the longest SysTick period, 0.8 s.
+//!   1 Hz is clamped to the longest SysTick period, 0.8 s. Between periods the core sleeps
+//!   (WFI); SysTick's interrupt wakes it at the boundary, USART2's for each byte. (Under QEMU a
+//!   core that polls SysTick keeps a host CPU busy and starves QEMU's I/O thread, which delivers
+//!   the link's bytes; sleeping frees it.)
 //! - **`now()`**: the DWT cycle counter CYCCNT, a free-running 32-bit up-counter in CPU cycles
 //!   ([`SYSCLK_HZ`] per second; wraps every 25.6 s, `wrapping_sub` differences are fine). The
 //!   real Cortex-M4 has it (`init` enables DCB trace and the counter); QEMU does not model
@@ -286,9 +289,16 @@ impl Stm32Board<AdvancedTimers> {
     }
 }
 
+/// The body of the `SysTick` exception handler (each STM32 image binds it: `#[exception] fn
+/// SysTick()`): nothing. The interrupt is there to wake [`Board::wait_period`]'s WFI; the
+/// period is still told by COUNTFLAG, which the exception does not clear.
+#[inline(always)]
+pub fn on_systick_interrupt() {}
+
 /// Halting the core in a debugger disables the thruster outputs and pauses the IWDG (module
-/// docs, *Safe state*).
+/// docs, *Safe state*); a probe keeps its connection (RTT) while the core sleeps in WFI.
 fn stop_in_debug(dbgmcu: &pac::DBGMCU) {
+    dbgmcu.cr().modify(|_, w| w.dbg_sleep().set_bit());
     dbgmcu.apb2_fz().modify(|_, w| {
         w.dbg_tim1_stop().set_bit();
         w.dbg_tim8_stop().set_bit()
@@ -402,6 +412,8 @@ impl<T: ThrusterOutputs> Board for Stm32Board<T> {
         self.syst.set_reload(reload);
         // Writing the current value clears it and COUNTFLAG.
         self.syst.clear_current();
+        // The interrupt only wakes `wait_period`'s WFI; the image binds an empty handler.
+        self.syst.enable_interrupt();
         self.syst.enable_counter();
         self.rate_hz = hz;
         self.set_watchdog_ms(watchdog_timeout_ms(hz));
@@ -410,6 +422,29 @@ impl<T: ThrusterOutputs> Board for Stm32Board<T> {
     fn period_elapsed(&mut self) -> bool {
         // COUNTFLAG is set at each wrap and cleared by reading it.
         self.syst.has_wrapped()
+    }
+
+    /// Sleeps (WFI) between interrupts until the boundary: SysTick's interrupt (an empty
+    /// handler, [`on_systick_interrupt`]) wakes the core at the boundary, a USART2 byte in
+    /// between. The flag is tested with interrupts masked and WFI entered still masked (a
+    /// pending interrupt ends WFI either way), so a boundary that comes between the test and
+    /// the WFI cannot be slept through.
+    fn wait_period(&mut self) -> bool {
+        let overrun = self.period_elapsed();
+        if !overrun {
+            loop {
+                cortex_m::interrupt::disable();
+                if self.period_elapsed() {
+                    // SAFETY: re-enables what this loop masked; no critical section is open.
+                    unsafe { cortex_m::interrupt::enable() };
+                    break;
+                }
+                cortex_m::asm::wfi();
+                // SAFETY: as above; the pending interrupt that woke the core runs here.
+                unsafe { cortex_m::interrupt::enable() };
+            }
+        }
+        overrun
     }
 
     /// CPU cycles (DWT CYCCNT, [`SYSCLK_HZ`] per second, wrapping).
