@@ -68,6 +68,10 @@ use crate::transport::{Serial, Transport};
 /// `-icount` on a loaded host is slow; the board itself answers every period).
 pub const PIL_REPLY_TIMEOUT: Duration = Duration::from_secs(10);
 
+/// Board periods real time's period 0 waits for an answer that took all it sent, before it
+/// takes one that names its state frame alone.
+const K0_PATIENCE: u32 = 10;
+
 /// The longest single read: the runner checks its deadlines at least this often.
 const READ_SLICE: Duration = Duration::from_millis(100);
 
@@ -689,8 +693,20 @@ impl BoardInTheLoop {
     /// thrusters hold what the board last commanded, as they would on the vehicle). Period 0
     /// waits for its answer, and the run's wall clock starts then.
     /// **Choice 66**, docs/design.md §21.
-    fn realtime_reply(&mut self, k: u64, expect_seq: Option<u16>) -> Result<Telemetry, String> {
+    fn realtime_reply(
+        &mut self,
+        k: u64,
+        expect_seq: Option<u16>,
+        last_sent: Option<u16>,
+    ) -> Result<Telemetry, String> {
         if k == 0 {
+            // The answer is the first telemetry that names the first state frame from a
+            // period in which the board had also taken the rest of what period 0 sent (the
+            // `StartMission` after it): when the two straddle one of the board's boundaries,
+            // the board's first answer names the state but is still `armed`, and flying on it
+            // would count a period with the thrusters off. A board that never takes it (the
+            // frames were damaged) is answered anyway after `K0_PATIENCE` periods.
+            let mut periods = 0;
             // The mission starts with the board's answer to its first state frame (bounded by
             // the reply timeout), so period 0 does not fly on a reply from before the mission
             // ran. The board sends telemetry just after its period boundary: the run's clock
@@ -708,7 +724,11 @@ impl BoardInTheLoop {
                 if let Some(rt) = &mut self.rt {
                     rt.answered(t.last_state_seq, heard);
                 }
-                if expect_seq.is_none_or(|seq| t.last_state_seq == seq) {
+                periods += 1;
+                let took_all = last_sent.is_none_or(|seq| t.last_rx_seq == seq);
+                if expect_seq.is_none_or(|seq| t.last_state_seq == seq)
+                    && (took_all || periods > K0_PATIENCE)
+                {
                     if let Some(rt) = &mut self.rt {
                         rt.origin = Some(rt.origin_after(heard));
                     }
@@ -864,6 +884,8 @@ impl ControlSource for BoardInTheLoop {
                 expect_seq = self.encode_state(frame, corrupt, delayed, &mut out)?;
             }
         }
+        // The last frame this period sent (real time's period 0 waits until the board took it).
+        let last_sent = (!out.is_empty()).then(|| self.seq.wrapping_sub(1));
         if !out.is_empty() {
             self.write(&out)?;
         }
@@ -881,7 +903,7 @@ impl ControlSource for BoardInTheLoop {
                     _ => break t,
                 }
             },
-            Pacing::Realtime => self.realtime_reply(k, expect_seq)?,
+            Pacing::Realtime => self.realtime_reply(k, expect_seq, last_sent)?,
         };
         self.note_status(&t, k);
         self.check_unit(&t)?;
