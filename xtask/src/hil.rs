@@ -20,8 +20,9 @@ use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
 use auv_link::sign::LinkKey;
+use auv_link::{BoardStatus, FailSafeReason};
 use host_sim::pacing::Pacing;
-use host_sim::pil::{Mode, PilComparison};
+use host_sim::pil::{FailSafeEventKind, Mode, PilComparison};
 use host_sim::qemu::QemuPty;
 use host_sim::record::Cases;
 
@@ -34,6 +35,9 @@ const SECONDS: &str = "5";
 const LONG_SECONDS: &str = "60";
 /// The most `hil` may take to notice a port that went away (s); it notices at its next read.
 const LOST_BOUND_S: u64 = 30;
+/// The most a real-time board may take to log its stale-state fail-safe once the host has
+/// stopped (s): 2 periods of its timer, and the log's way out through QEMU.
+const QUIET_BOUND_S: u64 = 5;
 
 /// A board HIL flies: its ELF, a name for the logs and messages, and the link key both ends
 /// are provisioned with (`None`: unsigned).
@@ -69,7 +73,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
                what: &str,
                pacing: Pacing,
                seconds: &str|
-     -> Option<(QemuPty, Command, std::path::PathBuf)> {
+     -> Option<(QemuPty, Command, std::path::PathBuf, std::path::PathBuf)> {
         let name = format!("{} {what}", board.name);
         let slug = format!("{}-{what}", board.name);
         let log = scratch.join(format!("hil-{slug}-qemu.log"));
@@ -111,7 +115,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
                 ""
             }
         );
-        Some((qemu, cmd, out))
+        Some((qemu, cmd, out, log))
     };
     let report = |ci: &mut Ci,
                   name: &str,
@@ -132,7 +136,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
     };
 
     // 1. Lock-step over the pty: the PIL protocol on a tty; must equal SIL bit for bit.
-    if let Some((qemu, mut cmd, _)) = hil(ci, "lockstep", Pacing::Lockstep, SECONDS) {
+    if let Some((qemu, mut cmd, _, _)) = hil(ci, "lockstep", Pacing::Lockstep, SECONDS) {
         let output = cmd.output();
         drop(qemu);
         match output {
@@ -155,7 +159,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
                         || c.pil.signed != board.key_file.is_some()
                     {
                         ci.fail(format!(
-                            "HIL lock-step over the pty: exit {}, max path {} m against SIL's {} m (must be bit for bit), board rx errors {}, dropped {}, refused {}, telemetry refused {}, signed {} (expected {}); the serial path must carry exactly what the socket does (raw mode: no echo, no line editing)",
+                            "HIL {who} lock-step over the pty: exit {}, max path {} m against SIL's {} m (must be bit for bit), board rx errors {}, dropped {}, refused {}, telemetry refused {}, signed {} (expected {}); the serial path must carry exactly what the socket does (raw mode: no echo, no line editing)",
                             o.status,
                             c.run.metrics.max_path,
                             c.sil_max_path,
@@ -172,14 +176,51 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
         }
     }
 
-    // 2. Real time over the pty: figures, reported.
-    if let Some((qemu, mut cmd, _)) = hil(ci, "realtime", Pacing::Realtime, SECONDS) {
+    // 2. Real time over the pty: figures, reported; then the host goes quiet, and the board,
+    //    on its own timer, must go to the stale-state fail-safe by itself.
+    if let Some((qemu, mut cmd, _, log)) = hil(ci, "realtime", Pacing::Realtime, SECONDS) {
         let output = cmd.output();
+        let stale = BoardStatus::FailSafe(FailSafeReason::StaleState).as_str();
+        let count = || {
+            std::fs::read_to_string(&log)
+                .unwrap_or_default()
+                .matches(stale)
+                .count()
+        };
+        let deadline = Instant::now() + Duration::from_secs(QUIET_BOUND_S);
+        let during = output
+            .as_ref()
+            .ok()
+            .and_then(|o| report(ci, &format!("{who} real time"), o));
+        let reported = during.as_ref().map_or(0, |c| {
+            c.pil
+                .failsafe_events
+                .iter()
+                .filter(|e| {
+                    e.kind == FailSafeEventKind::Enter
+                        && e.reason == FailSafeReason::StaleState.as_str()
+                })
+                .count()
+        });
+        while count() <= reported && Instant::now() < deadline {
+            std::thread::sleep(Duration::from_millis(20));
+        }
+        let logged = count();
         drop(qemu);
+        if output.is_ok() && during.is_some() {
+            if logged > reported {
+                println!("{who} after the host went quiet: the board logged `{stale}` by itself");
+            } else {
+                ci.fail(format!(
+                    "HIL {who} real time: the host stopped sending state frames, and within {QUIET_BOUND_S} s the board's log ({}) shows no new `{stale}` ({logged} in the log, {reported} during the run): its stale-state fail-safe did not act",
+                    ci.rel(&log)
+                ));
+            }
+        }
         match output {
             Err(e) => ci.fail(format!("HIL {who} real time: running host-sim: {e}")),
             Ok(o) => {
-                if let Some(c) = report(ci, &format!("{who} real time"), &o) {
+                if let Some(c) = during {
                     match &c.pil.realtime {
                         Some(r) if r.periods > 0 && c.pil.telemetry_frames > 0 => println!(
                             "{who} real time over {}: {:.0} frames/s, {r}; max path {:.3} m (SIL {:.3} m), {} fail-safe events, exit {}",
@@ -191,7 +232,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
                             o.status
                         ),
                         other => ci.fail(format!(
-                            "HIL real time: no timing figures in the report ({other:?}, {} telemetry frames)",
+                            "HIL {who} real time: no timing figures in the report ({other:?}, {} telemetry frames)",
                             c.pil.telemetry_frames
                         )),
                     }
@@ -204,7 +245,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
     if !port_lost {
         return;
     }
-    if let Some((mut qemu, mut cmd, out)) = hil(ci, "lost", Pacing::Lockstep, LONG_SECONDS) {
+    if let Some((mut qemu, mut cmd, out, _)) = hil(ci, "lost", Pacing::Lockstep, LONG_SECONDS) {
         let child = cmd.stdout(Stdio::piped()).stderr(Stdio::piped()).spawn();
         let mut child = match child {
             Ok(c) => c,
@@ -231,7 +272,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
             let _ = child.kill();
             let _ = child.wait();
             ci.fail(format!(
-                "HIL port lost: host-sim was still running {LOST_BOUND_S} s after QEMU (its port) ended: a hang"
+                "HIL {who} port lost: host-sim was still running {LOST_BOUND_S} s after QEMU (its port) ended: a hang"
             ));
             return;
         }
@@ -266,7 +307,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
         );
         if o.status.success() || message.is_none() || csv_rows == 0 || stopped.is_none() {
             ci.fail(format!(
-                "HIL port lost: expected a non-zero exit, a `link went away` message, the partial CSV and a JSON case marked stopped early; got exit {}, message {message:?}, {csv_rows} CSV rows, stopped {stopped:?}; stderr:\n{err}",
+                "HIL {who} port lost: expected a non-zero exit, a `link went away` message, the partial CSV and a JSON case marked stopped early; got exit {}, message {message:?}, {csv_rows} CSV rows, stopped {stopped:?}; stderr:\n{err}",
                 o.status
             ));
         }
