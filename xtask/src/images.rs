@@ -207,7 +207,14 @@ struct ElfFacts {
     stack_top: Option<u64>,
     /// It carries the STM32 emulator build's substitutions ([`EMULATOR_SYMBOL`]).
     emulated: bool,
+    /// The exceptions and interrupts whose vector is cortex-m-rt's `DefaultHandler` (which
+    /// loops forever), of those the STM32 board enables.
+    unbound: Vec<&'static str>,
 }
+
+/// The handlers the STM32 board needs bound (`stm32f405_handlers!`): it enables both
+/// interrupts, and an unbound one would hang the board at its first byte or period.
+const STM32_HANDLERS: [&str; 2] = ["USART2", "SysTick"];
 
 fn read_elf(path: &Path) -> Result<ElfFacts, String> {
     let bytes = std::fs::read(path).map_err(|e| format!("reading {}: {e}", path.display()))?;
@@ -239,6 +246,10 @@ fn read_elf(path: &Path) -> Result<ElfFacts, String> {
         reset_vector: symbol("__RESET_VECTOR"),
         stack_top: symbol("_stack_start"),
         emulated: symbol(EMULATOR_SYMBOL).is_some(),
+        unbound: STM32_HANDLERS
+            .into_iter()
+            .filter(|h| symbol(h).is_none() || symbol(h) == symbol("DefaultHandler"))
+            .collect(),
     })
 }
 
@@ -291,6 +302,13 @@ pub fn check(ci: &mut Ci, built: &Built) {
             } else {
                 format!("{label} carries the STM32 emulator build's substitutions ({EMULATOR_SYMBOL}: no clock tree, thrusters in RAM); only firmware-stm32f405-emulator may")
             });
+        }
+        let stm32 = matches!(v.image, Image::Stm32f405 | Image::Stm32f405Emulator);
+        if stm32 && !facts.unbound.is_empty() {
+            ci.fail(format!(
+                "{label}: {:?} go to DefaultHandler (which loops forever): the board enables them; does its main invoke firmware::stm32f405_handlers!()?",
+                facts.unbound
+            ));
         }
         let (reset, stack) = expected_map(v.image);
         if facts.reset_vector != Some(reset) || facts.stack_top != Some(stack) {

@@ -11,8 +11,7 @@ use auv_link::sign::LinkKey;
 use cortex_m_rt::entry;
 use defmt_rtt as _;
 use firmware::image::Image;
-use firmware::stm32f405::{self, halt, Stm32Board};
-use stm32f4xx_hal::pac::interrupt;
+use firmware::stm32f405::{halt, Stm32Board};
 
 /// `LINK_KEY` (`None`: built with `AUV150_LINK_UNSIGNED=1`) and `LINK_KEY_IS_CI_TEST_KEY`.
 mod link_key {
@@ -33,14 +32,6 @@ fn main() -> ! {
     )
 }
 
-#[interrupt]
-fn USART2() {
-    stm32f405::on_usart2_interrupt();
-}
-
-#[cortex_m_rt::exception]
-fn SysTick() {
-    stm32f405::on_systick_interrupt();
-}
+firmware::stm32f405_handlers!();
 
 firmware::fault_handlers!(halt);

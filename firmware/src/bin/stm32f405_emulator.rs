@@ -11,8 +11,7 @@ use defmt_semihosting as _;
 use firmware::image::Image;
 use firmware::semihosting::link_key_or_halt;
 use firmware::stm32f405::emulator::halt;
-use firmware::stm32f405::{self, Stm32Board};
-use stm32f4xx_hal::pac::interrupt;
+use firmware::stm32f405::Stm32Board;
 
 #[entry]
 fn main() -> ! {
@@ -22,14 +21,6 @@ fn main() -> ! {
     })
 }
 
-#[interrupt]
-fn USART2() {
-    stm32f405::on_usart2_interrupt();
-}
-
-#[cortex_m_rt::exception]
-fn SysTick() {
-    stm32f405::on_systick_interrupt();
-}
+firmware::stm32f405_handlers!();
 
 firmware::fault_handlers!(halt);

@@ -289,8 +289,28 @@ impl Stm32Board<AdvancedTimers> {
     }
 }
 
-/// The body of the `SysTick` exception handler (each STM32 image binds it: `#[exception] fn
-/// SysTick()`): nothing. The interrupt is there to wake [`Board::wait_period`]'s WFI; the
+/// Binds the STM32 board's handlers — `USART2` ([`on_usart2_interrupt`]) and `SysTick`
+/// ([`on_systick_interrupt`]) — in an image's binary. Each STM32 image invokes it once, at its
+/// top level (it brings the PAC's `interrupt` attribute into scope there).
+#[macro_export]
+macro_rules! stm32f405_handlers {
+    () => {
+        use stm32f4xx_hal::pac::interrupt;
+
+        #[interrupt]
+        fn USART2() {
+            $crate::stm32f405::on_usart2_interrupt();
+        }
+
+        #[cortex_m_rt::exception]
+        fn SysTick() {
+            $crate::stm32f405::on_systick_interrupt();
+        }
+    };
+}
+
+/// The body of the `SysTick` exception handler ([`stm32f405_handlers!`](crate::stm32f405_handlers)
+/// binds it): nothing. The interrupt is there to wake [`Board::wait_period`]'s WFI; the
 /// period is still told by COUNTFLAG, which the exception does not clear.
 #[inline(always)]
 pub fn on_systick_interrupt() {}

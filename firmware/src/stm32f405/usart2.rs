@@ -25,8 +25,8 @@ fn usart2() -> &'static pac::usart1::RegisterBlock {
     unsafe { &*pac::USART2::ptr() }
 }
 
-/// The body of the `USART2` interrupt handler (the STM32 image binds it: `#[interrupt] fn
-/// USART2()`): moves a received byte, with its status flags, into the receive queue, and the
+/// The body of the `USART2` interrupt handler (each STM32 image binds it:
+/// [`stm32f405_handlers!`](crate::stm32f405_handlers)): moves a received byte, with its status flags, into the receive queue, and the
 /// next queued byte into the data register.
 pub fn on_usart2_interrupt() {
     let u = usart2();
