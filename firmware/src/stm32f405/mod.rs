@@ -316,9 +316,9 @@ macro_rules! stm32f405_handlers {
 pub fn on_systick_interrupt() {}
 
 /// Halting the core in a debugger disables the thruster outputs and pauses the IWDG (module
-/// docs, *Safe state*); a probe keeps its connection (RTT) while the core sleeps in WFI.
+/// docs, *Safe state*). DBG_SLEEP (a probe's connection while the core sleeps) is left to the
+/// probe software, so that a board flying without a probe never runs with it set.
 fn stop_in_debug(dbgmcu: &pac::DBGMCU) {
-    dbgmcu.cr().modify(|_, w| w.dbg_sleep().set_bit());
     dbgmcu.apb2_fz().modify(|_, w| {
         w.dbg_tim1_stop().set_bit();
         w.dbg_tim8_stop().set_bit()
@@ -448,20 +448,30 @@ impl<T: ThrusterOutputs> Board for Stm32Board<T> {
     /// handler, [`on_systick_interrupt`]) wakes the core at the boundary, a USART2 byte in
     /// between. The flag is tested with interrupts masked and WFI entered still masked (a
     /// pending interrupt ends WFI either way), so a boundary that comes between the test and
-    /// the WFI cannot be slept through.
+    /// the WFI cannot be slept through. Interrupts are unmasked after each wake only if they
+    /// were unmasked on entry (a caller's critical section stays one: the flag still ends the
+    /// wait). A NOP follows the WFI: with a probe attached that sets DBGMCU's DBG_SLEEP, some
+    /// STM32 parts are reported to mis-fetch the instruction after a WFI executed with
+    /// interrupts masked (firmware/README.md, "Verified only on hardware").
     fn wait_period(&mut self) -> bool {
         let overrun = self.period_elapsed();
         if !overrun {
+            let unmasked = cortex_m::register::primask::read().is_active();
             loop {
                 cortex_m::interrupt::disable();
-                if self.period_elapsed() {
-                    // SAFETY: re-enables what this loop masked; no critical section is open.
+                let boundary = self.period_elapsed();
+                if !boundary {
+                    cortex_m::asm::wfi();
+                    cortex_m::asm::nop();
+                }
+                if unmasked {
+                    // SAFETY: restores the unmasked state this call found; the pending
+                    // interrupt that woke the core runs here.
                     unsafe { cortex_m::interrupt::enable() };
+                }
+                if boundary {
                     break;
                 }
-                cortex_m::asm::wfi();
-                // SAFETY: as above; the pending interrupt that woke the core runs here.
-                unsafe { cortex_m::interrupt::enable() };
             }
         }
         overrun
