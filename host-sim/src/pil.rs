@@ -68,8 +68,8 @@ use crate::transport::{Serial, Transport};
 /// `-icount` on a loaded host is slow; the board itself answers every period).
 pub const PIL_REPLY_TIMEOUT: Duration = Duration::from_secs(10);
 
-/// Board periods real time's period 0 waits for an answer that took all it sent, before it
-/// takes one that names its state frame alone.
+/// Board periods real time's period 0 waits for an answer that took all it sent (Choice 83),
+/// before it takes the newest telemetry.
 const K0_PATIENCE: u32 = 10;
 
 /// The longest single read: the runner checks its deadlines at least this often.
@@ -704,8 +704,10 @@ impl BoardInTheLoop {
             // period in which the board had also taken the rest of what period 0 sent (the
             // `StartMission` after it): when the two straddle one of the board's boundaries,
             // the board's first answer names the state but is still `armed`, and flying on it
-            // would count a period with the thrusters off. A board that never takes it (the
-            // frames were damaged) is answered anyway after `K0_PATIENCE` periods.
+            // would count a period with the thrusters off. After `K0_PATIENCE` board periods
+            // without such an answer (the frames were lost or damaged on the line), the newest
+            // telemetry is the answer: the mission goes on, and what the board did shows in
+            // the run's faults — never an unbounded wait while telemetry keeps coming.
             let mut periods = 0;
             // The mission starts with the board's answer to its first state frame (bounded by
             // the reply timeout), so period 0 does not fly on a reply from before the mission
@@ -726,9 +728,8 @@ impl BoardInTheLoop {
                 }
                 periods += 1;
                 let took_all = last_sent.is_none_or(|seq| t.last_rx_seq == seq);
-                if expect_seq.is_none_or(|seq| t.last_state_seq == seq)
-                    && (took_all || periods > K0_PATIENCE)
-                {
+                let names_state = expect_seq.is_none_or(|seq| t.last_state_seq == seq);
+                if (names_state && took_all) || periods > K0_PATIENCE {
                     if let Some(rt) = &mut self.rt {
                         rt.origin = Some(rt.origin_after(heard));
                     }
