@@ -212,8 +212,8 @@ pub struct PilArgs {
     pub common: LoopArgs,
     #[arg(long, default_value = "runs/pil")]
     pub out: PathBuf,
-    /// Firmware ELF: the QEMU flying image [default:
-    /// target/thumbv7em-none-eabihf/release/firmware-qemu].
+    /// Firmware ELF: a flying image that runs in QEMU, `firmware-qemu` or
+    /// `firmware-stm32f405-emulator` [default: target/thumbv7em-none-eabihf/release/firmware-qemu].
     #[arg(long)]
     pub elf: Option<PathBuf>,
 }

@@ -9,8 +9,9 @@
 //! QEMU 10's STM32F405 models the core (SysTick on a 168 MHz core clock, the NVIC), the USARTs
 //! and TIM2–TIM5; RCC, GPIO, TIM1/TIM8, the IWDG and DBGMCU are *unimplemented devices*:
 //! their registers read as zero and ignore writes. What this build does differently, and only
-//! this build ([`Stm32Board::init_emulated`]; the real image's [`Stm32Board::init`] has none
-//! of it — its ELF is checked not to contain this function):
+//! this build: 1 and 2 in [`Stm32Board::init_emulated`] (the real image's
+//! [`Stm32Board::init`] has none of it, and its ELF is checked not to contain this function),
+//! 3 and 4 in the emulator's binary (`src/bin/stm32f405_emulator.rs`):
 //!
 //! 1. **Clock tree.** `RCC.freeze()` waits for the crystal's ready flag, which QEMU never sets.
 //!    The emulator build takes the HAL's reset-state view instead (`RCC.constrain()`: the 16 MHz
