@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Every test of the workspace, set-up included (safe on a fresh machine):
-# host tests with two math backends of the core (kernels, micromath), the simulator and the closed loop, the
+# host tests with the three math backends of the core (kernels, micromath, libm), the simulator and the closed loop, the
 # firmware's host tests, and the firmware on the target (`cargo xtask firmware`, xtask/): every
 # image built, its memory map and sizes checked, the QEMU self-test (golden vectors,
 # instruction counts, fail-safe, snapshots, failure injection) and processor in the loop.
@@ -15,6 +15,9 @@ cargo test --workspace --profile host
 
 echo "== controller-core tests with the micromath backend"
 cargo test -p controller-core --profile host --features micromath
+
+echo "== controller-core tests with the libm backend"
+cargo test -p controller-core --profile host --features libm-math
 
 echo "== controller-core cross-build for thumbv7em-none-eabihf"
 cargo build -p controller-core --release --target thumbv7em-none-eabihf
