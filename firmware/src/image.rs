@@ -7,8 +7,8 @@
 //! `host-sim pil` reads the marker so that it flies only a flying image that runs in QEMU (the
 //! QEMU image, or the STM32 board code's emulator build), never the self-test (which would exit
 //! after its checks) or the STM32 flight image (which would wait for clocks QEMU does not
-//! have); `scripts/qemu-run.sh` picks the QEMU machine by it. `Cargo.toml`'s `[[bin]]` entries must agree; a host test checks
-//! that they do.
+//! have); `scripts/qemu-run.sh` picks the QEMU machine by it. `Cargo.toml`'s `[[bin]]` entries
+//! must agree; a host test checks that they do.
 //!
 //! Core only (no std, no target code): the host crates use it as they are.
 

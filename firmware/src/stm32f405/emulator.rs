@@ -36,12 +36,9 @@
 //! TXE-driven transmit), both queues, SysTick's period programming, the IWDG programming
 //! sequence, the DBGMCU writes, the GPIO port set-up, the supervisor and the control loop.
 //!
-//! Verified only on hardware (QEMU reads zeros or does nothing there): the clock tree and the
-//! 460 800 baud line rate; the pins' alternate functions; the PWM waveform, its neutral start
-//! and the DBGMCU freeze of TIM1/TIM8; the watchdog's timeout and reset (QEMU's IWDG never
-//! expires); DWT CYCCNT, so `now()` reads 0 and the telemetry's update timings are 0 here; line
-//! errors (QEMU's USART never overruns, frames or flags noise: it holds the next byte back
-//! until the data register is read).
+//! What stays verified only on hardware (where QEMU reads zeros or does nothing) is listed
+//! once, in firmware/README.md ("Verified only on hardware"). Here, DWT CYCCNT reads 0, so
+//! `now()` and the telemetry's update timings are 0.
 
 use super::{stop_in_debug, Stm32Board, ThrusterOutputs, PWM_COUNTS};
 use crate::image::Image;
@@ -51,10 +48,10 @@ use stm32f4xx_hal::prelude::*;
 
 pub use crate::semihosting::halt;
 
-/// The QEMU machine this build runs on.
+/// The QEMU machine this build runs on (the images' table says which).
 pub const QEMU_MACHINE: &str = match Image::Stm32f405Emulator.qemu_machine() {
     Some(m) => m,
-    None => "",
+    None => panic!("the emulator image runs in QEMU"),
 };
 
 /// A symbol that exists in an image exactly when [`Stm32Board::init_emulated`] is linked into
