@@ -101,13 +101,16 @@ pub(crate) const PHASE_FRAMES: usize = 8;
 pub(crate) fn board_edge(arrivals: &[Instant], period: Duration) -> Option<Instant> {
     let (&first, _) = arrivals.split_first()?;
     let p = period.as_nanos().max(1);
-    let phases: Vec<u128> = arrivals
-        .iter()
-        .map(|a| a.saturating_duration_since(first).as_nanos() % p)
-        .collect();
+    let phases: Vec<u128> = arrivals.iter().map(|&a| phase(a, first, period)).collect();
     let lag = |c: u128| -> u128 { phases.iter().map(|&ph| (ph + p - c) % p).sum() };
     let best = phases.iter().copied().min_by_key(|&c| lag(c))?;
     Some(first + Duration::from_nanos(best as u64))
+}
+
+/// How far `at` is past the last boundary of a clock that has one at `from` and every
+/// `period` after it (ns, in [0, period); 0 for an `at` before `from`).
+fn phase(at: Instant, from: Instant, period: Duration) -> u128 {
+    at.saturating_duration_since(from).as_nanos() % period.as_nanos().max(1)
 }
 
 /// The real-time pacer and its accumulators.
@@ -146,9 +149,7 @@ impl RealTime {
     pub(crate) fn origin_after(&self, answer: Instant) -> Instant {
         let boundary = match self.edge {
             Some(edge) if answer >= edge => {
-                let p = self.period.as_nanos().max(1);
-                let since = (answer - edge).as_nanos() % p;
-                answer - Duration::from_nanos(since as u64)
+                answer - Duration::from_nanos(phase(answer, edge, self.period) as u64)
             }
             _ => answer,
         };
