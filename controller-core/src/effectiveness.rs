@@ -20,6 +20,10 @@ use nalgebra::Matrix6x5;
 
 /// Number of thrusters.
 pub const THRUSTERS: usize = 5;
+/// The thrusters' names in thruster order ([`MAIN`], [`VERT_FORE`], …): the words of scenario
+/// files (`reversed_thrusters`), plots, tables, the preflight and the board's reports.
+pub const THRUSTER_NAMES: [&str; THRUSTERS] =
+    ["main", "vert fore", "vert aft", "horz fore", "horz aft"];
 /// Index of the stern main thruster (along +x).
 pub const MAIN: usize = 0;
 /// Index of the fore vertical tunnel thruster (reference axis +z).

@@ -6,8 +6,8 @@ use std::hint::black_box;
 use controller_core::model::{ParamVariation, VehicleParams};
 use controller_core::Table1Case;
 use criterion::{criterion_group, criterion_main, Criterion};
-use host_sim::paper;
 use host_sim::plant::{Plant, PlantState, PlantTerms};
+use host_sim::scenario::paper;
 use nalgebra::{Vector3, Vector6};
 
 fn bench(c: &mut Criterion) {
@@ -45,7 +45,7 @@ fn bench(c: &mut Criterion) {
     let mut group = c.benchmark_group("mission");
     group.sample_size(20);
     group.bench_function("lawn-mower-30x15, 70 s, 1 ms plant, 100 Hz loop", |b| {
-        b.iter(|| host_sim::sil::run(black_box(&scenario)))
+        b.iter(|| host_sim::sim::run(black_box(&scenario)))
     });
     group.finish();
 }

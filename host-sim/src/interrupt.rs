@@ -2,7 +2,7 @@
 //!
 //! The binary [`install`]s the handler. The first signal only sets a flag that the runs read
 //! once per control period ([`requested`]): each run stops at the period it is in
-//! ([`Outcome::Interrupted`](crate::record::Outcome::Interrupted)), its CSV is flushed and put
+//! ([`Outcome::Interrupted`](crate::sim::Outcome::Interrupted)), its CSV is flushed and put
 //! in place, runs not started are not started, and the command writes its plots and report,
 //! saying they are partial, and exits 130 ([`crate::cli::Exit::Interrupted`]). A second signal
 //! exits at once (130), leaving only the files already completed (never a half-written file

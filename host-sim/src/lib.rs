@@ -1,46 +1,35 @@
 //! AUV-150 desktop simulator: the full nonlinear 6-DOF plant (f64) closed around the f32
-//! `controller-core` exactly as the firmware runs it (software in the loop).
+//! `controller-core` exactly as the firmware runs it (software in the loop), the board in the
+//! loop (PIL, HIL), and the studies built on them (Table 1, the real vehicle, preflight, Monte
+//! Carlo).
 //!
-//! | module | owns |
-//! |---|---|
-//! | [`config`] | what a run is ([`config::SimConfig`]) |
-//! | [`scenario`] | TOML scenario files, and the one validation of a run ([`scenario::Scenario`]) |
-//! | [`plant`] | the 6-DOF plant with varying parameters, current and RK4 |
-//! | [`sil`] | the sampled-data loop: ZOH, actuator chain, noise, divergence |
-//! | [`metrics`] | the paper's Table-1 metrics from a run, accumulated as it goes |
-//! | [`decimate`] | the bounded plot series of a long run |
-//! | [`progress`] | progress of long commands, on a terminal or not |
-//! | [`interrupt`] | Ctrl-C / SIGTERM: finish the current period, keep what is done |
-//! | [`link`] | what the simulator sends the board over `auv-link` |
-//! | [`record`] | samples, outcome, metrics and JSON summary of a run |
-//! | [`paper`] | the paper's Table 1: cases, profiles, its numbers, notes, the twelve runs |
-//! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale |
-//! | [`real`] | the real vehicle's six missions (`scenarios/real/`) and the paper's through the real chain |
-//! | [`pil`] | processor and hardware in the loop: the firmware in QEMU or on a board flies the plant; PIL/HIL vs SIL |
-//! | [`pacing`] | lock-step or real time, and a real-time run's timing figures |
-//! | [`qemu`] | the QEMU image as a board in the loop: on a socket or a pty |
-//! | [`transport`] | the byte transport under the board link: TCP socket or serial port |
-//! | [`montecarlo`] | Monte Carlo over the Table-3 box |
-//! | [`output`] | CSV, plots, report |
-//! | [`cli`] | the `host-sim` commands |
+//! The crate is a stack of layers; a module uses only the layers below its own (a test holds
+//! this: `xtask`'s source scan, `host_sim_layers`). From the bottom:
+//!
+//! | layer | module | owns |
+//! |---|---|---|
+//! | 0 | [`interrupt`] | Ctrl-C / SIGTERM: the process-wide stop flag every long phase polls |
+//! | 1 | [`plant`] | the physics: Eq (1) in f64 with RK4, trim, the parameter variation profiles, the ocean current |
+//! | 2 | [`scenario`] | what a run is: [`scenario::SimConfig`], TOML files, the one validation, the paper's cases, the real vehicle's missions |
+//! | 3 | [`sim`] | the one closed loop (measure, control, actuate, integrate), what a run records, its metrics, bound and progress |
+//! | 4 | [`board`] | a board in the loop over any byte transport: the runner, pacing, QEMU launch, PIL/HIL vs SIL |
+//! | 4 | [`studies`] | Table 1, preflight feasibility, Monte Carlo |
+//! | 5 | [`output`] | output folders, CSV, plots, reports |
+//! | 6 | [`cli`] | the `host-sim` commands, one file each |
+//!
+//! [`board`] and [`studies`] share layer 4 and do not use each other.
+
+pub mod interrupt;
+
+pub mod plant;
+
+pub mod scenario;
+
+pub mod sim;
+
+pub mod board;
+pub mod studies;
+
+pub mod output;
 
 pub mod cli;
-pub mod config;
-pub mod decimate;
-pub mod interrupt;
-pub mod link;
-pub mod metrics;
-pub mod montecarlo;
-pub mod output;
-pub mod pacing;
-pub mod paper;
-pub mod pil;
-pub mod plant;
-pub mod preflight;
-pub mod progress;
-pub mod qemu;
-pub mod real;
-pub mod record;
-pub mod scenario;
-pub mod sil;
-pub mod transport;

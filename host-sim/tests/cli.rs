@@ -213,8 +213,9 @@ fn tempdir(tag: &str) -> std::path::PathBuf {
 /// The commands are library functions: run one in-process and read what it printed and wrote.
 #[test]
 fn the_run_command_runs_in_process() {
+    use host_sim::cli::Cases;
     use host_sim::cli::{self, Exit, RunArgs};
-    use host_sim::record::{Cases, RunSummary};
+    use host_sim::sim::record::RunSummary;
 
     let dir = tempdir("in-process");
     let path = dir.join("short.toml");

@@ -16,8 +16,8 @@ use std::time::{Duration, Instant};
 use controller_core::{Controller, ControllerConfig};
 use firmware::board::{receive, LinkBuffers};
 use firmware::supervisor::{BoardInfo, Supervisor};
-use host_sim::pil::PilComparison;
-use host_sim::record::Cases;
+use host_sim::board::BoardComparison;
+use host_sim::cli::Cases;
 use serialport::{SerialPort, TTYPort};
 
 /// The reply timeout the tests give `hil` (s).
@@ -195,7 +195,7 @@ fn a_mission_start_that_straddles_a_board_period_flies_no_period_disarmed() {
     stop.store(true, Ordering::Relaxed);
     let _ = board.join();
     let stderr = String::from_utf8_lossy(&output.stderr);
-    let report: Cases<PilComparison> = serde_json::from_slice(&output.stdout)
+    let report: Cases<BoardComparison> = serde_json::from_slice(&output.stdout)
         .unwrap_or_else(|e| panic!("no JSON report ({e}); stderr:\n{stderr}"));
     let case = &report.cases[0];
     assert!(

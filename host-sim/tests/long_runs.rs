@@ -2,11 +2,11 @@
 //! every bucket's extremes, the CSV streams every period, and a mission long enough for the
 //! heading to pass the controller's angle limit still flies.
 
-use host_sim::decimate::{Decimator, PLOTTED, PLOT_BUCKETS, PLOT_SAMPLES};
 use host_sim::output::CsvStream;
-use host_sim::record::{ControlStatus, Outcome, Sample};
 use host_sim::scenario::parse_scenario;
-use host_sim::sil;
+use host_sim::sim;
+use host_sim::sim::decimate::{Decimator, PLOTTED, PLOT_BUCKETS, PLOT_SAMPLES};
+use host_sim::sim::record::{ControlStatus, Outcome, Sample};
 
 fn sample(k: u64) -> Sample {
     // Signals that are not monotone, with a few isolated spikes and one NaN.
@@ -125,7 +125,12 @@ fn a_long_run_streams_every_period_and_keeps_a_bounded_plot_series() {
     std::fs::create_dir_all(&dir).unwrap();
     let path = dir.join("fast-circle-with.csv");
     let mut csv = CsvStream::create(&path).unwrap();
-    let r = sil::run_observed(&s, &mut sil::LocalController::new(&s), &mut csv);
+    let r = sim::fly(
+        &s,
+        &mut sim::LocalController::new(&s),
+        &mut csv,
+        sim::Recording::Plot,
+    );
     csv.finish().unwrap();
     let periods = s.steps() + 1;
     assert!(periods > PLOT_SAMPLES);

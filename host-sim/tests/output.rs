@@ -9,8 +9,8 @@ use host_sim::output::{
     plot_case, plot_case_with_limit, table_markdown, table_text, write_csv, write_report,
     ReportRow, CSV_COLUMNS,
 };
-use host_sim::paper::{table1_row, PaperRow};
-use host_sim::record::{ControlStatus, Metrics, Outcome, RunResult, Sample};
+use host_sim::sim::record::{ControlStatus, Metrics, Outcome, RunResult, Sample};
+use host_sim::studies::table1::{table1_row, PaperRow};
 
 const PNG_SIGNATURE: [u8; 8] = [0x89, b'P', b'N', b'G', 0x0D, 0x0A, 0x1A, 0x0A];
 

@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use firmware::image::Image;
-use host_sim::pil::check_flying_image;
+use host_sim::board::image::check_flying_image;
 
 fn fake_elf(name: &str, marker: Option<Image>) -> PathBuf {
     let mut bytes = b"\x7fELF".to_vec();

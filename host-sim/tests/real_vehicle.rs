@@ -9,9 +9,10 @@ use controller_core::kinematics::Attitude;
 use controller_core::model::{self, ParamVariation, VehicleParams, GRAVITY};
 use controller_core::{HeadingMode, ThrustUnit, TrajectoryKind};
 use host_sim::plant::{self, Plant, PlantState, PlantTerms};
-use host_sim::preflight::{self, Verdict, DEFAULT_MARGIN};
-use host_sim::real;
+use host_sim::scenario::real_vehicle;
 use host_sim::scenario::{load_scenario, parse_scenario, Scenario, ScenarioError};
+use host_sim::sim::bound;
+use host_sim::studies::preflight::{self, Verdict, DEFAULT_MARGIN};
 use nalgebra::{Vector3, Vector6};
 
 fn scenarios_dir() -> PathBuf {
@@ -115,7 +116,7 @@ fn the_real_chain_applies_the_commanded_wrench_in_the_configured_unit() {
                 c.controller.thrust_unit = ThrustUnit::from_name(unit).unwrap();
             })
             .unwrap();
-        let run = host_sim::sil::run(&s);
+        let run = host_sim::sim::run(&s);
         let mut checked = 0;
         // The last sample keeps the previous period's thrust (the run ends there).
         let last = run.samples.len() - 1;
@@ -219,8 +220,8 @@ fn bad_real_vehicle_keys_are_named() {
 
 #[test]
 fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
-    let compiled = real::real_scenarios().unwrap();
-    for ((file, _), s) in real::REAL_SCENARIOS.iter().zip(&compiled) {
+    let compiled = real_vehicle::real_scenarios().unwrap();
+    for ((file, _), s) in real_vehicle::REAL_SCENARIOS.iter().zip(&compiled) {
         let loaded = load_scenario(&scenarios_dir().join("real").join(file)).unwrap();
         assert_eq!(loaded.config(), s.config(), "{file}");
     }
@@ -230,7 +231,7 @@ fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
         assert_eq!(c.heading, HeadingMode::Tangent);
         assert!(c.trimmed && !c.ideal_actuators);
         assert_eq!(c.controller.thrust_unit, ThrustUnit::Kgf);
-        assert_eq!(c.variation, host_sim::paper::variation(*case));
+        assert_eq!(c.variation, host_sim::scenario::paper::variation(*case));
         // The whole 70 s path of the paper, at the mission's time scale.
         assert!((c.duration - 70.0 * f64::from(c.time_scale)).abs() < 0.01);
     }
@@ -241,7 +242,8 @@ fn the_static_demand_is_the_closed_form_of_weight_and_cg_moment() {
     // Untrimmed Table-3 payload, level: the thrusters must hold ΔW = 30·9.81 N upward and the
     // CG moment x_G W = 0.05·520·9.81 N m; the vertical pair pushing up shares them as
     // T_fore = (ΔW + M/1.8)/2 = 218.0 N, beyond its 80 % envelope of 157.7 N.
-    let paper = host_sim::paper::scenario(controller_core::Table1Case::Circular10R, true).unwrap();
+    let paper = host_sim::scenario::paper::scenario(controller_core::Table1Case::Circular10R, true)
+        .unwrap();
     let p = preflight::check(&paper, DEFAULT_MARGIN).unwrap();
     assert_eq!(p.verdict, Verdict::StaticallyInfeasible);
     assert_eq!(p.smallest_time_scale, None);
@@ -309,7 +311,7 @@ fn time_scale_cures_a_dynamic_infeasibility_and_the_proposal_is_tight() {
 fn what_check_calls_feasible_flies_within_the_bound_and_static_infeasibility_does_not() {
     // Short flights (20 s of each real mission, 8 s of each paper mission through the chain):
     // the verdict of the shortened scenario against its flown outcome.
-    let real_missions = real::real_scenarios().unwrap();
+    let real_missions = real_vehicle::real_scenarios().unwrap();
     for s in real_missions
         .iter()
         .filter(|s| {
@@ -325,22 +327,27 @@ fn what_check_calls_feasible_flies_within_the_bound_and_static_infeasibility_doe
         let short = s.with(|c| c.duration = 20.0).unwrap();
         let p = preflight::check(&short, DEFAULT_MARGIN).unwrap();
         assert_eq!(p.verdict, Verdict::Feasible, "{p}");
-        let run = host_sim::sil::run(&short);
+        let run = host_sim::sim::run(&short);
         assert!(
-            real::within_bound(&run),
+            bound::within_bound(&run),
             "{}: path {} m, saturated {}",
             run.name,
             run.metrics.max_path,
             run.metrics.saturated_fraction
         );
     }
-    let chain = real::paper_real_chain_scenarios(&real_missions).unwrap();
+    let chain = real_vehicle::paper_real_chain_scenarios(&real_missions).unwrap();
     for s in chain.iter().step_by(2) {
         let short = s.with(|c| c.duration = 8.0).unwrap();
         let p = preflight::check(&short, DEFAULT_MARGIN).unwrap();
         assert_eq!(p.verdict, Verdict::StaticallyInfeasible, "{p}");
-        let run = host_sim::sil::run(&short);
-        assert!(!real::within_bound(&run), "{}: {:?}", run.name, run.metrics);
+        let run = host_sim::sim::run(&short);
+        assert!(
+            !bound::within_bound(&run),
+            "{}: {:?}",
+            run.name,
+            run.metrics
+        );
     }
 }
 

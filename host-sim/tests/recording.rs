@@ -3,16 +3,16 @@
 //! is that of the full recording.
 
 use controller_core::Table1Case;
-use host_sim::config::VariationProfile;
-use host_sim::record::Sample;
-use host_sim::sil::{self, LocalController, Observer, Recording};
+use host_sim::plant::VariationProfile;
+use host_sim::sim::record::Sample;
+use host_sim::sim::{self, LocalController, Observer, Recording};
 
 /// The paper's lawn-mower holds three parameter sets (its Table-3 staircase) and the figure
 /// eight one: a run factorises M once per set, not once per plant step (70 000).
 #[test]
 fn a_run_factorises_m_once_per_parameter_set() {
     for case in [Table1Case::LawnMower30x15, Table1Case::FigureEight30x30] {
-        let scenario = host_sim::paper::scenario(case, true).unwrap();
+        let scenario = host_sim::scenario::paper::scenario(case, true).unwrap();
         let sets = match &scenario.config().variation {
             VariationProfile::Staircase(steps) => {
                 let mut values: Vec<_> = steps.iter().map(|s| s.1).collect();
@@ -22,7 +22,7 @@ fn a_run_factorises_m_once_per_parameter_set() {
             VariationProfile::Constant(_) => 1,
             other => panic!("unexpected profile {other:?}"),
         };
-        let run = sil::run(&scenario);
+        let run = sim::run(&scenario);
         assert!(!run.diverged(), "{}", run.outcome);
         assert_eq!(run.plant_factorisations, sets, "{}", case.name());
     }
@@ -43,7 +43,7 @@ impl Observer for Count {
 #[test]
 fn metrics_only_recording_keeps_no_samples_and_the_same_summary() {
     // A draw as Monte Carlo makes it (constant Δp), and a run that faults and diverges.
-    let circle = host_sim::paper::scenario(Table1Case::Circular10R, true).unwrap();
+    let circle = host_sim::scenario::paper::scenario(Table1Case::Circular10R, true).unwrap();
     let circle = circle
         .with(|c| {
             c.variation = VariationProfile::Constant(
@@ -51,7 +51,7 @@ fn metrics_only_recording_keeps_no_samples_and_the_same_summary() {
             )
         })
         .unwrap();
-    let real = host_sim::paper::scenario(Table1Case::FigureEight30x30, false)
+    let real = host_sim::scenario::paper::scenario(Table1Case::FigureEight30x30, false)
         .unwrap()
         .with(|c| {
             c.ideal_actuators = false;
@@ -60,13 +60,13 @@ fn metrics_only_recording_keeps_no_samples_and_the_same_summary() {
         .unwrap();
     for scenario in [circle, real] {
         let (mut seen_full, mut seen_lean) = (Count::default(), Count::default());
-        let full = sil::run_recorded(
+        let full = sim::fly(
             &scenario,
             &mut LocalController::new(&scenario),
             &mut seen_full,
             Recording::Plot,
         );
-        let lean = sil::run_recorded(
+        let lean = sim::fly(
             &scenario,
             &mut LocalController::new(&scenario),
             &mut seen_lean,

@@ -4,8 +4,9 @@ use std::path::{Path, PathBuf};
 
 use controller_core::model::ParamVariation;
 use controller_core::{BBound, ControllerConfig, RobustLaw, Table1Case, TrajectoryKind};
-use host_sim::config::{CurrentModel, SimConfig, VariationProfile};
-use host_sim::paper;
+use host_sim::plant::{CurrentModel, VariationProfile};
+use host_sim::scenario::paper;
+use host_sim::scenario::SimConfig;
 use host_sim::scenario::{load_scenario, parse_scenario, Scenario, ScenarioError};
 
 fn scenarios_dir() -> PathBuf {
@@ -143,8 +144,8 @@ fn example_file_runs() {
         .unwrap()
         .with(|c| c.duration = 5.0)
         .unwrap();
-    let result = host_sim::sil::run(&s);
-    assert_eq!(result.outcome, host_sim::record::Outcome::Completed);
+    let result = host_sim::sim::run(&s);
+    assert_eq!(result.outcome, host_sim::sim::record::Outcome::Completed);
 }
 
 #[test]

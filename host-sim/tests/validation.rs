@@ -2,7 +2,7 @@
 //! length, numerically unsafe values, runs too long for the step cap. Each is refused at load,
 //! naming its key and the reason.
 
-use host_sim::config::SimConfig;
+use host_sim::scenario::SimConfig;
 use host_sim::scenario::{parse_scenario, Scenario, ScenarioError, MAX_CONTROL_PERIODS};
 
 fn circle_with(extra: &str) -> String {

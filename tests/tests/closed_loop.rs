@@ -2,14 +2,15 @@
 //! paper's missions (docs/design.md §6–§7).
 
 use controller_core::{Table1Case, TrajectoryKind};
-use host_sim::config::{CurrentModel, SimConfig};
-use host_sim::paper;
-use host_sim::record::Outcome;
+use host_sim::plant::CurrentModel;
+use host_sim::scenario::paper;
 use host_sim::scenario::Scenario;
-use host_sim::sil;
+use host_sim::scenario::SimConfig;
+use host_sim::sim;
+use host_sim::sim::record::Outcome;
 
-fn run(config: SimConfig) -> host_sim::record::RunResult {
-    sil::run(&Scenario::new(config).expect("valid scenario"))
+fn run(config: SimConfig) -> host_sim::sim::record::RunResult {
+    sim::run(&Scenario::new(config).expect("valid scenario"))
 }
 
 /// Each Table-1 mission with Δu at the paper's defaults stays under 0.05 m max path error, and

@@ -10,7 +10,7 @@ use controller_core::{
     Controller, ControllerConfig, Status, Table1Case, Trajectory, TrajectoryKind,
 };
 use firmware::supervisor::{BoardInfo, Supervisor};
-use host_sim::link::state_frame;
+use host_sim::board::frames::state_frame;
 use nalgebra::Vector6;
 
 /// The six Table-1 missions and a descending helix (not in the paper; the one kind no

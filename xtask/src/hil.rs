@@ -21,10 +21,10 @@ use std::time::{Duration, Instant};
 
 use auv_link::sign::LinkKey;
 use auv_link::{BoardStatus, FailSafeReason};
-use host_sim::pacing::Pacing;
-use host_sim::pil::{Mode, PilComparison};
-use host_sim::qemu::QemuPty;
-use host_sim::record::Cases;
+use host_sim::board::emulator::QemuPty;
+use host_sim::board::Pacing;
+use host_sim::board::{BoardComparison, Mode};
+use host_sim::cli::Cases;
 
 use crate::ci::Ci;
 
@@ -120,8 +120,8 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
     let report = |ci: &mut Ci,
                   name: &str,
                   output: &std::process::Output|
-     -> Option<PilComparison> {
-        match serde_json::from_slice::<Cases<PilComparison>>(&output.stdout) {
+     -> Option<BoardComparison> {
+        match serde_json::from_slice::<Cases<BoardComparison>>(&output.stdout) {
             Ok(r) if r.cases.len() == 1 => r.cases.into_iter().next(),
             other => {
                 ci.fail(format!(

@@ -13,8 +13,8 @@ use auv_link::FailSafeReason;
 use auv_link::DEFAULT_STALE_PERIODS;
 use controller_core::HeadingMode;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
-use host_sim::pil::{FailSafeEventKind, PilComparison};
-use host_sim::record::Cases;
+use host_sim::board::{BoardComparison, FailSafeEventKind};
+use host_sim::cli::Cases;
 
 use crate::ci::Ci;
 use crate::images::{Built, Variant};
@@ -78,10 +78,10 @@ pub fn run(ci: &mut Ci, built: &Built) {
 }
 
 /// Both PIL checks. Runs the release `host-sim` binary with `--json` and reads its report into
-/// host-sim's own types ([`Cases`]`<`[`PilComparison`]`>`), so the check and the report cannot
+/// host-sim's own types ([`Cases`]`<`[`BoardComparison`]`>`), so the check and the report cannot
 /// disagree on a field.
 fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
-    type Case = PilComparison;
+    type Case = BoardComparison;
     let scratch = ci.scratch();
     let run = |ci: &mut Ci, name: &str, args: &[&str]| -> Option<(bool, Case)> {
         let out = scratch.join(format!("pil-{name}"));
@@ -106,7 +106,7 @@ fn pil_checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
             }
         };
         // host-sim prints its report even when it exits 1 (PIL ≠ SIL, or diverged).
-        match serde_json::from_slice::<Cases<PilComparison>>(&output.stdout) {
+        match serde_json::from_slice::<Cases<BoardComparison>>(&output.stdout) {
             Ok(r) if r.cases.len() == 1 => {
                 let case = r.cases.into_iter().next()?;
                 Some((output.status.success(), case))

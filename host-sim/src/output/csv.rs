@@ -7,8 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use super::atomic::Pending;
-use crate::record::{RunResult, Sample};
-use crate::sil::Observer;
+use crate::sim::{Observer, RunResult, Sample};
 
 /// The columns of [`write_csv`], in order.
 pub const CSV_COLUMNS: [&str; 47] = [

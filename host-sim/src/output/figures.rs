@@ -13,7 +13,9 @@ use super::atomic::Pending;
 use super::plot::{
     figure, min_max, render, usable, Line, Panel, Stroke, C_DESIRED, C_LIMIT, C_WITH, C_WITHOUT,
 };
-use crate::record::{RunResult, Sample, THRUSTER_NAMES};
+use controller_core::effectiveness::THRUSTER_NAMES;
+
+use crate::sim::{RunResult, Sample};
 
 const C_THRUSTERS: [RGBColor; 5] = [
     RGBColor(31, 119, 180),

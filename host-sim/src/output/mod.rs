@@ -19,6 +19,7 @@ pub mod dir;
 pub mod figures;
 mod plot;
 pub mod report;
+pub mod sections;
 
 pub use self::csv::{write_csv, CsvStream, CSV_COLUMNS};
 pub use self::dir::OutputDir;
@@ -31,7 +32,7 @@ pub use self::report::{
 /// The CSV file name of a run called `name`, with (`robust`) or without Δu:
 /// `{name}-with.csv` / `{name}-without.csv`.
 pub fn csv_name(name: &str, robust: bool) -> String {
-    format!("{name}-{}.csv", crate::record::du_suffix(robust))
+    format!("{name}-{}.csv", crate::sim::record::du_suffix(robust))
 }
 
 /// Writes the plots of the report rows' runs and of `extra_plots` (five per run, voltages

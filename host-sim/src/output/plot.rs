@@ -12,7 +12,7 @@ use plotters::element::DashedPathElement;
 use plotters::prelude::*;
 use plotters::style::text_anchor::{HPos, Pos, VPos};
 
-use crate::record::{Outcome, RunResult};
+use crate::sim::{Outcome, RunResult};
 
 const WIDTH: u32 = 1200;
 const HEIGHT: u32 = 900;

@@ -9,9 +9,10 @@ use anyhow::{Context, Result};
 use controller_core::Table1Case;
 
 use super::atomic;
-use crate::paper;
-use crate::preflight::{Preflight, Verdict};
-use crate::record::{Metrics, RunResult};
+use crate::sim::bound;
+use crate::sim::{Metrics, RunResult};
+use crate::studies::preflight::{Preflight, Verdict};
+use crate::studies::table1 as paper_table1;
 
 /// One row of a report table: a case, its run with Δu, optionally its run without Δu, and
 /// the paper's Table-1 case it reproduces, if any (its numbers are printed beside ours).
@@ -105,7 +106,7 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
                     None => ours,
                 }
             };
-            let p = row.case.map(paper::table1_row);
+            let p = row.case.map(paper_table1::table1_row);
             let ours = |f: fn(&Metrics) -> f64| m.as_ref().map(f);
             let other = |f: fn(&Metrics) -> f64, fmt: &dyn Fn(f64) -> String| {
                 m.as_ref().map_or("—".to_string(), |m| fmt(f(m)))
@@ -427,7 +428,7 @@ fn real_cells(rows: &[RealRow]) -> Vec<Vec<String>> {
                 fmt_err(m.rms_path),
                 fmt_fixed(m.peak_voltage, 1),
                 format!("{} %", fmt_fixed(100.0 * m.saturated_fraction, 1)),
-                if crate::real::within_bound(r.run) {
+                if bound::within_bound(r.run) {
                     "yes"
                 } else {
                     "NO"
@@ -445,8 +446,8 @@ pub fn real_table_legend() -> String {
     format!(
         "within bound: completed with max path error ≤ {} m and a thruster saturated in ≤ {} % \
          of the control periods (docs/design.md §9)",
-        crate::real::MAX_PATH_ERROR,
-        100.0 * crate::real::MAX_SATURATED_FRACTION
+        bound::MAX_PATH_ERROR,
+        100.0 * bound::MAX_SATURATED_FRACTION
     )
 }
 

@@ -134,7 +134,7 @@
 //! controller's bounds then no longer cover the plant), but the varied plant's inertia matrix
 //! M must stay positive definite.
 //!
-//! The six files `scenarios/<case>.toml` are the paper's Table-1 runs; [`crate::paper::config`]
+//! The six files `scenarios/<case>.toml` are the paper's Table-1 runs; [`paper::config`]
 //! builds the same [`SimConfig`] in code.
 
 use std::fmt;
@@ -142,16 +142,22 @@ use std::path::{Path, PathBuf};
 
 use controller_core::{Controller, Trajectory};
 
-use crate::config::SimConfig;
+use crate::plant::PlantState;
 
-mod check;
-mod exact;
+mod config;
+mod fixed_arrays;
+pub mod paper;
 mod parse;
+pub mod real_vehicle;
+mod start;
+mod validate;
 
-pub use check::{
+pub use config::{LinkFaults, SensorNoise, SimConfig, TickRange};
+pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
+pub use start::start_state;
+pub use validate::{
     MAX_CONTROL_PERIODS, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS, MAX_VARIATION_OMEGA_STEP,
 };
-pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
 
 /// Why a scenario could not be loaded or validated.
 #[derive(Debug)]
@@ -215,8 +221,8 @@ impl Scenario {
     /// Validates `config` (every check, see the module doc) and builds its controller and
     /// trajectory.
     pub fn new(config: SimConfig) -> Result<Self, ScenarioError> {
-        let controller = check::controller(&config)?;
-        let trajectory = check::trajectory(&config.mission())?;
+        let controller = validate::controller(&config)?;
+        let trajectory = validate::trajectory(&config.mission())?;
         Self::assemble(config, controller, trajectory, true)
     }
 
@@ -229,12 +235,12 @@ impl Scenario {
         let controller = if config.controller == self.config.controller {
             self.controller.clone()
         } else {
-            check::controller(&config)?
+            validate::controller(&config)?
         };
         let trajectory = if config.mission() == self.config.mission() {
             self.trajectory
         } else {
-            check::trajectory(&config.mission())?
+            validate::trajectory(&config.mission())?
         };
         // The mission's reference depends only on these (a Monte Carlo draw keeps them all).
         let same_mission = config.controller == self.config.controller
@@ -249,9 +255,9 @@ impl Scenario {
         trajectory: Trajectory,
         check_mission: bool,
     ) -> Result<Self, ScenarioError> {
-        let (steps, substeps) = check::run(&config)?;
+        let (steps, substeps) = validate::run(&config)?;
         if check_mission {
-            check::mission(&config, &controller, &trajectory, steps)?;
+            validate::mission(&config, &controller, &trajectory, steps)?;
         }
         Ok(Scenario {
             config,
@@ -296,6 +302,15 @@ impl Scenario {
     /// The control period 1/rate_hz (s).
     pub fn period(&self) -> f64 {
         1.0 / f64::from(self.config.controller.rate_hz)
+    }
+
+    /// Where the run starts: on the reference plus the configured offset ([`start_state`]).
+    pub fn initial_state(&self) -> PlantState {
+        start_state(
+            &self.trajectory,
+            self.config.controller.rate_hz,
+            &self.config.initial_offset,
+        )
     }
 }
 

@@ -13,14 +13,12 @@ use controller_core::{
 use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer};
 
-use super::check::invalid;
-use super::exact;
-use super::ScenarioError;
-use crate::config::{
-    CurrentModel, LinkFaults, SensorNoise, SimConfig, TickRange, VariationProfile,
-};
-use crate::paper;
-use crate::record::THRUSTER_NAMES;
+use controller_core::effectiveness::THRUSTER_NAMES;
+
+use super::validate::invalid;
+use super::{fixed_arrays, paper};
+use super::{LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
+use crate::plant::{CurrentModel, VariationProfile};
 
 /// Default `seed` of `[noise]` and of the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;
@@ -46,7 +44,7 @@ struct RawScenario {
     duration: Option<f64>,
     plant_step: Option<f64>,
     ideal_actuators: Option<bool>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     initial_offset: Option<[f64; 6]>,
     divergence_limit: Option<f64>,
     thruster_lag: Option<f64>,
@@ -239,11 +237,11 @@ impl CurrentName {
 #[serde(deny_unknown_fields)]
 struct RawCurrent {
     model: CurrentName,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     velocity: Option<[f64; 3]>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     mean: Option<[f64; 3]>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     sigma: Option<[f64; 3]>,
     tau: Option<f64>,
     seed: Option<u64>,
@@ -252,9 +250,9 @@ struct RawCurrent {
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 struct RawNoise {
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     eta_sigma: Option<[f64; 6]>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     nu_sigma: Option<[f64; 6]>,
     seed: Option<u64>,
 }
@@ -278,11 +276,11 @@ enum BBoundName {
 struct RawController {
     robust: Option<bool>,
     law: Option<LawName>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     k1: Option<[f64; 6]>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     k2: Option<[f64; 6]>,
-    #[serde(default, deserialize_with = "exact::option")]
+    #[serde(default, deserialize_with = "fixed_arrays::option")]
     q: Option<[f64; 2]>,
     beta: Option<f64>,
     mu: Option<f64>,

@@ -1,0 +1,165 @@
+//! The QEMU flying image as a board in the loop: started through the runner
+//! (`scripts/qemu-run.sh`) in its own process group, with UART0 on a socket (PIL, the
+//! runner's [`super::BoardInTheLoop::start`]) or on a pseudo-terminal ([`QemuPty`]: HIL
+//! without hardware).
+
+use std::os::unix::process::CommandExt;
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+use auv_link::sign::LinkKey;
+
+use super::image::check_flying_image;
+use super::pacing::Pacing;
+
+/// Starts the QEMU flying image through `runner` (`scripts/qemu-run.sh`) in its own process
+/// group, with UART0 on `serial` (QEMU's `-serial` argument: `tcp:…` for PIL, `pty` for HIL)
+/// and its log (stdout and stderr) into `log`. Lock-step runs under `-icount shift=0` (the
+/// runner's default: update timings are instruction counts); real time without `-icount`, so
+/// that QEMU's SysTick follows the wall clock (`QEMU_ICOUNT=off`).
+pub fn spawn_qemu(
+    elf: &Path,
+    runner: &Path,
+    serial: &str,
+    pacing: Pacing,
+    log: std::fs::File,
+    key: Option<&LinkKey>,
+) -> Result<Child, String> {
+    let log_err = log.try_clone().map_err(|e| e.to_string())?;
+    let mut qemu = Command::new("bash");
+    qemu
+        // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
+        // under `timeout`, two processes down).
+        .process_group(0)
+        .arg(runner)
+        .arg(elf);
+    if let Some(k) = key {
+        // The QEMU image's provisioning (firmware::semihosting::link_key); visible to this
+        // machine's process list, which is acceptable for a simulator's key.
+        let hex: String = k.bytes().iter().map(|b| format!("{b:02x}")).collect();
+        qemu.arg("-append").arg(format!("link-key={hex}"));
+    }
+    if pacing == Pacing::Realtime {
+        qemu.env("QEMU_ICOUNT", "off");
+    }
+    qemu.env("QEMU_SERIAL", serial)
+        .env("QEMU_TIMEOUT", "3600")
+        .stdin(Stdio::null())
+        .stdout(Stdio::from(log))
+        .stderr(Stdio::from(log_err))
+        .spawn()
+        .map_err(|e| format!("starting QEMU through {}: {e}", runner.display()))
+}
+
+/// Ends a process group started by [`spawn_qemu`] (bash runner, timeout, QEMU, defmt-print)
+/// and reaps its leader.
+pub fn stop_group(child: &mut Child) {
+    let _ = Command::new("kill")
+        .arg("-TERM")
+        .arg("--")
+        .arg(format!("-{}", child.id()))
+        .status();
+    let _ = child.kill();
+    let _ = child.wait();
+}
+
+/// The QEMU flying image with its UART0 on a pseudo-terminal (`-serial pty`): a real tty that
+/// `host-sim hil --port` opens as it would a USB-serial adapter (the CI's HIL without
+/// hardware). Ends QEMU when dropped.
+///
+/// **Choice 70** (docs/design.md §21): the runner makes the pty with `-chardev pty,path=…`
+/// and names it on stderr, since QEMU prints its own `char device redirected to` line on
+/// stdout, into the defmt stream; real time runs QEMU without `-icount`.
+pub struct QemuPty {
+    child: Child,
+    /// The pty's device (`/dev/pts/N`).
+    pub port: PathBuf,
+}
+
+/// The runner's line on stderr naming the pty: `qemu-run: UART0 on pty /dev/pts/N (link)`
+/// (`USART2` on the STM32 emulator's machine; scripts/qemu-run.sh; QEMU's own line goes to its
+/// stdout, the defmt stream).
+const PTY_LINE: (&str, &str) = ("qemu-run: ", " on pty ");
+
+impl QemuPty {
+    /// Starts `elf` through `runner` with `QEMU_SERIAL=pty`, its log into `log_path`
+    /// (created), and waits (at most 30 s) for the runner to name the pty in it.
+    pub fn start(
+        elf: &Path,
+        runner: &Path,
+        log_path: &Path,
+        pacing: Pacing,
+        key: Option<&LinkKey>,
+    ) -> Result<Self, String> {
+        check_flying_image(elf)?;
+        let log = std::fs::File::create(log_path)
+            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
+        let child = spawn_qemu(elf, runner, "pty", pacing, log, key)?;
+        let mut q = QemuPty {
+            child,
+            port: PathBuf::new(),
+        };
+        let deadline = Instant::now() + Duration::from_secs(30);
+        loop {
+            let text = std::fs::read_to_string(log_path).unwrap_or_default();
+            if let Some(port) = pty_of_log(&text) {
+                q.port = port;
+                return Ok(q);
+            }
+            if let Ok(Some(status)) = q.child.try_wait() {
+                return Err(format!(
+                    "QEMU ended ({status}) before naming its pty (see {})",
+                    log_path.display()
+                ));
+            }
+            if Instant::now() > deadline {
+                return Err(format!(
+                    "QEMU did not name its pty within 30 s (see {})",
+                    log_path.display()
+                ));
+            }
+            std::thread::sleep(Duration::from_millis(20));
+        }
+    }
+
+    /// Ends QEMU now (the board's port goes away).
+    pub fn kill(&mut self) {
+        stop_group(&mut self.child);
+    }
+}
+
+impl Drop for QemuPty {
+    fn drop(&mut self) {
+        stop_group(&mut self.child);
+    }
+}
+
+/// The pty QEMU's log names ([`PTY_LINE`]), if it does yet.
+pub fn pty_of_log(log: &str) -> Option<PathBuf> {
+    log.lines().find_map(|line| {
+        let (_uart, rest) = line.strip_prefix(PTY_LINE.0)?.split_once(PTY_LINE.1)?;
+        let path = rest.split_whitespace().next()?;
+        path.starts_with("/dev/").then(|| PathBuf::from(path))
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_pty_is_read_from_the_runners_line() {
+        let log = "INFO boot\nqemu-run: UART0 on pty /dev/pts/7 (/tmp/qemu-uart0.x)\nINFO tick 0";
+        assert_eq!(pty_of_log(log), Some(PathBuf::from("/dev/pts/7")));
+        assert_eq!(
+            pty_of_log("char device redirected to /dev/pts/3 (label serial0)"),
+            None
+        );
+        assert_eq!(pty_of_log("qemu-run: UART0 on pty "), None);
+        // The STM32 emulator's link is USART2.
+        let log = "qemu-run: USART2 on pty /dev/pts/12 (/tmp/qemu-uart0.y)\n";
+        assert_eq!(pty_of_log(log), Some(PathBuf::from("/dev/pts/12")));
+        assert_eq!(pty_of_log("INFO tick 3: UART0 on pty /dev/pts/1"), None);
+    }
+}

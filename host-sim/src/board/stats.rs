@@ -1,0 +1,92 @@
+//! The link and board figures of one run with a board in the loop: frames, the board's own
+//! counters as its telemetry reports them, fail-safe entries and exits, real-time timing.
+
+use serde::{Deserialize, Serialize};
+
+use super::pacing::{Pacing, RealTimeStats};
+
+/// Whether the board entered or left fail-safe.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FailSafeEventKind {
+    Enter,
+    Exit,
+}
+
+/// A change of the board's fail-safe state, as reported by its telemetry.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FailSafeEvent {
+    /// Control tick (the simulator's period) of the change.
+    pub tick: u64,
+    /// Its time (s).
+    pub t: f64,
+    /// "enter" or "exit".
+    pub kind: FailSafeEventKind,
+    /// Enter: the reason's name ([`auv_link::FailSafeReason::as_str`], e.g. `"stale state"`); exit: the
+    /// status the board left fail-safe for, as its Rust name (e.g. `"Running"`).
+    pub reason: String,
+}
+
+/// Link and board figures of one run with a board in the loop (PIL or HIL).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct BoardStats {
+    pub state_frames_sent: u64,
+    pub telemetry_frames: u64,
+    pub wall_seconds: f64,
+    /// State frames per wall-clock second.
+    pub frames_per_second: f64,
+    /// Longest `update` the board measured, in instructions (`-icount shift=0`): meaningful
+    /// for the QEMU image under `-icount` only (PIL; HIL lock-step against QEMU's pty), else
+    /// see [`BoardStats::worst_update_board_ticks`].
+    pub worst_update_instructions: u64,
+    pub board_rx_errors: u32,
+    pub board_loop_overruns: u32,
+    pub rearms: u32,
+    pub failsafe_events: Vec<FailSafeEvent>,
+    /// The link was signed (both ends).
+    #[serde(default)]
+    pub signed: bool,
+    /// Frames the board dropped as repeated, old or off its mission clock (its `rx_stale`).
+    #[serde(default)]
+    pub board_rx_stale: u32,
+    /// Frames the board refused for their authentication (its `rx_auth_errors`).
+    #[serde(default)]
+    pub board_rx_auth_errors: u32,
+    /// Commands the board refused, and the last reason ([`auv_link::Refusal::as_str`]).
+    #[serde(default)]
+    pub board_refused_commands: u32,
+    #[serde(default)]
+    pub board_last_refusal: Option<String>,
+    /// Telemetry frames this end refused: undecodable, badly signed, or out of sequence.
+    #[serde(default)]
+    pub telemetry_refused: u64,
+    /// The thrust unit of Eqs 31–32 the board reported flying (`"kgf"` or `"newton"`), and
+    /// its thruster mounting as the reversed-thruster mask (`Telemetry::reversed_thrusters`).
+    #[serde(default)]
+    pub board_thrust_unit: Option<String>,
+    #[serde(default)]
+    pub board_reversed_thrusters: Option<u8>,
+    /// The longest `update` in the board's own timer unit (QEMU: SysTick counts of
+    /// `INSTRUCTIONS_PER_TICK` instructions; the STM32: CPU cycles at 168 MHz).
+    #[serde(default)]
+    pub worst_update_board_ticks: u64,
+    /// What carried the link: `"tcp"` (PIL) or the serial port and its baud rate.
+    #[serde(default)]
+    pub link: String,
+    /// How the run was paced.
+    #[serde(default)]
+    pub pacing: Pacing,
+    /// The timing of a real-time run.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub realtime: Option<RealTimeStats>,
+}
+
+impl FailSafeEventKind {
+    /// `"enter"` or `"exit"` (as in the JSON).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            FailSafeEventKind::Enter => "enter",
+            FailSafeEventKind::Exit => "exit",
+        }
+    }
+}

@@ -1,0 +1,82 @@
+//! `host-sim check`: the preflight feasibility check of one scenario.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Result};
+use clap::Args;
+
+use super::common::load;
+use super::json::print_json;
+use super::Exit;
+use crate::studies::preflight::{self, Preflight, DEFAULT_MARGIN};
+
+/// `check`: the preflight feasibility check of one scenario (nothing is simulated).
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct CheckArgs {
+    #[arg(long)]
+    pub scenario: PathBuf,
+    /// Print one JSON object (the check's [`Preflight`]) instead of the text.
+    #[arg(long)]
+    pub json: bool,
+    /// Fraction of each thruster's envelope the reference may use, in (0, 1]; the rest is left
+    /// to the feedback.
+    #[arg(long, default_value_t = DEFAULT_MARGIN)]
+    pub margin: f64,
+}
+
+/// `check`: the preflight check of one scenario; exit 0 feasible, 1 infeasible.
+pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    if !(args.margin > 0.0 && args.margin <= 1.0) {
+        bail!(
+            "--margin must be a fraction of the envelope in (0, 1], got {}",
+            args.margin
+        );
+    }
+    let scenario = load(&args.scenario, false)?;
+    let p = preflight::check(&scenario, args.margin).map_err(|e| anyhow!(e))?;
+    if args.json {
+        print_json(stdout, &p)?;
+    } else {
+        writeln!(stdout, "{p}")?;
+        writeln!(stdout, "{}", preflight_table(&p))?;
+    }
+    Ok(if p.feasible() {
+        Exit::Success
+    } else {
+        Exit::Infeasible
+    })
+}
+
+/// The per-thruster part of `check`'s text.
+fn preflight_table(p: &Preflight) -> String {
+    let mut s = format!(
+        "thrust unit {}, heading {}, trimmed {}, time scale {}, margin {:.0} %\n",
+        p.thrust_unit,
+        p.heading,
+        p.trimmed,
+        p.time_scale,
+        100.0 * p.margin
+    );
+    s.push_str(&format!(
+        "{:<10} {:>18} {:>22} {:>22} {:>8}\n",
+        "thruster", "envelope (N)", "min demand (N) at t", "max demand (N) at t", "usage"
+    ));
+    for t in &p.thrusters {
+        s.push_str(&format!(
+            "{:<10} {:>18} {:>22} {:>22} {:>6.0} %\n",
+            t.thruster,
+            format!("[{:.1}, {:.1}]", t.envelope[0], t.envelope[1]),
+            format!("{:.1} at {:.2} s", t.min, t.t_min),
+            format!("{:.1} at {:.2} s", t.max, t.t_max),
+            100.0 * t.usage
+        ));
+    }
+    if let Some(k) = p.smallest_time_scale {
+        s.push_str(&format!(
+            "smallest feasible time scale: {k} (the same path then takes {:.1} s)\n",
+            p.duration * k / p.time_scale
+        ));
+    }
+    s
+}

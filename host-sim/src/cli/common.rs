@@ -1,0 +1,165 @@
+//! What the commands share: loading a scenario with the step cap, counting periods for the
+//! progress, flying a run into its CSV, the preflight verdicts, and how a set of runs ends.
+
+use std::io::Write;
+use std::path::Path;
+use std::sync::Mutex;
+
+use anyhow::{anyhow, Context, Result};
+
+use super::json::{print_json, Cases};
+use super::Exit;
+use crate::interrupt;
+use crate::output::{self, CsvStream, OutputDir, ReportRow};
+use crate::scenario::{load_config, Scenario};
+use crate::sim::progress::Progress;
+use crate::sim::record::RunSummary;
+use crate::sim::{self, ControlSource, LocalController, Recording, RunResult};
+use crate::studies::preflight::{self, Preflight, DEFAULT_MARGIN};
+
+/// Reads and validates a scenario file, with the step cap lifted if `allow_long_run`.
+pub(super) fn load(path: &Path, allow_long_run: bool) -> Result<Scenario> {
+    let ctx = || format!("scenario {}", path.display());
+    let mut config = load_config(path).with_context(ctx)?;
+    config.allow_long_run = allow_long_run;
+    Scenario::new(config).with_context(ctx)
+}
+
+/// The control periods of `scenarios`, for [`Progress`].
+pub(super) fn periods<'a>(scenarios: impl IntoIterator<Item = &'a Scenario>) -> u64 {
+    scenarios.into_iter().map(|s| s.steps() + 1).sum()
+}
+
+/// Outputs that could not be written completely, collected from parallel runs.
+#[derive(Default)]
+pub(super) struct Incomplete(Mutex<Vec<String>>);
+
+impl Incomplete {
+    pub(super) fn push(&self, what: String) {
+        self.0.lock().unwrap_or_else(|e| e.into_inner()).push(what);
+    }
+    pub(super) fn into_inner(self) -> Vec<String> {
+        self.0.into_inner().unwrap_or_else(|e| e.into_inner())
+    }
+}
+
+/// One run with the law from `source`, its CSV streamed into `dir` and its periods counted
+/// into `progress`; a CSV that cannot be written completely goes to `incomplete` (the run goes
+/// on: its metrics are still good).
+pub(super) fn run_into(
+    dir: &OutputDir,
+    scenario: &Scenario,
+    source: &mut dyn ControlSource,
+    progress: &Progress,
+    incomplete: &Incomplete,
+) -> RunResult {
+    let cfg = scenario.config();
+    let name = output::csv_name(&cfg.name, cfg.controller.robust);
+    let mut counter = progress.observer();
+    match dir.claim(&name).and_then(|p| CsvStream::create(&p)) {
+        Ok(mut csv) => {
+            let run = sim::fly(
+                scenario,
+                source,
+                &mut (&mut csv, &mut counter),
+                Recording::Plot,
+            );
+            if let Err(e) = csv.finish() {
+                incomplete.push(e.to_string());
+            }
+            run
+        }
+        Err(e) => {
+            incomplete.push(format!("{name} was not written: {e:#}"));
+            sim::fly(scenario, source, &mut counter, Recording::Plot)
+        }
+    }
+}
+
+/// [`run_into`] with the law on the host.
+pub(super) fn sil_into(
+    dir: &OutputDir,
+    scenario: &Scenario,
+    progress: &Progress,
+    incomplete: &Incomplete,
+) -> RunResult {
+    run_into(
+        dir,
+        scenario,
+        &mut LocalController::new(scenario),
+        progress,
+        incomplete,
+    )
+}
+
+/// Says once, on stderr, which outputs are incomplete.
+pub(super) fn report_incomplete(incomplete: &[String]) {
+    for i in incomplete {
+        eprintln!("host-sim: error: {i}");
+    }
+}
+
+/// Prints the runs of `rows` (JSON, or the table and the report's path) and says how the
+/// command ended.
+pub(super) fn print_runs(
+    stdout: &mut dyn Write,
+    json: bool,
+    rows: &[ReportRow],
+    checks: &[Preflight],
+    report: &Path,
+    incomplete: Vec<String>,
+) -> Result<Exit> {
+    report_incomplete(&incomplete);
+    let exit = runs_exit(runs(rows), !incomplete.is_empty(), false);
+    if json {
+        let cases: Cases<RunSummary> = Cases {
+            cases: runs(rows).map(RunResult::summary).collect(),
+            incomplete,
+            preflight: checks.to_vec(),
+        };
+        print_json(stdout, &cases)?;
+    } else {
+        for c in checks {
+            writeln!(stdout, "{c}")?;
+        }
+        writeln!(stdout, "{}", output::table_text(rows))?;
+        writeln!(stdout, "report: {}", report.display())?;
+    }
+    Ok(exit)
+}
+
+/// The preflight checks of `scenarios` (in parallel), at the default margin.
+pub(super) fn preflights<'a>(
+    scenarios: impl IntoIterator<Item = &'a Scenario>,
+) -> Result<Vec<Preflight>> {
+    use rayon::prelude::*;
+    let v: Vec<&Scenario> = scenarios.into_iter().collect();
+    v.par_iter()
+        .map(|s| {
+            preflight::check(s, DEFAULT_MARGIN)
+                .map_err(|e| anyhow!("preflight of {}: {e}", s.config().name))
+        })
+        .collect()
+}
+
+/// How a command with these runs ended ([`Exit::of`]); `failed`: another reason for exit 1.
+pub(super) fn runs_exit<'a>(
+    runs: impl Iterator<Item = &'a RunResult> + Clone,
+    incomplete: bool,
+    failed: bool,
+) -> Exit {
+    Exit::of(
+        incomplete,
+        runs.clone().any(RunResult::interrupted) || interrupt::requested(),
+        failed || runs.clone().any(RunResult::diverged),
+        runs.clone().any(RunResult::faulted_unexpectedly),
+    )
+}
+
+/// Every run of the rows: with, then without Δu.
+pub(super) fn runs<'a: 'r, 'r>(
+    rows: &'r [ReportRow<'a>],
+) -> impl Iterator<Item = &'a RunResult> + Clone + 'r {
+    rows.iter()
+        .flat_map(|r| std::iter::once(r.with).chain(r.without))
+}

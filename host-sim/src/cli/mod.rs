@@ -1,0 +1,111 @@
+//! The `host-sim` commands as library functions: each takes its arguments ([`clap::Args`], so
+//! the binary only parses and dispatches) and a writer for what it prints on stdout, writes its
+//! outputs, and returns how it ended ([`Exit`]). Errors (bad input, I/O) are `Err`: the binary
+//! prints them once and exits 2.
+//!
+//! ```text
+//! host-sim                                   # = host-sim table1
+//! host-sim table1 [--json] [--out DIR]
+//! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
+//! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
+//! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
+//! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
+//! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
+//! ```
+//!
+//! `check` is the preflight feasibility check ([`crate::studies::preflight`]): it simulates nothing, and
+//! exits 0 when the mission is feasible at its time scale, 1 when it is not (the verdict says
+//! whether a time scale helps), 2 on bad input. `run` and `table1` print the same verdict for
+//! each mission, one line each, and put it in the report; they never refuse to run.
+//!
+//! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`](crate::sim::record::RunSummary) (table1, run) or of
+//! [`BoardComparison`](crate::board::BoardComparison) (pil, hil), or the Monte Carlo [`Summary`](crate::studies::montecarlo::Summary); its
+//! keys come out sorted.
+//!
+//! Every command, before it computes anything: validates its input (scenario, flags, the step
+//! cap), checks and prepares the output folder ([`OutputDir::prepare`](crate::output::OutputDir::prepare): a folder, not a symlink,
+//! writable; the previous run's files removed), and for `pil` checks the firmware image. Then
+//! the runs stream their CSVs ([`CsvStream`](crate::output::CsvStream)) and show progress ([`Progress`](crate::sim::progress::Progress)), and the plots
+//! and the report follow. An output that cannot be written completely (a full disk) is named
+//! on stderr, in the report and in the JSON (`incomplete`), once, and the command exits 2; the
+//! other outputs are still written.
+//!
+//! # Exit codes
+//!
+//! | code | meaning |
+//! |---|---|
+//! | 0 | every run completed, the controller never in fail-safe unless expected (and PIL agreed with SIL) |
+//! | 1 | a run diverged (or lost its board), or PIL disagreed with SIL; `check`: the mission is infeasible |
+//! | 2 | bad input (scenario, flags, output folder, firmware image) or an I/O error; or an output could not be written completely |
+//! | 3 | a run had the controller in fail-safe (thrusters off) for some periods and its scenario does not say `expect_faults = true` |
+//! | 130 | interrupted (Ctrl-C, SIGTERM): what was done is written and marked partial |
+//!
+//! When several apply, the first of 2, 130, 1, 3 is the exit code. In `pil`, a run with link
+//! faults injected (flags or `[link_faults]`) expects the board's fail-safe. In `table1`, the
+//! paper's missions flown through the real chain are there to show what happens when the
+//! preflight says infeasible: their divergence and faults are reported, not an exit code.
+
+mod board_loop;
+mod check;
+mod common;
+mod hil;
+mod json;
+mod monte_carlo;
+mod pil;
+mod run;
+mod table1;
+
+pub use board_loop::LoopArgs;
+pub use check::{check, CheckArgs};
+pub use hil::{hil, HilArgs, DEFAULT_HIL_BAUD, DEFAULT_HIL_REPLY_TIMEOUT};
+pub use json::Cases;
+pub use monte_carlo::{monte_carlo, MonteCarloArgs};
+pub use pil::{pil, PilArgs};
+pub use run::{run, RunArgs};
+pub use table1::{table1, Table1Args, DEFAULT_TABLE1_OUT};
+
+/// How a command ended, as the process's exit code (see the module doc).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Exit {
+    /// Every run completed, no unexpected controller fault (and PIL agreed with SIL): exit 0.
+    Success,
+    /// A run diverged, or PIL disagreed with SIL: exit 1 (the outputs are written).
+    RunFailed,
+    /// An output could not be written completely (named on stderr and in the report): exit 2.
+    OutputIncomplete,
+    /// The controller was in fail-safe in some period of a run that does not expect faults:
+    /// exit 3 (the outputs are written).
+    Faulted,
+    /// Interrupted (Ctrl-C, SIGTERM); what was done is written, marked partial: exit 130.
+    Interrupted,
+    /// `check`: the mission is not feasible at its time scale: exit 1.
+    Infeasible,
+}
+
+impl Exit {
+    /// The process exit code (0, 1, 2, 3 or 130; 2 is also the binary's for an `Err`).
+    pub fn code(self) -> u8 {
+        match self {
+            Exit::Success => 0,
+            Exit::RunFailed | Exit::Infeasible => 1,
+            Exit::OutputIncomplete => 2,
+            Exit::Faulted => 3,
+            Exit::Interrupted => 130,
+        }
+    }
+
+    /// The exit of a command from what happened, in the order of precedence 2, 130, 1, 3.
+    fn of(incomplete: bool, interrupted: bool, failed: bool, faulted: bool) -> Self {
+        if incomplete {
+            Exit::OutputIncomplete
+        } else if interrupted {
+            Exit::Interrupted
+        } else if failed {
+            Exit::RunFailed
+        } else if faulted {
+            Exit::Faulted
+        } else {
+            Exit::Success
+        }
+    }
+}

@@ -1,0 +1,78 @@
+//! `host-sim run`: one scenario file, and its companion without Δu.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{Context, Result};
+use clap::Args;
+
+use super::common::{load, periods, preflights, print_runs, sil_into, Incomplete};
+use super::Exit;
+use crate::interrupt;
+use crate::output::{self, sections, OutputDir, ReportRow};
+use crate::sim::progress::Progress;
+
+/// `run`: one scenario from a TOML file (and its companion without Δu, for comparison).
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct RunArgs {
+    #[arg(long)]
+    pub scenario: PathBuf,
+    #[arg(long)]
+    pub json: bool,
+    /// Report folder; default `runs/<scenario name>`.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Run a scenario beyond the step cap (host_sim::scenario::MAX_CONTROL_PERIODS,
+    /// MAX_PLANT_STEPS: one day at 100 Hz and 1 ms).
+    #[arg(long)]
+    pub allow_long_run: bool,
+}
+
+/// `run`.
+pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    let scenario = load(&args.scenario, args.allow_long_run)?;
+    let cfg = scenario.config();
+    let out = args
+        .out
+        .clone()
+        .unwrap_or_else(|| PathBuf::from("runs").join(&cfg.name));
+    let companion = if cfg.controller.robust {
+        Some(
+            scenario
+                .with(|c| c.controller.robust = false)
+                .with_context(|| format!("scenario {} without Δu", args.scenario.display()))?,
+        )
+    } else {
+        None
+    };
+    let dir = OutputDir::prepare(&out)?;
+    // The verdict of the mission as the scenario flies it (with Δu: the check does not depend
+    // on the law).
+    let checks = preflights(std::iter::once(&scenario))?;
+    let progress = Progress::start(
+        &cfg.name,
+        periods(std::iter::once(&scenario).chain(&companion)),
+        !args.json,
+    );
+    let incomplete = Incomplete::default();
+    let with = sil_into(&dir, &scenario, &progress, &incomplete);
+    // A run interrupted is not followed by its companion (nothing would be done of it).
+    let without = companion
+        .as_ref()
+        .filter(|_| !interrupt::requested())
+        .map(|c| sil_into(&dir, c, &progress, &incomplete));
+    progress.finish();
+    let rows = [ReportRow::new(&with, without.as_ref())];
+    let mut incomplete = incomplete.into_inner();
+    let report = output::write_plots_and_report(
+        &dir,
+        &format!("AUV-150 scenario {}", with.name),
+        &rows,
+        &sections::preflight(&checks),
+        &[],
+        "",
+        f64::from(cfg.controller.voltage_limit),
+        &mut incomplete,
+    )?;
+    print_runs(stdout, args.json, &rows, &checks, &report, incomplete)
+}

@@ -1,0 +1,127 @@
+//! `host-sim table1` (and `host-sim` without a command): the paper's Table 1, then the real
+//! vehicle.
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::Result;
+use clap::Args;
+use controller_core::DEFAULT_V_LIMIT;
+
+use super::common::{periods, preflights, report_incomplete, runs_exit, sil_into, Incomplete};
+use super::json::{print_json, Cases};
+use super::Exit;
+use crate::output::{self, sections, OutputDir, RealRow, ReportRow};
+use crate::scenario::real_vehicle;
+use crate::scenario::Scenario;
+use crate::sim::progress::Progress;
+use crate::sim::record::RunSummary;
+use crate::sim::RunResult;
+use crate::studies::table1 as paper_table1;
+
+/// Default report folder of `table1`.
+pub const DEFAULT_TABLE1_OUT: &str = "runs/table1";
+
+/// `table1`: the paper's six Table-1 missions with and without Δu, side by side with the paper.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct Table1Args {
+    /// Print one JSON object on stdout instead of the table.
+    #[arg(long)]
+    pub json: bool,
+    /// Report folder (CSV, PNG, report.md).
+    #[arg(long, default_value = DEFAULT_TABLE1_OUT)]
+    pub out: PathBuf,
+}
+
+impl Default for Table1Args {
+    /// What `host-sim` without a command runs.
+    fn default() -> Self {
+        Table1Args {
+            json: false,
+            out: PathBuf::from(DEFAULT_TABLE1_OUT),
+        }
+    }
+}
+
+/// `table1`: the paper's Table 1 (ideal actuators), then the real vehicle: the missions of
+/// `scenarios/real/` and the paper's six through the real chain, with their preflight verdicts.
+pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
+    use rayon::prelude::*;
+    let jobs = paper_table1::jobs()?;
+    let real_jobs = real_vehicle::real_scenarios()?;
+    let chain_jobs = real_vehicle::paper_real_chain_scenarios(&real_jobs)?;
+    let dir = OutputDir::prepare(&args.out)?;
+    // The paper's missions' verdicts (the Table-1 cases, with Δu: the same mission as the
+    // real-chain runs), then the real ones.
+    let checks = preflights(chain_jobs.iter().chain(&real_jobs))?;
+    let all: Vec<&Scenario> = jobs.iter().chain(&real_jobs).chain(&chain_jobs).collect();
+    let progress = Progress::start("Table 1", periods(all.iter().copied()), !args.json);
+    let incomplete = Incomplete::default();
+    let results: Vec<RunResult> = all
+        .par_iter()
+        .map(|s| sil_into(&dir, s, &progress, &incomplete))
+        .collect();
+    progress.finish();
+    let (paper_runs, rest) = results.split_at(jobs.len());
+    let (real_runs, chain_runs) = rest.split_at(real_jobs.len());
+    let rows: Vec<ReportRow> = paper_runs
+        .chunks(2)
+        .map(|pair| ReportRow::new(&pair[0], pair.get(1)))
+        .collect();
+    let (chain_checks, real_checks) = checks.split_at(chain_jobs.len());
+    let real_rows: Vec<RealRow> = real_runs
+        .iter()
+        .zip(real_checks)
+        .chain(chain_runs.iter().zip(chain_checks))
+        .map(|(run, preflight)| RealRow { run, preflight })
+        .collect();
+    let sections = format!(
+        "{}\n{}\n{}\n\n{}",
+        sections::REAL_NOTES,
+        output::real_table_markdown(&real_rows),
+        output::report::real_table_legend(),
+        sections::preflight(&checks)
+    );
+    let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
+    let mut incomplete = incomplete.into_inner();
+    let report = output::write_plots_and_report(
+        &dir,
+        "AUV-150 Table 1 reproduction (software in the loop)",
+        &rows,
+        &sections,
+        &real_plots,
+        &paper_table1::notes(),
+        f64::from(DEFAULT_V_LIMIT),
+        &mut incomplete,
+    )?;
+    report_incomplete(&incomplete);
+    // The paper's missions through the real chain are expected to fail: they show what an
+    // infeasible verdict means, and do not make the command fail.
+    let exit = runs_exit(
+        paper_runs.iter().chain(real_runs),
+        !incomplete.is_empty(),
+        false,
+    );
+    if args.json {
+        let cases: Cases<RunSummary> = Cases {
+            cases: results.iter().map(RunResult::summary).collect(),
+            incomplete,
+            preflight: checks,
+        };
+        print_json(stdout, &cases)?;
+    } else {
+        writeln!(stdout, "{}", output::table_text(&rows))?;
+        writeln!(
+            stdout,
+            "The real vehicle: the missions of scenarios/real/ and the paper's through the real chain (kgf, ±24 V)"
+        )?;
+        for c in &checks {
+            writeln!(stdout, "{c}")?;
+        }
+        writeln!(stdout)?;
+        write!(stdout, "{}", output::real_table_text(&real_rows))?;
+        writeln!(stdout, "{}\n", output::report::real_table_legend())?;
+        writeln!(stdout, "report: {}", report.display())?;
+    }
+    Ok(exit)
+}

@@ -1,0 +1,79 @@
+//! Report sections built from the studies' and the board's results: the preflight verdicts,
+//! the real vehicle's introduction, and the board against SIL.
+
+use crate::board::{BoardComparison, Mode};
+use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
+
+/// What the report says about the real-vehicle table.
+pub const REAL_NOTES: &str = "\
+## The real vehicle (docs/design.md §9)
+
+The missions of `scenarios/real/` fly the Table-1 paths as a vehicle team would: heading along
+the course, the Table-3 payload trimmed to neutral buoyancy, Eqs 31–32 in kgf, and the real
+actuator chain (the board's voltages, clamped at ±24 V, turned back into thrust by Eqs 31–32),
+each at the time scale the preflight check proposes. Below them, the paper's own six missions
+(its headings, untrimmed payload, time scale 1) through the same real chain: what the preflight
+calls infeasible, flown anyway.
+";
+
+/// The report section of preflight verdicts: one line each.
+pub fn preflight(checks: &[Preflight]) -> String {
+    let mut s = format!(
+        "## Preflight (docs/design.md §9)\n\nWhether the real thrusters can fly each mission \
+         (`host-sim check --scenario FILE`): the force the reference needs at every corner of \
+         the parameter box, through the board's allocator, against {:.0} % of each thruster's \
+         envelope.\n\n",
+        100.0 * DEFAULT_MARGIN
+    );
+    for c in checks {
+        s.push_str(&format!("- {}\n", c.to_string().replace('|', "\\|")));
+    }
+    s
+}
+
+/// The report's PIL-vs-SIL section (HIL's too), and the timing of real-time runs.
+pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
+    let mut notes = String::from(
+        "## Board in the loop vs software in the loop\n\n\
+         | case | link | pacing | board max path (m) | SIL max path (m) | board − SIL (m) | frames/s | \
+         worst update (PIL: instructions; HIL: board timer ticks) | fail-safe events | re-arms | signed | board drops (old / auth) | \
+         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+    );
+    for c in cases {
+        notes += &format!(
+            "| {} | {} | {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
+            c.run.name,
+            c.pil.link,
+            c.pil.pacing.as_str(),
+            c.run.metrics.max_path,
+            c.sil_max_path,
+            c.pil_minus_sil_max_path,
+            c.pil.frames_per_second,
+            match c.mode {
+                Mode::Pil => c.pil.worst_update_instructions,
+                // The board's own unit: QEMU's SysTick counts, the STM32's CPU cycles.
+                Mode::Hil => c.pil.worst_update_board_ticks,
+            },
+            c.pil.failsafe_events.len(),
+            c.pil.rearms,
+            if c.pil.signed { "yes" } else { "no" },
+            c.pil.board_rx_stale,
+            c.pil.board_rx_auth_errors,
+            match &c.pil.board_last_refusal {
+                Some(r) => format!("{} (last: {r})", c.pil.board_refused_commands),
+                None => c.pil.board_refused_commands.to_string(),
+            },
+        );
+    }
+    let realtime: Vec<_> = cases
+        .iter()
+        .filter_map(|c| c.pil.realtime.as_ref().map(|r| (c, r)))
+        .collect();
+    if !realtime.is_empty() {
+        notes += "\n### Real-time pacing (docs/design.md §21)\n\n";
+        for (c, r) in realtime {
+            notes += &format!("- {}: {r}\n", c.run.name);
+        }
+    }
+    notes
+}

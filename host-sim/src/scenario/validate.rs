@@ -1,0 +1,405 @@
+//! The one validation of a [`SimConfig`]: every value against its range, each error naming the
+//! scenario file's dotted key. The controller's and the trajectory's own ranges are the core's
+//! ([`Controller::new`], [`Trajectory::new`]); here their errors are only mapped to keys.
+
+use controller_core::config::ConfigField;
+use controller_core::controller::{MAX_ANGULAR_RATE, MAX_LINEAR_SPEED, MAX_POSITION};
+use controller_core::model::{self, ParamVariation, VehicleParams, VARIED_PARAMETER_NAMES};
+use controller_core::{Controller, Mission, Trajectory};
+use controller_core::{Fault, Status};
+
+use super::start::start_state;
+use super::SimConfig;
+use crate::plant::{CurrentModel, VariationProfile};
+
+use super::ScenarioError;
+
+/// Longest accepted `duration` (s): one day.
+pub const MAX_DURATION: f64 = 86_400.0;
+/// Longest accepted `plant_step` (s).
+pub const MAX_PLANT_STEP: f64 = 0.1;
+/// Most control periods (duration × rate_hz) a run may have (one day at the default 100 Hz):
+/// each period is a CSV row (≈ 1 kB) and a controller update. More needs the explicit override
+/// [`SimConfig::allow_long_run`] (the CLI's `--allow-long-run`).
+pub const MAX_CONTROL_PERIODS: u64 = 8_640_000;
+/// Most plant RK4 steps a run may have (one day at the default 1 ms step): the work of a run.
+/// More needs [`SimConfig::allow_long_run`].
+pub const MAX_PLANT_STEPS: u64 = 86_400_000;
+/// Even with the override, step counts stay below 2⁵³, where counting in f64 is exact (a
+/// `plant_step` of 1e-300 would otherwise loop for ever).
+const ABSOLUTE_MAX_STEPS: f64 = 9_007_199_254_740_992.0;
+/// Largest ω·plant_step of an abs-sin variation (rad): at least 2π/0.1 ≈ 63 plant steps per
+/// period of sin, so that the plant resolves the variation (and ω·t stays finite).
+pub const MAX_VARIATION_OMEGA_STEP: f64 = 0.1;
+
+type Res<T> = Result<T, ScenarioError>;
+
+pub(super) fn invalid(key: impl Into<String>, message: impl Into<String>) -> ScenarioError {
+    ScenarioError::Invalid {
+        key: key.into(),
+        message: message.into(),
+    }
+}
+
+/// The controller, built; its error under the scenario key of the field it names
+/// (`controller.k1[3]`, `controller.pitch_limit_deg`), or `controller` for a check of the
+/// whole configuration and for settings a scenario file cannot reach.
+pub(super) fn controller(config: &SimConfig) -> Res<Controller> {
+    Controller::new(config.controller).map_err(|e| {
+        let key = match e.field() {
+            // The file gives the pitch limit in degrees.
+            Some(ConfigField {
+                name: "pitch_limit",
+                ..
+            }) => "controller.pitch_limit_deg".to_string(),
+            Some(ConfigField {
+                name: "priority", ..
+            }) => "controller.axis_priority".to_string(),
+            Some(ConfigField {
+                name: "params" | "uncertainty" | "geometry",
+                ..
+            })
+            | None => "controller".to_string(),
+            Some(ConfigField {
+                name,
+                index: Some(i),
+            }) => format!("controller.{name}[{i}]"),
+            Some(ConfigField { name, index: None }) => format!("controller.{name}"),
+        };
+        invalid(key, e.to_string())
+    })
+}
+
+/// The mission's trajectory, built; its error under `trajectory.<field>` (`trajectory.radius`,
+/// `trajectory.time_scale`, `trajectory.heading`).
+pub(super) fn trajectory(mission: &Mission) -> Res<Trajectory> {
+    Trajectory::new(*mission)
+        .map_err(|e| invalid(format!("trajectory.{}", e.parameter()), e.to_string()))
+}
+
+/// Everything else, in the order of the file; returns the step counts (control periods, plant
+/// steps per period). `config.controller` is valid (so `rate_hz ≥ 1`).
+pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
+    check_name(&config.name)?;
+    let rate = f64::from(config.controller.rate_hz);
+    let period = 1.0 / rate;
+
+    let d = positive("duration", config.duration)?;
+    if d > MAX_DURATION {
+        return Err(invalid(
+            "duration",
+            format!("must be ≤ {MAX_DURATION} s (one day), got {d}"),
+        ));
+    }
+    let h = positive("plant_step", config.plant_step)?;
+    if h > MAX_PLANT_STEP {
+        return Err(invalid(
+            "plant_step",
+            format!("must be ≤ {MAX_PLANT_STEP} s, got {h}"),
+        ));
+    }
+    if h > period {
+        return Err(invalid(
+            "plant_step",
+            format!("must be ≤ the control period 1/rate_hz = {period} s, got {h}"),
+        ));
+    }
+    // The loop holds τ over a whole number of plant steps (sil::run).
+    let substeps = (period / h).round();
+    let steps = (config.duration * rate).round();
+    step_cap(config, steps, substeps)?;
+    if (substeps * h - period).abs() >= 1e-9 * period {
+        return Err(invalid(
+            "plant_step",
+            format!(
+                "must divide the control period 1/rate_hz = {period} s into whole steps, got {h}"
+            ),
+        ));
+    }
+    each("initial_offset", &config.initial_offset, finite)?;
+    positive("divergence_limit", config.divergence_limit)?;
+    if let Some(lag) = config.thruster_lag {
+        positive("thruster_lag", lag)?;
+    }
+    variation(&config.variation, h)?;
+    current(&config.current, h)?;
+    if let Some(n) = &config.noise {
+        each("noise.eta_sigma", &n.eta_sigma, non_negative)?;
+        each("noise.nu_sigma", &n.nu_sigma, non_negative)?;
+    }
+    Ok((steps as u64, substeps as usize))
+}
+
+/// The run's size against [`MAX_CONTROL_PERIODS`] and [`MAX_PLANT_STEPS`] (unless
+/// `allow_long_run`), and against 2⁵³ always: `steps` = duration × rate_hz control periods
+/// (the run samples ticks 0..=steps), `substeps` plant steps each.
+fn step_cap(config: &SimConfig, steps: f64, substeps: f64) -> Res<()> {
+    let periods = steps;
+    let plant = steps * substeps;
+    let how = "(duration × rate_hz control periods, each 1/(rate_hz × plant_step) plant steps)";
+    if periods > ABSOLUTE_MAX_STEPS || plant > ABSOLUTE_MAX_STEPS {
+        return Err(invalid(
+            "plant_step",
+            format!(
+                "the run would take {plant:.3e} plant steps and {periods:.3e} control periods \
+                 {how}: more than 2^53, beyond any run"
+            ),
+        ));
+    }
+    if config.allow_long_run {
+        return Ok(());
+    }
+    let over = |count: f64, cap: u64, what: &str, key: &str| -> Res<()> {
+        if count > cap as f64 {
+            Err(invalid(
+                key,
+                format!(
+                    "the run would take {count:.0} {what} {how}, more than the cap of {cap} \
+                     (one day at the default 100 Hz and 1 ms); shorten it, or give \
+                     --allow-long-run to run it anyway (the CSV grows by ≈ 1 kB a period)"
+                ),
+            ))
+        } else {
+            Ok(())
+        }
+    };
+    over(periods, MAX_CONTROL_PERIODS, "control periods", "duration")?;
+    over(plant, MAX_PLANT_STEPS, "plant steps", "plant_step")
+}
+
+fn finite(key: &str, x: f64) -> Res<f64> {
+    if x.is_finite() {
+        Ok(x)
+    } else {
+        Err(invalid(key, format!("must be a finite number, got {x}")))
+    }
+}
+
+fn positive(key: &str, x: f64) -> Res<f64> {
+    finite(key, x)?;
+    if x > 0.0 {
+        Ok(x)
+    } else {
+        Err(invalid(key, format!("must be > 0, got {x}")))
+    }
+}
+
+fn non_negative(key: &str, x: f64) -> Res<f64> {
+    finite(key, x)?;
+    if x >= 0.0 {
+        Ok(x)
+    } else {
+        Err(invalid(key, format!("must be ≥ 0, got {x}")))
+    }
+}
+
+/// `check` on every element, keyed `key[i]`.
+fn each(key: &str, xs: &[f64], check: fn(&str, f64) -> Res<f64>) -> Res<()> {
+    for (i, &x) in xs.iter().enumerate() {
+        check(&format!("{key}[{i}]"), x)?;
+    }
+    Ok(())
+}
+
+fn check_name(name: &str) -> Res<()> {
+    if name.trim().is_empty() {
+        return Err(invalid("name", "must not be empty"));
+    }
+    if name == "." || name == ".." {
+        return Err(invalid(
+            "name",
+            format!("{name:?} is not a usable file name"),
+        ));
+    }
+    if let Some(c) = name
+        .chars()
+        .find(|&c| c == '/' || c == '\\' || c.is_control())
+    {
+        return Err(invalid(
+            "name",
+            format!("is used in file names and must not contain {c:?}, got {name:?}"),
+        ));
+    }
+    Ok(())
+}
+
+/// Every Δ finite (keyed `prefix.<name>`), and the varied plant's M positive definite (keyed
+/// `prefix`). M is affine in Δ, so this at the maximum of an abs-sin profile covers the whole
+/// profile.
+fn delta(prefix: &str, d: &ParamVariation<f64>) -> Res<()> {
+    for (name, x) in VARIED_PARAMETER_NAMES.iter().zip(d.to_array()) {
+        finite(&format!("{prefix}.{name}"), x)?;
+    }
+    let p = VehicleParams::auv150().with_variation(d);
+    if p.mass > 0.0 && model::mass_matrix(&p).cholesky().is_some() {
+        Ok(())
+    } else {
+        Err(invalid(
+            prefix,
+            "with this Δ the plant's inertia matrix M = M_RB + M_A is not positive definite",
+        ))
+    }
+}
+
+fn variation(v: &VariationProfile, plant_step: f64) -> Res<()> {
+    match v {
+        VariationProfile::None => Ok(()),
+        VariationProfile::Constant(d) => delta("variation", d),
+        VariationProfile::AbsSin { max, omega } => {
+            delta("variation", max)?;
+            let omega = positive("variation.omega", *omega)?;
+            if omega * plant_step > MAX_VARIATION_OMEGA_STEP {
+                return Err(invalid(
+                    "variation.omega",
+                    format!(
+                        "{omega} rad/s is too fast for the plant step {plant_step} s: ω·plant_step \
+                         must be ≤ {MAX_VARIATION_OMEGA_STEP} (≥ 63 plant steps per period), so \
+                         ω ≤ {} rad/s",
+                        MAX_VARIATION_OMEGA_STEP / plant_step
+                    ),
+                ));
+            }
+            Ok(())
+        }
+        VariationProfile::Staircase(steps) => {
+            if steps.is_empty() {
+                return Err(invalid(
+                    "variation.steps",
+                    "profile = \"staircase\" needs at least one [[variation.steps]]",
+                ));
+            }
+            let mut previous: Option<f64> = None;
+            for (i, (until, d)) in steps.iter().enumerate() {
+                let prefix = format!("variation.steps[{i}]");
+                let key = format!("{prefix}.until");
+                let until = *until;
+                if until.is_nan() {
+                    return Err(invalid(key, "must be a number, got NaN"));
+                }
+                match previous {
+                    None if until <= 0.0 => {
+                        return Err(invalid(key, format!("must be > 0 s, got {until}")));
+                    }
+                    Some(p) if until <= p => {
+                        return Err(invalid(
+                            key,
+                            format!(
+                                "step times must increase: {until} is not > \
+                                 variation.steps[{}].until = {p}",
+                                i - 1
+                            ),
+                        ));
+                    }
+                    _ => {}
+                }
+                previous = Some(until);
+                delta(&prefix, d)?;
+            }
+            Ok(())
+        }
+    }
+}
+
+fn current(c: &CurrentModel, plant_step: f64) -> Res<()> {
+    match c {
+        CurrentModel::None => Ok(()),
+        CurrentModel::Constant(v) => each("current.velocity", v, finite),
+        CurrentModel::GaussMarkov {
+            mean, sigma, tau, ..
+        } => {
+            each("current.mean", mean, finite)?;
+            each("current.sigma", sigma, non_negative)?;
+            let tau = positive("current.tau", *tau)?;
+            // Euler–Maruyama of v̇ = −(v − mean)/τ + …: v ← (1 − h/τ) v + …, unstable for
+            // h > 2τ, and its stationary variance is σ²/(1 − h/2τ) (≤ 5 % high for τ ≥ 10 h).
+            if tau < plant_step {
+                return Err(invalid(
+                    "current.tau",
+                    format!(
+                        "{tau} s is below the plant step {plant_step} s: the Gauss–Markov process \
+                         is stepped by Euler–Maruyama at the plant step, which is unstable for \
+                         tau < plant_step/2 and inflates the variance by 1/(1 − plant_step/(2 tau)) \
+                         (×2 at tau = plant_step); use tau ≥ plant_step, better ≥ 10 plant steps"
+                    ),
+                ));
+            }
+            Ok(())
+        }
+    }
+}
+
+/// Every control tick of the mission up to this many is checked by [`mission`]; a longer
+/// mission is checked at this many evenly spaced ticks.
+const MISSION_SAMPLES: u64 = 100_000;
+
+/// What the run would do to the controller, refused before it starts (with the reason):
+/// - a reference that leaves the range the controller accepts as input
+///   ([`MAX_POSITION`] per position component, [`MAX_LINEAR_SPEED`] for ‖η̇_d‖ of the
+///   position, [`MAX_ANGULAR_RATE`] for the Euler-angle rates): a vehicle on it would be in
+///   fail-safe (`fault:input-out-of-range`) from then on;
+/// - a law that overflows f32 on the reference itself (zero error, the first period): then
+///   every update would (`fault:non-finite-result`), e.g. for gains like 1e30.
+pub(super) fn mission(
+    config: &SimConfig,
+    controller: &Controller,
+    trajectory: &Trajectory,
+    steps: u64,
+) -> Res<()> {
+    let rate = config.controller.rate_hz;
+    let n = steps.clamp(1, MISSION_SAMPLES);
+    let t_of = |k: u64| k as f64 / f64::from(rate);
+    for j in 0..=n {
+        let k = (u128::from(j) * u128::from(steps) / u128::from(n)) as u64;
+        let d = trajectory.sample(k, rate);
+        let speed = d.eta_dot.fixed_rows::<3>(0).norm();
+        let turn = d.eta_dot.fixed_rows::<3>(3).norm();
+        let position = d.eta.fixed_rows::<3>(0).amax();
+        let refuse = |what: String| {
+            invalid(
+                "trajectory",
+                format!(
+                    "at t = {:.2} s {what}: a vehicle on this reference would be in fail-safe \
+                     (fault:input-out-of-range)",
+                    t_of(k)
+                ),
+            )
+        };
+        if !speed.is_finite() || speed > MAX_LINEAR_SPEED {
+            return Err(refuse(format!(
+                "the reference moves at {speed} m/s, above the {MAX_LINEAR_SPEED} m/s the \
+                 controller accepts"
+            )));
+        }
+        if !turn.is_finite() || turn > MAX_ANGULAR_RATE {
+            return Err(refuse(format!(
+                "the reference turns at {turn} rad/s, above the {MAX_ANGULAR_RATE} rad/s the \
+                 controller accepts"
+            )));
+        }
+        if !position.is_finite() || position > MAX_POSITION {
+            return Err(refuse(format!(
+                "the reference is {position} m from the mission origin along an axis, beyond \
+                 the ±{MAX_POSITION} m the controller accepts (shorten the mission)"
+            )));
+        }
+    }
+    let start = start_state(trajectory, rate, &[0.0; 6]);
+    let out = controller.update(
+        0,
+        &start.eta.cast::<f32>().into(),
+        &start.nu.cast::<f32>().into(),
+        trajectory,
+    );
+    if out.status == Status::Fault(Fault::NonFiniteResult) {
+        return Err(invalid(
+            "controller",
+            format!(
+                "on the reference itself (zero tracking error, first period) the law overflows \
+                 f32 ({}): every update would put the thrusters off; the gains k1, k2 (or q) are \
+                 too large",
+                out.status
+            ),
+        ));
+    }
+    Ok(())
+}

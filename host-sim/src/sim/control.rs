@@ -1,0 +1,61 @@
+//! Where the control law runs: the seam between the closed loop and the law. On the host
+//! ([`LocalController`]: software in the loop) or on a board ([`crate::board`]: processor or
+//! hardware in the loop), a period's answer is a [`ControlOut`].
+
+use controller_core::{Controller, Trajectory};
+
+use super::record::ControlStatus;
+use crate::scenario::Scenario;
+
+/// What one control period returns, whether the law ran here (SIL) or on the board (PIL).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ControlOut {
+    /// Whether the law ran ([`ControlStatus::is_ok`]); if not, the thrusters are off.
+    pub status: ControlStatus,
+    /// Commanded body force (used by ideal actuators).
+    pub tau: [f32; 6],
+    /// Voltages (used by the real actuator chain).
+    pub voltage: [f32; 5],
+    pub saturated: u8,
+    pub delta: f32,
+    pub delta_clamped: bool,
+    pub w_norm: f32,
+}
+
+/// Where the control law runs.
+pub trait ControlSource {
+    /// The control for period `k` from the measured state. An `Err` ends the run (e.g. the
+    /// board's link is gone) with the message as the reason; what was recorded is kept.
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String>;
+}
+
+/// The f32 core on the host, as the firmware runs it (software in the loop): the scenario's
+/// controller and trajectory.
+pub struct LocalController<'a> {
+    controller: &'a Controller,
+    trajectory: &'a Trajectory,
+}
+
+impl<'a> LocalController<'a> {
+    pub fn new(scenario: &'a Scenario) -> Self {
+        LocalController {
+            controller: scenario.controller(),
+            trajectory: scenario.trajectory(),
+        }
+    }
+}
+
+impl ControlSource for LocalController<'_> {
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
+        let out = self.controller.update(k, eta, nu, self.trajectory);
+        Ok(ControlOut {
+            status: ControlStatus::Law(out.status),
+            tau: out.tau,
+            voltage: out.voltage,
+            saturated: out.saturated,
+            delta: out.delta,
+            delta_clamped: out.delta_clamped,
+            w_norm: out.w_norm,
+        })
+    }
+}

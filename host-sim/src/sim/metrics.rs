@@ -1,0 +1,58 @@
+//! The paper's Table-1 metrics (docs/design.md §7) from a run's samples, accumulated as the run
+//! goes ([`Accumulator`]: constant memory whatever the duration) or from a slice
+//! ([`compute`]).
+
+use super::record::{Metrics, Sample};
+
+/// The metrics of the samples pushed so far: maximum absolute errors per axis, the paper's
+/// path error √(max|e_x|² + max|e_y|² + max|e_z|²), the RMS of the 3-D position error, and the
+/// actuator figures.
+#[derive(Clone, Debug, Default)]
+pub struct Accumulator {
+    m: Metrics,
+    sq: f64,
+    saturated: u64,
+    n: u64,
+}
+
+impl Accumulator {
+    pub fn push(&mut self, s: &Sample) {
+        let m = &mut self.m;
+        let e = &s.error;
+        m.max_x = m.max_x.max(e[0].abs());
+        m.max_y = m.max_y.max(e[1].abs());
+        m.max_z = m.max_z.max(e[2].abs());
+        m.max_roll = m.max_roll.max(e[3].abs());
+        m.max_pitch = m.max_pitch.max(e[4].abs());
+        m.max_yaw = m.max_yaw.max(e[5].abs());
+        self.sq += e[0] * e[0] + e[1] * e[1] + e[2] * e[2];
+        for v in s.voltage {
+            m.peak_voltage = m.peak_voltage.max(v.abs());
+        }
+        if s.saturated != 0 {
+            self.saturated += 1;
+        }
+        self.n += 1;
+    }
+
+    /// The metrics (all zero for no samples).
+    pub fn metrics(&self) -> Metrics {
+        let mut m = self.m;
+        if self.n == 0 {
+            return m;
+        }
+        m.max_path = (m.max_x * m.max_x + m.max_y * m.max_y + m.max_z * m.max_z).sqrt();
+        m.rms_path = (self.sq / self.n as f64).sqrt();
+        m.saturated_fraction = self.saturated as f64 / self.n as f64;
+        m
+    }
+}
+
+/// The metrics of `samples` ([`Accumulator`] over them).
+pub fn compute(samples: &[Sample]) -> Metrics {
+    let mut acc = Accumulator::default();
+    for s in samples {
+        acc.push(s);
+    }
+    acc.metrics()
+}

@@ -1,0 +1,185 @@
+//! The one closed loop: the f32 `controller-core` as the firmware runs it (on the host, or on
+//! a board through [`ControlSource`]), sampled at its own rate with zero-order hold, around the
+//! f64 plant integrated with RK4 at the plant step. [`fly`] is the loop; everything it uses is
+//! a module of its own:
+//!
+//! | module | owns |
+//! |---|---|
+//! | [`control`] | where the law runs: [`ControlSource`], [`LocalController`] (SIL), [`ControlOut`] |
+//! | [`navigation`] | what the law is told: measured η, ν (heading as navigation reports it, noise) |
+//! | [`thrusters`] | what the thrusters deliver (ideal or the real chain), their lag, B·thrust |
+//! | [`vehicle`] | the plant with its parameter profile and current, stepped by RK4 |
+//! | [`record`] | a run's samples, outcome, metrics and JSON summary |
+//! | [`recorder`] | what a run keeps as it goes (metrics, fault counts, plot series, observer) |
+//! | [`metrics`], [`decimate`] | the Table-1 metrics; the bounded plot series of a long run |
+//! | [`observer`], [`progress`] | who sees each sample as it is made; progress of long commands |
+//! | [`bound`] | the bound a real-vehicle run must fly within |
+//!
+//! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
+//! run with a reason; every sample recorded until then is kept. An interrupt
+//! ([`crate::interrupt`]) stops it at the period it is in.
+
+pub mod bound;
+pub mod control;
+pub mod decimate;
+pub mod metrics;
+pub mod navigation;
+pub mod observer;
+pub mod progress;
+pub mod record;
+pub mod recorder;
+pub mod thrusters;
+pub mod vehicle;
+
+use controller_core::effectiveness::THRUSTERS;
+use controller_core::Desired;
+
+pub use control::{ControlOut, ControlSource, LocalController};
+pub use observer::Observer;
+pub use record::{ControlStatus, Metrics, Outcome, RunResult, Sample};
+pub use recorder::Recording;
+
+use crate::interrupt;
+use crate::plant::PlantState;
+use crate::scenario::Scenario;
+use navigation::{wrap_pi, Navigation};
+use recorder::Recorder;
+use thrusters::{Thrusters, Thrusts};
+use vehicle::Vehicle;
+
+/// Runs one simulation with the law on the host (software in the loop), keeping the plot
+/// series.
+pub fn run(scenario: &Scenario) -> RunResult {
+    fly(
+        scenario,
+        &mut LocalController::new(scenario),
+        &mut (),
+        Recording::Plot,
+    )
+}
+
+/// Flies `scenario` with the law wherever `source` runs it, showing every sample to
+/// `observer` as it is made and keeping what `recording` says. Per control period k
+/// (t = k/rate): measure, control, actuate, then hold the thrust for the period while the plant
+/// is integrated (docs/design.md §7). Memory stays bounded whatever the duration.
+pub fn fly(
+    scenario: &Scenario,
+    source: &mut dyn ControlSource,
+    observer: &mut dyn Observer,
+    recording: Recording,
+) -> RunResult {
+    let cfg = scenario.config();
+    let (steps, substeps, period) = (scenario.steps(), scenario.substeps(), scenario.period());
+    let h = period / substeps as f64;
+    let mut vehicle = Vehicle::new(scenario);
+    let mut navigation = Navigation::new(cfg.noise.as_ref());
+    let mut thrusters = Thrusters::new(cfg, scenario.controller(), h);
+    let mut recorder = Recorder::new(observer, recording, steps + 1);
+    let mut outcome = Outcome::Completed;
+    for k in 0..=steps {
+        let t = k as f64 * period;
+        let reference = scenario.trajectory().sample(k, cfg.controller.rate_hz);
+        let error = tracking_error(&vehicle.state, &reference);
+        if let Some(stop) = stop(t, &vehicle.state, &error, cfg.divergence_limit) {
+            outcome = stop;
+            break;
+        }
+        // 1. Measure and control.
+        let (eta, nu) = navigation.measure(&vehicle.state);
+        let out = match source.control(k, &eta, &nu) {
+            Ok(out) => out,
+            Err(reason) => {
+                outcome = Outcome::Diverged { t, reason };
+                break;
+            }
+        };
+        // 2. Actuate: the thrust the thrusters are driven towards.
+        let target = thrusters.target(&out);
+        let mut sample = sample_of(t, &vehicle.state, &reference, error, &out);
+        sample.payload = cfg.variation.at(t).mass;
+        // 3. Hold it for the period: thruster lag, RK4 substeps (none after the last sample).
+        let (thrust, held): (Thrusts, Result<(), (f64, String)>) = if k < steps {
+            thrusters.hold(&target, substeps, |j, tau| {
+                let ts = t + j as f64 * h;
+                vehicle.step(ts, tau, h).map_err(|e| (ts, e.to_string()))
+            })
+        } else {
+            (thrusters.applied_or(&target), Ok(()))
+        };
+        sample.thrust = thrust;
+        sample.tau_applied = thrusters.wrench(&thrust).into();
+        recorder.record(sample);
+        if let Err((t, reason)) = held {
+            outcome = Outcome::Diverged { t, reason };
+            break;
+        }
+    }
+    let (metrics, faults, samples) = recorder.finish();
+    RunResult {
+        name: cfg.name.clone(),
+        case: cfg.case,
+        robust: cfg.controller.robust,
+        metrics,
+        outcome,
+        faults,
+        faults_expected: cfg.expect_faults,
+        samples,
+        plant_factorisations: vehicle.factorisations(),
+    }
+}
+
+/// e = η − η_d from the true pose, the yaw error wrapped to (−π, π].
+fn tracking_error(state: &PlantState, reference: &Desired) -> [f64; 6] {
+    let mut error = [0.0; 6];
+    for (i, e) in error.iter_mut().enumerate() {
+        *e = state.eta[i] - f64::from(reference.eta[i]);
+    }
+    error[5] = wrap_pi(error[5]);
+    error
+}
+
+/// Why the run stops before period t, if it does: an interrupt, a non-finite state, or a
+/// position error beyond the divergence limit.
+fn stop(t: f64, state: &PlantState, error: &[f64; 6], limit: f64) -> Option<Outcome> {
+    if interrupt::requested() {
+        return Some(Outcome::Interrupted { t });
+    }
+    let diverged = |reason: String| Some(Outcome::Diverged { t, reason });
+    if !state.is_finite() {
+        return diverged("plant state is not finite".into());
+    }
+    let position = (error[0] * error[0] + error[1] * error[1] + error[2] * error[2]).sqrt();
+    if position > limit {
+        return diverged(format!(
+            "position error {position:.1} m exceeds the divergence limit {limit} m"
+        ));
+    }
+    None
+}
+
+/// The sample of period t before its thrust is known (thrust, τ applied and payload are filled
+/// in by the loop).
+fn sample_of(
+    t: f64,
+    state: &PlantState,
+    reference: &Desired,
+    error: [f64; 6],
+    out: &ControlOut,
+) -> Sample {
+    Sample {
+        t,
+        eta: state.eta.into(),
+        eta_d: reference.eta.cast::<f64>().into(),
+        error,
+        tau: out.tau.map(f64::from),
+        tau_applied: [0.0; 6],
+        thrust: [0.0; THRUSTERS],
+        voltage: out.voltage.map(f64::from),
+        saturated: out.saturated,
+        delta: f64::from(out.delta),
+        delta_clamped: out.delta_clamped,
+        w_norm: f64::from(out.w_norm),
+        payload: 0.0,
+        status: out.status,
+    }
+}

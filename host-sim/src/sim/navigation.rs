@@ -1,0 +1,73 @@
+//! The simulated navigation computer: what the law is told of the vehicle's state each period
+//! (the plant's η, ν with the heading as a navigation solution reports it, plus seeded sensor
+//! noise), rounded to f32 as it crosses to the controller.
+
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+
+use crate::plant::PlantState;
+use crate::scenario::SensorNoise;
+
+/// x reduced into (−π, π].
+pub fn wrap_pi(x: f64) -> f64 {
+    use std::f64::consts::{PI, TAU};
+    let r = (x + PI).rem_euclid(TAU) - PI;
+    if r <= -PI {
+        r + TAU
+    } else {
+        r
+    }
+}
+
+/// The heading the simulated navigation reports: the plant's ψ while |ψ| ≤
+/// [`HEADING_REPORT_BOUND`], else ψ reduced by whole turns into (−π, π].
+///
+/// **Choice 33:** a navigation solution reports a heading, not a count of turns: the plant's ψ
+/// grows without bound on a circle (ω t), and the controller refuses |angle| beyond
+/// `controller_core::controller::MAX_ANGLE` (1000 rad), which a 24 h circle reaches after
+/// 10 000 s (the run then went to fail-safe and diverged). The reduction is applied only
+/// beyond 4π, which the paper's 70 s missions never reach (their ψ stays below 7.1 rad), so
+/// the Table-1 runs are bit for bit as before; the controller wraps the yaw error anyway
+/// (docs/design.md §4), so the jump by whole turns is invisible to the law.
+pub fn reported_heading(psi: f64) -> f64 {
+    if psi.abs() <= HEADING_REPORT_BOUND {
+        psi
+    } else {
+        wrap_pi(psi)
+    }
+}
+
+/// |ψ| (rad) up to which the simulated navigation reports the plant's heading unchanged
+/// ([`reported_heading`]).
+pub const HEADING_REPORT_BOUND: f64 = 4.0 * std::f64::consts::PI;
+
+/// The navigation computer of one run: its noise and the noise's generator.
+pub struct Navigation {
+    noise: Option<SensorNoise>,
+    rng: rand::rngs::StdRng,
+}
+
+impl Navigation {
+    /// A navigation with `noise` (seeded from it), or exact.
+    pub fn new(noise: Option<&SensorNoise>) -> Self {
+        Navigation {
+            noise: noise.cloned(),
+            rng: rand::rngs::StdRng::seed_from_u64(noise.map_or(0, |n| n.seed)),
+        }
+    }
+
+    /// The measured η, ν the controller is given, in f32.
+    pub fn measure(&mut self, state: &PlantState) -> ([f32; 6], [f32; 6]) {
+        let (mut eta, mut nu) = (state.eta, state.nu);
+        eta[5] = reported_heading(eta[5]);
+        if let Some(n) = &self.noise {
+            for i in 0..6 {
+                let a: f64 = StandardNormal.sample(&mut self.rng);
+                let b: f64 = StandardNormal.sample(&mut self.rng);
+                eta[i] += n.eta_sigma[i] * a;
+                nu[i] += n.nu_sigma[i] * b;
+            }
+        }
+        (eta.cast::<f32>().into(), nu.cast::<f32>().into())
+    }
+}

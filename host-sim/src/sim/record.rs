@@ -1,0 +1,318 @@
+//! What a run leaves behind: one [`Sample`] per control period, the outcome, and the metrics.
+
+use std::collections::BTreeMap;
+use std::fmt;
+
+use auv_link::BoardStatus;
+use controller_core::effectiveness::THRUSTERS;
+use controller_core::{Status, Table1Case};
+use serde::{Deserialize, Serialize};
+
+/// What produced a control period's output, and its state: the core's own [`Status`] when the
+/// law runs on the host (SIL), the board's [`BoardStatus`] when it runs on the board (PIL).
+///
+/// `Display` is the CSV `status` column: `ok` when the law ran (the core's [`Status::Ok`], the
+/// board's [`BoardStatus::Running`]); the core's name otherwise (`fault:pitch-limit`); for the
+/// board `board:` and its name with `": "` → `":"` and spaces → `-`
+/// (`board:fail-safe:stale-state`), so that the column holds one token.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ControlStatus {
+    /// The core on the host.
+    Law(Status),
+    /// The firmware on the board.
+    Board(BoardStatus),
+}
+
+impl ControlStatus {
+    /// True when the law ran this period (thrusters are driven); false: fail-safe, all off.
+    pub fn is_ok(&self) -> bool {
+        matches!(
+            self,
+            ControlStatus::Law(Status::Ok) | ControlStatus::Board(BoardStatus::Running)
+        )
+    }
+}
+
+impl fmt::Display for ControlStatus {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            _ if self.is_ok() => f.write_str("ok"),
+            ControlStatus::Law(s) => f.write_str(s.as_str()),
+            ControlStatus::Board(s) => {
+                let token = s.as_str().replace(": ", ":").replace(' ', "-");
+                write!(f, "board:{token}")
+            }
+        }
+    }
+}
+
+impl Serialize for ControlStatus {
+    fn serialize<S: serde::Serializer>(&self, serializer: S) -> Result<S::Ok, S::Error> {
+        serializer.collect_str(self)
+    }
+}
+
+/// One control period, as the controller saw and commanded it and as the plant was.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Sample {
+    /// Time (s).
+    pub t: f64,
+    /// True pose η (m, rad).
+    pub eta: [f64; 6],
+    /// Desired pose η_d.
+    pub eta_d: [f64; 6],
+    /// e = η − η_d from the true pose (yaw wrapped to (−π, π]).
+    pub error: [f64; 6],
+    /// Commanded body force τ (N, N m).
+    pub tau: [f64; 6],
+    /// Body force actually applied to the plant by the thrusters.
+    pub tau_applied: [f64; 6],
+    /// Thrust per thruster applied to the plant (N): [main, vert fore, vert aft, horz fore,
+    /// horz aft].
+    pub thrust: [f64; THRUSTERS],
+    /// Voltage per thruster from the controller (V), clamped to the supply limit.
+    pub voltage: [f64; THRUSTERS],
+    /// Saturation bits from the controller.
+    pub saturated: u8,
+    /// δ(e,t).
+    pub delta: f64,
+    /// True when the δ clamp was active.
+    pub delta_clamped: bool,
+    /// ‖w‖.
+    pub w_norm: f64,
+    /// Payload mass variation Δm (kg) at this time.
+    pub payload: f64,
+    /// Controller status: ok, or why the thrusters are off.
+    pub status: ControlStatus,
+}
+
+/// How a run ended.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+#[serde(tag = "kind", rename_all = "kebab-case")]
+pub enum Outcome {
+    Completed,
+    /// Stopped early; everything recorded up to `t` is kept.
+    Diverged {
+        t: f64,
+        reason: String,
+    },
+    /// Stopped at `t` on request (Ctrl-C, SIGTERM: [`crate::interrupt`]); everything recorded
+    /// before `t` is kept and every output says it is partial.
+    Interrupted {
+        t: f64,
+    },
+}
+
+impl fmt::Display for Outcome {
+    /// "completed", "DIVERGED at t = … s: reason" (the reason on one line) or
+    /// "INTERRUPTED at t = … s (partial)".
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            Outcome::Completed => f.write_str("completed"),
+            Outcome::Diverged { t, reason } => {
+                let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
+                write!(f, "DIVERGED at t = {t:.2} s: {reason}")
+            }
+            Outcome::Interrupted { t } => write!(f, "INTERRUPTED at t = {t:.2} s (partial)"),
+        }
+    }
+}
+
+/// The control periods of a run in which the law did not run (thrusters off: the core's
+/// fail-safe, or the board's), counted per status.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct FaultCounts {
+    /// Periods per status, by the CSV `status` token ([`ControlStatus`]'s `Display`, e.g.
+    /// `fault:pitch-limit`, `board:fail-safe:stale-state`); statuses that did not occur are
+    /// absent.
+    pub periods: BTreeMap<String, u64>,
+    /// Time of the first such period (s); `None` when there was none.
+    pub first_t: Option<f64>,
+}
+
+impl FaultCounts {
+    /// Counts `sample` if its status is not ok.
+    pub fn record(&mut self, sample: &Sample) {
+        if sample.status.is_ok() {
+            return;
+        }
+        *self.periods.entry(sample.status.to_string()).or_default() += 1;
+        self.first_t.get_or_insert(sample.t);
+    }
+
+    /// Every period in which the law did not run.
+    pub fn total(&self) -> u64 {
+        self.periods.values().sum()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.periods.is_empty()
+    }
+}
+
+impl fmt::Display for FaultCounts {
+    /// "0", or the total and the periods per status:
+    /// "12 (fault:pitch-limit 10, fault:non-finite-result 2; first at t = 3.20 s)".
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}", self.total())?;
+        if self.is_empty() {
+            return Ok(());
+        }
+        let parts: Vec<String> = self
+            .periods
+            .iter()
+            .map(|(status, n)| format!("{status} {n}"))
+            .collect();
+        write!(f, " ({}", parts.join(", "))?;
+        if let Some(t) = self.first_t {
+            write!(f, "; first at t = {t:.2} s")?;
+        }
+        f.write_str(")")
+    }
+}
+
+/// The paper's Table-1 metrics (docs/design.md §7) and the actuator figures.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct Metrics {
+    pub max_x: f64,
+    pub max_y: f64,
+    pub max_z: f64,
+    /// √(max|e_x|² + max|e_y|² + max|e_z|²), the paper's "path" error.
+    pub max_path: f64,
+    /// √(mean(e_x² + e_y² + e_z²)).
+    pub rms_path: f64,
+    pub max_roll: f64,
+    pub max_pitch: f64,
+    pub max_yaw: f64,
+    /// Largest |V| any thruster was commanded (V).
+    pub peak_voltage: f64,
+    /// Fraction of control periods with at least one thruster saturated.
+    pub saturated_fraction: f64,
+}
+
+/// One finished (or stopped) run.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RunResult {
+    pub name: String,
+    /// The paper's Table-1 case the run reproduces ([`crate::scenario::SimConfig::case`]).
+    #[serde(skip)]
+    pub case: Option<Table1Case>,
+    /// Whether Δu was on.
+    pub robust: bool,
+    pub outcome: Outcome,
+    pub metrics: Metrics,
+    /// The periods in fail-safe, per status.
+    pub faults: FaultCounts,
+    /// The scenario expects faults ([`crate::scenario::SimConfig::expect_faults`]): they are
+    /// reported but do not fail the command.
+    pub faults_expected: bool,
+    /// The samples the plots draw: every sample of a run of at most
+    /// [`super::decimate::PLOT_SAMPLES`] periods, else a decimated series (see
+    /// [`super::decimate`]). The CSV has every period (it is written as the run goes).
+    #[serde(skip)]
+    pub samples: Vec<Sample>,
+    /// How many times the plant formed and factorised M(p) ([`crate::plant::Plant::set_params`]):
+    /// once per distinct parameter set the run met, not once per step.
+    #[serde(skip)]
+    pub plant_factorisations: u64,
+}
+
+/// A run as the commands report it in JSON (`--json`): `{"case": name, "robust", the
+/// [`Metrics`] fields, "diverged": {"t", "reason"} if it stopped early}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct RunSummary {
+    /// The run's name ([`RunResult::name`]).
+    #[serde(rename = "case")]
+    pub name: String,
+    pub robust: bool,
+    #[serde(flatten)]
+    pub metrics: Metrics,
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub diverged: Option<Divergence>,
+    /// The time the run was interrupted at (Ctrl-C), if it was: its metrics cover [0, t).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interrupted: Option<f64>,
+    /// The periods in fail-safe, per status (`{"periods": {}, "first_t": null}` for none).
+    #[serde(default)]
+    pub faults: FaultCounts,
+    /// Whether the scenario expected faults.
+    #[serde(default)]
+    pub faults_expected: bool,
+}
+
+/// When and why a run stopped early ([`Outcome::Diverged`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Divergence {
+    pub t: f64,
+    pub reason: String,
+}
+
+impl RunResult {
+    /// The run's [`RunSummary`].
+    pub fn summary(&self) -> RunSummary {
+        RunSummary {
+            name: self.name.clone(),
+            robust: self.robust,
+            metrics: self.metrics,
+            diverged: match &self.outcome {
+                Outcome::Diverged { t, reason } => Some(Divergence {
+                    t: *t,
+                    reason: reason.clone(),
+                }),
+                _ => None,
+            },
+            interrupted: match self.outcome {
+                Outcome::Interrupted { t } => Some(t),
+                _ => None,
+            },
+            faults: self.faults.clone(),
+            faults_expected: self.faults_expected,
+        }
+    }
+
+    /// True if the run stopped early because it diverged.
+    pub fn diverged(&self) -> bool {
+        matches!(self.outcome, Outcome::Diverged { .. })
+    }
+
+    /// True if the run was interrupted (its outputs are partial).
+    pub fn interrupted(&self) -> bool {
+        matches!(self.outcome, Outcome::Interrupted { .. })
+    }
+
+    /// True if the controller was in fail-safe in some period and the scenario did not expect
+    /// it.
+    pub fn faulted_unexpectedly(&self) -> bool {
+        !self.faults.is_empty() && !self.faults_expected
+    }
+
+    /// "with Δu" or "without Δu", from [`RunResult::robust`]: the label of the run in tables,
+    /// plots and file names.
+    pub fn du_label(&self) -> &'static str {
+        du_label(self.robust)
+    }
+
+    /// `with` or `without` ([`RunResult::robust`]): the suffix of the run's CSV,
+    /// `{name}-with.csv`.
+    pub fn du_suffix(&self) -> &'static str {
+        du_suffix(self.robust)
+    }
+}
+
+/// `with` (robust) or `without`: how file names say whether Δu was on.
+pub fn du_suffix(robust: bool) -> &'static str {
+    if robust {
+        "with"
+    } else {
+        "without"
+    }
+}
+
+/// "with Δu" (robust) or "without Δu".
+pub fn du_label(robust: bool) -> &'static str {
+    if robust {
+        "with Δu"
+    } else {
+        "without Δu"
+    }
+}

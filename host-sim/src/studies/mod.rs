@@ -1,0 +1,13 @@
+//! The studies built on the closed loop: what the paper's Table 1 and the real vehicle show,
+//! whether the real thrusters can fly a mission before it is flown, and how the law fares over
+//! the parameter box.
+//!
+//! | module | owns |
+//! |---|---|
+//! | [`table1`] | the paper's printed Table 1, the notes on how our runs were made, the twelve runs |
+//! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale (`host-sim check`) |
+//! | [`montecarlo`] | Monte Carlo over the Table-3 box |
+
+pub mod montecarlo;
+pub mod preflight;
+pub mod table1;
