@@ -487,3 +487,29 @@ fn the_paper_column_follows_the_case_not_the_name() {
     // …and the missing run without Δu is listed with the paper's number for it.
     assert!(md.contains("not run") && md.contains("(0.506)"), "{md}");
 }
+
+/// Regression: the manifest listed the files in the order the parallel runs claimed them, so
+/// two runs of `table1` into one folder wrote different manifests (found comparing outputs
+/// byte for byte before and after the crate's restructure). The same files claimed in any
+/// order now give the same manifest.
+#[test]
+fn the_manifest_does_not_depend_on_the_order_files_were_claimed() {
+    let names = ["b-with.csv", "a-with.csv", "report.md", "a-without.csv"];
+    let manifest = |order: &[usize]| {
+        let path = scratch(&format!("manifest-order-{order:?}"));
+        let dir = host_sim::output::OutputDir::prepare(&path).unwrap();
+        for &i in order {
+            dir.claim(names[i]).unwrap();
+        }
+        std::fs::read_to_string(path.join(host_sim::output::dir::MANIFEST)).unwrap()
+    };
+    let forward = manifest(&[0, 1, 2, 3]);
+    assert_eq!(forward, manifest(&[3, 2, 1, 0]));
+    assert_eq!(forward, manifest(&[2, 0, 3, 1]));
+    for name in names {
+        assert!(
+            forward.lines().any(|l| l == name),
+            "{name} missing:\n{forward}"
+        );
+    }
+}

@@ -173,10 +173,14 @@ impl OutputDir {
         }
     }
 
+    /// Writes the manifest: the names sorted, so that it does not depend on which of the
+    /// parallel runs claimed its files first.
     fn write_manifest(&self, files: &[String]) -> io::Result<PathBuf> {
         let mut text = String::from(MANIFEST_HEADER);
         text.push('\n');
-        for f in files {
+        let mut sorted: Vec<&String> = files.iter().collect();
+        sorted.sort();
+        for f in sorted {
             text.push_str(f);
             text.push('\n');
         }
