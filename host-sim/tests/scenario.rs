@@ -659,3 +659,67 @@ fn a_scenario_built_in_code_is_validated_the_same_way() {
     let slow = s.with(|c| c.controller.rate_hz = 5);
     assert!(matches!(slow, Err(ScenarioError::Invalid { key, .. }) if key == "controller"));
 }
+
+/// Every key a TOML text names, commented out or not, as `table.key` (`key` at the top level):
+/// a line `[table]`/`[[table]]` (after any `#`) opens a table, a line `key = …` (after any `#`,
+/// `key` in lower case) names a key.
+fn keys_named(text: &str) -> std::collections::BTreeSet<String> {
+    let mut keys = std::collections::BTreeSet::new();
+    let mut table = String::new();
+    for line in text.lines() {
+        let line = line.trim_start_matches(|c: char| c == '#' || c.is_whitespace());
+        if let Some(rest) = line.strip_prefix('[') {
+            let name = rest.trim_start_matches('[');
+            table = name[..name.find(']').unwrap_or(name.len())].to_string();
+            continue;
+        }
+        let Some((key, _)) = line.split_once('=') else {
+            continue;
+        };
+        let key = key.trim_end();
+        let is_key = !key.is_empty()
+            && key
+                .chars()
+                .all(|c| c.is_ascii_lowercase() || c.is_ascii_digit() || c == '_');
+        if is_key {
+            keys.insert(match table.as_str() {
+                "" => key.to_string(),
+                t => format!("{t}.{key}"),
+            });
+        }
+    }
+    keys
+}
+
+/// The schema of `host_sim::scenario`'s module documentation (its TOML block) and the example
+/// that shows every knob, `scenarios/example-all-knobs.toml`, name the same keys: neither may
+/// gain a key the other does not document.
+#[test]
+fn the_schema_and_the_all_knobs_example_name_the_same_keys() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let module = std::fs::read_to_string(root.join("src/scenario/mod.rs")).unwrap();
+    let block: String = module
+        .lines()
+        .filter_map(|l| l.strip_prefix("//!"))
+        .skip_while(|l| l.trim() != "```toml")
+        .skip(1)
+        .take_while(|l| l.trim() != "```")
+        .map(|l| format!("{l}\n"))
+        .collect();
+    let schema = keys_named(&block);
+    let example = keys_named(
+        &std::fs::read_to_string(scenarios_dir().join("example-all-knobs.toml")).unwrap(),
+    );
+    assert!(
+        schema.len() > 50,
+        "the schema block was not found: {schema:?}"
+    );
+    let only_schema: Vec<_> = schema.difference(&example).collect();
+    let only_example: Vec<_> = example.difference(&schema).collect();
+    assert!(
+        only_schema.is_empty() && only_example.is_empty(),
+        "keys only in the schema: {only_schema:?}; only in example-all-knobs.toml: {only_example:?}"
+    );
+    // Every key the example shows is one the parser takes: the example parses as written.
+    load_scenario(&scenarios_dir().join("example-all-knobs.toml")).unwrap();
+}

@@ -20,6 +20,16 @@ pub enum Mode {
     Hil,
 }
 
+impl Mode {
+    /// `"PIL"` or `"HIL"`, as messages and progress name the mode.
+    pub fn name(self) -> &'static str {
+        match self {
+            Mode::Pil => "PIL",
+            Mode::Hil => "HIL",
+        }
+    }
+}
+
 /// One PIL run compared with SIL: an entry of `host-sim pil --json`'s `cases` (read it back
 /// with `serde_json::from_str::<Cases<PilComparison>>`). The PIL run's summary, its SIL twin's
 /// max path error and the difference, and the board and link figures.

@@ -17,7 +17,7 @@ use crate::interrupt;
 use crate::output::{self, atomic, sections, OutputDir, ReportRow};
 use crate::scenario::{paper, LinkFaults, Scenario, TickRange};
 use crate::sim::progress::Progress;
-use crate::sim::{self, LocalController, Recording};
+use crate::sim::{self, LocalController, Recording, RunResult};
 
 /// What `pil` and `hil` share: the missions, the link faults and key, the outputs.
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -130,15 +130,12 @@ pub(super) fn fly(
     stdout: &mut dyn Write,
     mut start: impl FnMut(&Scenario, &OutputDir) -> Result<Started>,
 ) -> Result<Exit> {
-    let (name, title) = match mode {
-        Mode::Pil => ("PIL", "AUV-150 processor in the loop (firmware in QEMU)"),
-        Mode::Hil => (
-            "HIL",
-            "AUV-150 hardware in the loop (board on a serial port)",
-        ),
+    let title = match mode {
+        Mode::Pil => "AUV-150 processor in the loop (firmware in QEMU)",
+        Mode::Hil => "AUV-150 hardware in the loop (board on a serial port)",
     };
     // Each scenario runs twice: SIL, then on the board.
-    let progress = Progress::start(name, 2 * periods(scenarios), !args.json);
+    let progress = Progress::start(mode.name(), 2 * periods(scenarios), !args.json);
     let incomplete = Incomplete::default();
     let mut cases = Vec::new();
     let mut runs = Vec::new();
@@ -147,36 +144,9 @@ pub(super) fn fly(
         if interrupt::requested() {
             break;
         }
-        let cfg = s.config();
-        let sil_run = sim::fly(
-            s,
-            &mut LocalController::new(s),
-            &mut progress.observer(),
-            Recording::Plot,
-        );
-        let Started { mut board, log } = start(s, dir)?;
-        let board_run = run_into(dir, s, &mut board, &progress, &incomplete);
-        let stats = board.finish();
-        if let Some((log, log_path)) = log {
-            if let Err(e) = log.commit() {
-                incomplete.push(format!("{} was not written: {e}", log_path.display()));
-            }
-        }
-        if let Some(d) = board_run.summary().diverged {
-            eprintln!(
-                "host-sim: error: {name} {}: stopped at t = {:.2} s: {} (what was recorded is kept in {})",
-                cfg.name,
-                d.t,
-                d.reason,
-                dir.path().display()
-            );
-        }
-        let c = BoardComparison::new(&board_run, &sil_run, stats, mode);
-        let interrupted = sil_run.interrupted() || board_run.interrupted();
-        // Real time does not repeat SIL (the board's clock, the link's latency): compared,
-        // not required to agree.
-        let must_agree = c.pil.pacing == Pacing::Lockstep && cfg.link_faults.is_empty();
-        failed |= board_run.diverged() || (must_agree && !interrupted && !c.agrees());
+        let started = start(s, dir)?;
+        let (c, board_run, ok) = fly_one(s, started, dir, mode, &progress, &incomplete);
+        failed |= !ok;
         cases.push(c);
         runs.push(board_run);
     }
@@ -197,30 +167,81 @@ pub(super) fn fly(
     report_incomplete(&incomplete);
     let exit = runs_exit(runs.iter(), !incomplete.is_empty(), failed);
     if args.json {
+        let preflight = Vec::new();
         print_json(
             stdout,
             &Cases {
                 cases,
                 incomplete,
-                preflight: Vec::new(),
+                preflight,
             },
         )?;
     } else {
-        writeln!(stdout, "{notes}")?;
-        for c in &cases {
-            for e in &c.pil.failsafe_events {
-                writeln!(
-                    stdout,
-                    "{}: fail-safe {} at t = {} s: {}",
-                    c.run.name,
-                    e.kind.as_str(),
-                    // As JSON writes it (3.0, not 3).
-                    serde_json::Value::from(e.t),
-                    e.reason
-                )?;
-            }
-        }
+        print_board_runs(stdout, &notes, &cases)?;
         writeln!(stdout, "report: {}", report.display())?;
     }
     Ok(exit)
+}
+
+/// One scenario in SIL, then with the board `started` for it; returns the comparison, the
+/// board's run, and whether it passed (did not diverge, and agreed with SIL where it must).
+fn fly_one(
+    s: &Scenario,
+    started: Started,
+    dir: &OutputDir,
+    mode: Mode,
+    progress: &Progress,
+    incomplete: &Incomplete,
+) -> (BoardComparison, RunResult, bool) {
+    let cfg = s.config();
+    let sil_run = sim::fly(
+        s,
+        &mut LocalController::new(s),
+        &mut progress.observer(),
+        Recording::Plot,
+    );
+    let Started { mut board, log } = started;
+    let board_run = run_into(dir, s, &mut board, progress, incomplete);
+    let stats = board.finish();
+    if let Some((log, log_path)) = log {
+        if let Err(e) = log.commit() {
+            incomplete.push(format!("{} was not written: {e}", log_path.display()));
+        }
+    }
+    if let Some(d) = board_run.summary().diverged {
+        eprintln!(
+            "host-sim: error: {} {}: stopped at t = {:.2} s: {} (what was recorded is kept in {})",
+            mode.name(),
+            cfg.name,
+            d.t,
+            d.reason,
+            dir.path().display()
+        );
+    }
+    let c = BoardComparison::new(&board_run, &sil_run, stats, mode);
+    let interrupted = sil_run.interrupted() || board_run.interrupted();
+    // Real time does not repeat SIL (the board's clock, the link's latency): compared,
+    // not required to agree.
+    let must_agree = c.pil.pacing == Pacing::Lockstep && cfg.link_faults.is_empty();
+    let ok = !board_run.diverged() && !(must_agree && !interrupted && !c.agrees());
+    (c, board_run, ok)
+}
+
+/// The text `pil` and `hil` print: the comparison with SIL, then every fail-safe entry and exit.
+fn print_board_runs(stdout: &mut dyn Write, notes: &str, cases: &[BoardComparison]) -> Result<()> {
+    writeln!(stdout, "{notes}")?;
+    for c in cases {
+        for e in &c.pil.failsafe_events {
+            writeln!(
+                stdout,
+                "{}: fail-safe {} at t = {} s: {}",
+                c.run.name,
+                e.kind.as_str(),
+                // As JSON writes it (3.0, not 3).
+                serde_json::Value::from(e.t),
+                e.reason
+            )?;
+        }
+    }
+    Ok(())
 }

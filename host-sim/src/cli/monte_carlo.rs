@@ -19,7 +19,7 @@ use crate::studies::montecarlo::{self, MonteCarloOptions, MAX_RUNS};
 /// reports percentiles and the worst case. Deterministic per seed.
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct MonteCarloArgs {
-    /// How many runs (at most host_sim::montecarlo::MAX_RUNS without --allow-long-run).
+    /// How many runs (at most host_sim::studies::montecarlo::MAX_RUNS without --allow-long-run).
     #[arg(long)]
     pub runs: usize,
     #[arg(long, default_value_t = 1)]
@@ -34,7 +34,7 @@ pub struct MonteCarloArgs {
     pub json: bool,
     #[arg(long, default_value = "runs/monte-carlo")]
     pub out: PathBuf,
-    /// Allow more than host_sim::montecarlo::MAX_RUNS runs, and runs beyond the step cap.
+    /// Allow more than host_sim::studies::montecarlo::MAX_RUNS runs, and runs beyond the step cap.
     #[arg(long)]
     pub allow_long_run: bool,
 }

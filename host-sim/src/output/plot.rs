@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::path::Path;
 
 use anyhow::{anyhow, Result};
+use plotters::coord::types::RangedCoordf64;
 use plotters::coord::Shift;
 use plotters::element::DashedPathElement;
 use plotters::prelude::*;
@@ -201,32 +202,9 @@ fn draw_no_data(area: &DrawingArea<BitMapBackend, Shift>, title: &str) -> Result
 }
 
 fn draw_panel(area: &DrawingArea<BitMapBackend, Shift>, panel: &Panel) -> Result<()> {
-    let all = || panel.lines.iter().flat_map(|l| l.pts.iter());
-    let xs = min_max(all().filter(|p| usable(p.1)).map(|p| p.0));
-    let ys = min_max(all().filter(|p| usable(p.0)).map(|p| p.1));
-    let (Some(xs), Some(ys)) = (xs, ys) else {
+    let Some(((x0, x1), (y0, y1))) = panel_ranges(area, panel) else {
         return draw_no_data(area, &panel.title);
     };
-    let (mut x0, mut x1) = match panel.x_range {
-        Some((a, b)) => padded(a, b, 0.0),
-        None if panel.equal_aspect => padded(xs.0, xs.1, 0.05),
-        None => padded(xs.0, xs.1, 0.0),
-    };
-    let (mut y0, mut y1) = padded(ys.0, ys.1, 0.05);
-
-    if panel.equal_aspect && panel.title.is_empty() {
-        // Plotting area in pixels, from the fixed margin and label-area sizes.
-        let (w, h) = area.dim_in_pixel();
-        let pw = f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1));
-        let ph = f64::from(h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1));
-        let scale = ((x1 - x0) / pw).max((y1 - y0) / ph);
-        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
-        x0 = cx - 0.5 * scale * pw;
-        x1 = cx + 0.5 * scale * pw;
-        y0 = cy - 0.5 * scale * ph;
-        y1 = cy + 0.5 * scale * ph;
-    }
-
     let mut builder = ChartBuilder::on(area);
     builder
         .margin(MARGIN)
@@ -252,42 +230,81 @@ fn draw_panel(area: &DrawingArea<BitMapBackend, Shift>, panel: &Panel) -> Result
         .bold_line_style(RGBColor(205, 205, 205))
         .draw()
         .map_err(plot_err)?;
-
     for line in &panel.lines {
-        let style = Stroke::style(line.color);
-        let segs = segments(&line.pts);
-        match line.stroke {
-            Stroke::Solid => {
-                chart
-                    .draw_series(
-                        segs.iter()
-                            .filter(|s| !is_point(s))
-                            .map(|s| PathElement::new(s.clone(), style)),
-                    )
-                    .map_err(plot_err)?;
-            }
-            Stroke::Dashed => {
-                chart
-                    .draw_series(
-                        segs.iter()
-                            .filter(|s| !is_point(s))
-                            .map(|s| DashedPathElement::new(s.clone(), 12, 7, style)),
-                    )
-                    .map_err(plot_err)?;
-            }
-            Stroke::Dots => {}
-        }
-        // Dots, and an isolated point of a line (a one-sample run, a point between two NaNs,
-        // a signal that does not move), which a path would not show.
-        let dots = segs.iter().flat_map(|s| match line.stroke {
-            Stroke::Dots => &s[..],
-            _ if is_point(s) => &s[..1],
-            _ => &[],
-        });
-        chart
-            .draw_series(dots.map(|p| Circle::new(*p, 3, style.filled())))
-            .map_err(plot_err)?;
+        draw_line(&mut chart, line)?;
     }
+    Ok(())
+}
+
+/// The panel's x and y ranges: its data's, padded (an equal-aspect panel widened to the
+/// plotting area's aspect), or `None` without a usable point.
+#[allow(clippy::type_complexity)]
+fn panel_ranges(
+    area: &DrawingArea<BitMapBackend, Shift>,
+    panel: &Panel,
+) -> Option<((f64, f64), (f64, f64))> {
+    let all = || panel.lines.iter().flat_map(|l| l.pts.iter());
+    let xs = min_max(all().filter(|p| usable(p.1)).map(|p| p.0))?;
+    let ys = min_max(all().filter(|p| usable(p.0)).map(|p| p.1))?;
+    let (mut x0, mut x1) = match panel.x_range {
+        Some((a, b)) => padded(a, b, 0.0),
+        None if panel.equal_aspect => padded(xs.0, xs.1, 0.05),
+        None => padded(xs.0, xs.1, 0.0),
+    };
+    let (mut y0, mut y1) = padded(ys.0, ys.1, 0.05);
+    if panel.equal_aspect && panel.title.is_empty() {
+        // Plotting area in pixels, from the fixed margin and label-area sizes.
+        let (w, h) = area.dim_in_pixel();
+        let pw = f64::from(w.saturating_sub(2 * MARGIN + Y_LABEL_AREA).max(1));
+        let ph = f64::from(h.saturating_sub(2 * MARGIN + X_LABEL_AREA).max(1));
+        let scale = ((x1 - x0) / pw).max((y1 - y0) / ph);
+        let (cx, cy) = (0.5 * (x0 + x1), 0.5 * (y0 + y1));
+        x0 = cx - 0.5 * scale * pw;
+        x1 = cx + 0.5 * scale * pw;
+        y0 = cy - 0.5 * scale * ph;
+        y1 = cy + 0.5 * scale * ph;
+    }
+    Some(((x0, x1), (y0, y1)))
+}
+
+/// One line of a panel: its path (solid or dashed), its dots, and any isolated point.
+fn draw_line(
+    chart: &mut ChartContext<BitMapBackend, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    line: &Line,
+) -> Result<()> {
+    let style = Stroke::style(line.color);
+    let segs = segments(&line.pts);
+    match line.stroke {
+        Stroke::Solid => {
+            chart
+                .draw_series(
+                    segs.iter()
+                        .filter(|s| !is_point(s))
+                        .map(|s| PathElement::new(s.clone(), style)),
+                )
+                .map_err(plot_err)?;
+        }
+        Stroke::Dashed => {
+            chart
+                .draw_series(
+                    segs.iter()
+                        .filter(|s| !is_point(s))
+                        .map(|s| DashedPathElement::new(s.clone(), 12, 7, style)),
+                )
+                .map_err(plot_err)?;
+        }
+        Stroke::Dots => {}
+    }
+    // Dots, and an isolated point of a line (a one-sample run, a point between two NaNs,
+    // a signal that does not move), which a path would not show.
+    let dots = segs.iter().flat_map(|s| match line.stroke {
+        Stroke::Dots => &s[..],
+        _ if is_point(s) => &s[..1],
+        _ => &[],
+    });
+    chart
+        .draw_series(dots.map(|p| Circle::new(*p, 3, style.filled())))
+        .map_err(plot_err)?;
     Ok(())
 }
 

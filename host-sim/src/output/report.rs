@@ -297,6 +297,29 @@ pub fn report_markdown(
          control periods in which the controller was in fail-safe (every thruster off), per \
          status.\n\n",
     );
+    s.push_str(&warnings(&runs, incomplete));
+    s.push_str(&table_markdown(rows));
+    if !sections.is_empty() {
+        s.push('\n');
+        s.push_str(sections);
+        if !sections.ends_with('\n') {
+            s.push('\n');
+        }
+    }
+    s.push_str(&plots_section(dir, plots));
+    if !notes.is_empty() {
+        let _ = write!(s, "\n## Notes\n\n{notes}");
+        if !notes.ends_with('\n') {
+            s.push('\n');
+        }
+    }
+    s
+}
+
+/// The report's warnings, each a heading and a list, for what the reader must not miss: outputs
+/// not written, runs interrupted, diverged or in fail-safe (expected or not).
+fn warnings(runs: &[&RunResult], incomplete: &[String]) -> String {
+    let mut s = String::new();
     let mut warn = |head: String, items: Vec<String>| {
         if items.is_empty() {
             return;
@@ -357,14 +380,12 @@ pub fn report_markdown(
         ),
         expected,
     );
-    s.push_str(&table_markdown(rows));
-    if !sections.is_empty() {
-        s.push('\n');
-        s.push_str(sections);
-        if !sections.ends_with('\n') {
-            s.push('\n');
-        }
-    }
+    s
+}
+
+/// The report's plots, each under its file name.
+fn plots_section(dir: &Path, plots: &[PathBuf]) -> String {
+    let mut s = String::new();
     if !plots.is_empty() {
         s.push_str("\n## Plots\n");
         for p in plots {
@@ -373,12 +394,6 @@ pub fn report_markdown(
                 |n| n.to_string_lossy().into_owned(),
             );
             let _ = write!(s, "\n### {name}\n\n![{name}]({})\n", link_target(dir, p));
-        }
-    }
-    if !notes.is_empty() {
-        let _ = write!(s, "\n## Notes\n\n{notes}");
-        if !notes.ends_with('\n') {
-            s.push('\n');
         }
     }
     s

@@ -62,10 +62,18 @@
 //! x_udot = 3.0
 //! y_vdot = 50.0
 //! # staircase only: one table per step, Δ holds while t ≤ until; the last step's `until` may
-//! # be left out (holds for ever).
+//! # be left out (holds for ever); a step's Δ fields are those above, 0 when left out.
 //! # [[variation.steps]]
 //! # until = 25.0
-//! # mass = 30.0 ...
+//! # mass = 30.0
+//! # x_g = 0.05
+//! # y_g = 0.02
+//! # z_g = 0.02
+//! # ix = 2.0
+//! # iy = 5.0
+//! # iz = 10.0
+//! # x_udot = 3.0
+//! # y_vdot = 50.0
 //!
 //! [current]                   # ocean current, earth frame (NED)
 //! model = "constant"          # "none" | "constant" | "gauss-markov"

@@ -186,6 +186,28 @@ pub fn run<O: Observer>(
         })
         .collect();
     let results: Vec<(Draw, Metrics, bool, bool)> = results?.into_iter().flatten().collect();
+    let metrics = summaries(&results);
+    let worst = results
+        .iter()
+        .max_by(|a, b| a.1.max_path.total_cmp(&b.1.max_path))
+        .map(|(d, m, ..)| (d.clone(), *m));
+    let draw = draw_text(opts);
+    Ok(Summary {
+        base: name.clone(),
+        runs: opts.runs,
+        done: results.len(),
+        partial: results.len() < opts.runs,
+        seed: opts.seed,
+        diverged: results.iter().filter(|r| r.2).count(),
+        faulted: results.iter().filter(|r| r.3).count(),
+        draw,
+        metrics,
+        worst,
+    })
+}
+
+/// The percentiles of every metric over the runs, and the run with each maximum.
+fn summaries(results: &[(Draw, Metrics, bool, bool)]) -> Vec<MetricSummary> {
     type Getter = (&'static str, fn(&Metrics) -> f64);
     let getters: [Getter; 10] = [
         ("max_x", |m| m.max_x),
@@ -199,7 +221,7 @@ pub fn run<O: Observer>(
         ("peak_voltage", |m| m.peak_voltage),
         ("saturated_fraction", |m| m.saturated_fraction),
     ];
-    let metrics = getters
+    getters
         .iter()
         .map(|(name, get)| {
             let mut v: Vec<(f64, usize)> =
@@ -215,12 +237,12 @@ pub fn run<O: Observer>(
                 worst_run: v.last().map_or(0, |x| x.1),
             }
         })
-        .collect();
-    let worst = results
-        .iter()
-        .max_by(|a, b| a.1.max_path.total_cmp(&b.1.max_path))
-        .map(|(d, m, ..)| (d.clone(), *m));
-    let draw = match opts.max_current {
+        .collect()
+}
+
+/// What each run draws, and what of the base it replaces.
+fn draw_text(opts: &MonteCarloOptions) -> String {
+    match opts.max_current {
         Some(v) => format!(
             "Δp uniform in the Table-3 box, constant over each run (replaces the base's \
              variation, which is none); a constant horizontal current of speed uniform in \
@@ -229,19 +251,7 @@ pub fn run<O: Observer>(
         None => "Δp uniform in the Table-3 box, constant over each run (replaces the base's \
                  variation, which is none); the base's own current"
             .to_string(),
-    };
-    Ok(Summary {
-        base: name.clone(),
-        runs: opts.runs,
-        done: results.len(),
-        partial: results.len() < opts.runs,
-        seed: opts.seed,
-        diverged: results.iter().filter(|r| r.2).count(),
-        faulted: results.iter().filter(|r| r.3).count(),
-        draw,
-        metrics,
-        worst,
-    })
+    }
 }
 
 impl Summary {
