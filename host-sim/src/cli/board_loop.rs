@@ -223,7 +223,8 @@ fn fly_one(
     // Real time does not repeat SIL (the board's clock, the link's latency): compared,
     // not required to agree.
     let must_agree = c.pil.pacing == Pacing::Lockstep && cfg.link_faults.is_empty();
-    let ok = !board_run.diverged() && !(must_agree && !interrupted && !c.agrees());
+    let disagrees = must_agree && !interrupted && !c.agrees();
+    let ok = !(board_run.diverged() || disagrees);
     (c, board_run, ok)
 }
 
