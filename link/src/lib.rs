@@ -13,11 +13,12 @@
 //!   byte of the body is always [`Envelope::version`] (a `u8` is one byte in postcard), so a
 //!   receiver checks the version before it interprets anything else.
 //! - **Signature:** optional, in the manner of MAVLink 2 signing: truncated HMAC-SHA-256 with a
-//!   48-bit timestamp that increases strictly per direction ([`sign`]). postcard's encoding of
-//!   an `Envelope` ends where the envelope ends, so what follows it is the trailer: nothing on
-//!   an unsigned frame, exactly [`sign::SIGNATURE_LEN`] bytes on a signed one, anything else
-//!   malformed. Each end has signing on or off ([`FrameDecoder::signed`], [`encode_signed`]);
-//!   with it on, unsigned frames are refused, and with it off, signed ones are.
+//!   48-bit timestamp that increases strictly per direction and, at the board, may not run
+//!   too far ahead ([`sign`]). postcard's encoding of an `Envelope` ends where the envelope
+//!   ends, so what follows it is the trailer: nothing on an unsigned frame, exactly
+//!   [`sign::SIGNATURE_LEN`] bytes on a signed one, anything else malformed. Each end has
+//!   signing on or off ([`FrameDecoder::signed`], [`encode_signed`]); with it on, unsigned
+//!   frames are refused, and with it off, signed ones are.
 //! - **CRC:** CRC-16/IBM-3740, a.k.a. CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, not
 //!   reflected, no final XOR; check value 0x29B1), over the postcard bytes and the signature,
 //!   appended little-endian. It detects every error of up to 3 bits and every burst of up to
