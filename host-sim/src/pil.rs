@@ -127,6 +127,10 @@ pub struct PilStats {
     /// Frames the board refused for their authentication (its `rx_auth_errors`).
     #[serde(default)]
     pub board_rx_auth_errors: u32,
+    /// Of those, authentic frames stamped too far ahead (its `rx_ahead`: this end's clock
+    /// jumped ahead of the board's count, auv_link::sign).
+    #[serde(default)]
+    pub board_rx_ahead: u32,
     /// Commands the board refused, and the last reason ([`auv_link::Refusal::as_str`]).
     #[serde(default)]
     pub board_refused_commands: u32,
@@ -788,6 +792,7 @@ impl BoardInTheLoop {
         self.stats.board_rx_errors = t.rx_errors;
         self.stats.board_rx_stale = t.rx_stale;
         self.stats.board_rx_auth_errors = t.rx_auth_errors;
+        self.stats.board_rx_ahead = t.rx_ahead;
         self.stats.board_refused_commands = t.refused_commands;
         self.stats.board_last_refusal = t.last_refusal.map(|r| r.as_str().to_string());
         self.stats.board_loop_overruns = t.loop_overruns;
@@ -940,7 +945,8 @@ pub fn mavlink_time() -> u64 {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| {
-            d.as_secs().saturating_sub(EPOCH_2015) * 100_000 + u64::from(d.subsec_micros() / 10)
+            d.as_secs().saturating_sub(EPOCH_2015) * auv_link::sign::UNITS_PER_SECOND
+                + u64::from(d.subsec_micros() / 10)
         })
 }
 
