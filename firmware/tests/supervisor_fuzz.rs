@@ -144,6 +144,21 @@ fn a_peer_stamping_the_last_timestamp_is_refused_and_the_board_flies_on() {
     assert_eq!(s.frames_accepted, s.frames_sent - 1, "{s:?}");
 }
 
+/// Found by the fuzz target (with this harness): raw bytes that are a signed `Arm` of
+/// timestamp 1 — libFuzzer learnt its MAC from the comparison that checks it. The harness now
+/// treats a raw chunk that verifies with the key as a key holder's frame.
+#[test]
+fn raw_bytes_that_verify_with_the_key_are_a_key_holders_frame() {
+    let mut v = vec![0xA9, OP_RAW, 29, 0x7A];
+    v.extend([0; 7]);
+    v.extend([
+        4, 4, 1, 1, 1, 2, 1, 1, 1, 1, 1, 7, 0xEF, 0x51, 0xA8, 0xE4, 0xEB, 0x3E, 2, 0x78, 0,
+    ]);
+    assert_eq!(v.len(), 3 + 29);
+    let s = run(&v);
+    assert_eq!((s.frames_sent, s.frames_accepted), (1, 1), "{s:?}");
+}
+
 /// A key holder whose clock jumped more than the lead ahead: every frame it sends is refused,
 /// and the board fails safe on the silence, still signing its telemetry.
 #[test]

@@ -574,12 +574,13 @@ impl Harness {
     }
 
     /// Bytes the harness did not build as a frame (a corruption, raw bytes), split at the
-    /// delimiters. A chunk equal to a frame sent earlier is that frame; otherwise, with
-    /// signing off, it is what `decode_frame` says it is, if it decodes; with signing on it
-    /// cannot be authentic (nobody but the harness holds the key).
+    /// delimiters. A chunk equal to a frame sent earlier is that frame; otherwise it is what
+    /// `decode_frame` says it is (signing off) or, signing on, a key holder's frame if it
+    /// verifies with the key: libFuzzer learns a MAC from the comparison that checks it, so the
+    /// fuzzer holds the key too (it wrote the signed `Arm` of timestamp 1 from raw bytes).
     fn raw(&mut self, bytes: &[u8]) {
         for chunk in bytes.split_inclusive(|&b| b == 0) {
-            let body = chunk.strip_suffix(&[0]).unwrap_or(chunk);
+            let mut body = chunk.strip_suffix(&[0]).unwrap_or(chunk).to_vec();
             let earlier = self
                 .history
                 .iter()
@@ -587,11 +588,11 @@ impl Harness {
                 .and_then(|(_, k)| *k);
             let known = earlier.or_else(|| {
                 if self.signing {
-                    None
+                    let mut v = Verifier::new(&KEY, Direction::ToBoard);
+                    let env = decode_frame_signed(&mut body, &mut v).ok()?;
+                    Some((env, Auth::Good(v.last_timestamp()?)))
                 } else {
-                    decode_frame(&mut body.to_vec())
-                        .ok()
-                        .map(|e| (e, Auth::Unsigned))
+                    decode_frame(&mut body).ok().map(|e| (e, Auth::Unsigned))
                 }
             });
             self.deliver(chunk, known);
