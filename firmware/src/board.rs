@@ -4,7 +4,7 @@
 //! navigation link (`embedded_io` serial), a period timer and a free-running tick counter.
 //! [`period`] is the whole loop body; it is the same on every board.
 
-use auv_link::sign::{Direction, LinkKey, Signer, Verifier};
+use auv_link::sign::{Direction, LinkKey, Signer, Verifier, UNITS_PER_SECOND};
 use auv_link::{encode, encode_signed, Envelope, FrameDecoder, LinkError, MAX_FRAME};
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_io::{Read, ReadReady, Write};
@@ -61,10 +61,11 @@ impl LinkBuffers {
     }
 
     /// A signed link with `key` (auv_link::sign): only frames the navigation computer signed
-    /// with it are accepted, and telemetry is signed with it.
+    /// with it are accepted — none stamped too far ahead (`Verifier::bounded`, Choices 95–96)
+    /// — and telemetry is signed with it.
     pub fn signed(key: &LinkKey) -> Self {
         LinkBuffers {
-            decoder: FrameDecoder::signed(Verifier::new(key, Direction::ToBoard)),
+            decoder: FrameDecoder::signed(Verifier::bounded(key, Direction::ToBoard)),
             tx: [0; MAX_FRAME],
             signer: Some(Signer::new(key, Direction::FromBoard)),
         }
@@ -94,6 +95,14 @@ impl LinkBuffers {
             }
         };
         Ok(&self.tx[..n])
+    }
+
+    /// A control period at `rate_hz` ended: the verifier counts its length (rounded up to the
+    /// timestamp's 10 µs), so that a navigation computer stamping its clock across a silence
+    /// the board lived through is not refused as too far ahead (Choice 96).
+    pub fn period_passed(&mut self, rate_hz: u32) {
+        let units = UNITS_PER_SECOND.div_ceil(u64::from(rate_hz.max(1)));
+        self.decoder.elapse(units);
     }
 }
 
@@ -180,6 +189,7 @@ pub fn period<B: Board>(board: &mut B, sup: &mut Supervisor, bufs: &mut LinkBuff
     if let Ok(frame) = bufs.encode(&env) {
         let _ = board.link().write_all(frame);
     }
+    bufs.period_passed(sup.rate_hz());
     board.feed_watchdog();
     step
 }

@@ -31,7 +31,8 @@ use heapless::spsc::{Consumer, Producer, Queue};
 /// Received bytes (and line errors) the queue holds: 11 ms of line at 460 800 baud, longer
 /// than a 100 Hz control period.
 pub const RX_CAPACITY: usize = 512;
-/// Bytes to send the queue holds: more than one telemetry frame (119 bytes).
+/// Bytes to send the queue holds: more than one telemetry frame (`auv_link::MAX_FRAME`, 162
+/// bytes signed).
 pub const TX_CAPACITY: usize = 512;
 
 /// Storage of the receive queue (heapless keeps one slot free: N = capacity + 1).

@@ -17,13 +17,15 @@
 //! is in every telemetry frame until the re-arm.
 //!
 //! Frames: a corrupt, unknown-version, badly authenticated or wrong-direction frame is counted
-//! (`rx_errors`) and dropped. A frame whose sequence number is not newer than the last accepted
-//! one ([`auv_link::seq`]) is counted (`rx_stale`) and dropped; in lock-step so is a state frame
-//! off the mission clock ([`MissionClock`]). A dropped frame never restarts the stale-state
-//! timer. Every refused command is counted and its reason reported ([`Refusal`]); a refused
-//! command changes nothing.
+//! (`rx_errors`; failed authentication also in `rx_auth_errors`, and an authentic frame stamped
+//! too far ahead also in `rx_ahead`) and dropped. A frame whose sequence number is not newer
+//! than the last accepted one ([`auv_link::seq`]) is counted (`rx_stale`) and dropped; in
+//! lock-step so is a state frame off the mission clock ([`MissionClock`]). A dropped frame never
+//! restarts the stale-state timer. Every refused command is counted and its reason reported
+//! ([`Refusal`]); a refused command changes nothing.
 
 use auv_link::seq::SeqCheck;
+use auv_link::sign::AuthError;
 use auv_link::{
     BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionPlan, Msg,
     Refusal, StateFrame, Telemetry, DEFAULT_STALE_PERIODS,
@@ -161,6 +163,7 @@ pub struct Supervisor {
     rx_errors: u32,
     rx_stale: u32,
     rx_auth_errors: u32,
+    rx_ahead: u32,
     refused_commands: u32,
     last_refusal: Option<Refusal>,
     loop_overruns: u32,
@@ -218,6 +221,7 @@ impl Supervisor {
             rx_errors: 0,
             rx_stale: 0,
             rx_auth_errors: 0,
+            rx_ahead: 0,
             refused_commands: 0,
             last_refusal: None,
             loop_overruns: 0,
@@ -284,6 +288,11 @@ impl Supervisor {
         self.rx_auth_errors
     }
 
+    /// Authentic frames refused for a timestamp too far ahead (`AuthError::Ahead`).
+    pub fn rx_ahead(&self) -> u32 {
+        self.rx_ahead
+    }
+
     pub fn refused_commands(&self) -> u32 {
         self.refused_commands
     }
@@ -298,11 +307,14 @@ impl Supervisor {
     }
 
     /// A frame failed to decode or to authenticate: counted (authentication failures also in
-    /// `rx_auth_errors`) and dropped.
+    /// `rx_auth_errors`, a timestamp too far ahead also in `rx_ahead`) and dropped.
     pub fn on_link_error(&mut self, e: &LinkError) {
         self.on_rx_error();
-        if matches!(e, LinkError::Auth(_)) {
+        if let LinkError::Auth(a) = e {
             self.rx_auth_errors = self.rx_auth_errors.saturating_add(1);
+            if *a == AuthError::Ahead {
+                self.rx_ahead = self.rx_ahead.saturating_add(1);
+            }
         }
     }
 
@@ -554,6 +566,7 @@ impl Supervisor {
             signing: self.board.signing,
             thrust_unit: self.controller.config().thrust_unit.into(),
             reversed_thrusters: self.mounting,
+            rx_ahead: self.rx_ahead,
         };
         self.periods_since_state = self.periods_since_state.saturating_add(1);
         self.clock.period();

@@ -279,3 +279,47 @@ fn an_absurd_loop_rate_is_refused() {
     assert_eq!(refused(&s), 1);
     assert_eq!(s.rate_hz(), 100);
 }
+
+// Issue 22's board defects. Like the ones above, each uses only the interface that predates its
+// fix (here: the board's signed end of the link, `LinkBuffers`, and `common::Host`), so that it
+// runs, and fails, on the code before the fix.
+
+/// Issue 22, item 6: a peer holding the key stamped a frame at 2⁴⁸ − 1; the board, which
+/// stamps above the last stamp it accepted, had no timestamp left to sign its telemetry with,
+/// and its navigation computer's later frames were replays, until the board reset. Now the
+/// board refuses that frame (above its ceiling, and far beyond the lead it allows), keeps
+/// signing, and flies on its peer's frames.
+#[test]
+fn a_frame_stamped_at_the_last_timestamp_leaves_the_board_able_to_sign() {
+    use auv_link::sign::MAX_TIMESTAMP;
+    use common::{board_info, controller, Host, KEY};
+    use firmware::board::LinkBuffers;
+
+    let mut s = Supervisor::new(controller(), board_info(true));
+    let mut link = LinkBuffers::signed(&KEY);
+    let mut nav = Host::signed(&KEY);
+    nav.send(&mut s, &mut link, Msg::Command(Command::Arm));
+    nav.send(
+        &mut s,
+        &mut link,
+        Msg::Command(Command::StartMission(CIRCLE)),
+    );
+    nav.send(&mut s, &mut link, Msg::State(state(0)));
+    // Another key holder's state frame, newer in sequence, stamped 2⁴⁸ − 1.
+    let mut wild = Host::signed(&KEY);
+    wild.seq = nav.seq;
+    if let Some(signer) = &mut wild.signer {
+        signer.advance_to(MAX_TIMESTAMP - 1);
+    }
+    wild.send(&mut s, &mut link, Msg::State(state(1)));
+    for k in 1..=6 {
+        nav.send(&mut s, &mut link, Msg::State(state(k)));
+        let step = s.step(false, NOW);
+        assert_eq!(step.telemetry.status, BoardStatus::Running, "period {k}");
+        let env = s.envelope(step.telemetry);
+        assert!(
+            link.encode(&env).is_ok(),
+            "period {k}: telemetry not signed"
+        );
+    }
+}

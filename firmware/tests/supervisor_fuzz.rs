@@ -120,20 +120,59 @@ fn replays_forgeries_and_the_wrong_signing_never_fly() {
     }
 }
 
-/// Found by the fuzz target: a peer holding the key that stamps a frame at 2⁴⁸ − 1 leaves the
-/// board no timestamp to sign its telemetry with (until it resets). The harness first asserted
-/// that telemetry always encodes; now the exhaustion is allowed only in exactly that case, and
-/// the board still fails safe (its peer's later frames are replays).
+/// Found by the fuzz target: a peer holding the key that stamps a frame at 2⁴⁸ − 1 left the
+/// board no timestamp to sign its telemetry with (until it reset), and its peer's later frames
+/// were replays. Now the board refuses that frame as too far ahead (above its ceiling), counts
+/// it, and flies on its peer's frames (the harness checks that every telemetry frame signs).
 #[test]
-fn a_peer_stamping_the_last_timestamp_exhausts_the_boards_stamps_and_it_fails_safe() {
+fn a_peer_stamping_the_last_timestamp_is_refused_and_the_board_flies_on() {
     let mut v = vec![1];
     v.extend(arm());
     v.extend(start());
-    // A restarted signer advanced to 2⁴⁸ − 2 (the harness reads a u64 and shifts it by 16).
+    // A restarted signer advanced to 2⁴⁸ − 2 (the harness reads a u64, whose low bits 0 say
+    // "anywhere", and shifts it by 16).
     v.extend([OP_STATE, 0, 0, SIGN_RESTARTED]);
     v.extend(((auv_link::sign::MAX_TIMESTAMP - 1) << 16).to_le_bytes());
     for _ in 0..6 {
         v.extend(state(SIGN_AS_EXPECTED));
+        v.extend(period(false));
+    }
+    let s = run(&v);
+    assert_eq!(s.periods_on, 6, "{s:?}");
+    assert_eq!(s.latches, 0, "{s:?}");
+    assert_eq!(s.ahead, 1, "{s:?}");
+    assert_eq!(s.frames_accepted, s.frames_sent - 1, "{s:?}");
+}
+
+/// Found by the fuzz target (with this harness): raw bytes that are a signed `Arm` of
+/// timestamp 1 — libFuzzer learnt its MAC from the comparison that checks it. The harness now
+/// treats a raw chunk that verifies with the key as a key holder's frame.
+#[test]
+fn raw_bytes_that_verify_with_the_key_are_a_key_holders_frame() {
+    let mut v = vec![0xA9, OP_RAW, 29, 0x7A];
+    v.extend([0; 7]);
+    v.extend([
+        4, 4, 1, 1, 1, 2, 1, 1, 1, 1, 1, 7, 0xEF, 0x51, 0xA8, 0xE4, 0xEB, 0x3E, 2, 0x78, 0,
+    ]);
+    assert_eq!(v.len(), 3 + 29);
+    let s = run(&v);
+    assert_eq!((s.frames_sent, s.frames_accepted), (1, 1), "{s:?}");
+}
+
+/// A key holder whose clock jumped more than the lead ahead: every frame it sends is refused,
+/// and the board fails safe on the silence, still signing its telemetry.
+#[test]
+fn when_every_frame_is_too_far_ahead_the_board_fails_safe_on_silence() {
+    let mut v = vec![1];
+    v.extend(arm());
+    v.extend(start());
+    v.extend(state(SIGN_AS_EXPECTED));
+    v.extend(period(false));
+    for _ in 0..6 {
+        // Low bits 1: "around the lead past the last stamp"; the offset 2²¹ − 1 puts it
+        // 2²⁰ − 1 units (10 s) beyond the lead, more than the periods counted.
+        v.extend([OP_STATE, 0, 0, SIGN_RESTARTED]);
+        v.extend((((1u64 << 21) - 1) << 16 | 1).to_le_bytes());
         v.extend(period(false));
     }
     let s = run(&v);
@@ -143,6 +182,8 @@ fn a_peer_stamping_the_last_timestamp_exhausts_the_boards_stamps_and_it_fails_sa
         "{s:?}"
     );
     assert_eq!(s.latches, 1, "{s:?}");
+    assert_eq!(s.ahead, 6, "{s:?}");
+    assert_eq!(s.frames_accepted, 3, "{s:?}: arm, start, the first state");
 }
 
 /// One piece of the grammar: mostly what a navigation computer sends, sometimes not.
@@ -168,6 +209,28 @@ fn piece() -> impl Strategy<Value = Vec<u8>> {
         // Anything else: an op with arbitrary arguments.
         3 => prop::collection::vec(any::<u8>(), 1..24),
     ]
+}
+
+/// The grammar must reach the timestamp rule both ways, or its invariant checks little: key
+/// holders' frames refused as too far ahead, and taken.
+#[test]
+fn the_grammar_reaches_the_timestamp_rule_both_ways() {
+    use proptest::strategy::ValueTree;
+    let mut runner = proptest::test_runner::TestRunner::deterministic();
+    let strategy = prop::collection::vec(piece(), 0..120);
+    let (mut ahead, mut taken) = (0, 0);
+    for _ in 0..200 {
+        let mut v = vec![1];
+        v.extend(arm());
+        v.extend(start());
+        for p in strategy.new_tree(&mut runner).unwrap().current() {
+            v.extend(p);
+        }
+        let s = run(&v);
+        ahead += s.ahead;
+        taken += s.restarted_taken;
+    }
+    assert!(ahead > 20 && taken > 20, "ahead {ahead}, taken {taken}");
 }
 
 proptest! {

@@ -54,8 +54,8 @@ pub enum LinkError {
     Serialize,
     /// CRC, version and body are fine, but the frame's authentication is not
     /// ([`crate::sign`]): unsigned on a signed link, signed on an unsigned one, a replayed
-    /// timestamp, a wrong direction or a bad MAC. From [`encode_signed`]: the signer's
-    /// timestamp is exhausted.
+    /// timestamp, a wrong direction, a bad MAC, or (the board's end) a timestamp too far
+    /// ahead. From [`encode_signed`]: the signer's timestamp is exhausted.
     Auth(AuthError),
 }
 
@@ -127,7 +127,8 @@ pub fn decode_frame(frame: &mut [u8]) -> Result<Envelope, LinkError> {
 }
 
 /// As [`decode_frame`], on a signed link: the body must be followed by a signature trailer
-/// that `verifier` accepts (direction, a newer timestamp, the MAC; [`crate::sign`]).
+/// that `verifier` accepts (direction, a newer timestamp, the MAC and, if bounded, a timestamp
+/// not too far ahead; [`crate::sign`]).
 pub fn decode_frame_signed(
     frame: &mut [u8],
     verifier: &mut Verifier,
@@ -227,6 +228,14 @@ impl FrameDecoder {
     /// The verifier of a signed link (`None`: signing off).
     pub const fn verifier(&self) -> Option<&Verifier> {
         self.verifier.as_ref()
+    }
+
+    /// The receiver's own time moved on by `units` (10 µs each): passed to a signed link's
+    /// verifier ([`Verifier::elapse`]); nothing on an unsigned link.
+    pub fn elapse(&mut self, units: u64) {
+        if let Some(v) = &mut self.verifier {
+            v.elapse(units);
+        }
     }
 
     /// Takes one received byte. Returns `Some` when the byte completes a frame (a `0x00` after
@@ -392,7 +401,7 @@ mod tests {
         use std::string::ToString;
         assert_eq!(
             LinkError::Version { got: 1 }.to_string(),
-            "protocol version 1, expected 3"
+            "protocol version 1, expected 4"
         );
         assert_eq!(
             LinkError::Overflow.to_string(),

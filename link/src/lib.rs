@@ -13,11 +13,12 @@
 //!   byte of the body is always [`Envelope::version`] (a `u8` is one byte in postcard), so a
 //!   receiver checks the version before it interprets anything else.
 //! - **Signature:** optional, in the manner of MAVLink 2 signing: truncated HMAC-SHA-256 with a
-//!   48-bit timestamp that increases strictly per direction ([`sign`]). postcard's encoding of
-//!   an `Envelope` ends where the envelope ends, so what follows it is the trailer: nothing on
-//!   an unsigned frame, exactly [`sign::SIGNATURE_LEN`] bytes on a signed one, anything else
-//!   malformed. Each end has signing on or off ([`FrameDecoder::signed`], [`encode_signed`]);
-//!   with it on, unsigned frames are refused, and with it off, signed ones are.
+//!   48-bit timestamp that increases strictly per direction and, at the board, may not run
+//!   too far ahead ([`sign`]). postcard's encoding of an `Envelope` ends where the envelope
+//!   ends, so what follows it is the trailer: nothing on an unsigned frame, exactly
+//!   [`sign::SIGNATURE_LEN`] bytes on a signed one, anything else malformed. Each end has
+//!   signing on or off ([`FrameDecoder::signed`], [`encode_signed`]); with it on, unsigned
+//!   frames are refused, and with it off, signed ones are.
 //! - **CRC:** CRC-16/IBM-3740, a.k.a. CRC-16/CCITT-FALSE (poly 0x1021, init 0xFFFF, not
 //!   reflected, no final XOR; check value 0x29B1), over the postcard bytes and the signature,
 //!   appended little-endian. It detects every error of up to 3 bits and every burst of up to
@@ -28,13 +29,13 @@
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 157 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 140 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//! - **Size:** at most [`MAX_FRAME`] = 162 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 145 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
 //!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
 //!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
-//!   board's link) the largest frame takes 3.4 ms, so a State frame in one direction and a
+//!   board's link) the largest frame takes 3.5 ms, so a State frame in one direction and a
 //!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
-//!   uses 34 % of the board's transmit bandwidth); 115 200 baud (13.6 ms) would not.
+//!   uses 35 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
 //!
 //! # Receiving
 //!

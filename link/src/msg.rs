@@ -18,7 +18,10 @@ use crate::refusal::Refusal;
 /// 3: `StartMission` carries a [`MissionPlan`] (heading, time scale); `SetConfig` the thrust
 /// unit, the thruster mounting and the axis priority; `Telemetry` the unit and mounting the
 /// board flies; refusals for an invalid time scale, tangent heading, mounting or priority.
-pub const PROTOCOL_VERSION: u8 = 3;
+///
+/// 4: `Telemetry` counts the authentic frames refused for a timestamp too far ahead
+/// ([`Telemetry::rx_ahead`], [`crate::sign::AuthError::Ahead`]).
+pub const PROTOCOL_VERSION: u8 = 4;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -375,6 +378,12 @@ pub struct Telemetry {
     pub thrust_unit: ThrustUnit,
     /// The board's thruster mounting, as [`ConfigPatch::reversed_thrusters`].
     pub reversed_thrusters: u8,
+    // Protocol 4: appended fields.
+    /// Authentic frames refused since boot because their timestamp ran too far ahead
+    /// ([`crate::sign::AuthError::Ahead`]: above the board's ceiling, or beyond the lead it
+    /// allows over the last accepted stamp; also counted in `rx_auth_errors` and `rx_errors`).
+    /// A navigation computer whose clock jumped sees it rise, and the board fail safe.
+    pub rx_ahead: u32,
 }
 
 impl Telemetry {
@@ -407,6 +416,7 @@ impl Telemetry {
         signing: true,
         thrust_unit: ThrustUnit::Newton,
         reversed_thrusters: u8::MAX,
+        rx_ahead: u32::MAX,
     };
 }
 
@@ -431,7 +441,8 @@ impl Telemetry {
         + U16
         + BOOL
         + ThrustUnit::MAX_SIZE
-        + U8;
+        + U8
+        + U32;
 
     /// The controller fault this report carries (`None`: no fault, or a code this crate does
     /// not know).

@@ -18,11 +18,21 @@
 //! - **Timestamp:** 48 bits, strictly increasing per direction: the receiver refuses any
 //!   timestamp not above the last one it accepted (replay protection, checked before the MAC
 //!   is computed, committed only after it matched). As in MAVLink the sender may use time —
-//!   `host-sim` uses 10 µs units since 2015-01-01 UTC, MAVLink's, so that a restarted host
-//!   still counts upwards — or a counter: the board has no clock, and stamps each frame with
-//!   one more than the larger of its previous stamp and the last stamp it accepted from the
-//!   navigation computer ([`Signer::advance_to`]), so after a reset its stamps rise above
-//!   everything it sent before as soon as it has heard one signed frame.
+//!   `host-sim` uses 10 µs units since 2015-01-01 UTC ([`UNITS_PER_SECOND`]), MAVLink's, so
+//!   that a restarted host still counts upwards — or a counter: the board has no clock, and
+//!   stamps each frame with one more than the larger of its previous stamp and the last stamp
+//!   it accepted from the navigation computer ([`Signer::advance_to`]), so after a reset its
+//!   stamps rise above everything it sent before as soon as it has heard one signed frame.
+//! - **How far ahead (the board's end, [`Verifier::bounded`]):** because the board follows its
+//!   peer's stamps, a key holder that stamped a frame at 2⁴⁸ − 1 would leave it nothing to sign
+//!   with until it reset. So the board also refuses an authentic frame ([`AuthError::Ahead`])
+//!   whose timestamp is above [`CEILING`] (2⁴⁸ − 2⁴⁰: its telemetry can always be signed for
+//!   another 2⁴⁰ frames, 174 years at 200 Hz), or more than [`MAX_LEAD`] (10 minutes) ahead of
+//!   the last one it accepted plus the time it counted since ([`Verifier::elapse`]): a
+//!   navigation computer stamping its clock across any silence the board lived through is
+//!   accepted, a clock that jumps ahead of the board's count by more than 10 minutes is not.
+//!   The first frame after a reset is bounded by the ceiling only (the board cannot know where
+//!   its peer's clock is). docs/design.md §20, Choices 95–96.
 //! - **MAC:** HMAC-SHA-256 (the `hmac` and `sha2` crates: no_std, no heap), truncated to 48
 //!   bits as MAVLink does, compared in constant time. A forger's chance per attempt is 2⁻⁴⁸.
 //!
@@ -32,10 +42,10 @@
 //!
 //! **Limits (as MAVLink's):** signing authenticates, it does not encrypt. The receiver keeps the
 //! last timestamp in RAM only: after it resets, the first validly signed frame is accepted
-//! whatever its timestamp, so a recording of earlier signed traffic could be replayed into a
-//! board that has just reset and not yet heard its navigation computer. The sequence numbers
-//! ([`crate::seq`]) and the lock-step mission clock limit what such a replay can do, but do not
-//! prevent it; a persisted timestamp floor would.
+//! whatever its timestamp (up to the board's [`CEILING`]), so a recording of earlier signed
+//! traffic could be replayed into a board that has just reset and not yet heard its navigation
+//! computer. The sequence numbers ([`crate::seq`]) and the lock-step mission clock limit what
+//! such a replay can do, but do not prevent it; a persisted timestamp floor would.
 
 use core::fmt;
 
@@ -52,6 +62,25 @@ pub const MAC_LEN: usize = 6;
 pub const SIGNATURE_LEN: usize = 1 + TIMESTAMP_LEN + MAC_LEN;
 /// Largest timestamp: 2⁴⁸ − 1.
 pub const MAX_TIMESTAMP: u64 = (1 << (8 * TIMESTAMP_LEN)) - 1;
+/// Timestamp units per second: MAVLink's 10 µs.
+pub const UNITS_PER_SECOND: u64 = 100_000;
+/// **Choice 95:** the stamps a [bounded](Verifier::bounded) receiver keeps for its own signer:
+/// 2⁴⁰, 174 years of frames at 200 Hz (the board's fastest loop) counted one by one, or 127
+/// days of MAVLink time.
+pub const RESERVE: u64 = 1 << 40;
+/// **Choice 95:** the highest timestamp a [bounded](Verifier::bounded) receiver accepts,
+/// `MAX_TIMESTAMP − RESERVE`, so that a board that follows its peer's stamps can sign another
+/// [`RESERVE`] frames whatever its peer sent. In MAVLink time it is November 2103; a peer
+/// stamping its clock never meets it before then.
+pub const CEILING: u64 = MAX_TIMESTAMP - RESERVE;
+/// **Choice 96:** how far a [bounded](Verifier::bounded) receiver lets a timestamp run ahead of
+/// the last one it accepted plus the time it counted since ([`Verifier::elapse`]): 10 minutes
+/// (6·10⁷ units, 60 000 frames at 100 Hz). It covers what the board's count does not see — a
+/// navigation computer's clock stepped forward at its boot, the board held by a debugger, a
+/// processor-in-the-loop board whose emulated clock lags the host's while a reply is awaited
+/// (at most the host's reply timeout, seconds) — and is the longest a frame accepted from a
+/// wrong clock can lock its peer's later frames out as replays.
+pub const MAX_LEAD: u64 = 10 * 60 * UNITS_PER_SECOND;
 
 /// HMAC-SHA-256's block: keys up to this length are zero-padded to it (RFC 2104).
 const BLOCK_LEN: usize = 64;
@@ -199,6 +228,10 @@ pub enum AuthError {
     /// [`encode_signed`](crate::encode_signed): the sender's timestamp reached
     /// [`MAX_TIMESTAMP`]; a new key is due.
     TimestampExhausted,
+    /// A [bounded](Verifier::bounded) receiver: the frame is authentic, but its timestamp is
+    /// above [`CEILING`] or more than [`MAX_LEAD`] ahead of the last one accepted plus the time
+    /// counted since (a peer's clock that jumped, or a stamp near 2⁴⁸).
+    Ahead,
 }
 
 impl fmt::Display for AuthError {
@@ -212,6 +245,7 @@ impl fmt::Display for AuthError {
             AuthError::Replay => f.write_str("signature timestamp not newer (replay)"),
             AuthError::BadMac => f.write_str("bad signature"),
             AuthError::TimestampExhausted => f.write_str("signing timestamp exhausted"),
+            AuthError::Ahead => f.write_str("signature timestamp too far ahead"),
         }
     }
 }
@@ -267,22 +301,41 @@ impl Signer {
     }
 }
 
-/// The receiving end of a signed direction: the keyed MAC, the direction expected and the last
-/// timestamp accepted.
+/// The receiving end of a signed direction: the keyed MAC, the direction expected, the last
+/// timestamp accepted and, if bounded, the time counted since.
 #[derive(Clone)]
 pub struct Verifier {
     mac: Hmac<Sha256>,
     direction: Direction,
     last: Option<u64>,
+    /// The board's end: the ceiling and the lead bound apply.
+    bounded: bool,
+    /// Time counted since `last` was accepted (or since creation), in timestamp units.
+    counted: u64,
 }
 
 impl Verifier {
-    /// A verifier that has accepted nothing yet: the first valid frame's timestamp may be any.
+    /// A verifier that has accepted nothing yet: the first valid frame's timestamp may be any,
+    /// and each later one any above the last (MAVLink's rule; the navigation computer's end,
+    /// which stamps with its own clock and does not follow the board's stamps).
     pub fn new(key: &LinkKey, direction: Direction) -> Self {
         Verifier {
             mac: key.mac(),
             direction,
             last: None,
+            bounded: false,
+            counted: 0,
+        }
+    }
+
+    /// A verifier for an end that follows its peer's stamps (the board): as [`new`](Self::new),
+    /// and an authentic frame is also refused ([`AuthError::Ahead`]) if its timestamp is above
+    /// [`CEILING`] or, after the first, more than [`MAX_LEAD`] above the last one accepted
+    /// plus the time counted since ([`elapse`](Self::elapse)). Choices 95–96.
+    pub fn bounded(key: &LinkKey, direction: Direction) -> Self {
+        Verifier {
+            bounded: true,
+            ..Self::new(key, direction)
         }
     }
 
@@ -291,9 +344,29 @@ impl Verifier {
         self.last
     }
 
+    /// The receiver's own time moved on by `units` (10 µs each): a bounded verifier lets the
+    /// next timestamp run ahead of the last one accepted by as much more (the board calls it
+    /// once per control period). Counts from the last accepted frame.
+    pub fn elapse(&mut self, units: u64) {
+        self.counted = self.counted.saturating_add(units);
+    }
+
+    /// The highest timestamp this verifier accepts now.
+    pub fn limit(&self) -> u64 {
+        match (self.bounded, self.last) {
+            (false, _) => MAX_TIMESTAMP,
+            (true, None) => CEILING,
+            (true, Some(last)) => last
+                .saturating_add(MAX_LEAD)
+                .saturating_add(self.counted)
+                .min(CEILING),
+        }
+    }
+
     /// Checks `trailer` against `covered` (the frame's postcard bytes): link id, then the
-    /// timestamp against the last accepted, then the MAC. Remembers the timestamp only if all
-    /// three pass.
+    /// timestamp against the last accepted, then the MAC, then (bounded) how far ahead the
+    /// timestamp is. Remembers the timestamp only if all pass, so only authentic frames are
+    /// counted as too far ahead.
     pub(crate) fn verify(
         &mut self,
         covered: &[u8],
@@ -313,7 +386,11 @@ impl Verifier {
         mac.update(&trailer[..1 + TIMESTAMP_LEN]);
         mac.verify_truncated_left(&trailer[1 + TIMESTAMP_LEN..])
             .map_err(|_| AuthError::BadMac)?;
+        if ts > self.limit() {
+            return Err(AuthError::Ahead);
+        }
         self.last = Some(ts);
+        self.counted = 0;
         Ok(())
     }
 }
@@ -332,6 +409,8 @@ impl fmt::Debug for Verifier {
         f.debug_struct("Verifier")
             .field("direction", &self.direction)
             .field("last", &self.last)
+            .field("bounded", &self.bounded)
+            .field("counted", &self.counted)
             .finish_non_exhaustive()
     }
 }

@@ -82,6 +82,7 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         signing: true,
         thrust_unit: ThrustUnit::Kgf,
         reversed_thrusters: 0b1_1110,
+        rx_ahead: 5,
     }
 }
 
@@ -312,9 +313,10 @@ fn largest_message_fits_max_frame_exactly() {
     assert_eq!(ConfigPatch::MAX_SIZE, 57);
     assert_eq!(Command::MAX_SIZE, 58);
     assert_eq!(MissionPlan::MAX_SIZE + 1, 23);
-    assert_eq!(Envelope::MAX_SIZE, 140);
-    assert_eq!(MAX_BODY, 155);
-    assert_eq!(MAX_FRAME, 157);
+    // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes).
+    assert_eq!(Envelope::MAX_SIZE, 145);
+    assert_eq!(MAX_BODY, 160);
+    assert_eq!(MAX_FRAME, 162);
     // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
     // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
@@ -376,7 +378,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 1, 2, 4, 0x7F, 0xFF] {
+    for version in [0u8, 1, 2, 3, 5, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -393,30 +395,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[4, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[5, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 4 })]
+        vec![Err(LinkError::Version { got: 5 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 3, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    assert_eq!(PROTOCOL_VERSION, 3);
-    let wire = frame_from_body(&[3, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 4, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 4);
+    let wire = frame_from_body(&[4, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
     // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
     // short: Deserialize.
     for body in [
-        &[3, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
-        &[&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
-        &[3, 0x00, 0x03][..],
-        &[3, 0x00, 0x01, 0x05][..],
-        &[3, 0x00, 0x00, 0x01][..],
-        &[3][..],
+        &[4, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[4, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[4, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[4, 0x00, 0x03][..],
+        &[4, 0x00, 0x01, 0x05][..],
+        &[4, 0x00, 0x00, 0x01][..],
+        &[4][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -425,7 +427,7 @@ fn hand_made_frames_match_the_documented_format() {
         );
     }
     // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
-    let signed = [&[3, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    let signed = [&[4, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
     assert_eq!(
         decode_stream(&frame_from_body(&signed)),
         vec![Err(LinkError::Auth(AuthError::SigningOff))]
@@ -666,6 +668,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<bool>(),
             any_unit(),
             any::<u8>(),
+            any::<u32>(),
         ),
     )
         .prop_map(
@@ -690,6 +693,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     signing,
                     thrust_unit,
                     reversed_thrusters,
+                    rx_ahead,
                 ),
             )| Telemetry {
                 tick,
@@ -716,6 +720,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 signing,
                 thrust_unit,
                 reversed_thrusters,
+                rx_ahead,
             },
         )
         .boxed()

@@ -77,6 +77,7 @@ fn telemetry_fault_code_is_the_cores() {
         signing: false,
         thrust_unit: ThrustUnit::Kgf,
         reversed_thrusters: 0,
+        rx_ahead: 0,
     };
     assert_eq!(t.fault(), None);
     for f in Fault::ALL {

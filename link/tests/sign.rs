@@ -1,11 +1,12 @@
-//! Signed frames: the documented layout built by hand, the policy at each end, replay, and
-//! every single-byte corruption of a signed frame.
+//! Signed frames: the documented layout built by hand, the policy at each end, replay, every
+//! single-byte corruption of a signed frame, and how far ahead the board lets a stamp run.
 
 #[path = "common/frames.rs"]
 mod frames;
 
 use auv_link::sign::{
-    AuthError, Direction, LinkKey, Signer, Verifier, MAC_LEN, SIGNATURE_LEN, TIMESTAMP_LEN,
+    AuthError, Direction, LinkKey, Signer, Verifier, CEILING, MAC_LEN, MAX_LEAD, MAX_TIMESTAMP,
+    RESERVE, SIGNATURE_LEN, TIMESTAMP_LEN, UNITS_PER_SECOND,
 };
 use auv_link::{
     decode_frame, decode_frame_signed, encode, encode_signed, Command, Envelope, FrameDecoder,
@@ -40,9 +41,9 @@ fn arm(seq: u16) -> Envelope {
 
 #[test]
 fn a_signed_frame_is_the_documented_layout() {
-    // postcard(Envelope{3, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
+    // postcard(Envelope{4, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
     // the first 6 bytes of HMAC-SHA-256(key, everything before the MAC) ‖ CRC-16 of it all.
-    let covered = [3u8, 0xAC, 0x02, 0x01, 0x00];
+    let covered = [4u8, 0xAC, 0x02, 0x01, 0x00];
     let id_time = [0u8, 5, 0, 0, 0, 0, 0];
     let mut mac = <Hmac<Sha256> as KeyInit>::new_from_slice(&KEY).unwrap();
     mac.update(&covered);
@@ -173,6 +174,191 @@ fn any_single_byte_corruption_of_a_signed_frame_is_refused_and_the_stream_recove
                 let oks: Vec<_> = got.iter().filter_map(|r| r.as_ref().ok()).collect();
                 assert_eq!(oks, vec![&arm(env.seq + 1)], "byte {pos} ^= {mask:#04x}");
             }
+        }
+    }
+}
+
+// ---------------------------------------------------------------------------------------------
+// The board's end: how far ahead a timestamp may run (Choices 95–96)
+
+/// A frame signed by a key holder whose next stamp is `ts`.
+fn stamped(env: &Envelope, ts: u64) -> Vec<u8> {
+    let mut s = Signer::new(&key(), Direction::ToBoard);
+    s.advance_to(ts - 1);
+    signed(env, &mut s)
+}
+
+fn one_shot(wire: &[u8], rx: &mut Verifier) -> Result<Envelope, LinkError> {
+    decode_frame_signed(&mut wire[..wire.len() - 1].to_vec(), rx)
+}
+
+const AHEAD: Result<Envelope, LinkError> = Err(LinkError::Auth(AuthError::Ahead));
+
+/// 2026-01-01 in MAVLink time (10 µs units since 2015-01-01: 11 years, 3 of them leap).
+const JAN_2026: u64 = (11 * 365 + 3) * 86_400 * UNITS_PER_SECOND;
+
+#[test]
+fn the_boards_verifier_refuses_a_stamp_too_far_ahead_and_keeps_its_peer() {
+    let mut rx = Verifier::bounded(&key(), Direction::ToBoard);
+    assert_eq!(one_shot(&stamped(&arm(1), JAN_2026), &mut rx), Ok(arm(1)));
+    // Ten minutes and 10 µs ahead of the last accepted stamp, nothing counted since: refused,
+    // and the peer's next frame on its clock is still taken.
+    let ten_minutes = 600 * 100_000;
+    assert_eq!(MAX_LEAD, ten_minutes);
+    let wild = stamped(&arm(2), JAN_2026 + ten_minutes + 1);
+    assert_eq!(one_shot(&wild, &mut rx), AHEAD);
+    assert_eq!(rx.last_timestamp(), Some(JAN_2026));
+    assert_eq!(
+        one_shot(&stamped(&arm(3), JAN_2026 + 1_000), &mut rx),
+        Ok(arm(3))
+    );
+    // Exactly ten minutes ahead is taken.
+    let t = JAN_2026 + 1_000 + ten_minutes;
+    assert_eq!(one_shot(&stamped(&arm(4), t), &mut rx), Ok(arm(4)));
+    // A night the board counted (10 h of 100 Hz periods): the peer's clock moved on by as much
+    // and may be up to ten minutes further.
+    for _ in 0..10 * 3600 * 100 {
+        rx.elapse(1_000);
+    }
+    let night = 10 * 3600 * 100_000;
+    assert_eq!(
+        one_shot(&stamped(&arm(5), t + night + ten_minutes + 1), &mut rx),
+        AHEAD
+    );
+    assert_eq!(
+        one_shot(&stamped(&arm(6), t + night + ten_minutes), &mut rx),
+        Ok(arm(6))
+    );
+    // The count starts again at each accepted frame.
+    assert_eq!(
+        one_shot(&stamped(&arm(7), t + night + 2 * ten_minutes + 1), &mut rx),
+        AHEAD
+    );
+}
+
+#[test]
+fn no_stamp_above_the_ceiling_is_taken_even_first() {
+    assert_eq!(CEILING, (1 << 48) - 1 - (1 << 40));
+    for ts in [MAX_TIMESTAMP, MAX_TIMESTAMP - 1, CEILING + 1] {
+        let mut rx = Verifier::bounded(&key(), Direction::ToBoard);
+        assert_eq!(one_shot(&stamped(&arm(1), ts), &mut rx), AHEAD, "{ts}");
+        assert_eq!(rx.last_timestamp(), None);
+    }
+    // The first frame after a reset may carry any stamp up to the ceiling (the board cannot
+    // know its peer's clock); later ones are bounded from it, and by the ceiling.
+    let mut rx = Verifier::bounded(&key(), Direction::ToBoard);
+    assert_eq!(
+        one_shot(&stamped(&arm(1), CEILING - 5), &mut rx),
+        Ok(arm(1))
+    );
+    assert_eq!(one_shot(&stamped(&arm(2), CEILING + 1), &mut rx), AHEAD);
+    assert_eq!(one_shot(&stamped(&arm(3), CEILING), &mut rx), Ok(arm(3)));
+}
+
+#[test]
+fn only_authentic_frames_count_as_ahead_and_the_navigation_end_is_unbounded() {
+    let mut rx = Verifier::bounded(&key(), Direction::ToBoard);
+    assert_eq!(one_shot(&stamped(&arm(1), 1_000), &mut rx), Ok(arm(1)));
+    // A forger's far-ahead stamp is a bad MAC, not a clock that jumped.
+    let mut forger = Signer::new(&LinkKey::new([0x55; 32]), Direction::ToBoard);
+    forger.advance_to(MAX_TIMESTAMP - 1);
+    assert_eq!(
+        one_shot(&signed(&arm(2), &mut forger), &mut rx),
+        Err(LinkError::Auth(AuthError::BadMac))
+    );
+    // The navigation computer's end keeps MAVLink's rule: the board's stamps jump from its own
+    // count to its peer's clock as soon as it hears it, and that is accepted.
+    let mut nav = Verifier::new(&key(), Direction::FromBoard);
+    let mut board = Signer::new(&key(), Direction::FromBoard);
+    let first = signed(&arm(1), &mut board);
+    board.advance_to(JAN_2026);
+    let jumped = signed(&arm(2), &mut board);
+    assert_eq!(one_shot(&first, &mut nav), Ok(arm(1)));
+    assert_eq!(one_shot(&jumped, &mut nav), Ok(arm(2)));
+    assert_eq!(nav.limit(), MAX_TIMESTAMP);
+}
+
+/// What a key holder sends the board, and the time the board counts between frames.
+#[derive(Clone, Debug)]
+enum Event {
+    /// A frame stamped this far above the peer's previous stamp (anything up to 2⁴⁸).
+    Step(u64),
+    /// A frame at this absolute stamp.
+    At(u64),
+    /// Control periods of 1/`rate` s the board counts (`rate` 1 ..= 200 Hz).
+    Periods(u32, u32),
+}
+
+fn event() -> impl Strategy<Value = Event> {
+    prop_oneof![
+        6 => prop_oneof![
+            1u64..2_000,
+            MAX_LEAD - 2_000..MAX_LEAD + 2_000,
+            0..=MAX_TIMESTAMP,
+        ]
+        .prop_map(Event::Step),
+        1 => prop_oneof![0..=MAX_TIMESTAMP, CEILING - 10..=MAX_TIMESTAMP].prop_map(Event::At),
+        3 => (0u32..10_000, 1u32..=200).prop_map(|(n, r)| Event::Periods(n, r)),
+    ]
+}
+
+use proptest::prelude::*;
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 256, ..ProptestConfig::default() })]
+
+    /// After any sequence of frames from a key holder, the board (a bounded verifier, and a
+    /// signer that follows it as `firmware::board::LinkBuffers` does) accepted exactly what
+    /// the documented rule allows, can still sign, and has at least `RESERVE` minus the frames
+    /// it sent left; the navigation computer verifies every one of them.
+    #[test]
+    fn a_key_holder_cannot_exhaust_the_boards_stamps(
+        events in prop::collection::vec(event(), 1..48),
+    ) {
+        let mut rx = Verifier::bounded(&key(), Direction::ToBoard);
+        let mut board = Signer::new(&key(), Direction::FromBoard);
+        let mut nav = Verifier::new(&key(), Direction::FromBoard);
+        let (mut peer, mut last, mut counted, mut sent) = (0u64, None::<u64>, 0u64, 0u64);
+        for (i, e) in events.iter().enumerate() {
+            let ts = match *e {
+                Event::Periods(n, rate) => {
+                    for _ in 0..n {
+                        rx.elapse(100_000u64.div_ceil(u64::from(rate)));
+                    }
+                    counted += u64::from(n) * 100_000u64.div_ceil(u64::from(rate));
+                    continue;
+                }
+                Event::Step(s) => peer.saturating_add(s),
+                Event::At(t) => t,
+            };
+            if ts == 0 || ts > MAX_TIMESTAMP {
+                continue;
+            }
+            peer = ts;
+            let env = arm(i as u16);
+            let got = one_shot(&stamped(&env, ts), &mut rx);
+            // The rule, from the docs: above the last; at most the ceiling; at most ten minutes
+            // plus the time counted ahead of the last.
+            let want = match last {
+                Some(l) if ts <= l => Err(LinkError::Auth(AuthError::Replay)),
+                _ if ts > CEILING => AHEAD,
+                Some(l) if ts - l > MAX_LEAD + counted => AHEAD,
+                _ => Ok(env),
+            };
+            prop_assert_eq!(got, want, "ts {}, last {:?}, counted {}", ts, last, counted);
+            if got.is_ok() {
+                last = Some(ts);
+                counted = 0;
+            }
+            // The board answers: one above the larger of its last stamp and the last accepted.
+            if let Some(t) = rx.last_timestamp() {
+                board.advance_to(t);
+            }
+            let frame = signed(&Envelope::new(i as u16, Msg::Command(Command::Disarm)), &mut board);
+            sent += 1;
+            prop_assert!(board.timestamp() <= CEILING + sent);
+            prop_assert!(MAX_TIMESTAMP - board.timestamp() >= RESERVE - sent);
+            prop_assert!(one_shot(&frame, &mut nav).is_ok());
         }
     }
 }

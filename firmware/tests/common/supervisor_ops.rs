@@ -20,8 +20,9 @@
 //!
 //! Every frame the harness builds is signed one of five ways (an argument byte): as the board
 //! expects (signed with the key if signing is on, else unsigned), the other way, with a wrong
-//! key, for the wrong direction (a reflected board frame), or by a restarted signer with an
-//! arbitrary (usually old) timestamp.
+//! key, for the wrong direction (a reflected board frame), or by a restarted signer (a key
+//! holder) with a timestamp from the input: anywhere in 48 bits, around the lead the board
+//! allows past the harness's last stamp, around the board's ceiling, or old.
 //!
 //! Invariants (the issue's, and what they imply), checked against the [`Model`], which learns
 //! only from what the harness sent and from the supervisor's public counters:
@@ -33,6 +34,15 @@
 //!   every earlier one; with signing off, none was signed. In lock-step, an accepted state frame
 //!   during a mission is on the mission clock (its tick rises by 1 ..= the periods run since the
 //!   last one). Every frame the harness built is counted exactly once (accepted, stale or error).
+//! - **Timestamps (Choices 95–96):** with signing on, an authentic frame reaches the
+//!   supervisor exactly when its timestamp is above the last accepted, at most
+//!   [`CEILING`], and (after the first) at most [`MAX_LEAD`] plus the time the board counted
+//!   since (one period length per period) above the last accepted; an authentic frame refused
+//!   for being ahead is counted in `rx_ahead` (and telemetry reports the count), nothing else
+//!   is. **The board can always sign:** every period's telemetry encodes, and, signed, the
+//!   navigation computer's end verifies it and its stamp is at most `CEILING` + the periods run,
+//!   so whatever a key holder sent, the board has at least `RESERVE` − periods stamps left
+//!   (174 years at 200 Hz).
 //! - **Thrusters off unless armed with a fresh, in-order state:** a period with any voltage ≠ 0
 //!   (or reported `Running`) needs the model armed, with a mission, nothing latched, no overrun,
 //!   and an accepted state frame at most `stale_periods` periods old (in lock-step, accepted
@@ -48,10 +58,12 @@
 #![allow(dead_code)]
 
 use auv_link::seq::SEQ_WINDOW;
-use auv_link::sign::{AuthError, Direction, LinkKey, Signer, MAX_TIMESTAMP};
+use auv_link::sign::{
+    Direction, LinkKey, Signer, Verifier, CEILING, MAX_LEAD, MAX_TIMESTAMP, UNITS_PER_SECOND,
+};
 use auv_link::{
-    decode_frame, encode, encode_signed, BoardStatus, Command, ConfigPatch, Envelope,
-    FailSafeReason, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
+    decode_frame, decode_frame_signed, encode, encode_signed, BoardStatus, Command, ConfigPatch,
+    Envelope, FailSafeReason, Heading, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
     ThrustUnit, DEFAULT_STALE_PERIODS, MAX_FRAME,
 };
 use controller_core::kinematics::{self, Attitude};
@@ -100,6 +112,10 @@ pub struct Stats {
     pub latches: u32,
     pub rearms_after_latch: u32,
     pub refusals: u32,
+    /// Authentic frames refused as too far ahead.
+    pub ahead: u32,
+    /// Frames of a restarted signer (a key holder's own stamp) that passed the link.
+    pub restarted_taken: u32,
 }
 
 /// Reads the input; missing bytes are 0.
@@ -168,6 +184,10 @@ struct Model {
     disarmed_since_latch: bool,
     last_seq: Option<u16>,
     last_timestamp: Option<u64>,
+    /// Time the board counted since `last_timestamp` was accepted (timestamp units).
+    counted: u64,
+    /// Authentic frames refused as too far ahead.
+    ahead: u32,
     /// Periods run since the last accepted state frame (`None`: none, or, in lock-step, none
     /// since the mission started).
     periods_since_state: Option<u64>,
@@ -189,6 +209,8 @@ impl Model {
             disarmed_since_latch: false,
             last_seq: None,
             last_timestamp: None,
+            counted: 0,
+            ahead: 0,
             periods_since_state: None,
             clock: None,
             mission_periods: 0,
@@ -233,6 +255,8 @@ struct Harness {
     signer: Signer,
     forger: Signer,
     reflector: Signer,
+    /// The navigation computer's end of the board's telemetry.
+    nav: Verifier,
     /// The last frames sent, and what each is (for replays).
     history: Vec<(Vec<u8>, Known)>,
     model: Model,
@@ -262,6 +286,7 @@ pub fn run(data: &[u8]) -> Stats {
         signer: Signer::new(&KEY, Direction::ToBoard),
         forger: Signer::new(&WRONG_KEY, Direction::ToBoard),
         reflector: Signer::new(&KEY, Direction::FromBoard),
+        nav: Verifier::new(&KEY, Direction::FromBoard),
         history: Vec::new(),
         model: Model::new(),
         stats: Stats::default(),
@@ -471,14 +496,28 @@ fn settings(sup: &Supervisor) -> (ControllerConfig, u8, bool) {
 }
 
 impl Harness {
-    fn counters(&self) -> (u32, u32, u32, u32, u32) {
+    fn counters(&self) -> (u32, u32, u32, u32, u32, u32) {
         (
             self.sup.rx_frames(),
             self.sup.rx_stale(),
             self.sup.rx_errors(),
             self.sup.refused_commands(),
             self.sup.rx_auth_errors(),
+            self.sup.rx_ahead(),
         )
+    }
+
+    /// A key holder's timestamp from 8 input bytes: the low 2 bits pick anywhere in 48 bits,
+    /// around the lead past the harness's last stamp, around the ceiling, or at or below it.
+    fn restarted_stamp(&self, raw: u64) -> u64 {
+        let last = self.signer.timestamp();
+        let r = raw >> 16;
+        match raw & 3 {
+            0 => r,
+            1 => last + MAX_LEAD - (1 << 20) + r % (1 << 21),
+            2 => CEILING - 8 + r % 16,
+            _ => r % (last + 1),
+        }
     }
 
     /// Builds the frame for `(seq, msg)`, signed as `how` says, sends it and checks what the
@@ -505,7 +544,7 @@ impl Harness {
                 ),
                 SIGN_RESTARTED => {
                     let mut restarted = Signer::new(&KEY, Direction::ToBoard);
-                    restarted.advance_to(input.u64() >> 16);
+                    restarted.advance_to(self.restarted_stamp(input.u64()));
                     let n = encode_signed(&env, &mut restarted, &mut out);
                     (n, Auth::Good(restarted.timestamp()))
                 }
@@ -519,6 +558,11 @@ impl Harness {
         let Ok(n) = n else { return };
         let frame = out[..n].to_vec();
         self.deliver(&frame, Some((env, auth)));
+        if let (true, SIGN_RESTARTED, Auth::Good(t)) = (signed, how % 5, auth) {
+            if self.signing && self.model.last_timestamp == Some(t) {
+                self.stats.restarted_taken += 1;
+            }
+        }
         self.remember(frame, Some((env, auth)));
     }
 
@@ -530,12 +574,13 @@ impl Harness {
     }
 
     /// Bytes the harness did not build as a frame (a corruption, raw bytes), split at the
-    /// delimiters. A chunk equal to a frame sent earlier is that frame; otherwise, with
-    /// signing off, it is what `decode_frame` says it is, if it decodes; with signing on it
-    /// cannot be authentic (nobody but the harness holds the key).
+    /// delimiters. A chunk equal to a frame sent earlier is that frame; otherwise it is what
+    /// `decode_frame` says it is (signing off) or, signing on, a key holder's frame if it
+    /// verifies with the key: libFuzzer learns a MAC from the comparison that checks it, so the
+    /// fuzzer holds the key too (it wrote the signed `Arm` of timestamp 1 from raw bytes).
     fn raw(&mut self, bytes: &[u8]) {
         for chunk in bytes.split_inclusive(|&b| b == 0) {
-            let body = chunk.strip_suffix(&[0]).unwrap_or(chunk);
+            let mut body = chunk.strip_suffix(&[0]).unwrap_or(chunk).to_vec();
             let earlier = self
                 .history
                 .iter()
@@ -543,11 +588,11 @@ impl Harness {
                 .and_then(|(_, k)| *k);
             let known = earlier.or_else(|| {
                 if self.signing {
-                    None
+                    let mut v = Verifier::new(&KEY, Direction::ToBoard);
+                    let env = decode_frame_signed(&mut body, &mut v).ok()?;
+                    Some((env, Auth::Good(v.last_timestamp()?)))
                 } else {
-                    decode_frame(&mut body.to_vec())
-                        .ok()
-                        .map(|e| (e, Auth::Unsigned))
+                    decode_frame(&mut body).ok().map(|e| (e, Auth::Unsigned))
                 }
             });
             self.deliver(chunk, known);
@@ -562,18 +607,19 @@ impl Harness {
         board::receive(&mut self.sup, &mut self.link, frame);
         let after = self.counters();
         let d = |a: u32, b: u32| a.checked_sub(b).expect("counters never go down");
-        let (accepted, stale, errors, refused, auth_errors) = (
+        let (accepted, stale, errors, refused, auth_errors, ahead) = (
             d(after.0, before.0),
             d(after.1, before.1),
             d(after.2, before.2),
             d(after.3, before.3),
             d(after.4, before.4),
+            d(after.5, before.5),
         );
         let Some((env, auth)) = known else {
             assert_eq!(
-                (accepted, stale),
-                (0, 0),
-                "only a frame reaches the supervisor"
+                (accepted, stale, ahead),
+                (0, 0, 0),
+                "only a frame reaches the supervisor; only an authentic one is ahead"
             );
             assert_eq!(refused, 0);
             return;
@@ -587,19 +633,51 @@ impl Harness {
         // A frame the harness built fails at the link only on authentication (or, signing off,
         // on a signature); an error without one is the supervisor's (telemetry to the board).
         let passed_link = accepted + stale == 1 || (errors == 1 && auth_errors == 0);
+        // An authentic frame on a signed link: the timestamp rule decides, from the docs.
+        let stamp = match (self.signing, auth) {
+            (true, Auth::Good(t)) => {
+                let m = &self.model;
+                let replay = m.last_timestamp.is_some_and(|l| t <= l);
+                let too_far = !replay
+                    && (t > CEILING
+                        || m.last_timestamp
+                            .is_some_and(|l| t - l > MAX_LEAD + m.counted));
+                assert_eq!(
+                    ahead,
+                    u32::from(too_far),
+                    "stamp {t}, last {:?}, counted {}",
+                    m.last_timestamp,
+                    m.counted
+                );
+                assert_eq!(
+                    passed_link,
+                    !replay && !too_far,
+                    "stamp {t}, last {:?}, counted {}",
+                    m.last_timestamp,
+                    m.counted
+                );
+                Some(t)
+            }
+            _ => {
+                assert_eq!(ahead, 0, "only an authentic frame is ahead: {auth:?}");
+                None
+            }
+        };
+        self.model.ahead += ahead;
+        self.stats.ahead += ahead;
         if passed_link {
             // It passed the link's checks: authentic as the board's mode requires.
-            match (self.signing, auth) {
-                (false, a) => assert_eq!(a, Auth::Unsigned, "signing off: {env:?}"),
-                (true, Auth::Good(t)) => {
-                    if let Some(last) = self.model.last_timestamp {
-                        assert!(t > last, "replayed timestamp {t} ≤ {last} accepted");
-                    }
+            match (self.signing, stamp) {
+                (false, _) => assert_eq!(auth, Auth::Unsigned, "signing off: {env:?}"),
+                (true, Some(t)) => {
                     self.model.last_timestamp = Some(t);
+                    self.model.counted = 0;
                     // As a navigation computer would: its next stamp goes above it.
                     self.signer.advance_to(t);
                 }
-                (true, a) => panic!("signing on, {a:?} frame reached the supervisor: {env:?}"),
+                (true, None) => {
+                    panic!("signing on, {auth:?} frame reached the supervisor: {env:?}")
+                }
             }
         }
         if matches!(env.msg, Msg::Telemetry(_)) {
@@ -797,23 +875,37 @@ impl Harness {
                 }
             },
         }
-        // The telemetry goes out: it always fits a frame. Signed, the board stamps above the
-        // last stamp it accepted: once a peer holding the key has stamped at (or within a few
-        // frames of) 2⁴⁸ − 1, the board cannot sign again until it resets (a finding of this
-        // fuzz target, as MAVLink's scheme: a new key is due).
+        assert_eq!(t.rx_ahead, self.model.ahead, "frames refused as ahead");
+        // The telemetry goes out: it always fits a frame and, signed, the board can always sign
+        // it (this fuzz target once found a key holder's stamp at 2⁴⁸ − 1 leaving it none): the
+        // navigation computer verifies it, and the stamp leaves at least RESERVE − periods.
         let env = self.sup.envelope(t);
-        match self.link.encode(&env) {
-            Ok(frame) => assert!(frame.len() <= MAX_FRAME),
-            Err(LinkError::Auth(AuthError::TimestampExhausted)) => assert!(
-                self.model
-                    .last_timestamp
-                    .is_some_and(|ts| ts > MAX_TIMESTAMP - 100_000),
-                "board's stamps exhausted after {:?}",
-                self.model.last_timestamp
-            ),
-            Err(e) => panic!("telemetry does not encode: {e:?}"),
+        let frame = match self.link.encode(&env) {
+            Ok(frame) => frame.to_vec(),
+            Err(e) => panic!("telemetry does not encode: {e:?}, model {:?}", self.model),
+        };
+        assert!(frame.len() <= MAX_FRAME);
+        if self.signing {
+            let body = frame.strip_suffix(&[0]).expect("a delimited frame");
+            let got = decode_frame_signed(&mut body.to_vec(), &mut self.nav);
+            assert_eq!(
+                got.map(|e| e.seq),
+                Ok(env.seq),
+                "the navigation end refused it"
+            );
+            let stamp = self.nav.last_timestamp().unwrap_or(0);
+            let periods = u64::from(self.stats.periods);
+            assert!(
+                stamp <= CEILING + periods,
+                "stamp {stamp}, {periods} periods"
+            );
+            assert!(MAX_TIMESTAMP - stamp >= auv_link::sign::RESERVE - periods);
         }
+        // The period is over: the board counts it (its link's lead bound grows by as much).
+        let rate = self.sup.rate_hz();
+        self.link.period_passed(rate);
         let m = &mut self.model;
+        m.counted += UNITS_PER_SECOND.div_ceil(u64::from(rate));
         m.periods_since_state = m.periods_since_state.map(|n| n + 1);
         m.mission_periods += 1;
         m.clock = m.clock.map(|(t, n)| (t, n + 1));

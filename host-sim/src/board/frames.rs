@@ -22,6 +22,7 @@ pub fn mavlink_time() -> u64 {
     std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
         .map_or(0, |d| {
-            d.as_secs().saturating_sub(EPOCH_2015) * 100_000 + u64::from(d.subsec_micros() / 10)
+            d.as_secs().saturating_sub(EPOCH_2015) * auv_link::sign::UNITS_PER_SECOND
+                + u64::from(d.subsec_micros() / 10)
         })
 }

@@ -197,6 +197,7 @@ impl BoardInTheLoop {
         self.stats.board_rx_errors = t.rx_errors;
         self.stats.board_rx_stale = t.rx_stale;
         self.stats.board_rx_auth_errors = t.rx_auth_errors;
+        self.stats.board_rx_ahead = t.rx_ahead;
         self.stats.board_refused_commands = t.refused_commands;
         self.stats.board_last_refusal = t.last_refusal.map(|r| r.as_str().to_string());
         self.stats.board_loop_overruns = t.loop_overruns;

@@ -52,6 +52,10 @@ pub struct BoardStats {
     /// Frames the board refused for their authentication (its `rx_auth_errors`).
     #[serde(default)]
     pub board_rx_auth_errors: u32,
+    /// Of those, authentic frames stamped too far ahead (its `rx_ahead`: this end's clock
+    /// jumped ahead of the board's count, auv_link::sign).
+    #[serde(default)]
+    pub board_rx_ahead: u32,
     /// Commands the board refused, and the last reason ([`auv_link::Refusal::as_str`]).
     #[serde(default)]
     pub board_refused_commands: u32,

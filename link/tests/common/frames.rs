@@ -255,8 +255,10 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         signing,
         thrust_unit,
         reversed_thrusters,
+        rx_ahead,
     } = a;
     *thrust_unit == b.thrust_unit
+        && *rx_ahead == b.rx_ahead
         && *reversed_thrusters == b.reversed_thrusters
         && *tick == b.tick
         && *status == b.status

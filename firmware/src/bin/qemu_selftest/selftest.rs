@@ -2,7 +2,7 @@
 //! `update`, the link and fail-safe exercise, the PWM mapping, and the failure injection that
 //! proves each kind of failure is visible.
 
-use auv_link::sign::{Direction, LinkKey, Signer, Verifier};
+use auv_link::sign::{Direction, LinkKey, Signer, Verifier, MAX_TIMESTAMP};
 use auv_link::{encode, encode_signed, Command, ConfigPatch, Envelope, FrameDecoder, Msg};
 use auv_link::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
 use auv_link::{BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, MAX_FRAME};
@@ -428,8 +428,9 @@ fn real_chain_exercise() -> bool {
     kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
 }
 
-/// A signed link: an unsigned frame and a replayed signed frame are refused, a signed one is
-/// taken; the telemetry says signing is on.
+/// A signed link: an unsigned frame, a replayed signed frame and one stamped at 2⁴⁸ − 1 are
+/// refused, a signed one is taken; the telemetry says signing is on, counts the stamp too far
+/// ahead, and is still signed.
 fn signed_link_exercise() -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
@@ -469,7 +470,24 @@ fn signed_link_exercise() -> bool {
         "signed link: unsigned refused {}, signed taken {}, replay refused {}, telemetry says signing {}",
         unsigned_refused, signed_taken, replay_refused, t.signing
     );
-    unsigned_refused && signed_taken && replay_refused && t.signing
+    // A key holder's frame stamped 2^48 - 1 (Choices 95-96): refused and counted, and the
+    // board still signs its telemetry.
+    host.advance_to(MAX_TIMESTAMP - 1);
+    frame(
+        &mut sup,
+        &mut link,
+        &Envelope::new(4, Msg::Command(Command::Arm)),
+        Some(&mut host),
+        false,
+    );
+    let ahead = sup.step(false, &now).telemetry;
+    let ahead_refused = sup.mode() == Mode::Disarmed && ahead.rx_ahead == 1;
+    let still_signed = link.encode(&sup.envelope(ahead)).is_ok();
+    info!(
+        "signed link: a stamp at 2^48 - 1 refused {} (rx_ahead {}), telemetry still signed {}",
+        ahead_refused, ahead.rx_ahead, still_signed
+    );
+    unsigned_refused && signed_taken && replay_refused && t.signing && ahead_refused && still_signed
 }
 
 /// The largest telemetry frame the board sends.
@@ -502,7 +520,7 @@ fn signing_cost() -> Option<(u32, u32)> {
         }
         .unwrap_or(0);
         let mut dec = if signed {
-            FrameDecoder::signed(Verifier::new(&key, Direction::ToBoard))
+            FrameDecoder::signed(Verifier::bounded(&key, Direction::ToBoard))
         } else {
             FrameDecoder::new()
         };
