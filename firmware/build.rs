@@ -50,7 +50,13 @@ fn main() {
 
     println!("cargo:rerun-if-env-changed={KEY_VAR}");
     println!("cargo:rerun-if-env-changed={UNSIGNED_VAR}");
-    println!("cargo:rerun-if-changed={CI_TEST_KEY}");
+    // CI_TEST_KEY is workspace-relative; cargo resolves a relative path against the package
+    // folder, where it names no file and would keep this script (and all that links the
+    // library) stale forever.
+    println!(
+        "cargo:rerun-if-changed={}",
+        root.join(CI_TEST_KEY).display()
+    );
     let ci_key = fs::read_to_string(root.join(CI_TEST_KEY))
         .ok()
         .and_then(|t| LinkKey::from_key_file(&t).ok());
