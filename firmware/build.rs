@@ -20,9 +20,7 @@ use controller_core::{
 };
 
 // The images' table, shared with the library (bin names, memory maps).
-#[allow(dead_code)]
-#[path = "src/image.rs"]
-mod image;
+use firmware_images::image;
 
 // The STM32 image's link key from the environment (host-tested in tests/provision.rs).
 #[path = "src/provision.rs"]
@@ -41,7 +39,6 @@ fn main() {
         println!("cargo:rustc-link-arg-bin={}=-L{}", img.bin(), dir.display());
         println!("cargo:rerun-if-changed={}", src.display());
     }
-    println!("cargo:rerun-if-changed=src/image.rs");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=../controller-core/src");
 
