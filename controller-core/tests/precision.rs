@@ -389,8 +389,13 @@ fn report_tau_error_over_the_missions() {
             roundings = roundings.max(cmp.in_roundings());
         }
     }
+    let bound = if cfg!(feature = "micromath") {
+        format!("micromath: bound {MICROMATH_TOLERANCE} of ‖τ‖∞")
+    } else {
+        format!("bound {ROUNDINGS} u·S")
+    };
     eprintln!(
-        "f32 τ vs f64 over the Table-1 missions ({}): worst {relative:.2e} of ‖τ‖∞, {roundings:.2} u·S (bound {ROUNDINGS})",
+        "f32 τ vs f64 over the Table-1 missions ({}): worst {relative:.2e} of ‖τ‖∞, {roundings:.2} u·S ({bound})",
         controller_core::math::BACKEND
     );
 }
