@@ -20,9 +20,7 @@ use controller_core::{
 };
 
 // The images' table, shared with the library (bin names, memory maps).
-#[allow(dead_code)]
-#[path = "src/image.rs"]
-mod image;
+use firmware_images::image;
 
 // The STM32 image's link key from the environment (host-tested in tests/provision.rs).
 #[path = "src/provision.rs"]
@@ -41,7 +39,6 @@ fn main() {
         println!("cargo:rustc-link-arg-bin={}=-L{}", img.bin(), dir.display());
         println!("cargo:rerun-if-changed={}", src.display());
     }
-    println!("cargo:rerun-if-changed=src/image.rs");
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=../controller-core/src");
 
@@ -50,7 +47,13 @@ fn main() {
 
     println!("cargo:rerun-if-env-changed={KEY_VAR}");
     println!("cargo:rerun-if-env-changed={UNSIGNED_VAR}");
-    println!("cargo:rerun-if-changed={CI_TEST_KEY}");
+    // CI_TEST_KEY is workspace-relative; cargo resolves a relative path against the package
+    // folder, where it names no file and would keep this script (and all that links the
+    // library) stale forever.
+    println!(
+        "cargo:rerun-if-changed={}",
+        root.join(CI_TEST_KEY).display()
+    );
     let ci_key = fs::read_to_string(root.join(CI_TEST_KEY))
         .ok()
         .and_then(|t| LinkKey::from_key_file(&t).ok());

@@ -2,7 +2,7 @@
 # Cargo runner for thumbv7em-none-eabihf: runs an ELF in QEMU and decodes its defmt log. Exit
 # status: QEMU's (semihosting exit code), 124 on timeout (a hang), 2 for an image QEMU cannot run.
 #
-# The machine comes from the image's marker (firmware/src/image.rs, Image::qemu_machine; a host
+# The machine comes from the image's marker (firmware/images/src/image.rs, Image::qemu_machine; a host
 # test checks that this script agrees): mps2-an386 (Cortex-M4F, the link on UART0, the first
 # -serial) for the QEMU images, netduinoplus2 (STM32F405, the link on USART2, the second
 # -serial) for the STM32 emulator build.

@@ -186,6 +186,36 @@ fn when_every_frame_is_too_far_ahead_the_board_fails_safe_on_silence() {
     assert_eq!(s.frames_accepted, 3, "{s:?}: arm, start, the first state");
 }
 
+/// Found by `flights_with_faults_hold_the_invariants` (issue 12; shrunk to `signing = false,
+/// pieces = [[3, 0]]`, kept in `supervisor_fuzz.proptest-regressions` until issue 18 turned
+/// persistence off): unsigned, arm, start a mission, one period without a state frame. The
+/// board reports running with its thrusters off while the mission waits `stale_periods` for its
+/// first state (Choice 77); the harness's model said it may run only when it may fly. The
+/// mission then latches stale state when its grace runs out.
+#[test]
+fn a_mission_still_waiting_for_its_first_state_runs_with_the_thrusters_off() {
+    let mut v = vec![0];
+    v.extend(arm());
+    v.extend(start());
+    // The shrunk case's one piece: [OP_PERIOD, 0].
+    v.extend(period(false));
+    let s = run(&v);
+    assert_eq!((s.periods, s.periods_on, s.latches), (1, 0, 0), "{s:?}");
+    // The rest of the grace, and one period beyond it.
+    for _ in 0..auv_link::DEFAULT_STALE_PERIODS {
+        v.extend(period(false));
+    }
+    let s = run(&v);
+    assert_eq!(s.latches, 0, "{s:?}: within the grace");
+    v.extend(period(false));
+    let s = run(&v);
+    assert_eq!(
+        (s.periods_on, s.latches),
+        (0, 1),
+        "{s:?}: stale after the grace"
+    );
+}
+
 /// One piece of the grammar: mostly what a navigation computer sends, sometimes not.
 fn piece() -> impl Strategy<Value = Vec<u8>> {
     let how = prop_oneof![

@@ -5,7 +5,7 @@
 
 use std::path::PathBuf;
 
-use firmware::image::Image;
+use firmware_images::image::Image;
 use host_sim::board::image::check_flying_image;
 
 fn fake_elf(name: &str, marker: Option<Image>) -> PathBuf {

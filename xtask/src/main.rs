@@ -16,6 +16,9 @@
 //!                                  at its exact ticks; hardware in the loop over QEMU's pty
 //!                                  (xtask/src/hil.rs): lock-step equals SIL, real-time
 //!                                  figures, the port going away mid-mission
+//! cargo xtask rebuild-noop         a second `cargo build --release -p host-sim` rebuilds
+//!   [--profile P]                  nothing, with the link key's variable changed
+//!                                  (xtask/src/rebuild.rs)
 //! ```
 //!
 //! `--bless` rewrites the snapshots from this run instead of comparing (review the diff, then
@@ -33,6 +36,7 @@ mod images;
 mod no_f64;
 mod pil;
 mod qemu;
+mod rebuild;
 mod selftest;
 mod snapshot;
 mod thumb;
@@ -74,13 +78,20 @@ enum Task {
     },
     /// Processor in the loop: PIL = SIL, and the link-fault case; HIL over QEMU's pty.
     Pil,
+    /// Build host-sim twice: the second build must rebuild nothing (no compile, no build
+    /// script, no link), with the link key's environment variable changed in between.
+    RebuildNoop {
+        /// The cargo profile (the README's commands use release).
+        #[arg(long, default_value = rebuild::README_PROFILE)]
+        profile: String,
+    },
 }
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
     let bless = match cli.command {
         Task::Firmware { bless } | Task::Images { bless } | Task::Selftest { bless } => bless,
-        Task::Pil => false,
+        Task::Pil | Task::RebuildNoop { .. } => false,
     };
     let mut ci = match Ci::new(bless) {
         Ok(ci) => ci,
@@ -110,6 +121,7 @@ fn main() -> ExitCode {
             let built = images::build(&mut ci, &[Variant::QEMU, Variant::EMULATOR]);
             pil::run(&mut ci, &built);
         }
+        Task::RebuildNoop { profile } => rebuild::run(&mut ci, &profile),
     }
     ci.finish()
 }

@@ -5,7 +5,7 @@ use std::path::{Path, PathBuf};
 /// The QEMU flying image as `cargo build -p firmware --release --target thumbv7em-none-eabihf
 /// --features qemu --bin firmware-qemu` (or `cargo xtask firmware`) leaves it under `root`.
 pub fn default_elf(root: &Path) -> PathBuf {
-    use firmware::image::{Image, TARGET};
+    use firmware_images::image::{Image, TARGET};
     root.join("target")
         .join(TARGET)
         .join("release")
@@ -14,9 +14,9 @@ pub fn default_elf(root: &Path) -> PathBuf {
 
 /// Refuses an ELF that is not the QEMU flying image: the self-test image would run its checks
 /// and exit, the STM32 image would wait for clocks QEMU does not have. The image says which it
-/// is by the marker in its flash ([`firmware::image::Image::of_elf`]).
+/// is by the marker in its flash ([`firmware_images::image::Image::of_elf`]).
 pub fn check_flying_image(elf: &Path) -> Result<(), String> {
-    use firmware::image::{Image, TARGET};
+    use firmware_images::image::{Image, TARGET};
     let bytes = std::fs::read(elf).map_err(|e| {
         format!(
             "firmware ELF {}: {e}; build it with `cargo build -p firmware --release --target {} --features qemu --bin {}`",

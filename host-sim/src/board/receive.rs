@@ -6,7 +6,7 @@ use std::time::{Duration, Instant};
 
 use auv_link::sign::AuthError;
 use auv_link::{BoardStatus, Envelope, LinkError, Msg, Telemetry, ThrustUnit};
-use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+use firmware_images::qemu_clock::INSTRUCTIONS_PER_TICK;
 
 use super::runner::BoardInTheLoop;
 use super::stats::{FailSafeEvent, FailSafeEventKind};

@@ -3,7 +3,7 @@
 //! The machine's core clock is 25 MHz, and SysTick counts core clock cycles. The runner starts
 //! QEMU with `-icount shift=0`: every instruction advances virtual time by 2⁰ ns = 1 ns, so one
 //! SysTick count (40 ns) is exactly 40 instructions, repeatably. The QEMU board's
-//! [`Board::now`](crate::board::Board::now) and the self-test time `update` in SysTick counts;
+//! `firmware::board::Board::now` and the self-test time `update` in SysTick counts;
 //! multiplied by [`INSTRUCTIONS_PER_TICK`] they are deterministic instruction counts (the
 //! target's benchmark: QEMU has no cycle counter, DWT CYCCNT reads 0).
 //!
@@ -35,7 +35,7 @@ mod tests {
 
     #[test]
     fn the_runner_uses_this_icount_shift() {
-        let runner = include_str!("../../scripts/qemu-run.sh");
+        let runner = include_str!("../../../scripts/qemu-run.sh");
         // The default of its QEMU_ICOUNT (`off` is only for real-time HIL, which counts
         // nothing in instructions).
         let flag = std::format!("icount=(-icount \"${{QEMU_ICOUNT:-shift={ICOUNT_SHIFT}}}\")");

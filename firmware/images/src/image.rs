@@ -2,13 +2,13 @@
 //! [`TARGET`] with its board's feature, linked with its board's memory map, and carrying a
 //! marker in its flash that says which image it is.
 //!
-//! The table below is the one place that says which images exist: `build.rs` links each with
-//! its memory map (it includes this file), `cargo xtask` builds, sizes and checks each, and
+//! The table below is the one place that says which images exist: the firmware's `build.rs`
+//! links each with its memory map (a build-dependency), `cargo xtask` builds, sizes and checks each, and
 //! `host-sim pil` reads the marker so that it flies only a flying image that runs in QEMU (the
 //! QEMU image, or the STM32 board code's emulator build), never the self-test (which would exit
 //! after its checks) or the STM32 flight image (which would wait for clocks QEMU does not
-//! have); `scripts/qemu-run.sh` picks the QEMU machine by it. `Cargo.toml`'s `[[bin]]` entries
-//! must agree; a host test checks that they do.
+//! have); `scripts/qemu-run.sh` picks the QEMU machine by it. The `[[bin]]` entries of the
+//! firmware's `Cargo.toml` must agree; a host test checks that they do.
 //!
 //! Core only (no std, no target code): the host crates use it as they are.
 
