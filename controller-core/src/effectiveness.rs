@@ -78,6 +78,46 @@ pub const AUV150_AXES: [[f32; 3]; THRUSTERS] = [
 pub const AUV150_REVERSED: u8 =
     (1 << VERT_FORE) | (1 << VERT_AFT) | (1 << HORZ_FORE) | (1 << HORZ_AFT);
 
+/// Which way each AUV-150 thruster's strong (positive) thrust pushes the vehicle under the
+/// reversed-thruster mask `reversed` ([`ThrusterGeometry::auv150`]), in words, thruster order:
+/// the main thruster `forward` or `aft`, the vertical pair `down` or `up`, the horizontal pair
+/// `starboard` or `port`. What scenario files, `host-sim check` and the board's log print, so
+/// that a team reads the mounting a board runs without decoding a bit mask.
+pub const fn mounting_words(reversed: u8) -> [&'static str; THRUSTERS] {
+    const WORDS: [[&str; 2]; THRUSTERS] = [
+        ["forward", "aft"],
+        ["down", "up"],
+        ["down", "up"],
+        ["starboard", "port"],
+        ["starboard", "port"],
+    ];
+    let mut out = [""; THRUSTERS];
+    let mut i = 0;
+    while i < THRUSTERS {
+        out[i] = WORDS[i][((reversed >> i) & 1) as usize];
+        i += 1;
+    }
+    out
+}
+
+/// The AUV-150 mounting `reversed` as one line: `main forward, vert fore up, vert aft down,
+/// horz fore port, horz aft port` ([`mounting_words`] after each [`THRUSTER_NAMES`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mounting(pub u8);
+
+impl fmt::Display for Mounting {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let words = mounting_words(self.0);
+        for (i, (name, word)) in THRUSTER_NAMES.iter().zip(words).enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            write!(f, "{name} {word}")?;
+        }
+        Ok(())
+    }
+}
+
 /// Thruster positions (m) and unit thrust directions, body frame (origin CO, x forward,
 /// y starboard, z down), in thruster order. The direction carries the **mounting sign**:
 /// positive thrust pushes the vehicle along it.

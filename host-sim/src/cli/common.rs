@@ -153,6 +153,7 @@ pub(super) fn runs_exit<'a>(
         runs.clone().any(RunResult::interrupted) || interrupt::requested(),
         failed || runs.clone().any(RunResult::diverged),
         runs.clone().any(RunResult::faulted_unexpectedly),
+        runs.clone().any(RunResult::missed_unexpectedly),
     )
 }
 

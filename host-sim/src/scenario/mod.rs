@@ -150,7 +150,7 @@ use std::path::{Path, PathBuf};
 
 use controller_core::{Controller, Trajectory};
 
-use crate::plant::PlantState;
+use crate::plant::{static_heel, PlantState};
 
 mod config;
 mod fixed_arrays;
@@ -160,7 +160,7 @@ pub mod real_vehicle;
 mod start;
 mod validate;
 
-pub use config::{LinkFaults, SensorNoise, SimConfig, TickRange};
+pub use config::{Bound, InitialAttitude, LinkFaults, SensorNoise, SimConfig, TickRange};
 pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
 pub use start::start_state;
 pub use validate::{
@@ -312,13 +312,20 @@ impl Scenario {
         1.0 / f64::from(self.config.controller.rate_hz)
     }
 
-    /// Where the run starts: on the reference plus the configured offset ([`start_state`]).
+    /// Where the run starts ([`start_state`]): on the reference plus the configured offset,
+    /// heeled to the payload's static heel if it starts in trim
+    /// ([`SimConfig::initial_attitude`]).
     pub fn initial_state(&self) -> PlantState {
-        start_state(
-            &self.trajectory,
-            self.config.controller.rate_hz,
-            &self.config.initial_offset,
-        )
+        let rate = self.config.controller.rate_hz;
+        let mut offset = self.config.initial_offset;
+        if self.config.initial_attitude() == InitialAttitude::Trim {
+            let d0 = self.trajectory.sample(0, rate);
+            let params = self.config.plant_params_at(0.0);
+            if let Some(heel) = static_heel(&params, f64::from(d0.eta[4])) {
+                offset[3] += heel - f64::from(d0.eta[3]);
+            }
+        }
+        start_state(&self.trajectory, rate, &offset)
     }
 }
 
