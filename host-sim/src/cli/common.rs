@@ -116,6 +116,7 @@ pub(super) fn print_runs(
             cases: runs(rows).map(RunResult::summary).collect(),
             incomplete,
             preflight: checks.to_vec(),
+            contract: None,
         };
         print_json(stdout, &cases)?;
     } else {

@@ -64,7 +64,7 @@ pub use json::Cases;
 pub use monte_carlo::{monte_carlo, MonteCarloArgs};
 pub use pil::{pil, PilArgs};
 pub use run::{run, RunArgs};
-pub use table1::{table1, Table1Args, DEFAULT_TABLE1_OUT};
+pub use table1::{table1, ContractRun, Table1Args, DEFAULT_TABLE1_OUT};
 pub use validate::{validate_preflight, Mountings, ValidateArgs};
 
 /// How a command ended, as the process's exit code (see the module doc).

@@ -12,7 +12,7 @@ use super::Exit;
 use crate::output::{atomic, OutputDir};
 use crate::sim::progress::Progress;
 use crate::studies::preflight::DEFAULT_MARGIN;
-use crate::studies::validation::{self, TEAM_MOUNTINGS};
+use crate::studies::validation::{self, Campaign, Measure, DEFAULT_RANDOM, TEAM_MOUNTINGS};
 
 /// Which thruster mountings the matrix flies.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
@@ -30,7 +30,7 @@ pub struct ValidateArgs {
     #[arg(long, value_enum, default_value_t = Mountings::All)]
     pub mountings: Mountings,
     /// Random missions besides the matrix.
-    #[arg(long, default_value_t = 200)]
+    #[arg(long, default_value_t = DEFAULT_RANDOM)]
     pub random: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -45,19 +45,27 @@ pub struct ValidateArgs {
 /// `validate-preflight`: exit 0 when no mission was falsely feasible, 1 otherwise.
 pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result<Exit> {
     if !(args.margin > 0.0 && args.margin <= 1.0) {
-        bail!("--margin must be a fraction of the envelope in (0, 1], got {}", args.margin);
+        bail!(
+            "--margin must be a fraction of the envelope in (0, 1], got {}",
+            args.margin
+        );
     }
-    let masks = match args.mountings {
-        Mountings::Team => TEAM_MOUNTINGS.to_vec(),
-        Mountings::All => validation::all_mountings(),
+    let campaign = Campaign {
+        masks: match args.mountings {
+            Mountings::Team => TEAM_MOUNTINGS.to_vec(),
+            Mountings::All => validation::all_mountings(),
+        },
+        random: args.random,
+        seed: args.seed,
     };
-    let mut missions = validation::matrix(&masks)?;
-    missions.extend(validation::random(args.random, args.seed)?);
+    let missions = campaign.missions()?;
     let dir = OutputDir::prepare(&args.out)?;
     let progress = Progress::start("missions", missions.len() as u64, !args.json);
     let counter = progress.observer();
-    let v = validation::validate(&missions, args.margin, || counter.add(1))
-        .map_err(|e| anyhow!(e))?;
+    let v = validation::validate(&missions, args.margin, Measure::Conservativeness, || {
+        counter.add(1)
+    })
+    .map_err(|e| anyhow!(e))?;
     progress.finish();
     let md = v.markdown();
     let report = dir.claim("report.md")?;

@@ -134,7 +134,14 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
                     };
                     format!("{}{expected}", r.faults)
                 }),
-                run.map_or("not run".to_string(), |r| r.outcome.to_string()),
+                run.map_or("not run".to_string(), |r| {
+                    let expected = if r.missed() && r.miss_expected {
+                        " (expected)"
+                    } else {
+                        ""
+                    };
+                    format!("{}{expected}", r.outcome)
+                }),
             ]);
         }
     }
@@ -369,6 +376,23 @@ fn warnings(runs: &[&RunResult], incomplete: &[String]) -> String {
             faulted.len()
         ),
         faulted,
+    );
+    let missed = pick(&|r| r.missed_unexpectedly().then(|| r.outcome.to_string()));
+    warn(
+        format!(
+            "**Warning: {} run(s) missed their bound** (`[bound]`; the real chain's default \
+             0.05 m and 1 % saturated periods):",
+            missed.len()
+        ),
+        missed,
+    );
+    let expected_miss = pick(&|r| (r.missed() && r.miss_expected).then(|| r.outcome.to_string()));
+    warn(
+        format!(
+            "{} run(s) missed their bound, as their scenario expects (`expect_missed = true`):",
+            expected_miss.len()
+        ),
+        expected_miss,
     );
     let expected =
         pick(&|r| (r.faults_expected && !r.faults.is_empty()).then(|| r.faults.to_string()));

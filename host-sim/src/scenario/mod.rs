@@ -36,6 +36,9 @@
 //! thruster_lag = 0.1          # s, > 0; leave out for no lag
 //! expect_faults = false       # true: periods with the controller in fail-safe are reported but
 //!                             # do not fail the command (else exit 3); default false
+//! initial_attitude = "trim"   # "trim" (the payload's static heel) | "level"; default trim for
+//!                             # the real chain, level for ideal actuators
+//! expect_missed = false       # true: a miss of [bound] is reported, no exit 4; default false
 //!
 //! [trajectory]                # required
 //! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix"
@@ -103,9 +106,14 @@
 //! b_bound = "controlled-rows" # "controlled-rows" | "literal"
 //! thrust_unit = "kgf"         # "kgf" | "newton": the unit of Eqs 31–32; default "kgf"
 //! axis_priority = ["pitch", "depth", "yaw", "sway", "surge"]  # the five axes, highest first
-//! reversed_thrusters = ["vert fore", "vert aft", "horz fore", "horz aft"]  # strong side
-//!                             # against the reference axis (+x main, +z vertical, +y
-//!                             # horizontal); default: the core's (this list)
+//! reversed_thrusters = ["vert fore", "horz fore", "horz aft"]  # strong side against the
+//!                             # reference axis (+x main, +z vertical, +y horizontal); default:
+//!                             # the core's (this list: fore up, aft down, both to port)
+//!
+//! [bound]                     # a run completing outside it is "missed" (exit 4); default these
+//!                             # two for the real chain (ideal_actuators = false), none for ideal
+//! max_path = 0.05             # m, > 0
+//! saturated = 0.01            # fraction of control periods with a thruster saturated, [0, 1]
 //!
 //! [link_faults]               # processor in the loop only: tick ranges "A..B" (A included)
 //! drop = ["100..101"]         # state frames not sent

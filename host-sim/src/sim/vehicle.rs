@@ -61,4 +61,3 @@ impl<'a> Vehicle<'a> {
         self.plant.as_ref().map_or(0, Plant::factorisations)
     }
 }
-

@@ -19,7 +19,7 @@ use controller_core::uncertainty::ParamBox;
 use controller_core::{HeadingMode, TrajectoryKind};
 use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use super::preflight::{self, Verdict};
 use crate::interrupt;
@@ -41,6 +41,50 @@ pub fn all_mountings() -> Vec<u8> {
 pub const RANDOM_MAX_CURRENT: f64 = 0.3;
 /// Relative resolution of the smallest flying time scale, found by bisection.
 pub const FLYING_TOLERANCE: f64 = 0.02;
+
+/// Which missions a campaign flies: the real paths under each mounting of `masks`, and
+/// `random` random missions from `seed`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Campaign {
+    pub masks: Vec<u8>,
+    pub random: usize,
+    pub seed: u64,
+}
+
+impl Default for Campaign {
+    /// The contract's campaign (docs/design.md §9): every mounting, 200 random missions, seed 1.
+    fn default() -> Self {
+        Campaign {
+            masks: all_mountings(),
+            random: DEFAULT_RANDOM,
+            seed: 1,
+        }
+    }
+}
+
+impl Campaign {
+    /// Its missions: the matrix, then the random ones.
+    pub fn missions(&self) -> Result<Vec<Scenario>, ScenarioError> {
+        let mut out = matrix(&self.masks)?;
+        out.extend(random(self.random, self.seed)?);
+        Ok(out)
+    }
+}
+
+/// Random missions of the contract's campaign.
+pub const DEFAULT_RANDOM: usize = 200;
+
+/// The campaign's two numbers and what they count, for reports and JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContractSummary {
+    pub campaign: Campaign,
+    pub missions: usize,
+    pub flown: usize,
+    pub refused: usize,
+    pub false_feasible: usize,
+    pub median_ratio: f64,
+    pub partial: bool,
+}
 
 /// One mission of the campaign, and what became of it.
 #[derive(Clone, Debug, Serialize)]
@@ -114,9 +158,8 @@ pub fn random(n: usize, seed: u64) -> Result<Vec<Scenario>, ScenarioError> {
 }
 
 fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
-    let mut rng = rand::rngs::StdRng::seed_from_u64(
-        seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
-    );
+    let mut rng =
+        rand::rngs::StdRng::seed_from_u64(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     let base = real_vehicle::real_scenarios()?.remove(0);
     loop {
         let speed = 0.5 + 2.0 * rng.random::<f64>();
@@ -126,17 +169,29 @@ fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
             0 => {
                 let radius = 8.0 + 32.0 * rng.random::<f64>();
                 let omega = (speed / radius) as f32;
-                TrajectoryKind::Circle { radius: radius as f32, omega, depth: 5.0 }
+                TrajectoryKind::Circle {
+                    radius: radius as f32,
+                    omega,
+                    depth: 5.0,
+                }
             }
             1 => {
                 let amplitude = 10.0 + 30.0 * rng.random::<f64>();
                 let omega = (speed / amplitude) as f32;
-                TrajectoryKind::FigureEight { amplitude: amplitude as f32, omega, depth: 5.0 }
+                TrajectoryKind::FigureEight {
+                    amplitude: amplitude as f32,
+                    omega,
+                    depth: 5.0,
+                }
             }
             _ => {
                 let scale = 0.5 + rng.random::<f64>();
                 let omega = (speed / (15.0 * scale)).clamp(0.02, 0.08) as f32;
-                TrajectoryKind::LawnMower { scale: scale as f32, omega, depth: 5.0 }
+                TrajectoryKind::LawnMower {
+                    scale: scale as f32,
+                    omega,
+                    depth: 5.0,
+                }
             }
         };
         let mask = rng.random_range(0..1u8 << THRUSTERS);
@@ -168,11 +223,8 @@ fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
             c.controller.geometry = ThrusterGeometry::auv150(mask);
             c.variation = variation.clone();
             c.trimmed = true;
-            c.current = CurrentModel::Constant([
-                current_speed * dir.cos(),
-                current_speed * dir.sin(),
-                0.0,
-            ]);
+            c.current =
+                CurrentModel::Constant([current_speed * dir.cos(), current_speed * dir.sin(), 0.0]);
         });
         match made {
             Ok(s) => return Ok(s),
@@ -204,8 +256,21 @@ fn flies(scenario: &Scenario) -> (bool, sim::Metrics) {
     (bound::within_bound(&run), run.metrics)
 }
 
+/// What a campaign measures besides the false-feasible count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measure {
+    /// Only whether each proposed scale flies within the bound.
+    Verdicts,
+    /// Also the smallest scale that flies, by bisection (about six flights more a mission).
+    Conservativeness,
+}
+
 /// Checks and flies one mission (see the module docs).
-pub fn validate_one(base: &Scenario, margin: f64) -> Result<MissionResult, String> {
+pub fn validate_one(
+    base: &Scenario,
+    margin: f64,
+    measure: Measure,
+) -> Result<MissionResult, String> {
     let p = preflight::check_as_written(base, margin)?;
     let mounting = base
         .config()
@@ -232,8 +297,9 @@ pub fn validate_one(base: &Scenario, margin: f64) -> Result<MissionResult, Strin
     };
     let scenario = |k: f64| at_scale(base, k).map_err(|e| e.to_string());
     let (within, m) = flies(&scenario(k)?);
-    (out.max_path, out.saturated, out.within) = (Some(m.max_path), Some(m.saturated_fraction), Some(within));
-    if within {
+    (out.max_path, out.saturated, out.within) =
+        (Some(m.max_path), Some(m.saturated_fraction), Some(within));
+    if within && measure == Measure::Conservativeness {
         out.smallest_flying = Some(smallest_flying(k, &mut |k| Ok(flies(&scenario(k)?).0))?);
     }
     Ok(out)
@@ -264,6 +330,7 @@ fn smallest_flying(
 pub fn validate(
     missions: &[Scenario],
     margin: f64,
+    measure: Measure,
     on_done: impl Fn() + Sync,
 ) -> Result<Validation, String> {
     let results: Result<Vec<Option<MissionResult>>, String> = missions
@@ -272,7 +339,7 @@ pub fn validate(
             if interrupt::requested() {
                 return Ok(None);
             }
-            let r = validate_one(m, margin).map(Some);
+            let r = validate_one(m, margin, measure).map(Some);
             on_done();
             r
         })
@@ -291,6 +358,33 @@ pub fn validate(
 }
 
 impl Validation {
+    /// Its two numbers, for `campaign`.
+    pub fn summary(&self, campaign: &Campaign) -> ContractSummary {
+        ContractSummary {
+            campaign: campaign.clone(),
+            missions: self.missions.len(),
+            flown: self.flown,
+            refused: self.refused,
+            false_feasible: self.false_feasible,
+            median_ratio: self.median_ratio,
+            partial: self.partial,
+        }
+    }
+
+    /// The two numbers in a sentence.
+    pub fn headline(&self) -> String {
+        format!(
+            "preflight contract: {} missions{}, {} flown at the proposed time scale, {} refused; \
+             false feasible {}; conservativeness median {:.2}× (proposed / smallest flying scale)",
+            self.missions.len(),
+            if self.partial { " (PARTIAL)" } else { "" },
+            self.flown,
+            self.refused,
+            self.false_feasible,
+            self.median_ratio
+        )
+    }
+
     /// The report: the two numbers, then one row per mission.
     pub fn markdown(&self) -> String {
         let mut s = format!(
@@ -302,7 +396,11 @@ impl Validation {
              | mission | mounting | verdict at k = 1 | proposed k | max path (m) | saturated | \
              within bound | smallest flying k |\n|---|---|---|---:|---:|---:|---|---:|\n",
             self.missions.len(),
-            if self.partial { " (PARTIAL: interrupted)" } else { "" },
+            if self.partial {
+                " (PARTIAL: interrupted)"
+            } else {
+                ""
+            },
             self.flown,
             self.refused,
             self.false_feasible,

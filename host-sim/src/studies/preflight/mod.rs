@@ -220,7 +220,11 @@ impl fmt::Display for Preflight {
                     .thrusters
                     .iter()
                     .max_by(|a, b| a.usage.total_cmp(&b.usage));
-                write!(f, "FEASIBLE at time scale {} for this mission", self.time_scale)?;
+                write!(
+                    f,
+                    "FEASIBLE at time scale {} for this mission",
+                    self.time_scale
+                )?;
                 if let Some(p) = peak {
                     write!(
                         f,
@@ -235,7 +239,10 @@ impl fmt::Display for Preflight {
                 f.write_str(")")?;
             }
             Verdict::StaticallyInfeasible => {
-                write!(f, "STATICALLY INFEASIBLE for this mission (margin {pct:.0} %): at rest")?;
+                write!(
+                    f,
+                    "STATICALLY INFEASIBLE for this mission (margin {pct:.0} %): at rest"
+                )?;
                 if let Some(v) = &self.static_violation {
                     write!(f, ", at t = {:.2} s, {}", v.t, fmt_violation(v))?;
                 }
@@ -261,7 +268,11 @@ impl fmt::Display for Preflight {
             }
         }
         match &self.whole_box {
-            Some(b) => write!(f, "; over the whole configured box: {}", b.short(self.time_scale)),
+            Some(b) => write!(
+                f,
+                "; over the whole configured box: {}",
+                b.short(self.time_scale)
+            ),
             None => Ok(()),
         }
     }
