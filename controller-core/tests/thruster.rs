@@ -11,7 +11,7 @@
 
 use controller_core::effectiveness::{MAIN, THRUSTERS, VERT_FORE};
 use controller_core::thruster::{
-    actuate, default_maps, Actuation, Envelope, ThrustUnit, ThrusterMap, ALL_SATURATED,
+    actuate, default_maps, Actuation, ThrustEnvelope, ThrustUnit, ThrusterMap, ALL_SATURATED,
     DEFAULT_V_LIMIT, MAIN_T_FOLD, MAIN_V_FOLD,
 };
 use proptest::prelude::*;
@@ -346,7 +346,7 @@ fn envelope_in_newtons_in_both_readings() {
         (tunnel_root(-24.0), tunnel_root(24.0)),
     ];
     for (unit, newtons) in [(ThrustUnit::Newton, 1.0), (ThrustUnit::Kgf, KGF)] {
-        let e = Envelope::new(&default_maps(), unit, 24.0);
+        let e = ThrustEnvelope::new(&default_maps(), unit, 24.0);
         for i in 0..THRUSTERS {
             let (lo, hi) = poly[usize::from(i != MAIN)];
             let (lo, hi) = (lo * newtons, hi * newtons);
@@ -365,7 +365,7 @@ fn envelope_in_newtons_in_both_readings() {
     }
     // The figures docs/design.md §9 quotes (kgf): main −171.29 … +718.89 N, tunnel −89.88 …
     // +197.13 N.
-    let e = Envelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
+    let e = ThrustEnvelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
     assert!((e.min[MAIN] + 171.29).abs() < 0.01 && (e.max[MAIN] - 718.89).abs() < 0.01);
     assert!((e.min[VERT_FORE] + 89.88).abs() < 0.01 && (e.max[VERT_FORE] - 197.13).abs() < 0.01);
     assert!(e.contains(&[0.0; 5]));

@@ -269,7 +269,7 @@ pub struct ConfigPatch {
     pub priority: Option<AxisPriority>,
 }
 
-/// The wire form of `controller_core::allocator::AxisPriority`: per row of τ = [X Y Z K M N],
+/// The wire form of `controller_core::allocation::AxisPriority`: per row of τ = [X Y Z K M N],
 /// the rank (higher is met first) and the least-squares weight between axes of equal rank
 /// (finite and > 0 on the actuated axes; the roll entries are carried and not used). Convert
 /// with `From` both ways ([`crate::mission`]).

@@ -377,7 +377,7 @@ fn real_chain_exercise() -> bool {
         thrust_unit: Some(ThrustUnit::Newton),
         reversed_thrusters: Some(0),
         priority: Some(AxisPriority::from(
-            controller_core::allocator::AxisPriority::default(),
+            controller_core::allocation::AxisPriority::default(),
         )),
         ..ConfigPatch::EMPTY
     };
