@@ -3,7 +3,9 @@
 //! general tilted layout, and the singular and ill-conditioned layouts it must refuse.
 
 use controller_core::allocation::{AllocationError, PseudoInverse, MAX_CONDITION};
-use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE};
+use controller_core::effectiveness::{
+    ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE, THRUSTERS,
+};
 use nalgebra::Vector6;
 use proptest::prelude::*;
 
@@ -23,7 +25,7 @@ fn wrench() -> impl Strategy<Value = [f32; 6]> {
 
 /// docs/design.md §5 closed form, in f64, for every thruster along its reference axis
 /// (+x, +z, +z, +y, +y); a reversed thruster (bit i of `reversed`) gives the negated thrust.
-fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; 5] {
+fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; THRUSTERS] {
     let [x, y, z, _k, m, n] = tau.map(|v| v as f64);
     let t = [
         x,

@@ -43,7 +43,7 @@ fn default_layout_is_the_spec_choice() {
 fn effectiveness_matrix_by_hand() {
     // Columns [d; r × d] by hand, rows X Y Z K M N: r × d for r = (x, 0, 0) is
     // (0, −x d_z, x d_y). Along the reference axes (+x, +z, +z, +y, +y):
-    let reference: [[f32; 6]; 5] = [
+    let reference: [[f32; 6]; THRUSTERS] = [
         [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],  // main: on the x axis, no moment
         [0.0, 0.0, 1.0, 0.0, -1.8, 0.0], // vertical fore: M = −1.8·T
         [0.0, 0.0, 1.0, 0.0, 1.8, 0.0],  // vertical aft: M = +1.8·T
@@ -51,7 +51,7 @@ fn effectiveness_matrix_by_hand() {
         [0.0, 1.0, 0.0, 0.0, 0.0, -1.8], // horizontal aft: N = −1.8·T
     ];
     // The real vehicle (default): the four tunnels reversed, their columns negated.
-    let default: [[f32; 6]; 5] = [
+    let default: [[f32; 6]; THRUSTERS] = [
         [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
         [0.0, 0.0, -1.0, 0.0, 1.8, 0.0], // pushing up fore: nose up
         [0.0, 0.0, -1.0, 0.0, -1.8, 0.0],

@@ -368,7 +368,7 @@ fn envelope_in_newtons_in_both_readings() {
     let e = ThrustEnvelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
     assert!((e.min[MAIN] + 171.29).abs() < 0.01 && (e.max[MAIN] - 718.89).abs() < 0.01);
     assert!((e.min[VERT_FORE] + 89.88).abs() < 0.01 && (e.max[VERT_FORE] - 197.13).abs() < 0.01);
-    assert!(e.contains(&[0.0; 5]));
+    assert!(e.contains(&[0.0; THRUSTERS]));
     assert!(!e.scaled(0.8).contains(&e.max));
 }
 
@@ -524,17 +524,17 @@ fn non_finite_commands_switch_the_thruster_off() {
 fn invalid_supply_limit_switches_everything_off() {
     let maps = default_maps();
     for v_limit in [f32::NAN, 0.0, -24.0, f32::INFINITY] {
-        let a = actuate(&maps, ThrustUnit::Newton, &[1.0; 5], v_limit);
-        assert_eq!(a.voltages, [0.0; 5]);
-        assert_eq!(a.thrusts, [0.0; 5]);
+        let a = actuate(&maps, ThrustUnit::Newton, &[1.0; THRUSTERS], v_limit);
+        assert_eq!(a.voltages, [0.0; THRUSTERS]);
+        assert_eq!(a.thrusts, [0.0; THRUSTERS]);
         assert_eq!(a.saturated, ALL_SATURATED, "v_limit = {v_limit}");
     }
 }
 
 #[test]
 fn off_is_zero_volts_zero_newtons() {
-    assert_eq!(Actuation::OFF.voltages, [0.0; 5]);
-    assert_eq!(Actuation::OFF.thrusts, [0.0; 5]);
+    assert_eq!(Actuation::OFF.voltages, [0.0; THRUSTERS]);
+    assert_eq!(Actuation::OFF.thrusts, [0.0; THRUSTERS]);
     assert_eq!(Actuation::OFF.saturated, 0);
 }
 

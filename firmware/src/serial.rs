@@ -28,6 +28,10 @@
 use embedded_io::{ErrorKind, ErrorType, Read, ReadReady, Write};
 use heapless::spsc::{Consumer, Producer, Queue};
 
+/// The navigation link's baud rate, 8N1 (10 bits on the wire a byte): the STM32 board's USART2
+/// and the default of `host-sim hil --baud`.
+pub const LINK_BAUD: u32 = 460_800;
+
 /// Received bytes (and line errors) the queue holds: 11 ms of line at 460 800 baud, longer
 /// than a 100 Hz control period.
 pub const RX_CAPACITY: usize = 512;

@@ -9,7 +9,7 @@ use auv_link::{
     Refusal, ThrustUnit,
 };
 use controller_core::allocation;
-use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED};
+use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED, THRUSTERS};
 use controller_core::{Controller, ControllerConfig, Mission, Trajectory};
 use firmware::supervisor::{Mode, Supervisor, NOT_AUV150};
 
@@ -125,7 +125,7 @@ fn the_board_flies_the_chain_it_reports() {
             })
             .collect();
         let got = fly(patch);
-        let bits = |v: &Vec<[f32; 5]>| -> Vec<[u32; 5]> {
+        let bits = |v: &Vec<[f32; THRUSTERS]>| -> Vec<[u32; THRUSTERS]> {
             v.iter().map(|a| a.map(f32::to_bits)).collect()
         };
         assert_eq!(bits(&got), bits(&want));

@@ -218,8 +218,8 @@ pub struct PilArgs {
     pub elf: Option<PathBuf>,
 }
 
-/// The STM32 board's link baud rate (firmware/src/stm32f405/mod.rs), `hil`'s default.
-pub const DEFAULT_HIL_BAUD: u32 = 460_800;
+/// The STM32 board's link baud rate (`firmware::serial::LINK_BAUD`), `hil`'s default.
+pub const DEFAULT_HIL_BAUD: u32 = firmware::serial::LINK_BAUD;
 
 /// `hil`'s default reply timeout (s): a board answers every period (10 ms at 100 Hz).
 pub const DEFAULT_HIL_REPLY_TIMEOUT: f64 = 5.0;
@@ -231,7 +231,7 @@ pub struct HilArgs {
     /// The serial device of the board's link (e.g. /dev/ttyUSB0, or QEMU's /dev/pts/N).
     #[arg(long)]
     pub port: String,
-    /// Baud rate (8N1, no flow control); the STM32 board's is 460800.
+    /// Baud rate (8N1, no flow control); the default is the STM32 board's.
     #[arg(long, default_value_t = DEFAULT_HIL_BAUD)]
     pub baud: u32,
     /// lockstep: the board runs a period per state frame (as PIL; equals SIL); realtime: the
@@ -780,7 +780,7 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .clone()
         .unwrap_or_else(|| crate::pil::default_elf(&root));
     crate::pil::check_flying_image(&elf).map_err(|e| anyhow!(e))?;
-    let runner = root.join("scripts/qemu-run.sh");
+    let runner = root.join(firmware::qemu_runner::SCRIPT);
     let key = link_key(&args.common)?;
     let dir = OutputDir::prepare(&args.out)?;
     fly(
