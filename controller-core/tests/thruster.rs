@@ -6,7 +6,7 @@
 //! in f64.
 //!
 //! The tolerances do not depend on the math backend: the module computes its inverse maps with
-//! `libm::sqrtf` in both backends (micromath's ≈ 6 % sqrt error would move the reported thrust by
+//! `libm::sqrtf` in every backend (micromath's ≈ 6 % sqrt error would move the reported thrust by
 //! up to 1.85 N, see the module docs), so the same numbers hold with `--features micromath`.
 
 use controller_core::effectiveness::{MAIN, THRUSTERS, VERT_FORE};
