@@ -19,7 +19,8 @@
 //! **Choice**: under the paper's own damping only the kgf reading reaches the vehicle's
 //! published 2–4 kn, and a wrong kgf guess under-drives the thrusters instead of over-driving
 //! them 9.81×). Everything else in the workspace is newtons: [`ThrusterMap::voltage_of_newtons`],
-//! [`ThrusterMap::newtons_of_voltage`], [`ThrustEnvelope`] and [`actuate`] convert at this one seam.
+//! [`ThrusterMap::newtons_of_voltage`], [`ThrustEnvelope`] and [`actuate`] convert at this one
+//! seam.
 //! 1 kgf = [`KGF_IN_NEWTONS`] = 9.80665 N, the standard kilogram-force (docs/design.md §9
 //! **Choice**: the paper gives no sign that its fits use its model's g = 9.81; the two differ by
 //! 0.03 %). Voltage is in volts.
@@ -371,9 +372,9 @@ pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
 ///    (within the inverse map's f32 round trip, ~1e-5 polynomial units).
 ///
 /// The controller's commands come from the saturation-aware allocator
-/// ([`crate::allocation::Allocator`]), which keeps them inside the [`ThrustEnvelope`]: then nothing is clipped
-/// here beyond the f32 rounding of a thrust that sits exactly on its envelope. Called with
-/// arbitrary commands it clips each thruster on its own.
+/// ([`crate::allocation::Allocator`]), which keeps them inside the [`ThrustEnvelope`]: then
+/// nothing is clipped here beyond the f32 rounding of a thrust that sits exactly on its
+/// envelope. Called with arbitrary commands it clips each thruster on its own.
 ///
 /// `v_limit` must be finite and > 0; otherwise every thruster is switched off (0 V, 0 N) with
 /// every bit set. Fixed work, never panics; for finite `v_limit` > 0 every output is finite

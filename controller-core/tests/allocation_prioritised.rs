@@ -1,9 +1,9 @@
-//! The saturation-aware allocator (`controller_core::allocation::Allocator`, docs/design.md §9): a feasible
-//! demand gives exactly B₅⁻¹τ; the thrusts are always inside the envelope; a higher-priority
-//! axis is met exactly whenever it is feasible on its own; the weighted least-squares optimum
-//! and the lexicographic optimum are no worse than a brute-force search over a fine grid of the
-//! box; the saturation bits and the unallocated part say what was given up. Every expected
-//! value is computed here from B and the envelope, in f64.
+//! The saturation-aware allocator (`controller_core::allocation::Allocator`, docs/design.md
+//! §9): a feasible demand gives exactly B₅⁻¹τ; the thrusts are always inside the envelope; a
+//! higher-priority axis is met exactly whenever it is feasible on its own; the weighted
+//! least-squares optimum and the lexicographic optimum are no worse than a brute-force search
+//! over a fine grid of the box; the saturation bits and the unallocated part say what was given
+//! up. Every expected value is computed here from B and the envelope, in f64.
 
 use controller_core::allocation::{
     Allocated, AllocationError, Allocator, AxisPriority, PseudoInverse,

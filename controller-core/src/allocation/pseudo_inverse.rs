@@ -72,8 +72,9 @@ impl PseudoInverse {
 
     /// Thrusts T (N, thruster order) = B₅⁻¹·[X Y Z M N]ᵀ for the wrench `tau` = [X Y Z K M N]
     /// (N, N·m). τ_K is ignored (roll is not actuated). Exact and unconstrained (the
-    /// saturation-aware allocation is [`Allocator`](super::Allocator)). Fixed work; a non-finite τ gives non-finite
-    /// thrusts, which [`actuate`](crate::thruster::actuate) turns into 0 V with the bits set.
+    /// saturation-aware allocation is [`Allocator`](super::Allocator)). Fixed work; a
+    /// non-finite τ gives non-finite thrusts, which [`actuate`](crate::thruster::actuate) turns
+    /// into 0 V with the bits set.
     #[inline]
     pub fn thrusts(&self, tau: &Vector6<f32>) -> [f32; THRUSTERS] {
         // The rows of `ACTUATED`, written out.

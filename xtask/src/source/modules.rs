@@ -345,9 +345,11 @@ fn depends(x: &str, xm: &Module, y: &str) -> bool {
         .any(|m| m == y || is_ancestor(y, m) || (is_ancestor(m, y) && !is_ancestor(m, x)))
 }
 
-/// The pairs of modules of `krate` that import each other (in the sense of [`depends`]), each
-/// pair once, sorted. A module and its own ancestor or descendant are never a pair: a parent
-/// declares and re-exports its children, and children use their parent's items.
+/// The pairs of modules of `krate` that import each other, each pair once, sorted. A module
+/// depends on another when its own code names that module, a module inside it, or a module
+/// that contains it other than one that contains the first module too (its parent's items are
+/// its siblings' as well). A module and its own ancestor or descendant are never a pair: a
+/// parent declares and re-exports its children, and children use their parent's items.
 pub fn import_circles(krate: &Crate) -> Vec<(String, String)> {
     let mut out = Vec::new();
     for (a, ma) in &krate.modules {
