@@ -8,10 +8,10 @@
 
 use core::fmt;
 
-use crate::allocation::AllocationError;
-use crate::allocator::AxisPriority;
+use crate::allocation::{AllocationError, AxisPriority};
+use crate::axes::{ACTUATED, ROLL};
 use crate::effectiveness::ThrusterGeometry;
-use crate::law::{RobustLaw, CONTROLLED, ROLL};
+use crate::law::RobustLaw;
 use crate::model::VehicleParams;
 use crate::thruster::ThrustUnit;
 use crate::uncertainty::{BoundsError, ParamBox};
@@ -178,7 +178,9 @@ impl ConfigError {
             ConfigError::Allocation(AllocationError::Weight { axis, .. }) => {
                 ("priority", Some(axis))
             }
-            ConfigError::Allocation(AllocationError::Envelope { .. }) => ("voltage_limit", None),
+            ConfigError::Allocation(AllocationError::ThrustEnvelope { .. }) => {
+                ("voltage_limit", None)
+            }
             ConfigError::Allocation(_) => ("geometry", None),
             ConfigError::Assumption2 { .. }
             | ConfigError::Theorem2 { .. }
@@ -281,7 +283,7 @@ impl ControllerConfig {
     /// Checks of the scalar settings that need no model (the model checks live in
     /// [`crate::controller::Controller::new`]).
     pub(crate) fn check_scalars(&self) -> Result<(), ConfigError> {
-        for &axis in CONTROLLED.iter() {
+        for &axis in ACTUATED.iter() {
             for (name, k) in [("k1", self.k1[axis]), ("k2", self.k2[axis])] {
                 if !(k.is_finite() && k > 0.0) {
                     return Err(ConfigError::Gain {

@@ -5,7 +5,7 @@
 #![deny(unsafe_code)]
 
 pub mod allocation;
-pub mod allocator;
+pub mod axes;
 pub mod config;
 pub mod controller;
 pub mod effectiveness;

@@ -1,5 +1,6 @@
 //! CSV, plots, tables and report of `host_sim::output`, on small hand-built runs.
 
+use controller_core::effectiveness::THRUSTERS;
 use std::path::{Path, PathBuf};
 
 use auv_link::{BoardStatus, FailSafeReason};
@@ -292,7 +293,7 @@ fn plot_case_survives_empty_single_and_nan_runs() {
     for s in &mut all_nan.samples {
         s.eta = [f64::NAN; 6];
         s.error = [f64::NAN; 6];
-        s.voltage = [f64::NAN; 5];
+        s.voltage = [f64::NAN; THRUSTERS];
     }
     let files = plot_case_with_limit(&dir, &holes, Some(&all_nan), f64::NAN).unwrap();
     assert_pngs(&files, &dir, "holes");

@@ -9,6 +9,7 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use auv_link::sign::LinkKey;
+use firmware_images::qemu_runner;
 
 use super::image::check_flying_image;
 use super::pacing::Pacing;
@@ -41,10 +42,10 @@ pub fn spawn_qemu(
         qemu.arg("-append").arg(format!("link-key={hex}"));
     }
     if pacing == Pacing::Realtime {
-        qemu.env("QEMU_ICOUNT", "off");
+        qemu.env(qemu_runner::ICOUNT_VAR, qemu_runner::ICOUNT_OFF);
     }
-    qemu.env("QEMU_SERIAL", serial)
-        .env("QEMU_TIMEOUT", "3600")
+    qemu.env(qemu_runner::SERIAL_VAR, serial)
+        .env(qemu_runner::TIMEOUT_VAR, "3600")
         .stdin(Stdio::null())
         .stdout(Stdio::from(log))
         .stderr(Stdio::from(log_err))
@@ -95,7 +96,7 @@ impl QemuPty {
         check_flying_image(elf)?;
         let log = std::fs::File::create(log_path)
             .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
-        let child = spawn_qemu(elf, runner, "pty", pacing, log, key)?;
+        let child = spawn_qemu(elf, runner, qemu_runner::SERIAL_PTY, pacing, log, key)?;
         let mut q = QemuPty {
             child,
             port: PathBuf::new(),

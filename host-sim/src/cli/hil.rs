@@ -12,8 +12,8 @@ use crate::board::{BoardInTheLoop, Mode, Pacing};
 use crate::output::OutputDir;
 use crate::scenario::Scenario;
 
-/// The STM32 board's link baud rate (firmware/src/stm32f405/mod.rs), `hil`'s default.
-pub const DEFAULT_HIL_BAUD: u32 = 460_800;
+/// The STM32 board's link baud rate (`firmware_images::LINK_BAUD`), `hil`'s default.
+pub const DEFAULT_HIL_BAUD: u32 = firmware_images::LINK_BAUD;
 
 /// `hil`'s default reply timeout (s): a board answers every period (10 ms at 100 Hz).
 pub const DEFAULT_HIL_REPLY_TIMEOUT: f64 = 5.0;
@@ -25,7 +25,7 @@ pub struct HilArgs {
     /// The serial device of the board's link (e.g. /dev/ttyUSB0, or QEMU's /dev/pts/N).
     #[arg(long)]
     pub port: String,
-    /// Baud rate (8N1, no flow control); the STM32 board's is 460800.
+    /// Baud rate (8N1, no flow control); the default is the STM32 board's.
     #[arg(long, default_value_t = DEFAULT_HIL_BAUD)]
     pub baud: u32,
     /// lockstep: the board runs a period per state frame (as PIL; equals SIL); realtime: the

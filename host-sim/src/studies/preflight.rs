@@ -7,7 +7,7 @@
 //! of the controller's parameter box** (Table 3 by default: 2⁹ plants, trimmed if the scenario
 //! is) and under **the configured current** (constant: that velocity; Gauss–Markov: every
 //! corner of mean ± [`GAUSS_MARKOV_SIGMAS`]·σ). Each τ goes through **the board's own
-//! allocator** ([`controller_core::allocator::Allocator`], the scenario's geometry, unit and
+//! allocator** ([`controller_core::allocation::Allocator`], the scenario's geometry, unit and
 //! axis priority) built on the envelope shrunk to the margin (default [`DEFAULT_MARGIN`] = 80 %
 //! of [T_min, T_max]): the mission is feasible when every block of every τ is met, i.e. every
 //! thruster's demand B₅⁻¹τ lies inside the margin envelope. The rest of the envelope is left to
@@ -32,11 +32,11 @@
 
 use std::fmt;
 
-use controller_core::allocator::{Allocator, AXIS_NAMES};
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
-use controller_core::thruster::Envelope;
+use controller_core::thruster::ThrustEnvelope;
+use controller_core::{allocation::Allocator, axes::NAMES as AXIS_NAMES};
 use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 use serde::{Deserialize, Serialize};
@@ -248,7 +248,7 @@ struct Checker<'a> {
     plants: Vec<Plant>,
     currents: Vec<Vector3<f64>>,
     margin_allocator: Allocator,
-    margin_envelope: Envelope,
+    margin_envelope: ThrustEnvelope,
 }
 
 /// The preflight check of `scenario` at `margin` (a fraction of the envelope, in (0, 1]).
@@ -455,7 +455,7 @@ impl<'a> Checker<'a> {
         &self,
         t: f64,
         tau: &Vector6<f32>,
-        priority: &controller_core::allocator::AxisPriority,
+        priority: &controller_core::allocation::AxisPriority,
         lost: &dyn Fn(usize) -> bool,
     ) -> Violation {
         let demand = self.scenario.controller().allocation().thrusts(tau);
