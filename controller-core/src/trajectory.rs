@@ -55,6 +55,7 @@ use nalgebra::Vector6;
 
 use crate::math;
 use crate::phase::{Frequency, LinearRate, MissionTime};
+use crate::readable::Readable;
 
 /// Desired state at one instant (earth frame, components [x y z φ θ ψ]).
 ///
@@ -209,7 +210,7 @@ impl fmt::Display for TrajectoryError {
         match *self {
             Self::NonFinite { parameter } => write!(f, "trajectory {parameter} is not finite"),
             Self::NotPositive { parameter, value } => {
-                write!(f, "trajectory {parameter} = {value} must be > 0")
+                write!(f, "trajectory {parameter} = {} must be > 0", Readable(value))
             }
             Self::OutOfRange {
                 parameter,
@@ -218,7 +219,10 @@ impl fmt::Display for TrajectoryError {
                 max,
             } => write!(
                 f,
-                "trajectory {parameter} = {value} is outside [{min}, {max}]"
+                "trajectory {parameter} = {} is outside [{}, {}]",
+                Readable(value),
+                Readable(min),
+                Readable(max)
             ),
             Self::TooSlowForTangent {
                 min_speed,
