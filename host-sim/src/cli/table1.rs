@@ -8,7 +8,10 @@ use anyhow::Result;
 use clap::Args;
 use controller_core::DEFAULT_V_LIMIT;
 
-use super::common::{periods, preflights, report_incomplete, runs_exit, sil_into, Incomplete};
+use super::common::{
+    interrupted_before_runs, periods, preflights, report_incomplete, runs_exit, sil_into,
+    Incomplete,
+};
 use super::json::{print_json, Cases};
 use super::Exit;
 use crate::output::{self, sections, OutputDir, RealRow, ReportRow};
@@ -53,7 +56,10 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     let dir = OutputDir::prepare(&args.out)?;
     // The paper's missions' verdicts (the Table-1 cases, with Δu: the same mission as the
     // real-chain runs), then the real ones.
-    let checks = preflights(chain_jobs.iter().chain(&real_jobs))?;
+    let title = "AUV-150 Table 1 reproduction (software in the loop)";
+    let Some(checks) = preflights(chain_jobs.iter().chain(&real_jobs))? else {
+        return interrupted_before_runs(&dir, title, args.json, stdout);
+    };
     let all: Vec<&Scenario> = jobs.iter().chain(&real_jobs).chain(&chain_jobs).collect();
     let progress = Progress::start("Table 1", periods(all.iter().copied()), !args.json);
     let incomplete = Incomplete::default();
@@ -86,7 +92,7 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     let mut incomplete = incomplete.into_inner();
     let report = output::write_plots_and_report(
         &dir,
-        "AUV-150 Table 1 reproduction (software in the loop)",
+        title,
         &rows,
         &sections,
         &real_plots,
