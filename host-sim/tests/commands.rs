@@ -382,6 +382,19 @@ fn pil_duration_obeys_the_duration_cap_and_the_step_cap() {
 const DAY: &str =
     "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n";
 
+/// `host-sim run --scenario s --out out`, started with its output piped.
+fn spawn_run(s: &Path, out: &Path) -> std::process::Child {
+    host_sim()
+        .args(["run", "--scenario"])
+        .arg(s)
+        .arg("--out")
+        .arg(out)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 /// Sends `signal` to `pid`.
 fn signal(pid: u32, signal: libc::c_int) {
     // SAFETY: kill(2) with a child's pid.
@@ -407,15 +420,7 @@ fn an_interrupt_before_the_first_period_acts_at_once() {
     let dir = tempdir("early-int");
     let s = scenario(&dir, "day", DAY);
     let out = dir.join("out");
-    let child = host_sim()
-        .args(["run", "--scenario"])
-        .arg(&s)
-        .arg("--out")
-        .arg(&out)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = spawn_run(&s, &out);
     std::thread::sleep(std::time::Duration::from_millis(1500));
     let t0 = std::time::Instant::now();
     signal(child.id(), libc::SIGINT);
@@ -498,15 +503,7 @@ fn a_second_run_into_a_folder_in_use_is_refused_at_once() {
         "hour",
         "name = \"hour\"\nduration = 3600\n[trajectory]\nkind = \"circle\"\nradius = 10\n",
     );
-    let first = host_sim()
-        .args(["run", "--scenario"])
-        .arg(&s)
-        .arg("--out")
-        .arg(&out)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let first = spawn_run(&s, &out);
     // Wait (bounded) until the first run holds the folder.
     let lock = out.join("host-sim.lock");
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(60);
@@ -565,15 +562,7 @@ fn streaming_run(
         "name = \"hour\"\nduration = 3600\n[controller]\nrate_hz = 500\n[trajectory]\nkind = \"circle\"\nradius = 10\n",
     );
     let out = dir.join("out");
-    let mut child = host_sim()
-        .args(["run", "--scenario"])
-        .arg(&s)
-        .arg("--out")
-        .arg(&out)
-        .stdout(Stdio::piped())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
+    let mut child = spawn_run(&s, &out);
     let mut err = BufReader::new(child.stderr.take().unwrap());
     let mut line = String::new();
     // The first progress line: the run is streaming its CSV.

@@ -195,8 +195,9 @@ pub enum ScenarioError {
 impl fmt::Display for ScenarioError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ScenarioError::Io { path, source } => {
-                write!(f, "cannot read scenario file {}: {source}", path.display())
+            // The reason is the source (Choice 128): printed once, by whoever prints the chain.
+            ScenarioError::Io { path, .. } => {
+                write!(f, "cannot read scenario file {}", path.display())
             }
             ScenarioError::Toml(message) => write!(f, "invalid scenario: {}", message.trim_end()),
             ScenarioError::Invalid { key, message } => {
@@ -206,11 +207,17 @@ impl fmt::Display for ScenarioError {
     }
 }
 
-/// The message says everything, the I/O reason included, so no error is given as the
-/// `source`: a chain printed whole (`{:#}`, as the binary does) says the reason once
-/// (**Choice 128**: the reason was printed twice, "Is a directory (os error 21): Is a
-/// directory (os error 21)").
-impl std::error::Error for ScenarioError {}
+/// The I/O reason of [`ScenarioError::Io`] is its `source()`, and not in its message: a chain
+/// printed whole (`{:#}`, as the binary does) says it once (**Choice 128**: it was printed
+/// twice, "Is a directory (os error 21): Is a directory (os error 21)").
+impl std::error::Error for ScenarioError {
+    fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
+        match self {
+            ScenarioError::Io { source, .. } => Some(source),
+            _ => None,
+        }
+    }
+}
 
 /// A validated run: its [`SimConfig`], the [`Controller`] and [`Trajectory`] built from it
 /// (once), and its step counts. Only [`Scenario::new`] makes one, so a `Scenario` always runs.
