@@ -532,6 +532,18 @@ fn a_second_run_into_a_folder_in_use_is_refused_at_once() {
     );
     let next = scenario(&dir, "next", &format!("name = \"next\"\n{SHORT}"));
     assert!(run(&[], &next, &out).status.success());
+    // A symlink planted as the lock file is not followed.
+    let victim = dir.join("victim");
+    std::fs::remove_file(&lock).unwrap();
+    std::os::unix::fs::symlink(&victim, &lock).unwrap();
+    let o = run(&[], &next, &out);
+    assert_eq!(o.status.code(), Some(2));
+    assert!(
+        stderr(&o).contains("host-sim.lock is a symlink"),
+        "{}",
+        stderr(&o)
+    );
+    assert!(!victim.exists());
 }
 
 /// Item 5: the reason of an unreadable scenario used to be printed twice ("Is a directory (os

@@ -232,8 +232,15 @@ fn lock(path: &Path) -> Result<File> {
         .truncate(false)
         .custom_flags(libc::O_NOFOLLOW)
         .open(&lock_path)
-        .with_context(|| {
-            format!("cannot open the lock file {shown} (a symlink there is not followed)")
+        .map_err(|e| match e.raw_os_error() {
+            Some(libc::ELOOP) => anyhow::anyhow!(
+                "{shown} is a symlink: host-sim does not follow a symlink it did not create; \
+                 remove it"
+            ),
+            _ => anyhow::Error::new(e).context(format!(
+                "output folder {} is not writable (its lock file {shown})",
+                path.display()
+            )),
         })?;
     match file.try_lock() {
         Ok(()) => {}
