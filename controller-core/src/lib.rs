@@ -14,6 +14,7 @@ pub mod law;
 pub mod math;
 pub mod model;
 pub mod phase;
+pub mod readable;
 pub mod thruster;
 pub mod trajectory;
 pub mod uncertainty;

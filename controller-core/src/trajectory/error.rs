@@ -3,6 +3,8 @@
 
 use core::fmt;
 
+use crate::readable::Readable;
+
 #[cfg(doc)]
 use crate::trajectory::{Mission, Trajectory, TrajectoryKind};
 
@@ -61,7 +63,7 @@ impl fmt::Display for TrajectoryError {
         match *self {
             Self::NonFinite { parameter } => write!(f, "trajectory {parameter} is not finite"),
             Self::NotPositive { parameter, value } => {
-                write!(f, "trajectory {parameter} = {value} must be > 0")
+                write!(f, "trajectory {parameter} = {} must be > 0", Readable(value))
             }
             Self::OutOfRange {
                 parameter,
@@ -70,7 +72,10 @@ impl fmt::Display for TrajectoryError {
                 max,
             } => write!(
                 f,
-                "trajectory {parameter} = {value} is outside [{min}, {max}]"
+                "trajectory {parameter} = {} is outside [{}, {}]",
+                Readable(value),
+                Readable(min),
+                Readable(max)
             ),
             Self::TooSlowForTangent {
                 min_speed,

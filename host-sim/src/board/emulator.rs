@@ -13,6 +13,7 @@ use firmware_images::qemu_runner;
 
 use super::image::check_flying_image;
 use super::pacing::Pacing;
+use crate::interrupt;
 
 /// Starts the QEMU flying image through `runner` (`scripts/qemu-run.sh`) in its own process
 /// group, with UART0 on `serial` (QEMU's `-serial` argument: `tcp:…` for PIL, `pty` for HIL)
@@ -113,6 +114,9 @@ impl QemuPty {
                     "QEMU ended ({status}) before naming its pty (see {})",
                     log_path.display()
                 ));
+            }
+            if interrupt::requested() {
+                return Err("interrupted while waiting for QEMU".to_string());
             }
             if Instant::now() > deadline {
                 return Err(format!(

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
+use controller_core::readable::Readable;
 
 use super::board_loop::{fly, link_key, loop_scenarios, LoopArgs, Started};
 use super::Exit;
@@ -49,7 +50,7 @@ pub fn hil(args: &HilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     {
         bail!(
             "--reply-timeout must be a time in (0, 3600] s, got {}",
-            args.reply_timeout
+            Readable(args.reply_timeout)
         );
     }
     if args.baud == 0 {

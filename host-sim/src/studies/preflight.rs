@@ -35,12 +35,14 @@ use std::fmt;
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
+use controller_core::readable::Readable;
 use controller_core::thruster::ThrustEnvelope;
 use controller_core::{allocation::Allocator, axes::NAMES as AXIS_NAMES};
 use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
+use crate::interrupt;
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::Scenario;
 
@@ -251,27 +253,60 @@ struct Checker<'a> {
     margin_envelope: ThrustEnvelope,
 }
 
+/// Why [`check`] gave no verdict.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CheckError {
+    /// The check cannot be made: a margin outside (0, 1], or a scenario whose allocator
+    /// cannot be built on the margin envelope.
+    Invalid(String),
+    /// A stop was requested ([`crate::interrupt`]) before the check was done: a day-long
+    /// mission is 1.7·10⁶ samples of the path at each of the 2⁹ corners, minutes of work, so
+    /// the check polls the request at every sample (**Choice 120**).
+    Interrupted,
+}
+
+impl fmt::Display for CheckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CheckError::Invalid(e) => f.write_str(e),
+            CheckError::Interrupted => f.write_str("interrupted before the check was done"),
+        }
+    }
+}
+
+impl std::error::Error for CheckError {}
+
+/// Stops a long loop of the check when a stop was requested.
+fn poll() -> Result<(), CheckError> {
+    if interrupt::requested() {
+        Err(CheckError::Interrupted)
+    } else {
+        Ok(())
+    }
+}
+
 /// The preflight check of `scenario` at `margin` (a fraction of the envelope, in (0, 1]).
 ///
 /// # Errors
-/// A margin outside (0, 1], or a scenario whose allocator cannot be built on the margin
-/// envelope.
-pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, String> {
+/// [`CheckError::Invalid`]: a margin outside (0, 1], or a scenario whose allocator cannot be
+/// built on the margin envelope; [`CheckError::Interrupted`]: a stop was requested.
+pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
     if !(margin > 0.0 && margin <= 1.0) {
-        return Err(format!(
-            "the margin must be a fraction of the envelope in (0, 1], got {margin}"
-        ));
+        return Err(CheckError::Invalid(format!(
+            "the margin must be a fraction of the envelope in (0, 1], got {}",
+            Readable(margin)
+        )));
     }
     let checker = Checker::new(scenario, margin)?;
     let cfg = scenario.config();
     let k = time_scale(cfg.time_scale);
-    let own = checker.sweep(1.0 / k, true);
-    let at_rest = checker.sweep(0.0, false);
+    let own = checker.sweep(1.0 / k, true)?;
+    let at_rest = checker.sweep(0.0, false)?;
     let statically_infeasible = at_rest.first.is_some();
     let smallest = if statically_infeasible {
         None
     } else {
-        checker.smallest_time_scale(own.first.is_none().then_some(k))
+        checker.smallest_time_scale(own.first.is_none().then_some(k))?
     };
     let verdict = if own.first.is_none() {
         Verdict::Feasible
@@ -342,7 +377,7 @@ fn currents(model: &CurrentModel) -> Vec<Vector3<f64>> {
 }
 
 impl<'a> Checker<'a> {
-    fn new(scenario: &'a Scenario, margin: f64) -> Result<Self, String> {
+    fn new(scenario: &'a Scenario, margin: f64) -> Result<Self, CheckError> {
         let cfg = scenario.config();
         let controller = scenario.controller();
         // The path at k = 1, sampled over the part the scenario flies.
@@ -350,24 +385,27 @@ impl<'a> Checker<'a> {
             time_scale: 1.0,
             ..cfg.mission()
         })
-        .map_err(|e| format!("the mission at time scale 1: {e}"))?;
+        .map_err(|e| CheckError::Invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / time_scale(cfg.time_scale);
         let n = (span * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
         let samples = (0..=n)
             .map(|j| {
+                if j % 4096 == 0 {
+                    poll()?;
+                }
                 let d = path.sample(j, SAMPLE_RATE_HZ);
                 let eta = d.eta.cast::<f64>();
                 let att = Attitude::from_eta(&eta);
-                PathSample {
+                Ok(PathSample {
                     s: j as f64 / f64::from(SAMPLE_RATE_HZ),
                     eta,
                     eta_dot: d.eta_dot.cast::<f64>(),
                     eta_ddot: d.eta_ddot.cast::<f64>(),
                     jinv: kinematics::jacobian_inv(&att),
                     att,
-                }
+                })
             })
-            .collect();
+            .collect::<Result<_, CheckError>>()?;
         let bx = controller.config().uncertainty.cast(f64::from);
         let nominal = VehicleParams::auv150();
         let plants = (0..controller_core::uncertainty::ParamBox::<f64>::CORNERS)
@@ -377,7 +415,7 @@ impl<'a> Checker<'a> {
                     p = plant::trimmed(&p);
                 }
                 Plant::new(p, PlantTerms::default())
-                    .map_err(|e| format!("parameter box corner {c}: {e}"))
+                    .map_err(|e| CheckError::Invalid(format!("parameter box corner {c}: {e}")))
             })
             .collect::<Result<_, _>>()?;
         let margin_envelope = controller.envelope().scaled(margin as f32);
@@ -386,7 +424,11 @@ impl<'a> Checker<'a> {
             &margin_envelope,
             &controller.config().priority,
         )
-        .map_err(|e| format!("the allocator on the {margin} margin envelope: {e}"))?;
+        .map_err(|e| {
+            CheckError::Invalid(format!(
+                "the allocator on the {margin} margin envelope: {e}"
+            ))
+        })?;
         Ok(Checker {
             scenario,
             samples,
@@ -398,8 +440,8 @@ impl<'a> Checker<'a> {
     }
 
     /// Every sample at 1/k = `inv_k`; stops at the first violation unless `full` (which also
-    /// collects the peaks).
-    fn sweep(&self, inv_k: f64, full: bool) -> Sweep {
+    /// collects the peaks), and at a stop request.
+    fn sweep(&self, inv_k: f64, full: bool) -> Result<Sweep, CheckError> {
         let allocation = self.scenario.controller().allocation();
         let priority = &self.scenario.controller().config().priority;
         let k_scn = time_scale(self.scenario.config().time_scale);
@@ -408,6 +450,8 @@ impl<'a> Checker<'a> {
             peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
         };
         for smp in &self.samples {
+            // One sample is every corner of the box: tens of microseconds.
+            poll()?;
             // Time of this sample at the scale checked (at rest: at the scenario's).
             let t = if inv_k > 0.0 {
                 smp.s / inv_k
@@ -441,14 +485,14 @@ impl<'a> Checker<'a> {
                         if (0..6).any(lost) {
                             out.first = Some(self.violation(t, &tau32, priority, &lost));
                             if !full {
-                                return out;
+                                return Ok(out);
                             }
                         }
                     }
                 }
             }
         }
-        out
+        Ok(out)
     }
 
     fn violation(
@@ -478,34 +522,34 @@ impl<'a> Checker<'a> {
         }
     }
 
-    fn feasible_at(&self, k: f64) -> bool {
-        self.sweep(1.0 / k, false).first.is_none()
+    fn feasible_at(&self, k: f64) -> Result<bool, CheckError> {
+        Ok(self.sweep(1.0 / k, false)?.first.is_none())
     }
 
     /// The smallest feasible time scale in [1, MAX_TIME_SCALE] (see the module docs), given a
     /// scale already known to be feasible, if any.
-    fn smallest_time_scale(&self, known: Option<f64>) -> Option<f64> {
+    fn smallest_time_scale(&self, known: Option<f64>) -> Result<Option<f64>, CheckError> {
         let max = f64::from(Trajectory::MAX_TIME_SCALE);
-        if known == Some(1.0) || self.feasible_at(1.0) {
-            return Some(1.0);
+        if known == Some(1.0) || self.feasible_at(1.0)? {
+            return Ok(Some(1.0));
         }
         // Doubling to a feasible upper end.
         let (mut lo, mut hi) = (1.0, known.unwrap_or(max).min(max));
         let mut k = 2.0f64;
         while k < hi {
-            if self.feasible_at(k) {
+            if self.feasible_at(k)? {
                 hi = k;
                 break;
             }
             lo = k;
             k *= 2.0;
         }
-        if known.is_none() && hi == max && !self.feasible_at(max) {
-            return None;
+        if known.is_none() && hi == max && !self.feasible_at(max)? {
+            return Ok(None);
         }
         while hi / lo > 1.0 + TIME_SCALE_TOLERANCE {
             let mid = (lo * hi).sqrt();
-            if self.feasible_at(mid) {
+            if self.feasible_at(mid)? {
                 hi = mid;
             } else {
                 lo = mid;
@@ -513,6 +557,6 @@ impl<'a> Checker<'a> {
         }
         let rounded = ((hi / TIME_SCALE_STEP).ceil() * TIME_SCALE_STEP).min(max);
         // Rounded up a feasible scale: feasible again wherever feasibility is monotone.
-        Some((rounded * 100.0).round() / 100.0)
+        Ok(Some((rounded * 100.0).round() / 100.0))
     }
 }

@@ -307,7 +307,11 @@ fn real_chain_scenario(ci: &mut Ci) -> Option<(&'static str, u8)> {
     let s = match host_sim::scenario::load_scenario(&path) {
         Ok(s) => s,
         Err(e) => {
-            ci.fail(format!("PIL real-chain: {REAL_CHAIN}: {e}"));
+            // The whole chain: an unreadable file's reason is the error's source.
+            ci.fail(format!(
+                "PIL real-chain: {REAL_CHAIN}: {:#}",
+                anyhow::Error::from(e)
+            ));
             return None;
         }
     };
