@@ -43,7 +43,7 @@ if [ "${QEMU_SERIAL:-}" = pty ]; then
      sleep 0.1
    done) &
 fi
-command -v qemu-system-arm >/dev/null || { echo "qemu-system-arm not found (see .ci/run)" >&2; exit 127; }
+command -v qemu-system-arm >/dev/null || { echo "qemu-system-arm not found (bash scripts/setup.sh installs it)" >&2; exit 127; }
 command -v defmt-print >/dev/null || { echo "defmt-print not found: cargo install defmt-print --locked" >&2; exit 127; }
 # --foreground: stay in the caller's process group, so that stopping the runner stops QEMU.
 timeout --foreground "${QEMU_TIMEOUT:-120}" qemu-system-arm \

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Installs what the tests need on a fresh Debian bookworm machine; does nothing that is
-# already there. Called by scripts/test-all.sh and .ci/run.
+# already there. The first step of `cargo xtask ci` (xtask/src/steps.rs).
 #  - rustup: the toolchain, rustfmt, clippy and the thumbv7em-none-eabihf target
 #  - Debian: fontconfig + a font (host-sim's plots), qemu-system-arm from bookworm-backports
 #    (QEMU 10 with mps2-an386; plain bookworm's 7.2 would remove the image's qemu-utils)

@@ -8,11 +8,12 @@
 
 use core::fmt;
 
-use crate::allocation::AllocationError;
-use crate::allocator::AxisPriority;
+use crate::allocation::{AllocationError, AxisPriority};
+use crate::axes::{ACTUATED, ROLL};
 use crate::effectiveness::ThrusterGeometry;
-use crate::law::{RobustLaw, CONTROLLED, ROLL};
+use crate::law::RobustLaw;
 use crate::model::VehicleParams;
+use crate::readable::Readable;
 use crate::thruster::ThrustUnit;
 use crate::uncertainty::{BoundsError, ParamBox};
 
@@ -178,7 +179,9 @@ impl ConfigError {
             ConfigError::Allocation(AllocationError::Weight { axis, .. }) => {
                 ("priority", Some(axis))
             }
-            ConfigError::Allocation(AllocationError::Envelope { .. }) => ("voltage_limit", None),
+            ConfigError::Allocation(AllocationError::ThrustEnvelope { .. }) => {
+                ("voltage_limit", None)
+            }
             ConfigError::Allocation(_) => ("geometry", None),
             ConfigError::Assumption2 { .. }
             | ConfigError::Theorem2 { .. }
@@ -205,29 +208,36 @@ impl fmt::Display for ConfigError {
         match *self {
             ConfigError::Gain { name, axis, value } => write!(
                 f,
-                "gain {name}[{axis}] must be a finite number > 0 on a controlled axis, got {value}"
+                "gain {name}[{axis}] must be a finite number > 0 on a controlled axis, got {}", Readable(value)
             ),
             ConfigError::RollGain { k1, k2 } => write!(
                 f,
-                "roll is not actuated: gains k1[{ROLL}] and k2[{ROLL}] must both be 0, got {k1} and {k2}"
+                "roll is not actuated: gains k1[{ROLL}] and k2[{ROLL}] must both be 0, got {} and {}", Readable(k1), Readable(k2)
             ),
             ConfigError::LyapunovWeight { index, value } => write!(
                 f,
-                "Lyapunov weight q[{index}] must be a finite number > 0 (Q positive definite), got {value}"
+                "Lyapunov weight q[{index}] must be a finite number > 0 (Q positive definite), got {}", Readable(value)
             ),
             ConfigError::NotPositive { name, value } => {
-                write!(f, "{name} must be a finite number > 0, got {value}")
+                write!(f, "{name} must be a finite number > 0, got {}", Readable(value))
             }
             ConfigError::OutOfRange {
                 name,
                 value,
                 min,
                 max,
-            } => write!(f, "{name} must be in ({min}, {max}), got {value}"),
+            } => write!(
+                f,
+                "{name} must be in ({}, {}), got {}",
+                Readable(min),
+                Readable(max),
+                Readable(value)
+            ),
             ConfigError::PitchLimit { value } => write!(
                 f,
-                "pitch_limit must be in (0°, 90°), got {}° ({value} rad)",
-                value.to_degrees()
+                "pitch_limit must be in (0°, 90°), got {}° ({} rad)",
+                Readable(value.to_degrees()),
+                Readable(value)
             ),
             ConfigError::ZeroRate => write!(f, "rate_hz must be ≥ 1 Hz, got 0"),
             ConfigError::NonFiniteParams => write!(f, "nominal vehicle parameters are not finite"),
@@ -260,7 +270,11 @@ impl fmt::Display for ConfigError {
                 mu,
             } => write!(
                 f,
-                "loop period {period} s is too long for axis {axis}: with δ_max = {delta_max} and μ = {mu} the boundary-layer gain needs T < {max_period} s (docs/design.md §8)"
+                "loop period {} s is too long for axis {axis}: with δ_max = {} and μ = {} the boundary-layer gain needs T < {} s (docs/design.md §8)",
+                Readable(period),
+                Readable(delta_max),
+                Readable(mu),
+                Readable(max_period)
             ),
             ConfigError::Allocation(e) => write!(f, "thruster allocation: {e}"),
         }
@@ -281,7 +295,7 @@ impl ControllerConfig {
     /// Checks of the scalar settings that need no model (the model checks live in
     /// [`crate::controller::Controller::new`]).
     pub(crate) fn check_scalars(&self) -> Result<(), ConfigError> {
-        for &axis in CONTROLLED.iter() {
+        for &axis in ACTUATED.iter() {
             for (name, k) in [("k1", self.k1[axis]), ("k2", self.k2[axis])] {
                 if !(k.is_finite() && k > 0.0) {
                     return Err(ConfigError::Gain {

@@ -8,15 +8,14 @@
 
 use nalgebra::{Matrix6, Vector6};
 
-use crate::allocation::Allocation;
-use crate::allocator::Allocated;
-use crate::allocator::Allocator;
+use crate::allocation::{Allocated, Allocator, PseudoInverse};
+use crate::axes::ACTUATED;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
 use crate::kinematics::{Attitude, Kinematics};
-use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw, CONTROLLED};
+use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw};
 use crate::model::{self, VehicleParams};
-use crate::thruster::{self, Actuation, Envelope, ThrusterMap};
+use crate::thruster::{self, Actuation, ThrustEnvelope, ThrusterMap};
 use crate::trajectory::{Desired, Trajectory};
 use crate::uncertainty::UncertaintyBounds;
 
@@ -206,9 +205,9 @@ impl Controller {
     /// and §8 is made here; see [`ConfigError`] for the list.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
         config.check_scalars()?;
-        let allocation = Allocation::new(&config.geometry)?;
+        let allocation = PseudoInverse::new(&config.geometry)?;
         let maps = thruster::default_maps();
-        let envelope = Envelope::new(&maps, config.thrust_unit, config.voltage_limit);
+        let envelope = ThrustEnvelope::new(&maps, config.thrust_unit, config.voltage_limit);
         let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
         let bounds = UncertaintyBounds::compute(&config.params, &config.uncertainty)?;
@@ -228,7 +227,7 @@ impl Controller {
 
         let mut lyapunov = [AxisLyapunov::default(); 6];
         let mut k_norm = 0.0f32;
-        for &i in CONTROLLED.iter() {
+        for &i in ACTUATED.iter() {
             let (k1, k2) = (config.k1[i], config.k2[i]);
             lyapunov[i] = AxisLyapunov::solve(k1, k2, config.q[0], config.q[1]);
             // ‖[K₁ K₂]‖₂ of diagonal blocks: max over axes of √(k₁² + k₂²).
@@ -240,7 +239,7 @@ impl Controller {
         // discontinuous law has no such pole (it chatters, bounded by δ), so only the
         // nominal gain is checked for it.
         let period = 1.0 / config.rate_hz as f32;
-        for &i in CONTROLLED.iter() {
+        for &i in ACTUATED.iter() {
             let layer_gain = match (config.robust, config.law) {
                 (true, RobustLaw::BoundaryLayer) => lyapunov[i].p22 * config.delta_max / config.mu,
                 _ => 0.0,
@@ -305,8 +304,8 @@ impl Controller {
     }
 
     /// The exact (unconstrained) thrust allocation B₅⁻¹.
-    pub fn allocation(&self) -> &Allocation {
-        self.allocator.allocation()
+    pub fn allocation(&self) -> &PseudoInverse {
+        self.allocator.pseudo_inverse()
     }
 
     /// The saturation-aware allocator `update` flies (docs/design.md §9).
@@ -316,7 +315,7 @@ impl Controller {
 
     /// Each thruster's envelope [T_min, T_max] (N) at the supply limit, in the configured
     /// thrust unit's reading of Eqs 31–32.
-    pub fn envelope(&self) -> &Envelope {
+    pub fn envelope(&self) -> &ThrustEnvelope {
         self.allocator.envelope()
     }
 
@@ -430,7 +429,7 @@ impl Controller {
         let u_bar = law::nominal_input(&desired.eta_ddot, &self.k1, &self.k2, &e1, &e2);
 
         let mut e_sq = 0.0f32;
-        for &i in CONTROLLED.iter() {
+        for &i in ACTUATED.iter() {
             e_sq += e1[i] * e1[i] + e2[i] * e2[i];
         }
         let delta_raw = law::uncertainty_bound(
@@ -500,7 +499,7 @@ impl Controller {
             demand,
             self.config.voltage_limit,
         );
-        let tau_achieved = self.allocator.allocation().wrench(&act.thrusts);
+        let tau_achieved = self.allocator.pseudo_inverse().wrench(&act.thrusts);
         (act, tau_achieved)
     }
 }
@@ -517,7 +516,7 @@ pub enum Stage {
     Trajectory,
     /// e₁, e₂, ū, δ, w, Δu and τ.
     Law,
-    /// Thrust demand: the saturation-aware allocator ([`crate::allocator::Allocator`]).
+    /// Thrust demand: the saturation-aware allocator ([`Allocator`]).
     Allocation,
     /// Voltages (Eqs 31–32), achieved thrusts and achieved wrench.
     Maps,

@@ -3,7 +3,7 @@
 //! This module says where the five thrusters sit and which way they push, and turns that into
 //! the 6×5 matrix B whose column i is the wrench [dᵢ; rᵢ × dᵢ] of one newton on thruster i
 //! (rows X Y Z K M N). In PX4's terms it is the *actuator effectiveness*; solving B·T = τ for
-//! T is the *control allocation* of [`crate::allocation`] and [`crate::allocator`], and what a thruster does with a
+//! T is the *control allocation* of [`crate::allocation`], and what a thruster does with a
 //! voltage is [`crate::thruster`].
 //!
 //! Thruster order everywhere: `[main, vertical fore, vertical aft, horizontal fore,
@@ -130,7 +130,7 @@ impl fmt::Display for Mounting {
 /// horizontal tunnels at x = ±1.8 m along −y (pushing to port); all on the centre line. It is
 /// configuration: [`effectiveness`](Self::effectiveness) accepts any geometry that passes its
 /// checks, and the allocator any whose 5×5 allocation is block diagonal
-/// ([`crate::allocator`]).
+/// ([`crate::allocation::Allocator`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ThrusterGeometry {
     /// Position rᵢ of thruster i, m.
@@ -227,7 +227,7 @@ impl ThrusterGeometry {
     ///
     /// Rejects, with the thruster and its numbers: a non-finite position or direction, and a
     /// direction with |‖d‖ − 1| > [`UNIT_TOLERANCE`]. Whether B can be inverted is the
-    /// allocation's question ([`crate::allocation::Allocation::new`]).
+    /// allocation's question ([`crate::allocation::PseudoInverse::new`]).
     ///
     /// For the AUV-150 layout, with r = (x, 0, 0): r × d = (0, −x d_z, x d_y), so a downward
     /// (+z) tunnel thrust at x = +1.8 m gives M = −1.8·T and a starboard (+y) one N = +1.8·T;

@@ -5,20 +5,15 @@
 //! force τ by the inversion-free route. [`crate::controller::Controller::update`] strings them
 //! together with the allocation.
 //!
-//! Axes: η = [x y z φ θ ψ]. Roll (index 3) is neither actuated nor controlled (K₁₄ = K₂₄ = 0
-//! in the paper): it is excluded from ‖e‖, from w and from Δu.
+//! Axes: η = [x y z φ θ ψ]. Roll ([`crate::axes::ROLL`]) is neither actuated nor controlled
+//! (K₁₄ = K₂₄ = 0 in the paper): it is excluded from ‖e‖, from w and from Δu; the controlled
+//! axes are [`crate::axes::ACTUATED`].
 
 use nalgebra::{Matrix6, RealField, Vector6};
 
+use crate::axes::YAW;
 use crate::kinematics::Kinematics;
 use crate::model::{self, VehicleParams};
-
-/// Indices of the controlled axes in η: x, y, z, θ, ψ.
-pub const CONTROLLED: [usize; 5] = [0, 1, 2, 4, 5];
-/// Index of roll in η.
-pub const ROLL: usize = 3;
-/// Index of yaw in η.
-pub const YAW: usize = 5;
 
 /// Which robust term Δu the law adds to ū.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

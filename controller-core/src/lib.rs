@@ -5,7 +5,7 @@
 #![deny(unsafe_code)]
 
 pub mod allocation;
-pub mod allocator;
+pub mod axes;
 pub mod config;
 pub mod controller;
 pub mod effectiveness;
@@ -14,6 +14,7 @@ pub mod law;
 pub mod math;
 pub mod model;
 pub mod phase;
+pub mod readable;
 pub mod thruster;
 pub mod trajectory;
 pub mod uncertainty;

@@ -19,7 +19,8 @@
 //! **Choice**: under the paper's own damping only the kgf reading reaches the vehicle's
 //! published 2–4 kn, and a wrong kgf guess under-drives the thrusters instead of over-driving
 //! them 9.81×). Everything else in the workspace is newtons: [`ThrusterMap::voltage_of_newtons`],
-//! [`ThrusterMap::newtons_of_voltage`], [`Envelope`] and [`actuate`] convert at this one seam.
+//! [`ThrusterMap::newtons_of_voltage`], [`ThrustEnvelope`] and [`actuate`] convert at this one
+//! seam.
 //! 1 kgf = [`KGF_IN_NEWTONS`] = 9.80665 N, the standard kilogram-force (docs/design.md §9
 //! **Choice**: the paper gives no sign that its fits use its model's g = 9.81; the two differ by
 //! 0.03 %). Voltage is in volts.
@@ -36,8 +37,8 @@
 //! square root feeds a cancellation), whose whole ±24 V range is only −9.2…+20.1 N. The
 //! reported thrust is the saturation-honesty signal, so it must not depend on the backend; the
 //! cost is five `sqrtf` per tick. With libm the inverse is within 1.2e-5 N of the exact root
-//! over ±24 V in both backends (asserted by `tests/thruster.rs`). `cbrt` is libm in both
-//! backends and goes through [`crate::math::cbrt`].
+//! over ±24 V in every backend (asserted by `tests/thruster.rs`). `cbrt` goes through
+//! [`crate::math::cbrt`]: libm's with `libm-math`, the kernels' otherwise (micromath has none).
 
 use crate::effectiveness::THRUSTERS;
 use crate::math;
@@ -196,7 +197,7 @@ impl ThrusterMap {
 
     /// The thrust envelope at a supply limit in polynomial units: the range of thrust
     /// reachable with voltages in [−`v_limit`, +`v_limit`], as (lowest, highest). In newtons:
-    /// [`Envelope::new`].
+    /// [`ThrustEnvelope::new`].
     ///
     /// In closed form: the tunnel map is increasing, so (T(−V), T(+V)); the main map is
     /// decreasing on its branch and folds, so (T_fold, T(−V)) once V ≥ V_fold = 0.719 V (the
@@ -233,19 +234,18 @@ impl ThrusterMap {
 ///
 /// At ±24 V, kgf (the default): main −171.29 … +718.89 N, tunnels −89.88 … +197.13 N;
 /// newtons: main −17.47 … +73.31 N, tunnels −9.17 … +20.10 N.
-#[doc(alias = "thrust_envelope")]
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Envelope {
+pub struct ThrustEnvelope {
     /// T_min per thruster (N), thruster order.
     pub min: [f32; THRUSTERS],
     /// T_max per thruster (N), thruster order.
     pub max: [f32; THRUSTERS],
 }
 
-impl Envelope {
+impl ThrustEnvelope {
     /// The envelope of `maps` (thruster order) read in `unit` at ±`v_limit`.
-    pub fn new(maps: &[ThrusterMap; THRUSTERS], unit: ThrustUnit, v_limit: f32) -> Envelope {
-        let mut e = Envelope {
+    pub fn new(maps: &[ThrusterMap; THRUSTERS], unit: ThrustUnit, v_limit: f32) -> ThrustEnvelope {
+        let mut e = ThrustEnvelope {
             min: [0.0; THRUSTERS],
             max: [0.0; THRUSTERS],
         };
@@ -259,8 +259,8 @@ impl Envelope {
 
     /// This envelope shrunk to `fraction` of itself about 0 N (each bound times `fraction`;
     /// every default envelope contains 0 N): the preflight check's margin (docs/design.md §9).
-    pub fn scaled(&self, fraction: f32) -> Envelope {
-        Envelope {
+    pub fn scaled(&self, fraction: f32) -> ThrustEnvelope {
+        ThrustEnvelope {
             min: self.min.map(|x| x * fraction),
             max: self.max.map(|x| x * fraction),
         }
@@ -372,9 +372,9 @@ pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
 ///    (within the inverse map's f32 round trip, ~1e-5 polynomial units).
 ///
 /// The controller's commands come from the saturation-aware allocator
-/// ([`crate::allocator`]), which keeps them inside the [`Envelope`]: then nothing is clipped
-/// here beyond the f32 rounding of a thrust that sits exactly on its envelope. Called with
-/// arbitrary commands it clips each thruster on its own.
+/// ([`crate::allocation::Allocator`]), which keeps them inside the [`ThrustEnvelope`]: then
+/// nothing is clipped here beyond the f32 rounding of a thrust that sits exactly on its
+/// envelope. Called with arbitrary commands it clips each thruster on its own.
 ///
 /// `v_limit` must be finite and > 0; otherwise every thruster is switched off (0 V, 0 N) with
 /// every bit set. Fixed work, never panics; for finite `v_limit` > 0 every output is finite

@@ -139,7 +139,7 @@ pub fn spectral_norm<T: RealField + Copy>(a: &Matrix6<T>) -> Result<T, BoundsErr
 
 /// Zeroes the roll row: S₀ as a 6×6 selector (same norm as the 5×6 product).
 fn controlled_rows<T: RealField + Copy>(mut a: Matrix6<T>) -> Matrix6<T> {
-    a.row_mut(crate::law::ROLL).fill(T::zero());
+    a.row_mut(crate::axes::ROLL).fill(T::zero());
     a
 }
 

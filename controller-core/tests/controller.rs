@@ -4,6 +4,7 @@
 #![allow(clippy::field_reassign_with_default)]
 
 use controller_core::controller::MAX_POSITION;
+use controller_core::effectiveness::THRUSTERS;
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::{self, VehicleParams};
 use controller_core::{Controller, ControllerConfig, Fault, Status, Table1Case, Trajectory};
@@ -91,8 +92,8 @@ fn faults_turn_every_thruster_off_and_say_why() {
     let check = |eta: [f32; 6], nu: [f32; 6], fault: Fault| {
         let out = c.update(100, &eta, &nu, &tr);
         assert_eq!(out.status, Status::Fault(fault));
-        assert_eq!(out.voltage, [0.0; 5]);
-        assert_eq!(out.thrust, [0.0; 5]);
+        assert_eq!(out.voltage, [0.0; THRUSTERS]);
+        assert_eq!(out.thrust, [0.0; THRUSTERS]);
         assert_eq!(out.tau, [0.0; 6]);
     };
     let mut bad = eta;

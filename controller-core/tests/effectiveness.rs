@@ -2,7 +2,7 @@
 //! docs/design.md §5): the default layout is the documented choice, B is checked column by
 //! column against r × d worked out by hand, and bad geometries are rejected with their numbers.
 
-use controller_core::allocation::{Allocation, AllocationError};
+use controller_core::allocation::{AllocationError, PseudoInverse};
 use controller_core::effectiveness::{
     GeometryError, ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE, MAIN, THRUSTERS,
     VERT_AFT, VERT_FORE,
@@ -43,7 +43,7 @@ fn default_layout_is_the_spec_choice() {
 fn effectiveness_matrix_by_hand() {
     // Columns [d; r × d] by hand, rows X Y Z K M N: r × d for r = (x, 0, 0) is
     // (0, −x d_z, x d_y). Along the reference axes (+x, +z, +z, +y, +y):
-    let reference: [[f32; 6]; 5] = [
+    let reference: [[f32; 6]; THRUSTERS] = [
         [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],  // main: on the x axis, no moment
         [0.0, 0.0, 1.0, 0.0, -1.8, 0.0], // vertical fore: M = −1.8·T
         [0.0, 0.0, 1.0, 0.0, 1.8, 0.0],  // vertical aft: M = +1.8·T
@@ -52,7 +52,7 @@ fn effectiveness_matrix_by_hand() {
     ];
     // The real vehicle (default): the vertical fore and both horizontal tunnels reversed,
     // their columns negated.
-    let default: [[f32; 6]; 5] = [
+    let default: [[f32; 6]; THRUSTERS] = [
         [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
         [0.0, 0.0, -1.0, 0.0, 1.8, 0.0],  // pushing up fore: nose up
         [0.0, 0.0, 1.0, 0.0, 1.8, 0.0],   // pushing down aft: nose up
@@ -70,7 +70,7 @@ fn effectiveness_matrix_by_hand() {
             }
         }
         // The allocation keeps this very matrix.
-        let a = Allocation::new(&g).expect("AUV-150 layout accepted");
+        let a = PseudoInverse::new(&g).expect("AUV-150 layout accepted");
         assert_eq!(a.matrix(), b);
     }
 }
@@ -89,7 +89,7 @@ fn rejects_non_unit_direction() {
     );
     assert!(err.to_string().contains("thruster 1"), "{err}");
     // The allocation refuses the geometry with the same error and message.
-    let alloc_err = Allocation::new(&g).expect_err("non-unit direction");
+    let alloc_err = PseudoInverse::new(&g).expect_err("non-unit direction");
     assert_eq!(alloc_err, AllocationError::Geometry(err));
     assert_eq!(alloc_err.to_string(), err.to_string());
     // Within the 1e-3 tolerance: accepted; just outside: rejected.
@@ -117,7 +117,7 @@ fn rejects_non_finite_geometry() {
         Err(GeometryError::NonFinite { thruster: MAIN })
     );
     assert_eq!(
-        Allocation::new(&g),
+        PseudoInverse::new(&g),
         Err(AllocationError::Geometry(GeometryError::NonFinite {
             thruster: MAIN
         }))

@@ -6,12 +6,12 @@
 //! in f64.
 //!
 //! The tolerances do not depend on the math backend: the module computes its inverse maps with
-//! `libm::sqrtf` in both backends (micromath's ≈ 6 % sqrt error would move the reported thrust by
+//! `libm::sqrtf` in every backend (micromath's ≈ 6 % sqrt error would move the reported thrust by
 //! up to 1.85 N, see the module docs), so the same numbers hold with `--features micromath`.
 
 use controller_core::effectiveness::{MAIN, THRUSTERS, VERT_FORE};
 use controller_core::thruster::{
-    actuate, default_maps, Actuation, Envelope, ThrustUnit, ThrusterMap, ALL_SATURATED,
+    actuate, default_maps, Actuation, ThrustEnvelope, ThrustUnit, ThrusterMap, ALL_SATURATED,
     DEFAULT_V_LIMIT, MAIN_T_FOLD, MAIN_V_FOLD,
 };
 use proptest::prelude::*;
@@ -346,7 +346,7 @@ fn envelope_in_newtons_in_both_readings() {
         (tunnel_root(-24.0), tunnel_root(24.0)),
     ];
     for (unit, newtons) in [(ThrustUnit::Newton, 1.0), (ThrustUnit::Kgf, KGF)] {
-        let e = Envelope::new(&default_maps(), unit, 24.0);
+        let e = ThrustEnvelope::new(&default_maps(), unit, 24.0);
         for i in 0..THRUSTERS {
             let (lo, hi) = poly[usize::from(i != MAIN)];
             let (lo, hi) = (lo * newtons, hi * newtons);
@@ -365,10 +365,10 @@ fn envelope_in_newtons_in_both_readings() {
     }
     // The figures docs/design.md §9 quotes (kgf): main −171.29 … +718.89 N, tunnel −89.88 …
     // +197.13 N.
-    let e = Envelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
+    let e = ThrustEnvelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
     assert!((e.min[MAIN] + 171.29).abs() < 0.01 && (e.max[MAIN] - 718.89).abs() < 0.01);
     assert!((e.min[VERT_FORE] + 89.88).abs() < 0.01 && (e.max[VERT_FORE] - 197.13).abs() < 0.01);
-    assert!(e.contains(&[0.0; 5]));
+    assert!(e.contains(&[0.0; THRUSTERS]));
     assert!(!e.scaled(0.8).contains(&e.max));
 }
 
@@ -524,17 +524,17 @@ fn non_finite_commands_switch_the_thruster_off() {
 fn invalid_supply_limit_switches_everything_off() {
     let maps = default_maps();
     for v_limit in [f32::NAN, 0.0, -24.0, f32::INFINITY] {
-        let a = actuate(&maps, ThrustUnit::Newton, &[1.0; 5], v_limit);
-        assert_eq!(a.voltages, [0.0; 5]);
-        assert_eq!(a.thrusts, [0.0; 5]);
+        let a = actuate(&maps, ThrustUnit::Newton, &[1.0; THRUSTERS], v_limit);
+        assert_eq!(a.voltages, [0.0; THRUSTERS]);
+        assert_eq!(a.thrusts, [0.0; THRUSTERS]);
         assert_eq!(a.saturated, ALL_SATURATED, "v_limit = {v_limit}");
     }
 }
 
 #[test]
 fn off_is_zero_volts_zero_newtons() {
-    assert_eq!(Actuation::OFF.voltages, [0.0; 5]);
-    assert_eq!(Actuation::OFF.thrusts, [0.0; 5]);
+    assert_eq!(Actuation::OFF.voltages, [0.0; THRUSTERS]);
+    assert_eq!(Actuation::OFF.thrusts, [0.0; THRUSTERS]);
     assert_eq!(Actuation::OFF.saturated, 0);
 }
 

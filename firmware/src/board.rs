@@ -6,6 +6,7 @@
 
 use auv_link::sign::{Direction, LinkKey, Signer, Verifier, UNITS_PER_SECOND};
 use auv_link::{encode, encode_signed, Envelope, FrameDecoder, LinkError, MAX_FRAME};
+use controller_core::effectiveness::THRUSTERS;
 use embedded_hal::pwm::SetDutyCycle;
 use embedded_io::{Read, ReadReady, Write};
 
@@ -20,7 +21,7 @@ pub trait Board {
     /// H-bridge supply voltage V_s (V).
     fn supply_voltage(&self) -> f32;
     /// The five thruster channels, order [main, vert fore, vert aft, horz fore, horz aft].
-    fn thrusters(&mut self) -> &mut [Self::Thruster; 5];
+    fn thrusters(&mut self) -> &mut [Self::Thruster; THRUSTERS];
     /// The navigation link.
     fn link(&mut self) -> &mut Self::Link;
     /// Sets the control-loop rate (Hz).
@@ -152,7 +153,7 @@ pub fn pump<L: Read + ReadReady>(link: &mut L, sup: &mut Supervisor, bufs: &mut 
 }
 
 /// Applies voltages to the thrusters (neutral duty for 0 V).
-pub fn drive<B: Board>(board: &mut B, voltages: &[f32; 5]) {
+pub fn drive<B: Board>(board: &mut B, voltages: &[f32; THRUSTERS]) {
     let vs = board.supply_voltage();
     for (ch, v) in board.thrusters().iter_mut().zip(voltages.iter()) {
         // A PWM channel error leaves that channel as it was; there is nothing better to do

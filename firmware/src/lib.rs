@@ -5,10 +5,11 @@
 //! step's instruction budgets on the target), [`pwm`] (voltage → H-bridge duty), [`board`]
 //! (the board trait and one control period),
 //! [`serial`] (the UART's byte queues between interrupt and loop), [`image`] (which images
-//! exist and how to tell their ELFs apart) and [`qemu_clock`] (QEMU's instruction counts).
+//! exist and how to tell their ELFs apart), [`qemu_clock`] (QEMU's instruction counts) and
+//! [`qemu_runner`] (what `scripts/qemu-run.sh` reads).
 //!
 //! Target only (`thumbv7em-none-eabihf`): `rt` (boot, the flying loop, fault reports) and one
-//! module per board, each behind its feature — `qemu` (mps2-an386) and `stm32f405`, whose
+//! module per board, each behind its feature — `mps2_an386` (feature `qemu`) and `stm32f405`, whose
 //! `emulator` build (feature `stm32f405-emulator`) runs the STM32 board code under QEMU's
 //! netduinoplus2 — and `semihosting` (exit and boot configuration under QEMU). The features
 //! only add a board (and its crates); they can be combined. The images themselves are the
@@ -24,13 +25,13 @@ pub mod serial;
 pub mod supervisor;
 
 // Their own crate, without this package's build script, so that host-sim can use them alone.
-pub use firmware_images::{image, qemu_clock};
+pub use firmware_images::{image, qemu_clock, qemu_runner, LINK_KEY_VAR, LINK_UNSIGNED_VAR};
 
 #[cfg(target_os = "none")]
 pub mod rt;
 
 #[cfg(all(target_os = "none", feature = "qemu"))]
-pub mod qemu;
+pub mod mps2_an386;
 
 #[cfg(all(
     target_os = "none",

@@ -7,9 +7,10 @@
 ///
 /// **Choice:** 200 Hz. One period must carry a telemetry frame out and a state frame in; the
 /// largest frame (`auv_link::MAX_FRAME` = 162 bytes, signed) takes 3.5 ms at the STM32 board's
-/// 460 800 baud, so the link alone allows at most ≈ 280 Hz, and 200 Hz (5 ms) leaves room for
-/// the update and the state frame's own latency. The core's `update` costs ≈ 0.2 ms on the
-/// 168 MHz M4F (firmware/README.md). Before this limit the board accepted 4 294 967 295 Hz.
+/// 460 800 baud ([`crate::serial::LINK_BAUD`]), so the link alone allows at most ≈ 280 Hz, and
+/// 200 Hz (5 ms) leaves room for the update and the state frame's own latency. The core's
+/// `update` costs ≈ 0.2 ms on the 168 MHz M4F (firmware/README.md). Before this limit the
+/// board accepted 4 294 967 295 Hz.
 pub const MAX_RATE_HZ: u32 = 200;
 
 /// Longest the board may keep flying on its last state frame (ms): `stale_periods` periods at
@@ -34,8 +35,9 @@ mod tests {
 
     #[test]
     fn the_largest_frame_fits_a_period_at_the_maximum_rate() {
-        // 460 800 baud 8N1: 10 bits a byte on the wire.
-        let frame_ns = auv_link::MAX_FRAME as u64 * 10 * 1_000_000_000 / 460_800;
+        // LINK_BAUD 8N1: 10 bits a byte on the wire.
+        let frame_ns =
+            auv_link::MAX_FRAME as u64 * 10 * 1_000_000_000 / crate::serial::LINK_BAUD as u64;
         let period_ns = 1_000_000_000 / MAX_RATE_HZ as u64;
         assert!(
             frame_ns < period_ns,

@@ -5,10 +5,7 @@
 
 use auv_link::sign::LinkKey;
 
-/// The build-time link key of the STM32 image: 64 hexadecimal digits.
-pub const KEY_VAR: &str = "AUV150_LINK_KEY";
-/// `1`: build the STM32 image without a key (signing off), explicitly.
-pub const UNSIGNED_VAR: &str = "AUV150_LINK_UNSIGNED";
+pub use firmware_images::{LINK_KEY_VAR as KEY_VAR, LINK_UNSIGNED_VAR as UNSIGNED_VAR};
 /// The public test key CI builds with (workspace-relative).
 pub const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
 

@@ -28,6 +28,8 @@
 use embedded_io::{ErrorKind, ErrorType, Read, ReadReady, Write};
 use heapless::spsc::{Consumer, Producer, Queue};
 
+pub use firmware_images::LINK_BAUD;
+
 /// Received bytes (and line errors) the queue holds: 11 ms of line at 460 800 baud, longer
 /// than a 100 Hz control period.
 pub const RX_CAPACITY: usize = 512;

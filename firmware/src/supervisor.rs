@@ -40,7 +40,7 @@ use crate::limits;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Step {
     /// Voltage per thruster (0 V = neutral duty in fail-safe).
-    pub voltages: [f32; 5],
+    pub voltages: [f32; THRUSTERS],
     pub telemetry: Telemetry,
 }
 
@@ -141,6 +141,19 @@ impl MissionClock {
 struct Latch {
     reason: FailSafeReason,
     fault: u8,
+}
+
+/// What one period's control gave the thrusters and reports: the controller's output, or zeros
+/// (0 V, 0 N) when it did not fly.
+#[derive(Clone, Copy, Default)]
+struct Control {
+    voltages: [f32; THRUSTERS],
+    thrusts: [f32; THRUSTERS],
+    tau: [f32; 6],
+    saturated: u8,
+    delta: f32,
+    delta_clamped: bool,
+    w_norm: f32,
 }
 
 /// Board state around the controller.
@@ -488,66 +501,95 @@ impl Supervisor {
         if overrun {
             self.loop_overruns = self.loop_overruns.saturating_add(1);
         }
-        let mut voltages = [0.0f32; 5];
-        let mut thrusts = [0.0f32; 5];
-        let mut tau = [0.0f32; 6];
-        let (mut saturated, mut delta, mut delta_clamped, mut w_norm) =
-            (0u8, 0.0f32, false, 0.0f32);
+        let (status, control) = self.control(overrun, now);
+        let telemetry = self.telemetry(status, &control);
+        self.periods_since_state = self.periods_since_state.saturating_add(1);
+        self.clock.period();
+        self.tick += 1;
+        Step {
+            voltages: control.voltages,
+            telemetry,
+        }
+    }
+
+    /// This period's status, and the controller's output if it flew (zeros otherwise: the
+    /// thrusters off).
+    fn control(&mut self, overrun: bool, now: &dyn Fn() -> u32) -> (BoardStatus, Control) {
+        let off = Control::default();
         let stale = self.periods_since_state > u32::from(self.stale_periods);
-        let status = match (self.armed, self.latched, self.mission, self.state) {
-            (false, _, _, _) => BoardStatus::Disarmed,
-            (true, Some(l), _, _) => BoardStatus::FailSafe(l.reason),
-            (true, None, None, _) => BoardStatus::Armed,
-            (true, None, Some(_), _) if overrun => self.latch(FailSafeReason::Overrun, 0),
+        match (self.armed, self.latched, self.mission, self.state) {
+            (false, _, _, _) => (BoardStatus::Disarmed, off),
+            (true, Some(l), _, _) => (BoardStatus::FailSafe(l.reason), off),
+            (true, None, None, _) => (BoardStatus::Armed, off),
+            (true, None, Some(_), _) if overrun => (self.latch(FailSafeReason::Overrun, 0), off),
             // A mission still waiting for its first state frame: StartMission and that frame
             // may straddle a period edge, so the mission gets the same `stale_periods` grace
             // as a state that stops arriving (thrusters off meanwhile), then latches.
             (true, None, Some((_, start)), None) => {
                 if self.tick.wrapping_sub(start) > u64::from(self.stale_periods) {
-                    self.latch(FailSafeReason::StaleState, 0)
+                    (self.latch(FailSafeReason::StaleState, 0), off)
                 } else {
-                    BoardStatus::Running
+                    (BoardStatus::Running, off)
                 }
             }
-            (true, None, Some(_), Some(_)) if stale => self.latch(FailSafeReason::StaleState, 0),
-            (true, None, Some((traj, start)), Some(s)) => {
-                // Mission time: the board's own ticks since StartMission; in lock-step the
-                // state frame's t_ticks, on the mission clock (so PIL does not depend on host
-                // speed).
-                let mission_ticks = if self.lockstep {
-                    s.t_ticks
-                } else {
-                    self.tick.wrapping_sub(start)
-                };
-                let t0 = now();
-                let out = self.controller.update(mission_ticks, &s.eta, &s.nu, &traj);
-                let dt = now().wrapping_sub(t0);
-                self.worst_update_ticks = self.worst_update_ticks.max(dt);
-                match out.status {
-                    Status::Ok => {
-                        voltages = out.voltage;
-                        thrusts = out.thrust;
-                        tau = out.tau;
-                        saturated = out.saturated;
-                        delta = out.delta;
-                        delta_clamped = out.delta_clamped;
-                        w_norm = out.w_norm;
-                        BoardStatus::Running
-                    }
-                    Status::Fault(f) => self.latch(FailSafeReason::ControllerFault, f.code()),
-                }
+            (true, None, Some(_), Some(_)) if stale => {
+                (self.latch(FailSafeReason::StaleState, 0), off)
             }
+            (true, None, Some((traj, start)), Some(s)) => self.fly(&traj, start, &s, now),
+        }
+    }
+
+    /// `update` on the latest state frame, timed; a fault latches the fail-safe.
+    fn fly(
+        &mut self,
+        traj: &Trajectory,
+        start: u64,
+        s: &StateFrame,
+        now: &dyn Fn() -> u32,
+    ) -> (BoardStatus, Control) {
+        // Mission time: the board's own ticks since StartMission; in lock-step the state
+        // frame's t_ticks, on the mission clock (so PIL does not depend on host speed).
+        let mission_ticks = if self.lockstep {
+            s.t_ticks
+        } else {
+            self.tick.wrapping_sub(start)
         };
-        let telemetry = Telemetry {
+        let t0 = now();
+        let out = self.controller.update(mission_ticks, &s.eta, &s.nu, traj);
+        let dt = now().wrapping_sub(t0);
+        self.worst_update_ticks = self.worst_update_ticks.max(dt);
+        match out.status {
+            Status::Ok => (
+                BoardStatus::Running,
+                Control {
+                    voltages: out.voltage,
+                    thrusts: out.thrust,
+                    tau: out.tau,
+                    saturated: out.saturated,
+                    delta: out.delta,
+                    delta_clamped: out.delta_clamped,
+                    w_norm: out.w_norm,
+                },
+            ),
+            Status::Fault(f) => (
+                self.latch(FailSafeReason::ControllerFault, f.code()),
+                Control::default(),
+            ),
+        }
+    }
+
+    /// The period's telemetry: its status and control, and the board's counters.
+    fn telemetry(&self, status: BoardStatus, c: &Control) -> Telemetry {
+        Telemetry {
             tick: self.tick,
             status,
-            voltages,
-            thrusts,
-            tau,
-            saturated,
-            delta,
-            delta_clamped,
-            w_norm,
+            voltages: c.voltages,
+            thrusts: c.thrusts,
+            tau: c.tau,
+            saturated: c.saturated,
+            delta: c.delta,
+            delta_clamped: c.delta_clamped,
+            w_norm: c.w_norm,
             controller_fault: self.latched.map_or(0, |l| l.fault),
             loop_overruns: self.loop_overruns,
             worst_update_ticks: self.worst_update_ticks,
@@ -564,13 +606,6 @@ impl Supervisor {
             thrust_unit: self.controller.config().thrust_unit.into(),
             reversed_thrusters: self.mounting,
             rx_ahead: self.rx_ahead,
-        };
-        self.periods_since_state = self.periods_since_state.saturating_add(1);
-        self.clock.period();
-        self.tick += 1;
-        Step {
-            voltages,
-            telemetry,
         }
     }
 

@@ -12,6 +12,7 @@
 //! link).
 
 use auv_link::{BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg};
+use controller_core::effectiveness::THRUSTERS;
 use firmware::supervisor::Supervisor;
 
 mod common;
@@ -189,7 +190,7 @@ fn disarm_drops_the_mission() {
     q.give(&mut s, Msg::State(state(2)));
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, BoardStatus::Armed);
-    assert_eq!(st.voltages, [0.0; 5]);
+    assert_eq!(st.voltages, [0.0; THRUSTERS]);
 }
 
 #[test]

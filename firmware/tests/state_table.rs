@@ -10,6 +10,7 @@
 //! counted, and the latched reason is kept exactly when the next state is latched.
 
 use auv_link::{Command, ConfigPatch, FailSafeReason, MissionSpec, Msg, Refusal};
+use controller_core::effectiveness::THRUSTERS;
 use firmware::board::{self, LinkBuffers};
 use firmware::supervisor::{Mode, Supervisor};
 
@@ -235,7 +236,7 @@ impl Rig {
     }
 
     /// Applies `event`; returns the period's voltages for period events.
-    fn apply(&mut self, event: Event) -> Option<[f32; 5]> {
+    fn apply(&mut self, event: Event) -> Option<[f32; THRUSTERS]> {
         let invalid_mission = MissionSpec::Circle {
             radius: -1.0,
             omega: 0.1,

@@ -7,6 +7,7 @@ use auv_link::{
     BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionSpec, Msg, Refusal,
     Telemetry,
 };
+use controller_core::effectiveness::THRUSTERS;
 use firmware::limits::{MAX_RATE_HZ, MAX_STALE_MS};
 use firmware::pwm;
 use firmware::supervisor::{Mode, Supervisor};
@@ -35,11 +36,11 @@ fn disarmed_and_armed_without_mission_keep_thrusters_off() {
     h.give(&mut s, Msg::State(state(0)));
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, BoardStatus::Disarmed);
-    assert_eq!(st.voltages, [0.0; 5]);
+    assert_eq!(st.voltages, [0.0; THRUSTERS]);
     h.command(&mut s, Command::Arm);
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, BoardStatus::Armed);
-    assert_eq!(st.voltages, [0.0; 5]);
+    assert_eq!(st.voltages, [0.0; THRUSTERS]);
 }
 
 #[test]
@@ -51,7 +52,7 @@ fn stale_state_fails_safe_after_the_configured_periods_and_latches_until_rearm()
     assert_eq!(status(&mut s), BoardStatus::Running);
     let st = s.step(false, NOW);
     assert_eq!(st.telemetry.status, STALE);
-    assert_eq!(st.voltages, [0.0; 5]);
+    assert_eq!(st.voltages, [0.0; THRUSTERS]);
     // Frames return, but the fail-safe latches until disarm + arm, and a mission is started
     // again (disarming dropped it).
     h.give(&mut s, Msg::State(state(4)));
@@ -97,7 +98,7 @@ fn controller_fault_and_overrun_fail_safe() {
         BoardStatus::FailSafe(FailSafeReason::ControllerFault)
     );
     assert_ne!(st.telemetry.controller_fault, 0);
-    assert_eq!(st.voltages, [0.0; 5]);
+    assert_eq!(st.voltages, [0.0; THRUSTERS]);
 
     let (mut s, _) = running();
     let st = s.step(true, NOW);
@@ -480,7 +481,7 @@ fn start_mission_in_lockstep_drops_the_state_held_from_before() {
     for _ in 0..=2 {
         let st = s.step(false, NOW);
         assert_eq!(st.telemetry.status, BoardStatus::Running);
-        assert_eq!(st.voltages, [0.0; 5]);
+        assert_eq!(st.voltages, [0.0; THRUSTERS]);
     }
     assert_eq!(status(&mut s), STALE);
 }
@@ -495,7 +496,7 @@ fn start_mission_and_its_first_state_may_straddle_a_period() {
     h.command(&mut s, Command::StartMission(CIRCLE));
     let idle = s.step(false, NOW);
     assert_eq!(idle.telemetry.status, BoardStatus::Running);
-    assert_eq!(idle.voltages, [0.0; 5]);
+    assert_eq!(idle.voltages, [0.0; THRUSTERS]);
     let ctl = s.controller().clone();
     let traj = controller_core::Trajectory::table1(controller_core::Table1Case::Circular10R);
     let f = state(0);

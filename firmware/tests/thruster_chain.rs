@@ -8,8 +8,8 @@ use auv_link::{
     AxisPriority, BoardStatus, Command, ConfigPatch, Heading, MissionPlan, MissionSpec, Msg,
     Refusal, ThrustUnit,
 };
-use controller_core::allocator;
-use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED};
+use controller_core::allocation;
+use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED, THRUSTERS};
 use controller_core::{Controller, ControllerConfig, Mission, Trajectory};
 use firmware::supervisor::{Mode, Supervisor, NOT_AUV150};
 
@@ -17,8 +17,8 @@ mod common;
 use common::{state, supervisor, Host, CIRCLE, NOW};
 
 /// A priority unlike the default (surge first, then sway …), with unequal weights.
-fn surge_first() -> allocator::AxisPriority {
-    allocator::AxisPriority {
+fn surge_first() -> allocation::AxisPriority {
+    allocation::AxisPriority {
         rank: [5, 4, 2, 0, 1, 3],
         weight: [1.0, 2.0, 0.5, 1.0, 4.0, 0.25],
     }
@@ -125,7 +125,7 @@ fn the_board_flies_the_chain_it_reports() {
             })
             .collect();
         let got = fly(patch);
-        let bits = |v: &Vec<[f32; 5]>| -> Vec<[u32; 5]> {
+        let bits = |v: &Vec<[f32; THRUSTERS]>| -> Vec<[u32; THRUSTERS]> {
             v.iter().map(|a| a.map(f32::to_bits)).collect()
         };
         assert_eq!(bits(&got), bits(&want));
@@ -182,7 +182,7 @@ fn an_invalid_mounting_or_priority_is_refused_with_its_reason_and_nothing_change
     let mut h = Host::new();
     let before = *s.controller().config();
     let weight = |axis: usize, w: f32| {
-        let mut p = allocator::AxisPriority::default();
+        let mut p = allocation::AxisPriority::default();
         p.weight[axis] = w;
         AxisPriority::from(p)
     };

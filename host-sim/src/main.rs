@@ -50,6 +50,12 @@ enum Command {
 }
 
 fn main() -> ExitCode {
+    // A file-size limit (`ulimit -f`) makes a write fail with EFBIG, which the outputs report as
+    // incomplete (exit 2), instead of killing the process with SIGXFSZ (Choice 121).
+    // SAFETY: setting a signal's disposition to "ignore" before any thread is started.
+    unsafe {
+        libc::signal(libc::SIGXFSZ, libc::SIG_IGN);
+    }
     if let Err(e) = host_sim::interrupt::install() {
         eprintln!("host-sim: warning: no Ctrl-C handler ({e}): an interrupt loses the run");
     }

@@ -216,3 +216,47 @@ fn a_mission_start_that_straddles_a_board_period_flies_no_period_disarmed() {
     let want = if others == 0 { Some(0) } else { Some(3) };
     assert_eq!(output.status.code(), want, "stderr:\n{stderr}");
 }
+
+/// Issue 22, item 1: the board's set-up waits up to the reply timeout (here an hour) for a
+/// silent board; Ctrl-C ends the wait and the command, as any other phase: exit 130, the
+/// report says partial.
+#[test]
+fn an_interrupt_ends_the_wait_for_a_silent_board() {
+    let (_master, path) = pty();
+    let scenario =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/lawn-mower-20x10.toml");
+    let out = out_dir("interrupted");
+    let child = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args([
+            "hil",
+            "--port",
+            &path,
+            "--reply-timeout",
+            "3600",
+            "--scenario",
+        ])
+        .arg(&scenario)
+        .args(["--duration", "1", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .expect("running host-sim");
+    std::thread::sleep(Duration::from_millis(1500));
+    let t0 = Instant::now();
+    // SAFETY: kill(2) with the child's pid.
+    assert_eq!(
+        unsafe { libc::kill(child.id() as libc::pid_t, libc::SIGINT) },
+        0
+    );
+    let o = child.wait_with_output().unwrap();
+    let t = t0.elapsed();
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    assert!(t < Duration::from_secs(10), "took {t:?}");
+    let report = std::fs::read_to_string(out.join("report.md")).unwrap();
+    assert!(
+        report.contains("(PARTIAL)") || report.contains("hardware in the loop"),
+        "{report}"
+    );
+    let _ = std::fs::remove_dir_all(&out);
+}

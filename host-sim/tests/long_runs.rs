@@ -2,6 +2,7 @@
 //! every bucket's extremes, the CSV streams every period, and a mission long enough for the
 //! heading to pass the controller's angle limit still flies.
 
+use controller_core::effectiveness::THRUSTERS;
 use host_sim::output::CsvStream;
 use host_sim::scenario::parse_scenario;
 use host_sim::sim;
@@ -26,7 +27,7 @@ fn sample(k: u64) -> Sample {
         ],
         tau: [0.0; 6],
         tau_applied: [0.0; 6],
-        thrust: [0.0; 5],
+        thrust: [0.0; THRUSTERS],
         voltage: [
             w(5.0, 0.0),
             w(6.0, 0.0),

@@ -1,5 +1,6 @@
 //! CSV, plots, tables and report of `host_sim::output`, on small hand-built runs.
 
+use controller_core::effectiveness::THRUSTERS;
 use std::path::{Path, PathBuf};
 
 use auv_link::{BoardStatus, FailSafeReason};
@@ -293,7 +294,7 @@ fn plot_case_survives_empty_single_and_nan_runs() {
     for s in &mut all_nan.samples {
         s.eta = [f64::NAN; 6];
         s.error = [f64::NAN; 6];
-        s.voltage = [f64::NAN; 5];
+        s.voltage = [f64::NAN; THRUSTERS];
     }
     let files = plot_case_with_limit(&dir, &holes, Some(&all_nan), f64::NAN).unwrap();
     assert_pngs(&files, &dir, "holes");
@@ -513,4 +514,52 @@ fn the_manifest_does_not_depend_on_the_order_files_were_claimed() {
             "{name} missing:\n{forward}"
         );
     }
+}
+
+/// Issue 22, item 4: a run that recorded no period (it stopped at t = 0) has no metrics; they
+/// used to print as 0.000 beside the DIVERGED flag, which read as a perfect run.
+#[test]
+fn a_run_with_no_sample_shows_no_metric_as_a_number() {
+    use host_sim::sim::metrics::compute;
+    use host_sim::sim::record::RunSummary;
+
+    let m = compute(&[]);
+    assert!(!m.recorded());
+    for v in [
+        m.max_x,
+        m.max_path,
+        m.rms_path,
+        m.peak_voltage,
+        m.saturated_fraction,
+    ] {
+        assert!(v.is_nan(), "{m:?}");
+    }
+    let mut empty = synthetic("stopped-at-0", true, 0, 1.0);
+    empty.metrics = m;
+    let empty = diverged(empty, 0.0, "plant state is not finite");
+    let rows = [ReportRow {
+        with: &empty,
+        without: None,
+        case: None,
+    }];
+    for table in [table_markdown(&rows), table_text(&rows)] {
+        let row = table.lines().find(|l| l.contains("stopped-at-0")).unwrap();
+        assert!(row.contains("DIVERGED at t = 0.00 s"), "{row}");
+        assert!(row.contains('—') && !row.contains("0.000"), "{row}");
+        assert!(!row.contains("NaN"), "{row}");
+    }
+    // The JSON says null, and reads back.
+    let json = serde_json::to_value(empty.summary()).unwrap();
+    assert!(
+        json["max_path"].is_null() && json["rms_path"].is_null(),
+        "{json}"
+    );
+    let back: RunSummary = serde_json::from_value(json).unwrap();
+    assert!(back.metrics.max_path.is_nan() && back.diverged.is_some());
+    // A run with samples keeps its numbers.
+    let run = synthetic("flew", true, 10, 0.1);
+    let json = serde_json::to_value(run.summary()).unwrap();
+    assert!(json["max_path"].is_f64(), "{json}");
+    let back: RunSummary = serde_json::from_value(json).unwrap();
+    assert_eq!(back.metrics, run.metrics);
 }

@@ -139,3 +139,77 @@ fn the_step_cap_refuses_a_long_fast_run_unless_overridden() {
         }
     }
 }
+
+/// Issue 22, item 4: finite values beyond what the vehicle can meet used to load, diverge at
+/// t = 0 and print 0.000 metrics; each is refused, naming its key, its number readable.
+#[test]
+fn absurd_finite_values_are_refused_with_their_key() {
+    let top = |extra: &str| format!("{extra}\n{}", circle_with(""));
+    for (text, key) in [
+        (top("initial_offset = [1e308, 0, 0, 0, 0, 0]"), "initial_offset"),
+        // 60 m from the reference with the default 50 m divergence limit.
+        (top("initial_offset = [0, 60, 0, 0, 0, 0]"), "initial_offset"),
+        (top("initial_offset = [0, 0, 0, 4, 0, 0]"), "initial_offset[3]"),
+        (top("initial_offset = [0, 0, 0, 0, 1.6, 0]"), "initial_offset[4]"),
+        (top("initial_offset = [0, 0, 0, 0, 0, -1e308]"), "initial_offset[5]"),
+        (top("divergence_limit = 1e308"), "divergence_limit"),
+        (top("thruster_lag = 1e308"), "thruster_lag"),
+        (
+            circle_with("[current]\nmodel = \"constant\"\nvelocity = [1e308, 0, 0]\n"),
+            "current.velocity",
+        ),
+        (
+            circle_with("[current]\nmodel = \"constant\"\nvelocity = [4, 4, 0]\n"),
+            "current.velocity",
+        ),
+        (
+            circle_with("[current]\nmodel = \"gauss-markov\"\nmean = [0, 1e308, 0]\nsigma = [0, 0, 0]\ntau = 30\n"),
+            "current.mean",
+        ),
+        (
+            circle_with("[current]\nmodel = \"gauss-markov\"\nsigma = [1e308, 0, 0]\ntau = 30\n"),
+            "current.sigma",
+        ),
+        (circle_with("[noise]\neta_sigma = [1e308, 0, 0, 0, 0, 0]\n"), "noise.eta_sigma[0]"),
+        (circle_with("[noise]\neta_sigma = [0, 0, 0, 0, 0, 7]\n"), "noise.eta_sigma[5]"),
+        (circle_with("[noise]\nnu_sigma = [0, 0, 0, 0, 0, 1e308]\n"), "noise.nu_sigma[5]"),
+    ] {
+        let (k, message) = invalid(&text);
+        assert_eq!(k, key, "{text}: {message}");
+        assert!(!message.contains("00000000"), "{key}: {message}");
+    }
+    let (_, message) = invalid(&top("initial_offset = [1e308, 0, 0, 0, 0, 0]"));
+    assert!(
+        message.contains("1e308") && message.contains("divergence_limit"),
+        "{message}"
+    );
+    // Just inside each limit: accepted (a 4.9 m/s current, a start 49 m off, pitched 83°).
+    for ok in [
+        top("initial_offset = [0, 49, 0, 3.1, 1.45, -3.1]"),
+        circle_with("[current]\nmodel = \"constant\"\nvelocity = [3, 3.9, 0]\n"),
+        top("divergence_limit = 10000\nthruster_lag = 10"),
+    ] {
+        parse_scenario(&ok).unwrap_or_else(|e| panic!("{ok}: {e}"));
+    }
+}
+
+/// Issue 22, item 5: a number in a message reads as the user wrote it, not as 309 digits.
+#[test]
+fn numbers_in_messages_are_readable() {
+    let (key, message) = invalid(&circle_with(
+        "[variation]\nprofile = \"abs-sin\"\nomega = 1e308\n",
+    ));
+    assert_eq!(key, "variation.omega");
+    assert!(
+        message.starts_with("1e308 rad/s is too fast") && message.len() < 200,
+        "{message}"
+    );
+    // The core's own messages too.
+    let (key, message) = invalid(&circle_with("[controller]\nmu = -1e30\n"));
+    assert_eq!(key, "controller.mu");
+    assert!(message.ends_with("got -1e30"), "{message}");
+    let (_, message) = invalid(&circle_with("[controller]\nk2 = [1e30, 4, 4, 0, 4, 4]\n"));
+    assert!(!message.contains("0000000000"), "{message}");
+    let (_, message) = invalid(&format!("duration = 1e300\n{}", circle_with("")));
+    assert!(message.ends_with("got 1e300"), "{message}");
+}

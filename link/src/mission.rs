@@ -106,16 +106,16 @@ impl From<MissionSpec> for MissionPlan {
     }
 }
 
-impl From<controller_core::allocator::AxisPriority> for AxisPriority {
-    fn from(p: controller_core::allocator::AxisPriority) -> Self {
-        let controller_core::allocator::AxisPriority { rank, weight } = p;
+impl From<controller_core::allocation::AxisPriority> for AxisPriority {
+    fn from(p: controller_core::allocation::AxisPriority) -> Self {
+        let controller_core::allocation::AxisPriority { rank, weight } = p;
         AxisPriority { rank, weight }
     }
 }
 
-impl From<AxisPriority> for controller_core::allocator::AxisPriority {
+impl From<AxisPriority> for controller_core::allocation::AxisPriority {
     fn from(p: AxisPriority) -> Self {
         let AxisPriority { rank, weight } = p;
-        controller_core::allocator::AxisPriority { rank, weight }
+        controller_core::allocation::AxisPriority { rank, weight }
     }
 }

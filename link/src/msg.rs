@@ -5,6 +5,7 @@
 //! changes the protocol: bump [`PROTOCOL_VERSION`] and update the `MAX_SIZE` constants (the
 //! `max_sizes_are_exact` test fails until they match).
 
+use controller_core::effectiveness::THRUSTERS;
 use serde::{Deserialize, Serialize};
 
 use crate::refusal::Refusal;
@@ -272,7 +273,7 @@ pub struct ConfigPatch {
     pub priority: Option<AxisPriority>,
 }
 
-/// The wire form of `controller_core::allocator::AxisPriority`: per row of τ = [X Y Z K M N],
+/// The wire form of `controller_core::allocation::AxisPriority`: per row of τ = [X Y Z K M N],
 /// the rank (higher is met first) and the least-squares weight between axes of equal rank
 /// (finite and > 0 on the actuated axes; the roll entries are carried and not used). Convert
 /// with `From` both ways ([`crate::mission`]).
@@ -329,9 +330,9 @@ pub struct Telemetry {
     /// What the board is doing.
     pub status: BoardStatus,
     /// Voltage per thruster (V), order [main, vert fore, vert aft, horz fore, horz aft].
-    pub voltages: [f32; 5],
+    pub voltages: [f32; THRUSTERS],
     /// Achieved thrust per thruster (N), same order.
-    pub thrusts: [f32; 5],
+    pub thrusts: [f32; THRUSTERS],
     /// Commanded body force τ = [X Y Z K M N] (N, N m): what ideal actuators would apply
     /// (processor in the loop with ideal actuators).
     pub tau: [f32; 6],
@@ -399,8 +400,8 @@ impl Telemetry {
     pub const LARGEST: Telemetry = Telemetry {
         tick: u64::MAX,
         status: BoardStatus::FailSafe(FailSafeReason::Overrun),
-        voltages: [f32::MAX; 5],
-        thrusts: [f32::MIN; 5],
+        voltages: [f32::MAX; THRUSTERS],
+        thrusts: [f32::MIN; THRUSTERS],
         tau: [f32::MAX; 6],
         saturated: u8::MAX,
         delta: f32::MAX,

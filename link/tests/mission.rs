@@ -139,13 +139,13 @@ fn every_kind_round_trips_through_a_frame() {
         assert_eq!(controller_core::ThrustUnit::from(ThrustUnit::from(u)), u);
     }
     // The axis priority, field for field (a non-default one, so a swapped field would show).
-    let p = controller_core::allocator::AxisPriority {
+    let p = controller_core::allocation::AxisPriority {
         rank: [1, 5, 2, 0, 4, 3],
         weight: [0.5, 1.0, 2.0, 3.0, 4.0, 8.0],
     };
     let wire = AxisPriority::from(p);
     assert_eq!((wire.rank, wire.weight), (p.rank, p.weight));
-    assert_eq!(controller_core::allocator::AxisPriority::from(wire), p);
+    assert_eq!(controller_core::allocation::AxisPriority::from(wire), p);
 }
 
 #[test]

@@ -2,6 +2,7 @@
 //! the firmware logs (its defmt snapshots hold them) and what host-sim's reports and JSON say.
 
 use auv_link::{BoardStatus, FailSafeReason, Refusal, Telemetry, ThrustUnit};
+use controller_core::effectiveness::THRUSTERS;
 use controller_core::Fault;
 
 #[test]
@@ -55,8 +56,8 @@ fn telemetry_fault_code_is_the_cores() {
     let mut t = Telemetry {
         tick: 0,
         status: BoardStatus::FailSafe(FailSafeReason::ControllerFault),
-        voltages: [0.0; 5],
-        thrusts: [0.0; 5],
+        voltages: [0.0; THRUSTERS],
+        thrusts: [0.0; THRUSTERS],
         tau: [0.0; 6],
         saturated: 0,
         delta: 0.0,

@@ -8,8 +8,8 @@ use std::path::{Path, PathBuf};
 use firmware::image::{Image, EMULATOR_SYMBOL, TARGET};
 use object::{Object, ObjectSection, ObjectSymbol};
 
-use crate::ci::Ci;
 use crate::snapshot::{self, SizeKey, Sizes};
+use xtask::ci::Ci;
 
 /// Flash budget of every image (bytes): well inside the STM32F405's 1 MiB, so that the board
 /// keeps room for a bootloader and a second image.
@@ -289,77 +289,15 @@ pub fn check(ci: &mut Ci, built: &Built) {
             hex(facts.stack_top),
             ci.rel(elf)
         );
-        if facts.image != Some(v.image) {
-            ci.fail(format!(
-                "{label}: the ELF's image marker says {:?}, not {:?} (firmware::image; does its main call Image::embed?)",
-                facts.image, v.image
-            ));
-        }
-        let emulator = v.image == Image::Stm32f405Emulator;
-        if facts.emulated != emulator {
-            ci.fail(if emulator {
-                format!("{label}: no {EMULATOR_SYMBOL} symbol; does it call Stm32Board::init_emulated? (without the symbol the flight image's check below proves nothing)")
-            } else {
-                format!("{label} carries the STM32 emulator build's substitutions ({EMULATOR_SYMBOL}: no clock tree, thrusters in RAM); only firmware-stm32f405-emulator may")
-            });
-        }
-        let stm32 = matches!(v.image, Image::Stm32f405 | Image::Stm32f405Emulator);
-        if stm32 && !facts.unbound.is_empty() {
-            ci.fail(format!(
-                "{label}: {:?} go to DefaultHandler (which loops forever): the board enables them; does its main invoke firmware::stm32f405_handlers!()?",
-                facts.unbound
-            ));
-        }
-        let (reset, stack) = expected_map(v.image);
-        if facts.reset_vector != Some(reset) || facts.stack_top != Some(stack) {
-            ci.fail(format!(
-                "{label} is linked with the wrong memory map: reset vector {} and stack top {}, expected {reset:#010x} and {stack:#010x} from {} (firmware/build.rs gives each bin its map)",
-                hex(facts.reset_vector),
-                hex(facts.stack_top),
-                v.image.memory_map()
-            ));
-        }
-        let flash_budget = if v.image == Image::QemuSelftest {
-            SELFTEST_FLASH_BUDGET
-        } else {
-            FLASH_BUDGET
-        };
-        if facts.sizes.flash > flash_budget {
-            ci.fail(format!(
-                "{label}: flash {} B exceeds the budget of {flash_budget} B",
-                facts.sizes.flash
-            ));
-        }
-        if facts.sizes.ram > RAM_BUDGET {
-            ci.fail(format!(
-                "{label}: static RAM {} B exceeds the budget of {RAM_BUDGET} B",
-                facts.sizes.ram
-            ));
-        }
+        check_identity(ci, &label, v.image, &facts);
+        check_memory_map(ci, &label, v.image, &facts);
+        check_budgets(ci, &label, v.image, facts.sizes);
         let key = SizeKey {
             bin: v.image.bin().to_string(),
             backend: v.backend.name().to_string(),
         };
         if !ci.bless {
-            match snapshot.get(&key) {
-                None => ci.fail(format!(
-                    "{label}: no entry in {} (cargo xtask images --bless adds it)",
-                    snapshot::SIZES
-                )),
-                Some(snap) => {
-                    for (what, now, then) in [
-                        ("flash", facts.sizes.flash, snap.flash),
-                        ("static RAM", facts.sizes.ram, snap.ram),
-                    ] {
-                        if !snapshot::size_close(now, then) {
-                            ci.fail(format!(
-                                "{label}: {what} {now} B is more than 10 % from the snapshot's {then} B in {} (a size jump is a review item; if it is intended: cargo xtask images --bless)",
-                                snapshot::SIZES
-                            ));
-                        }
-                    }
-                }
-            }
+            compare_sizes(ci, &label, snapshot.get(&key), facts.sizes);
         }
         measured.insert(key, facts.sizes);
     }
@@ -367,6 +305,87 @@ pub fn check(ci: &mut Ci, built: &Built) {
         match snapshot::write_sizes(&snapshot_path, &measured) {
             Ok(()) => println!("blessed {}", snapshot::SIZES),
             Err(e) => ci.fail(e),
+        }
+    }
+}
+
+/// The ELF is the image it was built as: its marker, the emulator build's substitutions only
+/// in the emulator image, and the STM32 board's interrupt handlers bound.
+fn check_identity(ci: &mut Ci, label: &str, image: Image, facts: &ElfFacts) {
+    if facts.image != Some(image) {
+        ci.fail(format!(
+            "{label}: the ELF's image marker says {:?}, not {image:?} (firmware::image; does its main call Image::embed?)",
+            facts.image
+        ));
+    }
+    let emulator = image == Image::Stm32f405Emulator;
+    if facts.emulated != emulator {
+        ci.fail(if emulator {
+            format!("{label}: no {EMULATOR_SYMBOL} symbol; does it call Stm32Board::init_emulated? (without the symbol the flight image's check below proves nothing)")
+        } else {
+            format!("{label} carries the STM32 emulator build's substitutions ({EMULATOR_SYMBOL}: no clock tree, thrusters in RAM); only firmware-stm32f405-emulator may")
+        });
+    }
+    let stm32 = matches!(image, Image::Stm32f405 | Image::Stm32f405Emulator);
+    if stm32 && !facts.unbound.is_empty() {
+        ci.fail(format!(
+            "{label}: {:?} go to DefaultHandler (which loops forever): the board enables them; does its main invoke firmware::stm32f405_handlers!()?",
+            facts.unbound
+        ));
+    }
+}
+
+/// The ELF links to its board's memory ([`expected_map`]).
+fn check_memory_map(ci: &mut Ci, label: &str, image: Image, facts: &ElfFacts) {
+    let (reset, stack) = expected_map(image);
+    if facts.reset_vector != Some(reset) || facts.stack_top != Some(stack) {
+        ci.fail(format!(
+            "{label} is linked with the wrong memory map: reset vector {} and stack top {}, expected {reset:#010x} and {stack:#010x} from {} (firmware/build.rs gives each bin its map)",
+            hex(facts.reset_vector),
+            hex(facts.stack_top),
+            image.memory_map()
+        ));
+    }
+}
+
+/// Flash and static RAM within their budgets.
+fn check_budgets(ci: &mut Ci, label: &str, image: Image, sizes: Sizes) {
+    let flash_budget = if image == Image::QemuSelftest {
+        SELFTEST_FLASH_BUDGET
+    } else {
+        FLASH_BUDGET
+    };
+    if sizes.flash > flash_budget {
+        ci.fail(format!(
+            "{label}: flash {} B exceeds the budget of {flash_budget} B",
+            sizes.flash
+        ));
+    }
+    if sizes.ram > RAM_BUDGET {
+        ci.fail(format!(
+            "{label}: static RAM {} B exceeds the budget of {RAM_BUDGET} B",
+            sizes.ram
+        ));
+    }
+}
+
+/// Flash and static RAM within 10 % of the image's entry in the size snapshot.
+fn compare_sizes(ci: &mut Ci, label: &str, snap: Option<&Sizes>, sizes: Sizes) {
+    let Some(snap) = snap else {
+        return ci.fail(format!(
+            "{label}: no entry in {} (cargo xtask images --bless adds it)",
+            snapshot::SIZES
+        ));
+    };
+    for (what, now, then) in [
+        ("flash", sizes.flash, snap.flash),
+        ("static RAM", sizes.ram, snap.ram),
+    ] {
+        if !snapshot::size_close(now, then) {
+            ci.fail(format!(
+                "{label}: {what} {now} B is more than 10 % from the snapshot's {then} B in {} (a size jump is a review item; if it is intended: cargo xtask images --bless)",
+                snapshot::SIZES
+            ));
         }
     }
 }

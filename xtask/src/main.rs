@@ -1,7 +1,11 @@
-//! The firmware's CI as code, in the manner of defmt's and RTIC's xtasks (`cargo xtask …`; the
-//! alias is in `.cargo/config.toml`). `scripts/test-all.sh` runs `cargo xtask firmware`.
+//! The workspace's CI as code, in the manner of defmt's and RTIC's xtasks (`cargo xtask …`; the
+//! alias is in `.cargo/config.toml`). `.ci/run` and the README's test command run
+//! `cargo xtask ci`.
 //!
 //! ```text
+//! cargo xtask ci                   the CI: set-up, link key, fmt, clippy, host tests with the
+//!                                  three math backends, cross-builds, then `firmware` below
+//!                                  (src/steps.rs lists the steps)
 //! cargo xtask firmware [--bless]   everything below, in this order
 //! cargo xtask images   [--bless]   build every image; its marker, memory map, flash and RAM
 //!                                  against the budgets and firmware/snapshots/sizes.txt; the
@@ -13,9 +17,9 @@
 //!                                  injection (a wrong answer, a panic, a HardFault, a hang)
 //! cargo xtask pil                  processor in the loop: a short mission must equal SIL bit
 //!                                  for bit; the link-fault case must enter and leave fail-safe
-//!                                  at its exact ticks; hardware in the loop over QEMU's pty
-//!                                  (xtask/src/hil.rs): lock-step equals SIL, real-time
-//!                                  figures, the port going away mid-mission
+//!                                  at its exact ticks; hardware in the loop over QEMU's pty:
+//!                                  lock-step equals SIL, real-time figures, the port going away
+//!                                  mid-mission (the package xtask/loop/, xtask-loop)
 //! cargo xtask rebuild-noop         a second `cargo build --release -p host-sim` rebuilds
 //!   [--profile P]                  nothing, with the link key's variable changed
 //!                                  (xtask/src/rebuild.rs)
@@ -27,29 +31,30 @@
 //!
 //! QEMU runs through `scripts/qemu-run.sh` (the cargo runner, kept in shell with
 //! `scripts/setup.sh`); everything else is here. The images, their features and ELF names come
-//! from `firmware::image`.
+//! from `firmware::image`, the runner's variables from `firmware::qemu_runner`.
 
 mod callgraph;
-mod ci;
-mod hil;
 mod images;
+mod in_the_loop;
 mod no_f64;
-mod pil;
-mod qemu;
+mod qemu_run;
 mod rebuild;
 mod selftest;
 mod snapshot;
+mod steps;
 mod thumb;
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
+use xtask::ci::Ci;
 
-use crate::ci::Ci;
 use crate::images::Variant;
 
 #[derive(Parser)]
-#[command(about = "AUV-150 firmware CI: images, QEMU self-test, snapshots, PIL")]
+#[command(
+    about = "AUV-150 CI: the whole CI, or the firmware's images, QEMU self-test, snapshots, PIL"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Task,
@@ -57,7 +62,9 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Task {
-    /// Every firmware check: images, self-test, failure injection, PIL.
+    /// The whole CI, step by step (set-up, lints, every test, the firmware's checks).
+    Ci,
+    /// Every firmware check: images, self-test, failure injection, PIL and HIL.
     Firmware {
         /// Rewrite firmware/snapshots/ from this run instead of comparing.
         #[arg(long)]
@@ -70,7 +77,7 @@ enum Task {
         #[arg(long)]
         bless: bool,
     },
-    /// Run the QEMU self-test (both math backends) and the failure injection.
+    /// Run the QEMU self-test (each math backend) and the failure injection.
     Selftest {
         /// Rewrite firmware/snapshots/selftest-*.log from this run instead of comparing.
         #[arg(long)]
@@ -79,9 +86,9 @@ enum Task {
     /// Processor in the loop: PIL = SIL, and the link-fault case; HIL over QEMU's pty.
     Pil,
     /// Build host-sim twice: the second build must rebuild nothing (no compile, no build
-    /// script, no link), with the link key's environment variable changed in between.
+    /// script, no link), with the link key's variable changed in between.
     RebuildNoop {
-        /// The cargo profile (the README's commands use release).
+        /// The cargo profile to build with.
         #[arg(long, default_value = rebuild::README_PROFILE)]
         profile: String,
     },
@@ -89,11 +96,15 @@ enum Task {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
-    let bless = match cli.command {
-        Task::Firmware { bless } | Task::Images { bless } | Task::Selftest { bless } => bless,
-        Task::Pil | Task::RebuildNoop { .. } => false,
+    let (title, bless) = match cli.command {
+        Task::Ci => ("CI", false),
+        Task::Firmware { bless } | Task::Images { bless } | Task::Selftest { bless } => {
+            ("firmware CI", bless)
+        }
+        Task::Pil => ("firmware CI", false),
+        Task::RebuildNoop { .. } => ("rebuild check", false),
     };
-    let mut ci = match Ci::new(bless) {
+    let mut ci = match Ci::new(title, bless) {
         Ok(ci) => ci,
         Err(e) => {
             eprintln!("xtask: {e:#}");
@@ -101,13 +112,8 @@ fn main() -> ExitCode {
         }
     };
     match cli.command {
-        Task::Firmware { .. } => {
-            let built = images::build(&mut ci, &Variant::ALL);
-            images::check(&mut ci, &built);
-            no_f64::run(&mut ci, &built);
-            selftest::run(&mut ci, &built);
-            pil::run(&mut ci, &built);
-        }
+        Task::Ci => steps::ci(&mut ci),
+        Task::Firmware { .. } => firmware(&mut ci),
         Task::Images { .. } => {
             let built = images::build(&mut ci, &Variant::ALL);
             images::check(&mut ci, &built);
@@ -119,9 +125,18 @@ fn main() -> ExitCode {
         }
         Task::Pil => {
             let built = images::build(&mut ci, &[Variant::QEMU, Variant::EMULATOR]);
-            pil::run(&mut ci, &built);
+            in_the_loop::run(&mut ci, &built);
         }
         Task::RebuildNoop { profile } => rebuild::run(&mut ci, &profile),
     }
     ci.finish()
+}
+
+/// Every firmware check (`cargo xtask firmware`, and the CI's last step).
+fn firmware(ci: &mut Ci) {
+    let built = images::build(ci, &Variant::ALL);
+    images::check(ci, &built);
+    no_f64::run(ci, &built);
+    selftest::run(ci, &built);
+    in_the_loop::run(ci, &built);
 }

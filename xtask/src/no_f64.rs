@@ -15,8 +15,8 @@ use std::path::Path;
 use firmware::image::Image;
 
 use crate::callgraph::{CallGraph, InlineFrames};
-use crate::ci::Ci;
 use crate::images::{Built, Variant};
+use xtask::ci::Ci;
 
 /// Whether a soft-float f64 routine reachable from `update` fails the firmware CI: it does. The
 /// trajectory's phases are integer arithmetic and the default math backend is the core's f32

@@ -16,13 +16,11 @@
 use std::process::Stdio;
 use std::time::Instant;
 
-use crate::ci::Ci;
+use xtask::ci::Ci;
 
 // The variable the firmware's build script reads (`cargo:rerun-if-env-changed`).
 #[allow(dead_code)]
-#[path = "../../firmware/src/provision.rs"]
-mod provision;
-use provision::KEY_VAR;
+use firmware::LINK_KEY_VAR as KEY_VAR;
 
 /// The cargo profile the README's commands build host-sim with.
 pub const README_PROFILE: &str = "release";

@@ -5,11 +5,12 @@
 use controller_core::Stage;
 use firmware::budget;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+use firmware::qemu_runner::TIMED_OUT;
 
-use crate::ci::Ci;
 use crate::images::{Backend, Built, Variant};
-use crate::qemu::{self, TIMED_OUT};
+use crate::qemu_run;
 use crate::snapshot;
+use xtask::ci::Ci;
 
 /// Seconds a self-test run may take (it needs about one on an idle machine).
 const SELFTEST_TIMEOUT_S: u32 = 120;
@@ -33,7 +34,7 @@ pub fn run(ci: &mut Ci, built: &Built) {
         let Some(elf) = built.elf(v) else { continue };
         let backend = v.backend.name();
         ci.step(&format!("self-test in QEMU, {backend} backend"));
-        let run = match qemu::run(
+        let run = match qemu_run::run(
             ci,
             elf,
             &[],
@@ -224,7 +225,7 @@ fn inject_failures(ci: &mut Ci, elf: &std::path::Path) {
             INJECTION_TIMEOUT_S
         };
         let arg = format!("inject={kind}");
-        let run = match qemu::run(
+        let run = match qemu_run::run(
             ci,
             elf,
             &["-append", &arg],

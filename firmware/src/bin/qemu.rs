@@ -8,7 +8,7 @@
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::image::Image;
-use firmware::qemu::{halt, QemuBoard};
+use firmware::mps2_an386::{halt, QemuBoard};
 use firmware::semihosting::link_key_or_halt;
 
 #[entry]

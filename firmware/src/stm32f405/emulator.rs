@@ -43,6 +43,7 @@
 use super::{stop_in_debug, Stm32Board, ThrusterOutputs, PWM_COUNTS};
 use crate::image::Image;
 use crate::pwm::MemPwm;
+use controller_core::effectiveness::THRUSTERS;
 use stm32f4xx_hal::pac;
 use stm32f4xx_hal::prelude::*;
 
@@ -61,11 +62,11 @@ pub const QEMU_MACHINE: &str = match Image::Stm32f405Emulator.qemu_machine() {
 static EMULATOR_SUBSTITUTIONS: u8 = 0;
 
 /// The five thruster outputs as RAM channels (substitution 2 above).
-pub struct EmulatedTimers([MemPwm; 5]);
+pub struct EmulatedTimers([MemPwm; THRUSTERS]);
 
 impl ThrusterOutputs for EmulatedTimers {
     type Channel = MemPwm;
-    fn channels(&mut self) -> &mut [MemPwm; 5] {
+    fn channels(&mut self) -> &mut [MemPwm; THRUSTERS] {
         &mut self.0
     }
 }
@@ -88,7 +89,7 @@ impl Stm32Board<EmulatedTimers> {
         // Substitution 1: the HAL's reset-state clocks, nothing programmed.
         let mut rcc = dp.RCC.constrain();
         let gpioa = dp.GPIOA.split(&mut rcc);
-        let thrusters = EmulatedTimers([MemPwm::neutral(PWM_COUNTS); 5]);
+        let thrusters = EmulatedTimers([MemPwm::neutral(PWM_COUNTS); THRUSTERS]);
         Stm32Board::assemble(
             cp,
             dp.USART2,

@@ -79,6 +79,7 @@
 
 use core::convert::Infallible;
 
+use controller_core::effectiveness::THRUSTERS;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::{DWT, SYST};
 use embedded_hal::pwm::{ErrorType as PwmErrorType, SetDutyCycle};
@@ -92,6 +93,7 @@ use stm32f4xx_hal::timer::{ErasedChannel, PwmHzManager};
 
 use crate::board::Board;
 use crate::pwm;
+use crate::serial::LINK_BAUD;
 
 mod usart2;
 pub use usart2::{on_usart2_interrupt, Usart2Link};
@@ -112,8 +114,6 @@ pub const PWM_HZ: u32 = 20_000;
 /// Counts of one PWM period, the channels' full duty: the advanced timers' clock (2 × PCLK2 =
 /// 168 MHz) over [`PWM_HZ`], no prescaler.
 pub const PWM_COUNTS: u16 = (2 * PCLK2_HZ / PWM_HZ) as u16;
-/// Navigation-link baud rate (8N1).
-pub const LINK_BAUD: u32 = 460_800;
 /// H-bridge supply voltage V_s (V): nominal, not measured. The duty for a commanded voltage
 /// is computed against it ([`crate::pwm::duty_fraction`]).
 pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
@@ -153,13 +153,13 @@ pub trait ThrusterOutputs {
     /// One channel.
     type Channel: SetDutyCycle;
     /// The five channels, order [main, vert fore, vert aft, horz fore, horz aft].
-    fn channels(&mut self) -> &mut [Self::Channel; 5];
+    fn channels(&mut self) -> &mut [Self::Channel; THRUSTERS];
 }
 
 /// The thruster outputs of the real board: TIM1 CH1–CH4 and TIM8 CH1 (pin map above), the
 /// timers held so nothing else can reconfigure them.
 pub struct AdvancedTimers {
-    channels: [Thruster; 5],
+    channels: [Thruster; THRUSTERS],
     _tim1: PwmHzManager<pac::TIM1>,
     _tim8: PwmHzManager<pac::TIM8>,
 }
@@ -202,7 +202,7 @@ impl AdvancedTimers {
 
 impl ThrusterOutputs for AdvancedTimers {
     type Channel = Thruster;
-    fn channels(&mut self) -> &mut [Thruster; 5] {
+    fn channels(&mut self) -> &mut [Thruster; THRUSTERS] {
         &mut self.channels
     }
 }
@@ -407,7 +407,7 @@ impl<T: ThrusterOutputs> Board for Stm32Board<T> {
         SUPPLY_VOLTAGE
     }
 
-    fn thrusters(&mut self) -> &mut [T::Channel; 5] {
+    fn thrusters(&mut self) -> &mut [T::Channel; THRUSTERS] {
         self.thrusters.channels()
     }
 

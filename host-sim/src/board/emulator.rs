@@ -9,9 +9,11 @@ use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
 use auv_link::sign::LinkKey;
+use firmware_images::qemu_runner;
 
 use super::image::check_flying_image;
 use super::pacing::Pacing;
+use crate::interrupt;
 
 /// Starts the QEMU flying image through `runner` (`scripts/qemu-run.sh`) in its own process
 /// group, with UART0 on `serial` (QEMU's `-serial` argument: `tcp:…` for PIL, `pty` for HIL)
@@ -41,10 +43,10 @@ pub fn spawn_qemu(
         qemu.arg("-append").arg(format!("link-key={hex}"));
     }
     if pacing == Pacing::Realtime {
-        qemu.env("QEMU_ICOUNT", "off");
+        qemu.env(qemu_runner::ICOUNT_VAR, qemu_runner::ICOUNT_OFF);
     }
-    qemu.env("QEMU_SERIAL", serial)
-        .env("QEMU_TIMEOUT", "3600")
+    qemu.env(qemu_runner::SERIAL_VAR, serial)
+        .env(qemu_runner::TIMEOUT_VAR, "3600")
         .stdin(Stdio::null())
         .stdout(Stdio::from(log))
         .stderr(Stdio::from(log_err))
@@ -95,7 +97,7 @@ impl QemuPty {
         check_flying_image(elf)?;
         let log = std::fs::File::create(log_path)
             .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
-        let child = spawn_qemu(elf, runner, "pty", pacing, log, key)?;
+        let child = spawn_qemu(elf, runner, qemu_runner::SERIAL_PTY, pacing, log, key)?;
         let mut q = QemuPty {
             child,
             port: PathBuf::new(),
@@ -112,6 +114,9 @@ impl QemuPty {
                     "QEMU ended ({status}) before naming its pty (see {})",
                     log_path.display()
                 ));
+            }
+            if interrupt::requested() {
+                return Err("interrupted while waiting for QEMU".to_string());
             }
             if Instant::now() > deadline {
                 return Err(format!(

@@ -10,6 +10,7 @@ use firmware_images::qemu_clock::INSTRUCTIONS_PER_TICK;
 
 use super::runner::BoardInTheLoop;
 use super::stats::{FailSafeEvent, FailSafeEventKind};
+use crate::interrupt;
 
 /// The longest single read: the runner checks its deadlines at least this often.
 const READ_SLICE: Duration = Duration::from_millis(100);
@@ -90,6 +91,11 @@ impl BoardInTheLoop {
                     rt.arrived(self.heard);
                 }
                 return Ok(Some(t));
+            }
+            // The set-up and a lock-step period may wait up to the reply timeout (an hour):
+            // a stop request ends the wait (Choice 120).
+            if interrupt::requested() {
+                return Err("interrupted while waiting for the board".to_string());
             }
             let now = Instant::now();
             let silent_until = self.heard + self.reply_timeout;

@@ -21,6 +21,7 @@ use super::image::check_flying_image;
 use super::pacing::{board_edge, Pacing, RealTime, PHASE_FRAMES};
 use super::stats::BoardStats;
 use super::transport::{Serial, Transport};
+use crate::interrupt;
 use crate::scenario::{LinkFaults, Scenario};
 
 /// How long PIL waits for valid telemetry before it gives up on QEMU (an idle QEMU under
@@ -114,6 +115,10 @@ impl BoardInTheLoop {
             match listener.accept() {
                 Ok((s, _)) => break s,
                 Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                    if interrupt::requested() {
+                        stop_group(&mut child);
+                        return Err("interrupted while waiting for QEMU".to_string());
+                    }
                     if Instant::now() > deadline {
                         stop_group(&mut child);
                         return Err(format!(

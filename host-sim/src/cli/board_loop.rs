@@ -140,18 +140,35 @@ pub(super) fn fly(
     let mut cases = Vec::new();
     let mut runs = Vec::new();
     let mut failed = false;
+    // The scenarios an interrupt left unflown (before or during their set-up).
+    let mut not_flown = Vec::new();
     for s in scenarios {
         if interrupt::requested() {
-            break;
+            not_flown.push(s.config().name.as_str());
+            continue;
         }
-        let started = start(s, dir)?;
+        let started = match start(s, dir) {
+            Ok(started) => started,
+            // The set-up gave up waiting for the board because a stop was requested.
+            Err(_) if interrupt::requested() => {
+                not_flown.push(s.config().name.as_str());
+                continue;
+            }
+            Err(e) => return Err(e),
+        };
         let (c, board_run, ok) = fly_one(s, started, dir, mode, &progress, &incomplete);
         failed |= !ok;
         cases.push(c);
         runs.push(board_run);
     }
     progress.finish();
-    let notes = sections::board_vs_sil(&cases);
+    let mut notes = sections::board_vs_sil(&cases);
+    if !not_flown.is_empty() {
+        notes = format!(
+            "**INTERRUPTED (PARTIAL)**: not flown: {}.\n\n{notes}",
+            not_flown.join(", ")
+        );
+    }
     let rows: Vec<ReportRow> = runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
     let report = output::write_plots_and_report(

@@ -5,11 +5,12 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
+use controller_core::readable::Readable;
 
 use super::common::load;
 use super::json::print_json;
 use super::Exit;
-use crate::studies::preflight::{self, Preflight, DEFAULT_MARGIN};
+use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 
 /// `check`: the preflight feasibility check of one scenario (nothing is simulated).
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -30,11 +31,18 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
     if !(args.margin > 0.0 && args.margin <= 1.0) {
         bail!(
             "--margin must be a fraction of the envelope in (0, 1], got {}",
-            args.margin
+            Readable(args.margin)
         );
     }
     let scenario = load(&args.scenario, false)?;
-    let p = preflight::check(&scenario, args.margin).map_err(|e| anyhow!(e))?;
+    let p = match preflight::check(&scenario, args.margin) {
+        Ok(p) => p,
+        Err(CheckError::Interrupted) => {
+            eprintln!("host-sim: check: interrupted before the verdict");
+            return Ok(Exit::Interrupted);
+        }
+        Err(e) => return Err(anyhow!(e)),
+    };
     if args.json {
         print_json(stdout, &p)?;
     } else {

@@ -10,12 +10,12 @@ use anyhow::{anyhow, Context, Result};
 use super::json::{print_json, Cases};
 use super::Exit;
 use crate::interrupt;
-use crate::output::{self, CsvStream, OutputDir, ReportRow};
+use crate::output::{self, atomic, CsvStream, OutputDir, ReportRow};
 use crate::scenario::{load_config, Scenario};
 use crate::sim::progress::Progress;
 use crate::sim::record::RunSummary;
 use crate::sim::{self, ControlSource, LocalController, Recording, RunResult};
-use crate::studies::preflight::{self, Preflight, DEFAULT_MARGIN};
+use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 
 /// Reads and validates a scenario file, with the step cap lifted if `allow_long_run`.
 pub(super) fn load(path: &Path, allow_long_run: bool) -> Result<Scenario> {
@@ -129,18 +129,51 @@ pub(super) fn print_runs(
     Ok(exit)
 }
 
-/// The preflight checks of `scenarios` (in parallel), at the default margin.
+/// The preflight checks of `scenarios` (in parallel), at the default margin; `None` when a
+/// stop was requested before they were done ([`interrupted_before_runs`]).
 pub(super) fn preflights<'a>(
     scenarios: impl IntoIterator<Item = &'a Scenario>,
-) -> Result<Vec<Preflight>> {
+) -> Result<Option<Vec<Preflight>>> {
     use rayon::prelude::*;
     let v: Vec<&Scenario> = scenarios.into_iter().collect();
-    v.par_iter()
-        .map(|s| {
-            preflight::check(s, DEFAULT_MARGIN)
-                .map_err(|e| anyhow!("preflight of {}: {e}", s.config().name))
-        })
-        .collect()
+    let checks: Result<Vec<Preflight>, (&Scenario, CheckError)> = v
+        .par_iter()
+        .map(|s| preflight::check(s, DEFAULT_MARGIN).map_err(|e| (*s, e)))
+        .collect();
+    match checks {
+        Ok(c) => Ok(Some(c)),
+        Err((_, CheckError::Interrupted)) => Ok(None),
+        Err((s, e)) => Err(anyhow!("preflight of {}: {e}", s.config().name)),
+    }
+}
+
+/// How a command ends when it is interrupted before its runs started (**Choice 120**): its
+/// report says so and nothing else is written; the JSON has no cases; exit 130.
+pub(super) fn interrupted_before_runs(
+    dir: &OutputDir,
+    title: &str,
+    json: bool,
+    stdout: &mut dyn Write,
+) -> Result<Exit> {
+    let what = "INTERRUPTED during the preflight check, before any run started: nothing was \
+                simulated";
+    let path = dir.claim("report.md")?;
+    let text = format!("# {title} (PARTIAL)\n\n**{what}.**\n");
+    atomic::write(&path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+    eprintln!("host-sim: {what}");
+    if json {
+        let cases: Cases<RunSummary> = Cases {
+            cases: Vec::new(),
+            incomplete: Vec::new(),
+            preflight: Vec::new(),
+            contract: None,
+        };
+        print_json(stdout, &cases)?;
+    } else {
+        writeln!(stdout, "{what}")?;
+        writeln!(stdout, "report: {}", path.display())?;
+    }
+    Ok(Exit::Interrupted)
 }
 
 /// How a command with these runs ended ([`Exit::of`]); `failed`: another reason for exit 1.

@@ -5,6 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
+use controller_core::readable::Readable;
 
 use super::board_loop::{fly, link_key, loop_scenarios, LoopArgs, Started};
 use super::Exit;
@@ -12,8 +13,8 @@ use crate::board::{BoardInTheLoop, Mode, Pacing};
 use crate::output::OutputDir;
 use crate::scenario::Scenario;
 
-/// The STM32 board's link baud rate (firmware/src/stm32f405/mod.rs), `hil`'s default.
-pub const DEFAULT_HIL_BAUD: u32 = 460_800;
+/// The STM32 board's link baud rate (`firmware_images::LINK_BAUD`), `hil`'s default.
+pub const DEFAULT_HIL_BAUD: u32 = firmware_images::LINK_BAUD;
 
 /// `hil`'s default reply timeout (s): a board answers every period (10 ms at 100 Hz).
 pub const DEFAULT_HIL_REPLY_TIMEOUT: f64 = 5.0;
@@ -25,7 +26,7 @@ pub struct HilArgs {
     /// The serial device of the board's link (e.g. /dev/ttyUSB0, or QEMU's /dev/pts/N).
     #[arg(long)]
     pub port: String,
-    /// Baud rate (8N1, no flow control); the STM32 board's is 460800.
+    /// Baud rate (8N1, no flow control); the default is the STM32 board's.
     #[arg(long, default_value_t = DEFAULT_HIL_BAUD)]
     pub baud: u32,
     /// lockstep: the board runs a period per state frame (as PIL; equals SIL); realtime: the
@@ -49,7 +50,7 @@ pub fn hil(args: &HilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     {
         bail!(
             "--reply-timeout must be a time in (0, 3600] s, got {}",
-            args.reply_timeout
+            Readable(args.reply_timeout)
         );
     }
     if args.baud == 0 {

@@ -24,11 +24,14 @@
 //!
 //! Every command, before it computes anything: validates its input (scenario, flags, the step
 //! cap), checks and prepares the output folder ([`OutputDir::prepare`](crate::output::OutputDir::prepare): a folder, not a symlink,
-//! writable; the previous run's files removed), and for `pil` checks the firmware image. Then
+//! writable, not in use by another run (its lock is held for the command's life); the previous
+//! run's files removed), and for `pil` checks the firmware image. Then
 //! the runs stream their CSVs ([`CsvStream`](crate::output::CsvStream)) and show progress ([`Progress`](crate::sim::progress::Progress)), and the plots
-//! and the report follow. An output that cannot be written completely (a full disk) is named
-//! on stderr, in the report and in the JSON (`incomplete`), once, and the command exits 2; the
-//! other outputs are still written.
+//! and the report follow. An output that cannot be written completely (a full disk, the
+//! file-size limit) is named on stderr, in the report and in the JSON (`incomplete`), once,
+//! and the command exits 2; the other outputs are still written. An interrupt acts in every
+//! phase ([`crate::interrupt`]); one that comes before the runs (during the preflight check)
+//! leaves a report saying nothing was simulated.
 //!
 //! # Exit codes
 //!

@@ -5,13 +5,14 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
 use clap::Args;
+use controller_core::readable::Readable;
 use controller_core::Table1Case;
 
 use super::common::load;
 use super::Exit;
 use crate::output::{atomic, OutputDir};
 use crate::plant::{CurrentModel, VariationProfile};
-use crate::scenario::{paper, Scenario};
+use crate::scenario::{paper, Scenario, MAX_CURRENT_SPEED};
 use crate::sim::progress::Progress;
 use crate::studies::montecarlo::{self, MonteCarloOptions, MAX_RUNS};
 
@@ -78,8 +79,12 @@ pub fn monte_carlo(args: &MonteCarloArgs, stdout: &mut dyn Write) -> Result<Exit
         );
     }
     if let Some(c) = args.current {
-        if !(c.is_finite() && c >= 0.0) {
-            bail!("--current must be a finite speed ≥ 0 m/s, got {c}");
+        if !(c.is_finite() && (0.0..=MAX_CURRENT_SPEED).contains(&c)) {
+            bail!(
+                "--current must be a finite speed in [0, {MAX_CURRENT_SPEED}] m/s (a current the \
+                 vehicle could meet: host_sim::scenario::MAX_CURRENT_SPEED), got {}",
+                Readable(c)
+            );
         }
     }
     let base = monte_carlo_base(args)?;

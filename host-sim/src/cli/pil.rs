@@ -34,7 +34,7 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let root = workspace_root();
     let elf = args.elf.clone().unwrap_or_else(|| default_elf(&root));
     check_flying_image(&elf).map_err(|e| anyhow!(e))?;
-    let runner = root.join("scripts/qemu-run.sh");
+    let runner = root.join(firmware_images::qemu_runner::SCRIPT);
     let key = link_key(&args.common)?;
     let dir = OutputDir::prepare(&args.out)?;
     fly(

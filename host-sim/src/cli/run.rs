@@ -6,7 +6,9 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 use clap::Args;
 
-use super::common::{load, periods, preflights, print_runs, sil_into, Incomplete};
+use super::common::{
+    interrupted_before_runs, load, periods, preflights, print_runs, sil_into, Incomplete,
+};
 use super::Exit;
 use crate::interrupt;
 use crate::output::{self, sections, OutputDir, ReportRow};
@@ -48,7 +50,10 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let dir = OutputDir::prepare(&out)?;
     // The verdict of the mission as the scenario flies it (with Δu: the check does not depend
     // on the law).
-    let checks = preflights(std::iter::once(&scenario))?;
+    let title = format!("AUV-150 scenario {}", cfg.name);
+    let Some(checks) = preflights(std::iter::once(&scenario))? else {
+        return interrupted_before_runs(&dir, &title, args.json, stdout);
+    };
     let progress = Progress::start(
         &cfg.name,
         periods(std::iter::once(&scenario).chain(&companion)),
@@ -66,7 +71,7 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let mut incomplete = incomplete.into_inner();
     let report = output::write_plots_and_report(
         &dir,
-        &format!("AUV-150 scenario {}", with.name),
+        &title,
         &rows,
         &sections::preflight(&checks, std::iter::once(&with).chain(&without)),
         &[],

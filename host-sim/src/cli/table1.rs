@@ -2,13 +2,16 @@
 //! vehicle.
 
 use std::io::Write;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::{anyhow, Result};
 use clap::Args;
 use controller_core::DEFAULT_V_LIMIT;
 
-use super::common::{periods, preflights, report_incomplete, runs_exit, sil_into, Incomplete};
+use super::common::{
+    interrupted_before_runs, periods, preflights, report_incomplete, runs_exit, sil_into,
+    Incomplete,
+};
 use super::json::{print_json, Cases};
 use super::Exit;
 use crate::output::{self, sections, OutputDir, RealRow, ReportRow};
@@ -17,7 +20,7 @@ use crate::scenario::Scenario;
 use crate::sim::progress::Progress;
 use crate::sim::record::RunSummary;
 use crate::sim::RunResult;
-use crate::studies::preflight::DEFAULT_MARGIN;
+use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
 use crate::studies::table1 as paper_table1;
 use crate::studies::validation::{self, Campaign, Measure, Validation, TEAM_MOUNTINGS};
 
@@ -83,7 +86,10 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     let dir = OutputDir::prepare(&args.out)?;
     // The paper's missions' verdicts (the Table-1 cases, with Δu: the same mission as the
     // real-chain runs), then the real ones.
-    let checks = preflights(chain_jobs.iter().chain(&real_jobs))?;
+    let title = "AUV-150 Table 1 reproduction (software in the loop)";
+    let Some(checks) = preflights(chain_jobs.iter().chain(&real_jobs))? else {
+        return interrupted_before_runs(&dir, title, args.json, stdout);
+    };
     let all: Vec<&Scenario> = jobs.iter().chain(&real_jobs).chain(&chain_jobs).collect();
     let progress = Progress::start("Table 1", periods(all.iter().copied()), !args.json);
     let incomplete = Incomplete::default();
@@ -123,7 +129,7 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     let mut incomplete = incomplete.into_inner();
     let report = output::write_plots_and_report(
         &dir,
-        "AUV-150 Table 1 reproduction (software in the loop)",
+        title,
         &rows,
         &sections,
         &real_plots,
@@ -149,21 +155,14 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         };
         print_json(stdout, &cases)?;
     } else {
-        writeln!(stdout, "{}", output::table_text(&rows))?;
-        writeln!(
+        print_text(
             stdout,
-            "The real vehicle: the missions of scenarios/real/ and the paper's through the real chain (kgf, ±24 V)"
+            &rows,
+            &checks,
+            &real_rows,
+            contract.as_ref().map(|(_, v)| v),
+            &report,
         )?;
-        for c in &checks {
-            writeln!(stdout, "{c}")?;
-        }
-        writeln!(stdout)?;
-        write!(stdout, "{}", output::real_table_text(&real_rows))?;
-        writeln!(stdout, "{}\n", output::report::real_table_legend())?;
-        if let Some((_, v)) = &contract {
-            writeln!(stdout, "{}\n", v.headline())?;
-        }
-        writeln!(stdout, "report: {}", report.display())?;
     }
     Ok(exit)
 }
@@ -183,4 +182,32 @@ fn contract(campaign: &Campaign, json: bool) -> Result<(Campaign, Validation)> {
     .map_err(|e| anyhow!(e))?;
     progress.finish();
     Ok((campaign.clone(), v))
+}
+
+/// The text `table1` prints: the paper's table, the real vehicle's verdicts and table, the
+/// preflight contract's two numbers, the report's path.
+fn print_text(
+    stdout: &mut dyn Write,
+    rows: &[ReportRow],
+    checks: &[Preflight],
+    real_rows: &[RealRow],
+    contract: Option<&Validation>,
+    report: &Path,
+) -> Result<()> {
+    writeln!(stdout, "{}", output::table_text(rows))?;
+    writeln!(
+        stdout,
+        "The real vehicle: the missions of scenarios/real/ and the paper's through the real chain (kgf, ±24 V)"
+    )?;
+    for c in checks {
+        writeln!(stdout, "{c}")?;
+    }
+    writeln!(stdout)?;
+    write!(stdout, "{}", output::real_table_text(real_rows))?;
+    writeln!(stdout, "{}\n", output::report::real_table_legend())?;
+    if let Some(v) = contract {
+        writeln!(stdout, "{}\n", v.headline())?;
+    }
+    writeln!(stdout, "report: {}", report.display())?;
+    Ok(())
 }

@@ -72,6 +72,15 @@ impl Pending {
         self.committed = true;
         Ok(self.dest.clone())
     }
+
+    /// Renames the temporary file, as it is, to `partial` (not synced: what a run that ends
+    /// early keeps of a streamed file, [`super::csv::CsvStream`]). If the rename fails, the
+    /// temporary file is left as it is rather than removed.
+    pub fn keep_as(mut self, partial: &Path) -> io::Result<PathBuf> {
+        self.committed = true;
+        fs::rename(&self.tmp, partial)?;
+        Ok(partial.to_path_buf())
+    }
 }
 
 impl Drop for Pending {

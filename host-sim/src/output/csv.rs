@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 
 use super::atomic::Pending;
+use crate::interrupt;
 use crate::sim::{Observer, RunResult, Sample};
 
 /// The columns of [`write_csv`], in order.
@@ -108,13 +109,38 @@ pub fn write_csv(path: &Path, run: &RunResult) -> Result<()> {
 /// stays bounded whatever the duration. The rows go to a temporary file, which
 /// [`CsvStream::finish`] flushes and renames onto the final name ([`super::atomic`]).
 ///
-/// A write error (a full disk: ENOSPC) stops the writing but not the run: the error and the
-/// time of the first row lost are kept, [`CsvStream::finish`] returns them as a
-/// [`CsvIncomplete`] naming the file, and the temporary file is removed (which also gives the
-/// disk space back for the report).
+/// A write error (a full disk: ENOSPC; the file-size limit: EFBIG) stops the writing but not
+/// the run: the error and the time of the first row lost are kept, [`CsvStream::finish`]
+/// returns them as a [`CsvIncomplete`] naming the file, and the temporary file is removed
+/// (which also gives the disk space back for the report).
+///
+/// What was streamed survives any other exit that can run code (**Choice 126**): a stream
+/// dropped without [`finish`](CsvStream::finish) (a panic unwinding) and a second signal
+/// ([`crate::interrupt::keep_on_exit`]) rename the temporary file to
+/// [`partial_name`]`(name)`, e.g. `circle-with.partial.csv`: the rows written so far, under a
+/// name that says they are not the whole run.
 pub struct CsvStream {
-    pending: Pending,
+    pending: Option<Pending>,
     rows: CsvRows<File>,
+    _streaming: interrupt::Streaming,
+}
+
+/// The name the rows of `name` (`circle-with.csv`) keep when the run ends without finishing
+/// its CSV: `circle-with.partial.csv`.
+pub fn partial_name(name: &str) -> String {
+    match name.strip_suffix(".csv") {
+        Some(stem) => format!("{stem}.partial.csv"),
+        None => format!("{name}.partial"),
+    }
+}
+
+/// [`partial_name`] of a path.
+fn partial_path(dest: &Path) -> PathBuf {
+    let name = dest
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    dest.with_file_name(partial_name(&name))
 }
 
 impl CsvStream {
@@ -122,9 +148,11 @@ impl CsvStream {
     pub fn create(dest: &Path) -> Result<Self> {
         let (pending, file) =
             Pending::create(dest).with_context(|| format!("writing {}", dest.display()))?;
+        let streaming = interrupt::keep_on_exit(pending.tmp_path(), &partial_path(dest));
         Ok(CsvStream {
-            pending,
+            pending: Some(pending),
             rows: CsvRows::new(file),
+            _streaming: streaming,
         })
     }
 
@@ -134,16 +162,31 @@ impl CsvStream {
     }
 
     /// The CSV in place under its final name, or why it is not.
-    pub fn finish(self) -> Result<PathBuf, CsvIncomplete> {
-        let dest = self.pending.dest().to_path_buf();
+    pub fn finish(mut self) -> Result<PathBuf, CsvIncomplete> {
+        let Some(pending) = self.pending.take() else {
+            unreachable!("a CsvStream is finished once (finish takes it)")
+        };
+        let dest = pending.dest().to_path_buf();
         let incomplete = |error: String| CsvIncomplete {
             path: dest.clone(),
             error,
         };
-        self.rows.finish().map_err(incomplete)?;
-        self.pending
+        let rows = std::mem::replace(&mut self.rows, CsvRows::closed());
+        rows.finish().map_err(incomplete)?;
+        pending
             .commit()
             .map_err(|e| incomplete(format!("putting it in place: {e}")))
+    }
+}
+
+impl Drop for CsvStream {
+    /// Not finished (a panic unwinding): the rows written so far are kept under the partial
+    /// name (the writer flushes its buffer into the renamed file as it is dropped next).
+    fn drop(&mut self) {
+        if let Some(pending) = self.pending.take() {
+            let partial = partial_path(pending.dest());
+            let _ = pending.keep_as(&partial);
+        }
     }
 }
 
@@ -194,6 +237,15 @@ impl<W: Write> CsvRows<W> {
             writer: Some(writer),
             rec: Vec::with_capacity(CSV_COLUMNS.len()),
             error,
+        }
+    }
+
+    /// A writer that writes nothing (what [`CsvStream::finish`] leaves behind).
+    fn closed() -> Self {
+        CsvRows {
+            writer: None,
+            rec: Vec::new(),
+            error: None,
         }
     }
 

@@ -6,10 +6,20 @@
 //!   symlink it did not create, and it creates none; a symlink higher up the path is the
 //!   user's choice of disk and is followed as usual); it is created if it does not exist;
 //! - it must be writable: the new manifest is written there first;
+//! - **one run at a time** (**Choice 122**): the run holds an exclusive advisory lock
+//!   (`flock`) on the folder's [`LOCK`] file for its whole life (until the [`OutputDir`] is
+//!   dropped, or the process ends, however it ends); the file names the process that holds
+//!   it. A second run into the same folder is refused at once: "output folder … is in use by
+//!   process N on HOST". The lock file stays (removing it would let two runs lock two
+//!   different files); it is neither an output nor in the manifest;
 //! - **reuse:** the folder keeps a manifest, [`MANIFEST`], of the files its last run wrote.
-//!   The files it lists are removed (a symlink among them is unlinked, not followed), and so are
-//!   temporary files that a killed run left ([`super::atomic::TMP_PREFIX`]). Files host-sim did
-//!   not write are never touched. A folder that is not empty and has no manifest is refused
+//!   The files it lists are removed (a symlink among them is unlinked, not followed), with the
+//!   `.partial.csv` of each CSV listed (what a run that ended early kept of it,
+//!   [`super::csv::partial_name`]), and so are the temporary files
+//!   ([`super::atomic::TMP_PREFIX`]`{pid}-…`) of processes that no longer exist (**Choice
+//!   123**: under the lock no live host-sim writes there, and the name's pid is asked of the
+//!   system; a pid alive, whoever it is now, keeps its file). Files host-sim did not write
+//!   are never touched. A folder that is not empty and has no manifest is refused
 //!   with a message listing what is in it: host-sim cannot tell its old outputs from the user's
 //!   files there, and will not mix them with new ones. So after a run the folder holds exactly
 //!   that run's files (and the user's own, untouched).
@@ -18,25 +28,31 @@
 //! written, so that a run killed half-way still has its files listed) and written whole or not
 //! at all ([`super::atomic`]).
 
-use std::fs;
-use std::io;
+use std::fs::{self, File, OpenOptions};
+use std::io::{self, Read, Write};
+use std::os::unix::fs::OpenOptionsExt;
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
 use anyhow::{bail, Context, Result};
 
 use super::atomic::{self, TMP_PREFIX};
+use super::csv::partial_name;
 
 /// The manifest's file name.
 pub const MANIFEST: &str = "host-sim-manifest.txt";
 const MANIFEST_HEADER: &str = "# host-sim: the files the last run wrote into this folder; \
      the next run removes them first (do not edit)";
 
-/// A checked output folder (see the module doc).
+/// The lock file's name: locked by the run using the folder, and naming its process.
+pub const LOCK: &str = "host-sim.lock";
+
+/// A checked output folder (see the module doc), locked for as long as it lives.
 #[derive(Debug)]
 pub struct OutputDir {
     path: PathBuf,
     files: Mutex<Vec<String>>,
+    _lock: File,
 }
 
 impl OutputDir {
@@ -58,20 +74,26 @@ impl OutputDir {
                 .with_context(|| format!("cannot create the output folder {shown}"))?,
             Err(e) => bail!("cannot use the output folder {shown}: {e}"),
         }
+        // A folder of someone else's files is refused before the lock file is made there.
+        previous_files(path)?;
         let dir = OutputDir {
             path: path.to_path_buf(),
             files: Mutex::new(Vec::new()),
+            _lock: lock(path)?,
         };
-        let previous = dir.previous_files()?;
-        for name in &previous {
+        for name in &previous_files(path)? {
             dir.remove_entry(name)?;
+            // What a run that ended before finishing this CSV kept of it (Choice 126).
+            if name.ends_with(".csv") {
+                dir.remove_entry(&partial_name(name))?;
+            }
         }
         for entry in fs::read_dir(path).with_context(|| format!("cannot list {shown}"))? {
             let name = entry
                 .with_context(|| format!("cannot list {shown}"))?
                 .file_name();
             let name = name.to_string_lossy();
-            if name.starts_with(TMP_PREFIX) {
+            if stale_tmp(&name) {
                 dir.remove_entry(&name)?;
             }
         }
@@ -103,59 +125,6 @@ impl OutputDir {
     /// The files claimed so far, in order.
     pub fn files(&self) -> Vec<String> {
         self.files.lock().unwrap_or_else(|e| e.into_inner()).clone()
-    }
-
-    /// The names in the previous run's manifest; refuses a non-empty folder without one.
-    fn previous_files(&self) -> Result<Vec<String>> {
-        let manifest = self.path.join(MANIFEST);
-        let shown = self.path.display();
-        match fs::symlink_metadata(&manifest) {
-            Ok(m) if !m.is_file() => bail!(
-                "{} is not a regular file (a symlink?): host-sim will not read or replace it; \
-                 remove it",
-                manifest.display()
-            ),
-            Ok(_) => {}
-            Err(e) if e.kind() == io::ErrorKind::NotFound => {
-                let mut others: Vec<String> = fs::read_dir(&self.path)
-                    .with_context(|| format!("cannot list {shown}"))?
-                    .filter_map(|e| e.ok())
-                    .map(|e| e.file_name().to_string_lossy().into_owned())
-                    .filter(|n| !n.starts_with(TMP_PREFIX))
-                    .collect();
-                if others.is_empty() {
-                    return Ok(Vec::new());
-                }
-                others.sort();
-                let n = others.len();
-                others.truncate(5);
-                bail!(
-                    "output folder {shown} is not empty and has no {MANIFEST}, so host-sim did \
-                     not write it and cannot tell old outputs from other files ({n} entries: \
-                     {}{}); empty it, or give another --out",
-                    others.join(", "),
-                    if n > 5 { ", …" } else { "" }
-                );
-            }
-            Err(e) => bail!("cannot read {}: {e}", manifest.display()),
-        }
-        let text = fs::read_to_string(&manifest)
-            .with_context(|| format!("cannot read {}", manifest.display()))?;
-        let mut names = Vec::new();
-        for line in text.lines().map(str::trim) {
-            if line.is_empty() || line.starts_with('#') {
-                continue;
-            }
-            if !plain_name(line) || line == MANIFEST {
-                bail!(
-                    "{} lists {line:?}, which host-sim never writes (the manifest was edited?); \
-                     remove the manifest and empty the folder",
-                    manifest.display()
-                );
-            }
-            names.push(line.to_string());
-        }
-        Ok(names)
     }
 
     /// Removes `name` if it is a file or a symlink (the link, not what it points to).
@@ -195,4 +164,140 @@ fn plain_name(name: &str) -> bool {
         && name != ".."
         && !name.contains(['/', '\\'])
         && !name.chars().any(char::is_control)
+}
+
+/// The names in the previous run's manifest; refuses a non-empty folder without one.
+fn previous_files(path: &Path) -> Result<Vec<String>> {
+    let manifest = path.join(MANIFEST);
+    let shown = path.display();
+    match fs::symlink_metadata(&manifest) {
+        Ok(m) if !m.is_file() => bail!(
+            "{} is not a regular file (a symlink?): host-sim will not read or replace it; \
+             remove it",
+            manifest.display()
+        ),
+        Ok(_) => {}
+        Err(e) if e.kind() == io::ErrorKind::NotFound => {
+            let mut others: Vec<String> = fs::read_dir(path)
+                .with_context(|| format!("cannot list {shown}"))?
+                .filter_map(|e| e.ok())
+                .map(|e| e.file_name().to_string_lossy().into_owned())
+                .filter(|n| !n.starts_with(TMP_PREFIX) && n != LOCK)
+                .collect();
+            if others.is_empty() {
+                return Ok(Vec::new());
+            }
+            others.sort();
+            let n = others.len();
+            others.truncate(5);
+            bail!(
+                "output folder {shown} is not empty and has no {MANIFEST}, so host-sim did \
+                 not write it and cannot tell old outputs from other files ({n} entries: \
+                 {}{}); empty it, or give another --out",
+                others.join(", "),
+                if n > 5 { ", …" } else { "" }
+            );
+        }
+        Err(e) => bail!("cannot read {}: {e}", manifest.display()),
+    }
+    let text = fs::read_to_string(&manifest)
+        .with_context(|| format!("cannot read {}", manifest.display()))?;
+    let mut names = Vec::new();
+    for line in text.lines().map(str::trim) {
+        if line.is_empty() || line.starts_with('#') {
+            continue;
+        }
+        if !plain_name(line) || line == MANIFEST || line == LOCK {
+            bail!(
+                "{} lists {line:?}, which host-sim never writes (the manifest was edited?); \
+                 remove the manifest and empty the folder",
+                manifest.display()
+            );
+        }
+        names.push(line.to_string());
+    }
+    Ok(names)
+}
+
+/// Takes the folder's lock (see the module doc): the [`LOCK`] file, created if needed (never
+/// through a symlink), locked exclusively, and its content replaced by this process's id and
+/// host. Another holder: refused, naming it.
+fn lock(path: &Path) -> Result<File> {
+    let lock_path = path.join(LOCK);
+    let shown = lock_path.display();
+    let mut file = OpenOptions::new()
+        .read(true)
+        .write(true)
+        .create(true)
+        .truncate(false)
+        .custom_flags(libc::O_NOFOLLOW)
+        .open(&lock_path)
+        .map_err(|e| match e.raw_os_error() {
+            Some(libc::ELOOP) => anyhow::anyhow!(
+                "{shown} is a symlink: host-sim does not follow a symlink it did not create; \
+                 remove it"
+            ),
+            _ => anyhow::Error::new(e).context(format!(
+                "output folder {} is not writable (its lock file {shown})",
+                path.display()
+            )),
+        })?;
+    match file.try_lock() {
+        Ok(()) => {}
+        Err(fs::TryLockError::WouldBlock) => {
+            let mut holder = String::new();
+            let _ = file.read_to_string(&mut holder);
+            let holder = match holder.split_whitespace().collect::<Vec<_>>()[..] {
+                [pid, host, ..] => format!("process {pid} on {host}"),
+                [pid] => format!("process {pid}"),
+                [] => "another process".to_string(),
+            };
+            bail!(
+                "output folder {} is in use by {holder} (another host-sim run writes there); \
+                 wait for it to end, or give another --out",
+                path.display()
+            );
+        }
+        Err(fs::TryLockError::Error(e)) => {
+            return Err(e).with_context(|| format!("cannot lock {shown}"));
+        }
+    }
+    let id = format!("{} {}\n", std::process::id(), host_name());
+    file.set_len(0)
+        .and_then(|()| file.write_all(id.as_bytes()))
+        .with_context(|| format!("output folder {} is not writable", path.display()))?;
+    Ok(file)
+}
+
+/// This machine's name (for the lock file), or `?`.
+fn host_name() -> String {
+    let mut buf = [0u8; 256];
+    // SAFETY: the buffer is valid for its length; gethostname writes at most that much.
+    let ok = unsafe { libc::gethostname(buf.as_mut_ptr().cast(), buf.len()) } == 0;
+    let end = buf.iter().position(|&b| b == 0).unwrap_or(buf.len());
+    match std::str::from_utf8(&buf[..end]) {
+        Ok(h) if ok && !h.is_empty() && !h.contains(char::is_whitespace) => h.to_string(),
+        _ => "?".to_string(),
+    }
+}
+
+/// A temporary file ([`TMP_PREFIX`]`{pid}-{n}.{name}`) whose writing process no longer exists.
+fn stale_tmp(name: &str) -> bool {
+    let Some(rest) = name.strip_prefix(TMP_PREFIX) else {
+        return false;
+    };
+    let Some(pid) = rest
+        .split('-')
+        .next()
+        .and_then(|p| p.parse::<libc::pid_t>().ok())
+    else {
+        return false;
+    };
+    if pid <= 0 {
+        return false;
+    }
+    // SAFETY: signal 0 sends nothing; it only asks whether the process exists.
+    let alive = unsafe { libc::kill(pid, 0) } == 0
+        || io::Error::last_os_error().raw_os_error() != Some(libc::ESRCH);
+    !alive
 }

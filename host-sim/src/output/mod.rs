@@ -21,7 +21,7 @@ mod plot;
 pub mod report;
 pub mod sections;
 
-pub use self::csv::{write_csv, CsvStream, CSV_COLUMNS};
+pub use self::csv::{partial_name, write_csv, CsvStream, CSV_COLUMNS};
 pub use self::dir::OutputDir;
 pub use self::figures::{plot_case, plot_case_with_limit, plot_names};
 pub use self::report::{

@@ -98,7 +98,8 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
             let col = usize::from(robust);
             let du = if robust { "with" } else { "without" }.to_string();
             let name = run.map_or(row.with.name.as_str(), |r| r.name.as_str());
-            let m = run.map(|r| r.metrics);
+            // A run that recorded no period has no metrics: every cell `—` (Choice 129).
+            let m = run.map(|r| r.metrics).filter(Metrics::recorded);
             let ours_vs = |ours: Option<f64>, paper: Option<f64>| -> String {
                 let ours = ours.map_or("—".to_string(), fmt_err);
                 match paper {
@@ -458,15 +459,16 @@ pub fn verdict_cell(p: &Preflight) -> String {
 fn real_cells(rows: &[RealRow]) -> Vec<Vec<String>> {
     rows.iter()
         .map(|r| {
-            let m = &r.run.metrics;
+            let m = Some(r.run.metrics).filter(Metrics::recorded);
+            let cell = |f: &dyn Fn(&Metrics) -> String| m.as_ref().map_or("—".to_string(), f);
             vec![
                 r.run.name.clone(),
                 r.preflight.heading.clone(),
                 format!("{}", r.preflight.time_scale),
-                fmt_err(m.max_path),
-                fmt_err(m.rms_path),
-                fmt_fixed(m.peak_voltage, 1),
-                format!("{} %", fmt_fixed(100.0 * m.saturated_fraction, 1)),
+                cell(&|m| fmt_err(m.max_path)),
+                cell(&|m| fmt_err(m.rms_path)),
+                cell(&|m| fmt_fixed(m.peak_voltage, 1)),
+                cell(&|m| format!("{} %", fmt_fixed(100.0 * m.saturated_fraction, 1))),
                 if bound::within_bound(r.run) {
                     "yes"
                 } else {

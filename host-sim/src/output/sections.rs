@@ -71,13 +71,14 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
     );
     for c in cases {
         notes += &format!(
-            "| {} | {} | {} | {:.5} | {:.5} | {:+.2e} | {:.0} | {} | {} | {} | {} | {} / {} | {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} / {} | {} | {} |\n",
             c.run.name,
             c.pil.link,
             c.pil.pacing.as_str(),
-            c.run.metrics.max_path,
-            c.sil_max_path,
-            c.pil_minus_sil_max_path,
+            // A run that recorded no period has no metric (NaN, Choice 129).
+            metric(c.run.metrics.max_path, |v| format!("{v:.5}")),
+            metric(c.sil_max_path, |v| format!("{v:.5}")),
+            metric(c.pil_minus_sil_max_path, |v| format!("{v:+.2e}")),
             c.pil.frames_per_second,
             match c.mode {
                 Mode::Pil => c.pil.worst_update_instructions,
@@ -111,4 +112,13 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
         }
     }
     notes
+}
+
+/// A metric's cell: `—` for none (NaN: a run that recorded no period).
+fn metric(v: f64, fmt: impl Fn(f64) -> String) -> String {
+    if v.is_nan() {
+        "—".to_string()
+    } else {
+        fmt(v)
+    }
 }

@@ -31,9 +31,11 @@
 //! duration = 70.0             # s, (0, 86400]; and the step cap below
 //! plant_step = 0.001          # s, (0, 0.1] and ≤ the control period 1/rate_hz
 //! ideal_actuators = true      # thrusters deliver the allocated thrust whatever the voltage limit
-//! initial_offset = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # added to η(0) = η_d(0), m and rad
-//! divergence_limit = 50.0     # m, > 0
-//! thruster_lag = 0.1          # s, > 0; leave out for no lag
+//! initial_offset = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # added to η(0) = η_d(0), m and rad; the
+//!                             # position part ≤ divergence_limit in norm, roll and yaw within
+//!                             # ±π, pitch inside ±π/2
+//! divergence_limit = 50.0     # m, (0, 10000]
+//! thruster_lag = 0.1          # s, (0, 10]; leave out for no lag
 //! expect_faults = false       # true: periods with the controller in fail-safe are reported but
 //!                             # do not fail the command (else exit 3); default false
 //! initial_attitude = "trim"   # "trim" (the payload's static heel) | "level"; default trim for
@@ -80,15 +82,15 @@
 //!
 //! [current]                   # ocean current, earth frame (NED)
 //! model = "constant"          # "none" | "constant" | "gauss-markov"
-//! velocity = [0.2, 0.1, 0.0]  # constant (required), m/s
-//! mean = [0.0, 0.0, 0.0]      # gauss-markov, m/s, default zeros
-//! sigma = [0.05, 0.05, 0.0]   # gauss-markov (required), m/s, ≥ 0
+//! velocity = [0.2, 0.1, 0.0]  # constant (required), m/s, ‖velocity‖ ≤ 5 (MAX_CURRENT_SPEED)
+//! mean = [0.0, 0.0, 0.0]      # gauss-markov, m/s, default zeros, ‖mean‖ ≤ 5
+//! sigma = [0.05, 0.05, 0.0]   # gauss-markov (required), m/s, ≥ 0, ‖sigma‖ ≤ 5
 //! tau = 30.0                  # gauss-markov (required), s, > 0
 //! seed = 1                    # gauss-markov, default 1
 //!
 //! [noise]                     # present = measurement noise on; absent = off
-//! eta_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # default zeros, ≥ 0
-//! nu_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]   # default zeros, ≥ 0
+//! eta_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # default zeros, ≥ 0; m ≤ divergence_limit, rad ≤ π
+//! nu_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]   # default zeros, ≥ 0; m/s ≤ 50, rad/s ≤ 50
 //! seed = 1                                    # default 1
 //!
 //! [controller]
@@ -134,6 +136,11 @@
 //!   below half the step, and its variance is σ²/(1 − h/2τ));
 //! - `variation.omega` · `plant_step` ≤ [`MAX_VARIATION_OMEGA_STEP`] (the plant resolves the
 //!   variation; 1e308 used to give NaN parameters);
+//! - what the vehicle can meet (**Choice 124**): the start offset (its position part within
+//!   `divergence_limit`, which is at most the controller's 10 km; roll and yaw within ±π, pitch
+//!   inside ±π/2), the current's speed ([`MAX_CURRENT_SPEED`]), the thruster lag
+//!   ([`MAX_THRUSTER_LAG`]) and the noise σ (see the schema): 10³⁰⁸ used to pass and diverge at
+//!   t = 0;
 //! - the reference stays inside what the controller accepts as input
 //!   (`controller_core::controller::MAX_POSITION`, `MAX_LINEAR_SPEED`, `MAX_ANGULAR_RATE`;
 //!   checked at every tick up to 10⁵ ticks, else at 10⁵ evenly spaced ones): a faster or
@@ -172,7 +179,8 @@ pub use config::{Bound, InitialAttitude, LinkFaults, SensorNoise, SimConfig, Tic
 pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
 pub use start::start_state;
 pub use validate::{
-    MAX_CONTROL_PERIODS, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS, MAX_VARIATION_OMEGA_STEP,
+    MAX_CONTROL_PERIODS, MAX_CURRENT_SPEED, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS,
+    MAX_THRUSTER_LAG, MAX_VARIATION_OMEGA_STEP,
 };
 
 /// Why a scenario could not be loaded or validated.
@@ -195,8 +203,9 @@ pub enum ScenarioError {
 impl fmt::Display for ScenarioError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            ScenarioError::Io { path, source } => {
-                write!(f, "cannot read scenario file {}: {source}", path.display())
+            // The reason is the source (Choice 128): printed once, by whoever prints the chain.
+            ScenarioError::Io { path, .. } => {
+                write!(f, "cannot read scenario file {}", path.display())
             }
             ScenarioError::Toml(message) => write!(f, "invalid scenario: {}", message.trim_end()),
             ScenarioError::Invalid { key, message } => {
@@ -206,6 +215,9 @@ impl fmt::Display for ScenarioError {
     }
 }
 
+/// The I/O reason of [`ScenarioError::Io`] is its `source()`, and not in its message: a chain
+/// printed whole (`{:#}`, as the binary does) says it once (**Choice 128**: it was printed
+/// twice, "Is a directory (os error 21): Is a directory (os error 21)").
 impl std::error::Error for ScenarioError {
     fn source(&self) -> Option<&(dyn std::error::Error + 'static)> {
         match self {

@@ -4,9 +4,9 @@
 
 use std::fmt;
 
-use controller_core::allocator::{AxisPriority, AXIS_NAMES};
 use controller_core::effectiveness::ThrusterGeometry;
 use controller_core::model::{ParamVariation, VARIED_PARAMETERS, VARIED_PARAMETER_NAMES};
+use controller_core::{allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
 use controller_core::{
     BBound, ControllerConfig, HeadingMode, RobustLaw, Table1Case, ThrustUnit, TrajectoryKind,
 };

@@ -2,14 +2,17 @@
 //! scenario file's dotted key. The controller's and the trajectory's own ranges are the core's
 //! ([`Controller::new`], [`Trajectory::new`]); here their errors are only mapped to keys.
 
+use std::f64::consts::{FRAC_PI_2, PI};
+
 use controller_core::config::ConfigField;
 use controller_core::controller::{MAX_ANGULAR_RATE, MAX_LINEAR_SPEED, MAX_POSITION};
 use controller_core::model::{self, ParamVariation, VehicleParams, VARIED_PARAMETER_NAMES};
+use controller_core::readable::Readable;
 use controller_core::{Controller, Mission, Trajectory};
 use controller_core::{Fault, Status};
 
 use super::start::start_state;
-use super::SimConfig;
+use super::{SensorNoise, SimConfig};
 use crate::plant::{CurrentModel, VariationProfile};
 
 use super::ScenarioError;
@@ -28,6 +31,14 @@ pub const MAX_PLANT_STEPS: u64 = 86_400_000;
 /// Even with the override, step counts stay below 2⁵³, where counting in f64 is exact (a
 /// `plant_step` of 1e-300 would otherwise loop for ever).
 const ABSOLUTE_MAX_STEPS: f64 = 9_007_199_254_740_992.0;
+/// Fastest ocean current (m/s, ‖v‖; for a Gauss–Markov current its mean, and ‖σ‖):
+/// **Choice 124**, twice the AUV-150's top speed. At full main thrust (≈ 719 N at ±24 V) the
+/// surge damping 120 u|u| N allows √(719/120) ≈ 2.45 m/s; a current beyond twice that no
+/// thrust model (ideal or real) makes a question worth simulating, and 10³⁰⁸ m/s made every
+/// run diverge at t = 0.
+pub const MAX_CURRENT_SPEED: f64 = 5.0;
+/// Longest `thruster_lag` (s), Choice 124: real thrusters answer in about 0.1 s.
+pub const MAX_THRUSTER_LAG: f64 = 10.0;
 /// Largest ω·plant_step of an abs-sin variation (rad): at least 2π/0.1 ≈ 63 plant steps per
 /// period of sin, so that the plant resolves the variation (and ω·t stays finite).
 pub const MAX_VARIATION_OMEGA_STEP: f64 = 0.1;
@@ -88,20 +99,24 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     if d > MAX_DURATION {
         return Err(invalid(
             "duration",
-            format!("must be ≤ {MAX_DURATION} s (one day), got {d}"),
+            format!("must be ≤ {MAX_DURATION} s (one day), got {}", Readable(d)),
         ));
     }
     let h = positive("plant_step", config.plant_step)?;
     if h > MAX_PLANT_STEP {
         return Err(invalid(
             "plant_step",
-            format!("must be ≤ {MAX_PLANT_STEP} s, got {h}"),
+            format!("must be ≤ {MAX_PLANT_STEP} s, got {}", Readable(h)),
         ));
     }
     if h > period {
         return Err(invalid(
             "plant_step",
-            format!("must be ≤ the control period 1/rate_hz = {period} s, got {h}"),
+            format!(
+                "must be ≤ the control period 1/rate_hz = {} s, got {}",
+                Readable(period),
+                Readable(h)
+            ),
         ));
     }
     // The loop holds τ over a whole number of plant steps (sil::run).
@@ -112,7 +127,9 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
         return Err(invalid(
             "plant_step",
             format!(
-                "must divide the control period 1/rate_hz = {period} s into whole steps, got {h}"
+                "must divide the control period 1/rate_hz = {} s into whole steps, got {}",
+                Readable(period),
+                Readable(h)
             ),
         ));
     }
@@ -127,17 +144,120 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
             ));
         }
     }
-    positive("divergence_limit", config.divergence_limit)?;
+    let limit = at_most(
+        "divergence_limit",
+        positive("divergence_limit", config.divergence_limit)?,
+        f64::from(MAX_POSITION),
+        "m, the positions the controller accepts",
+    )?;
+    start_offset(&config.initial_offset, limit)?;
     if let Some(lag) = config.thruster_lag {
-        positive("thruster_lag", lag)?;
+        let what = "s: a thruster slower than that is not one the vehicle has";
+        at_most(
+            "thruster_lag",
+            positive("thruster_lag", lag)?,
+            MAX_THRUSTER_LAG,
+            what,
+        )?;
     }
     variation(&config.variation, h)?;
     current(&config.current, h)?;
     if let Some(n) = &config.noise {
-        each("noise.eta_sigma", &n.eta_sigma, non_negative)?;
-        each("noise.nu_sigma", &n.nu_sigma, non_negative)?;
+        noise(n, limit)?;
     }
     Ok((steps as u64, substeps as usize))
+}
+
+/// `x` if it is ≤ `max` (a physical limit, Choice 124; `unit` says what `max` is).
+fn at_most(key: &str, x: f64, max: f64, unit: &str) -> Res<f64> {
+    if x <= max {
+        Ok(x)
+    } else {
+        Err(invalid(
+            key,
+            format!("must be ≤ {} {unit}, got {}", Readable(max), Readable(x)),
+        ))
+    }
+}
+
+/// Where a run may start (Choice 124): the position offset inside the divergence limit (else
+/// the run stops before its first period, with nothing recorded), roll and yaw within ±π (a
+/// larger offset is the same attitude), pitch inside ±π/2 (where the Euler angles are
+/// singular). A pitch past the controller's pitch limit is allowed: it starts the controller
+/// in fail-safe, which is a case worth flying.
+fn start_offset(offset: &[f64; 6], limit: f64) -> Res<()> {
+    let p = norm3(&[offset[0], offset[1], offset[2]]);
+    if p > limit {
+        return Err(invalid(
+            "initial_offset",
+            format!(
+                "the start is {} m from the reference, beyond divergence_limit = {} m: the run \
+                 would stop before its first period",
+                Readable(p),
+                Readable(limit)
+            ),
+        ));
+    }
+    let half_turn = "rad (a larger offset is the same attitude)";
+    at_most("initial_offset[3]", offset[3].abs(), PI, half_turn)?;
+    at_most("initial_offset[5]", offset[5].abs(), PI, half_turn)?;
+    if offset[4].abs() >= FRAC_PI_2 {
+        return Err(invalid(
+            "initial_offset[4]",
+            format!(
+                "the pitch offset must be inside ±π/2 rad, where the Euler angles are singular, \
+                 got {}",
+                Readable(offset[4])
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// Measurement noise a sensor could have (Choice 124): each σ ≥ 0; a position σ at most the
+/// divergence limit, an angle σ at most π, a velocity σ at most what the controller accepts
+/// as input.
+fn noise(n: &SensorNoise, limit: f64) -> Res<()> {
+    each("noise.eta_sigma", &n.eta_sigma, non_negative)?;
+    each("noise.nu_sigma", &n.nu_sigma, non_negative)?;
+    let linear = f64::from(MAX_LINEAR_SPEED);
+    let angular = f64::from(MAX_ANGULAR_RATE);
+    for i in 0..6 {
+        let (max, unit) = if i < 3 {
+            (limit, "m, the divergence limit")
+        } else {
+            (PI, "rad")
+        };
+        at_most(&format!("noise.eta_sigma[{i}]"), n.eta_sigma[i], max, unit)?;
+        let (max, unit) = if i < 3 {
+            (linear, "m/s, the speeds the controller accepts")
+        } else {
+            (angular, "rad/s, the rates the controller accepts")
+        };
+        at_most(&format!("noise.nu_sigma[{i}]"), n.nu_sigma[i], max, unit)?;
+    }
+    Ok(())
+}
+
+/// ‖v‖, without overflow for any finite v (a message then names 1e308, not inf).
+fn norm3(v: &[f64; 3]) -> f64 {
+    let m = v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if m == 0.0 {
+        return 0.0;
+    }
+    m * v.iter().map(|x| (x / m) * (x / m)).sum::<f64>().sqrt()
+}
+
+/// A current's speed ‖v‖ within [`MAX_CURRENT_SPEED`] (Choice 124).
+fn current_speed(key: &str, v: &[f64; 3]) -> Res<()> {
+    let speed = norm3(v);
+    at_most(
+        key,
+        speed,
+        MAX_CURRENT_SPEED,
+        "m/s in norm, twice the AUV-150's top speed: a current the vehicle could never meet",
+    )
+    .map(|_| ())
 }
 
 /// The run's size against [`MAX_CONTROL_PERIODS`] and [`MAX_PLANT_STEPS`] (unless
@@ -181,7 +301,10 @@ fn finite(key: &str, x: f64) -> Res<f64> {
     if x.is_finite() {
         Ok(x)
     } else {
-        Err(invalid(key, format!("must be a finite number, got {x}")))
+        Err(invalid(
+            key,
+            format!("must be a finite number, got {}", Readable(x)),
+        ))
     }
 }
 
@@ -190,7 +313,7 @@ fn positive(key: &str, x: f64) -> Res<f64> {
     if x > 0.0 {
         Ok(x)
     } else {
-        Err(invalid(key, format!("must be > 0, got {x}")))
+        Err(invalid(key, format!("must be > 0, got {}", Readable(x))))
     }
 }
 
@@ -199,7 +322,7 @@ fn non_negative(key: &str, x: f64) -> Res<f64> {
     if x >= 0.0 {
         Ok(x)
     } else {
-        Err(invalid(key, format!("must be ≥ 0, got {x}")))
+        Err(invalid(key, format!("must be ≥ 0, got {}", Readable(x))))
     }
 }
 
@@ -262,10 +385,11 @@ fn variation(v: &VariationProfile, plant_step: f64) -> Res<()> {
                 return Err(invalid(
                     "variation.omega",
                     format!(
-                        "{omega} rad/s is too fast for the plant step {plant_step} s: ω·plant_step \
-                         must be ≤ {MAX_VARIATION_OMEGA_STEP} (≥ 63 plant steps per period), so \
-                         ω ≤ {} rad/s",
-                        MAX_VARIATION_OMEGA_STEP / plant_step
+                        "{} rad/s is too fast for the plant step {} s: ω·plant_step must be ≤ \
+                         {MAX_VARIATION_OMEGA_STEP} (≥ 63 plant steps per period), so ω ≤ {} rad/s",
+                        Readable(omega),
+                        Readable(plant_step),
+                        Readable(MAX_VARIATION_OMEGA_STEP / plant_step)
                     ),
                 ));
             }
@@ -288,15 +412,20 @@ fn variation(v: &VariationProfile, plant_step: f64) -> Res<()> {
                 }
                 match previous {
                     None if until <= 0.0 => {
-                        return Err(invalid(key, format!("must be > 0 s, got {until}")));
+                        return Err(invalid(
+                            key,
+                            format!("must be > 0 s, got {}", Readable(until)),
+                        ));
                     }
                     Some(p) if until <= p => {
                         return Err(invalid(
                             key,
                             format!(
-                                "step times must increase: {until} is not > \
-                                 variation.steps[{}].until = {p}",
-                                i - 1
+                                "step times must increase: {} is not > \
+                                 variation.steps[{}].until = {}",
+                                Readable(until),
+                                i - 1,
+                                Readable(p)
                             ),
                         ));
                     }
@@ -313,12 +442,17 @@ fn variation(v: &VariationProfile, plant_step: f64) -> Res<()> {
 fn current(c: &CurrentModel, plant_step: f64) -> Res<()> {
     match c {
         CurrentModel::None => Ok(()),
-        CurrentModel::Constant(v) => each("current.velocity", v, finite),
+        CurrentModel::Constant(v) => {
+            each("current.velocity", v, finite)?;
+            current_speed("current.velocity", v)
+        }
         CurrentModel::GaussMarkov {
             mean, sigma, tau, ..
         } => {
             each("current.mean", mean, finite)?;
+            current_speed("current.mean", mean)?;
             each("current.sigma", sigma, non_negative)?;
+            current_speed("current.sigma", sigma)?;
             let tau = positive("current.tau", *tau)?;
             // Euler–Maruyama of v̇ = −(v − mean)/τ + …: v ← (1 − h/τ) v + …, unstable for
             // h > 2τ, and its stationary variance is σ²/(1 − h/2τ) (≤ 5 % high for τ ≥ 10 h).
@@ -326,10 +460,12 @@ fn current(c: &CurrentModel, plant_step: f64) -> Res<()> {
                 return Err(invalid(
                     "current.tau",
                     format!(
-                        "{tau} s is below the plant step {plant_step} s: the Gauss–Markov process \
+                        "{} s is below the plant step {} s: the Gauss–Markov process \
                          is stepped by Euler–Maruyama at the plant step, which is unstable for \
                          tau < plant_step/2 and inflates the variance by 1/(1 − plant_step/(2 tau)) \
-                         (×2 at tau = plant_step); use tau ≥ plant_step, better ≥ 10 plant steps"
+                         (×2 at tau = plant_step); use tau ≥ plant_step, better ≥ 10 plant steps",
+                        Readable(tau),
+                        Readable(plant_step)
                     ),
                 ));
             }
@@ -376,20 +512,23 @@ pub(super) fn mission(
         };
         if !speed.is_finite() || speed > MAX_LINEAR_SPEED {
             return Err(refuse(format!(
-                "the reference moves at {speed} m/s, above the {MAX_LINEAR_SPEED} m/s the \
-                 controller accepts"
+                "the reference moves at {} m/s, above the {MAX_LINEAR_SPEED} m/s the controller \
+                 accepts",
+                Readable(speed)
             )));
         }
         if !turn.is_finite() || turn > MAX_ANGULAR_RATE {
             return Err(refuse(format!(
-                "the reference turns at {turn} rad/s, above the {MAX_ANGULAR_RATE} rad/s the \
-                 controller accepts"
+                "the reference turns at {} rad/s, above the {MAX_ANGULAR_RATE} rad/s the \
+                 controller accepts",
+                Readable(turn)
             )));
         }
         if !position.is_finite() || position > MAX_POSITION {
             return Err(refuse(format!(
-                "the reference is {position} m from the mission origin along an axis, beyond \
-                 the ±{MAX_POSITION} m the controller accepts (shorten the mission)"
+                "the reference is {} m from the mission origin along an axis, beyond the \
+                 ±{MAX_POSITION} m the controller accepts (shorten the mission)",
+                Readable(position)
             )));
         }
     }

@@ -11,7 +11,7 @@ pub const MAX_SATURATED_FRACTION: f64 = Bound::REAL_VEHICLE.saturated;
 /// Why `metrics` lie outside `bound`, if they do: every limit exceeded, and by how much.
 pub fn miss(bound: &Bound, metrics: &Metrics) -> Option<String> {
     let mut reasons = Vec::new();
-    if !(metrics.max_path <= bound.max_path) {
+    if beyond(metrics.max_path, bound.max_path) {
         reasons.push(format!(
             "max path error {:.4} m > {} m ({:.1}× the bound)",
             metrics.max_path,
@@ -19,7 +19,7 @@ pub fn miss(bound: &Bound, metrics: &Metrics) -> Option<String> {
             metrics.max_path / bound.max_path
         ));
     }
-    if !(metrics.saturated_fraction <= bound.saturated) {
+    if beyond(metrics.saturated_fraction, bound.saturated) {
         reasons.push(format!(
             "saturated in {:.1} % of the periods > {} %",
             100.0 * metrics.saturated_fraction,
@@ -34,4 +34,12 @@ pub fn miss(bound: &Bound, metrics: &Metrics) -> Option<String> {
 pub fn within_bound(run: &RunResult) -> bool {
     matches!(run.outcome, Outcome::Completed | Outcome::Missed { .. })
         && miss(&Bound::REAL_VEHICLE, &run.metrics).is_none()
+}
+
+/// `x` is above `limit`, or not a number (NaN is never within a bound).
+fn beyond(x: f64, limit: f64) -> bool {
+    !matches!(
+        x.partial_cmp(&limit),
+        Some(std::cmp::Ordering::Less | std::cmp::Ordering::Equal)
+    )
 }

@@ -35,11 +35,11 @@ impl Accumulator {
         self.n += 1;
     }
 
-    /// The metrics (all zero for no samples).
+    /// The metrics ([`Metrics::NONE`] for no samples).
     pub fn metrics(&self) -> Metrics {
         let mut m = self.m;
         if self.n == 0 {
-            return m;
+            return Metrics::NONE;
         }
         m.max_path = (m.max_x * m.max_x + m.max_y * m.max_y + m.max_z * m.max_z).sqrt();
         m.rms_path = (self.sq / self.n as f64).sqrt();

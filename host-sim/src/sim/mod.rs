@@ -88,6 +88,11 @@ pub fn fly(
         let (eta, nu) = navigation.measure(&vehicle.state);
         let out = match source.control(k, &eta, &nu) {
             Ok(out) => out,
+            // A board's wait for its answer gives up on a stop request.
+            Err(_) if interrupt::requested() => {
+                outcome = Outcome::Interrupted { t };
+                break;
+            }
             Err(reason) => {
                 outcome = Outcome::Diverged { t, reason };
                 break;

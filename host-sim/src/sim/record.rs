@@ -178,22 +178,62 @@ impl fmt::Display for FaultCounts {
 }
 
 /// The paper's Table-1 metrics (docs/design.md §7) and the actuator figures.
+///
+/// A run that recorded no period has none (**Choice 129**): every field is NaN
+/// ([`Metrics::NONE`]; the maximum and the mean of nothing), which the JSON writes as `null`
+/// (and reads back as NaN), the tables as `—`; never 0, which read as a perfect run.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct Metrics {
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_x: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_y: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_z: f64,
     /// √(max|e_x|² + max|e_y|² + max|e_z|²), the paper's "path" error.
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_path: f64,
     /// √(mean(e_x² + e_y² + e_z²)).
+    #[serde(deserialize_with = "nan_if_null")]
     pub rms_path: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_roll: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_pitch: f64,
+    #[serde(deserialize_with = "nan_if_null")]
     pub max_yaw: f64,
     /// Largest |V| any thruster was commanded (V).
+    #[serde(deserialize_with = "nan_if_null")]
     pub peak_voltage: f64,
     /// Fraction of control periods with at least one thruster saturated.
+    #[serde(deserialize_with = "nan_if_null")]
     pub saturated_fraction: f64,
+}
+
+impl Metrics {
+    /// The metrics of a run that recorded no period: every one NaN.
+    pub const NONE: Metrics = Metrics {
+        max_x: f64::NAN,
+        max_y: f64::NAN,
+        max_z: f64::NAN,
+        max_path: f64::NAN,
+        rms_path: f64::NAN,
+        max_roll: f64::NAN,
+        max_pitch: f64::NAN,
+        max_yaw: f64::NAN,
+        peak_voltage: f64::NAN,
+        saturated_fraction: f64::NAN,
+    };
+
+    /// False for [`Metrics::NONE`]: the run recorded no period.
+    pub fn recorded(&self) -> bool {
+        !self.max_path.is_nan()
+    }
+}
+
+/// A metric as JSON has it: a number, or `null` for none (NaN).
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
 /// One finished (or stopped) run.

@@ -269,10 +269,27 @@ impl Summary {
             );
         }
         s += "| metric | p50 | p90 | p99 | max | worst run |\n|---|---|---|---|---|---|\n";
+        // No run done: no statistic (NaN), shown as `—` (Choice 129).
+        let cell = |v: f64| {
+            if v.is_nan() {
+                "—".to_string()
+            } else {
+                format!("{v:.4}")
+            }
+        };
         for m in &self.metrics {
+            let worst = if self.done == 0 {
+                "—".to_string()
+            } else {
+                m.worst_run.to_string()
+            };
             s += &format!(
-                "| {} | {:.4} | {:.4} | {:.4} | {:.4} | {} |\n",
-                m.name, m.p50, m.p90, m.p99, m.max, m.worst_run
+                "| {} | {} | {} | {} | {} | {worst} |\n",
+                m.name,
+                cell(m.p50),
+                cell(m.p90),
+                cell(m.p99),
+                cell(m.max)
             );
         }
         if let Some((d, m)) = &self.worst {

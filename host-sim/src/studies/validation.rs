@@ -21,7 +21,7 @@ use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
-use super::preflight::{self, Verdict};
+use super::preflight::{self, CheckError, Verdict};
 use crate::interrupt;
 use crate::plant::{CurrentModel, VariationProfile};
 use crate::scenario::{real_vehicle, Scenario, ScenarioError, SimConfig};
@@ -265,13 +265,18 @@ pub enum Measure {
     Conservativeness,
 }
 
-/// Checks and flies one mission (see the module docs).
+/// Checks and flies one mission (see the module docs); `None` if a stop was requested
+/// ([`crate::interrupt`]) during its check.
 pub fn validate_one(
     base: &Scenario,
     margin: f64,
     measure: Measure,
-) -> Result<MissionResult, String> {
-    let p = preflight::check_as_written(base, margin)?;
+) -> Result<Option<MissionResult>, String> {
+    let p = match preflight::check_as_written(base, margin) {
+        Ok(p) => p,
+        Err(CheckError::Interrupted) => return Ok(None),
+        Err(CheckError::Invalid(e)) => return Err(e),
+    };
     let mounting = base
         .config()
         .controller
@@ -293,7 +298,7 @@ pub fn validate_one(
         smallest_flying: None,
     };
     let Some(k) = proposed else {
-        return Ok(out);
+        return Ok(Some(out));
     };
     let scenario = |k: f64| at_scale(base, k).map_err(|e| e.to_string());
     let (within, m) = flies(&scenario(k)?);
@@ -302,7 +307,7 @@ pub fn validate_one(
     if within && measure == Measure::Conservativeness {
         out.smallest_flying = Some(smallest_flying(k, &mut |k| Ok(flies(&scenario(k)?).0))?);
     }
-    Ok(out)
+    Ok(Some(out))
 }
 
 /// The smallest scale in [1, `k`] at which `flies_at` holds, given that it holds at `k`, by
@@ -339,7 +344,7 @@ pub fn validate(
             if interrupt::requested() {
                 return Ok(None);
             }
-            let r = validate_one(m, margin, measure).map(Some);
+            let r = validate_one(m, margin, measure);
             on_done();
             r
         })

@@ -2,8 +2,8 @@
 //! whole `update`, and the math kernels.
 //!
 //! SysTick counts 40 instructions a count under `-icount shift=0` (`firmware::qemu_clock`), too
-//! coarse for one call of a stage. So each call is repeated [`REPS`] = 40 times back to back on
-//! the same inputs (every call does the same work: the core keeps no state), the loop's own
+//! coarse for one call of a stage. So each call is repeated `counter::REPS` = 40 times back to
+//! back on the same inputs (every call does the same work: the core keeps no state), the loop's own
 //! cost (an empty loop, counted the same way) is subtracted, and the total of 40 calls in
 //! instructions divided by 40 is one call's count (quantised to one instruction; what remains
 //! of the loop is passing the inputs and taking the result's address). Inputs and results pass
@@ -15,44 +15,10 @@
 use core::hint::black_box;
 
 use controller_core::{Controller, ControllerConfig, Stage, Table1Case, Trajectory};
-use cortex_m::peripheral::SYST;
 use defmt::{error, info};
-use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 
-use crate::selftest::{elapsed, Golden, GOLDEN};
-
-/// Calls per count: one SysTick count over `REPS` calls is one instruction per call.
-const REPS: u32 = INSTRUCTIONS_PER_TICK;
-
-/// Instructions of `REPS` calls of `f`, divided by `REPS`, loop included.
-fn raw_per_call<R>(f: &mut impl FnMut() -> R) -> u32 {
-    let t0 = SYST::get_current();
-    for _ in 0..REPS {
-        // A reference to the result where the call left it: the result must exist, but is not
-        // moved (a move of update's 236-byte Output is a memcpy of ~170 instructions).
-        black_box(&f());
-    }
-    let t1 = SYST::get_current();
-    elapsed(t0, t1) * INSTRUCTIONS_PER_TICK / REPS
-}
-
-/// Counts per call, with the cost of the counting loop itself removed.
-pub struct Counter {
-    overhead: u32,
-}
-
-impl Counter {
-    pub fn new() -> Self {
-        Counter {
-            overhead: raw_per_call(&mut || ()),
-        }
-    }
-
-    /// Instructions of one call of `f`.
-    pub fn count<R>(&self, mut f: impl FnMut() -> R) -> u32 {
-        raw_per_call(&mut f).saturating_sub(self.overhead)
-    }
-}
+use crate::counter::Counter;
+use crate::golden::{Golden, GOLDEN};
 
 /// Largest and mean count.
 #[derive(Clone, Copy, Default)]

@@ -10,7 +10,7 @@ use controller_core::math::{self, kernels};
 use controller_core::phase::{Frequency, MissionTime};
 use defmt::{error, info};
 
-use crate::cost::Counter;
+use crate::counter::Counter;
 
 include!(concat!(env!("OUT_DIR"), "/kernel_golden.rs"));
 

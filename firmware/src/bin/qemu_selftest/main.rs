@@ -7,6 +7,8 @@
 #![no_main]
 
 mod cost;
+mod counter;
+mod golden;
 mod kernels;
 mod selftest;
 mod stack;
@@ -14,7 +16,7 @@ mod stack;
 use cortex_m_rt::entry;
 use defmt_semihosting as _;
 use firmware::image::Image;
-use firmware::qemu::halt;
+use firmware::mps2_an386::halt;
 use firmware::rt;
 
 #[entry]

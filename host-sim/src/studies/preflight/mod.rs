@@ -41,15 +41,17 @@
 use std::fmt;
 
 use controller_core::effectiveness::{Mounting, THRUSTERS, THRUSTER_NAMES};
+use controller_core::readable::Readable;
 use controller_core::Trajectory;
 use serde::{Deserialize, Serialize};
 
+use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
 mod sweep;
 
-use sweep::Checker;
+use sweep::{Checker, Peaks};
 
 /// Default fraction of each thruster's envelope the reference may use (the rest is left to
 /// the feedback): 80 %.
@@ -66,6 +68,38 @@ pub const GAUSS_MARKOV_SIGMAS: f64 = 3.0;
 
 /// Samples per second of path time ([`SAMPLE_PERIOD`]).
 const SAMPLE_RATE_HZ: u32 = 20;
+
+/// Why [`check`] gave no verdict.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CheckError {
+    /// The check cannot be made: a margin outside (0, 1], or a scenario whose allocator or
+    /// plants cannot be built.
+    Invalid(String),
+    /// A stop was requested ([`crate::interrupt`]) before the check was done: a day-long
+    /// mission is 1.7·10⁶ samples of the path at each of the 2⁹ corners, minutes of work, so
+    /// the check polls the request at every sample (**Choice 120**).
+    Interrupted,
+}
+
+impl fmt::Display for CheckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CheckError::Invalid(e) => f.write_str(e),
+            CheckError::Interrupted => f.write_str("interrupted before the check was done"),
+        }
+    }
+}
+
+impl std::error::Error for CheckError {}
+
+/// Stops a long loop of the check when a stop was requested.
+pub(super) fn poll() -> Result<(), CheckError> {
+    if interrupt::requested() {
+        Err(CheckError::Interrupted)
+    } else {
+        Ok(())
+    }
+}
 
 /// Which payloads and currents a verdict covers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -298,8 +332,9 @@ impl ScopeVerdict {
 /// mission as written and the whole configured box.
 ///
 /// # Errors
-/// A margin outside (0, 1], or a scenario whose allocator or plants cannot be built.
-pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, String> {
+/// [`CheckError::Invalid`]: a margin outside (0, 1], or a scenario whose allocator or plants
+/// cannot be built; [`CheckError::Interrupted`]: a stop was requested.
+pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
     check_scopes(scenario, margin, true)
 }
 
@@ -308,15 +343,20 @@ pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, String> {
 ///
 /// # Errors
 /// As [`check`].
-pub fn check_as_written(scenario: &Scenario, margin: f64) -> Result<Preflight, String> {
+pub fn check_as_written(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
     check_scopes(scenario, margin, false)
 }
 
-fn check_scopes(scenario: &Scenario, margin: f64, whole_box: bool) -> Result<Preflight, String> {
+fn check_scopes(
+    scenario: &Scenario,
+    margin: f64,
+    whole_box: bool,
+) -> Result<Preflight, CheckError> {
     if !(margin > 0.0 && margin <= 1.0) {
-        return Err(format!(
-            "the margin must be a fraction of the envelope in (0, 1], got {margin}"
-        ));
+        return Err(CheckError::Invalid(format!(
+            "the margin must be a fraction of the envelope in (0, 1], got {}",
+            Readable(margin)
+        )));
     }
     let checker = Checker::new(scenario, margin)?;
     let cfg = scenario.config();
@@ -371,7 +411,7 @@ fn verdict(
     checker: &Checker,
     scope: Scope,
     k: f64,
-) -> Result<(ScopeVerdict, [(f64, f64, f64, f64); THRUSTERS]), String> {
+) -> Result<(ScopeVerdict, Peaks), CheckError> {
     let own = checker.sweep(scope, 1.0 / k, true)?;
     let at_rest = checker.sweep(scope, 0.0, false)?;
     let statically_infeasible = at_rest.first.is_some();
@@ -411,9 +451,9 @@ fn smallest_time_scale(
     checker: &Checker,
     scope: Scope,
     known: Option<f64>,
-) -> Result<Option<f64>, String> {
+) -> Result<Option<f64>, CheckError> {
     let max = f64::from(Trajectory::MAX_TIME_SCALE);
-    let feasible_at = |k: f64| -> Result<bool, String> {
+    let feasible_at = |k: f64| -> Result<bool, CheckError> {
         Ok(checker.sweep(scope, 1.0 / k, false)?.first.is_none())
     };
     if known == Some(1.0) || feasible_at(1.0)? {

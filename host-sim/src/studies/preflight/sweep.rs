@@ -3,17 +3,17 @@
 //! scale — the attitude the vehicle holds there ([`super::attitude`]), the force it needs,
 //! the board's allocator on the margin envelope.
 
-use controller_core::allocator::{Allocator, AxisPriority, AXIS_NAMES};
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
-use controller_core::thruster::Envelope;
+use controller_core::thruster::ThrustEnvelope;
 use controller_core::uncertainty::ParamBox;
+use controller_core::{allocation::Allocator, allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
 use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 
 use super::attitude::{self, Swing};
-use super::{time_scale, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ};
+use super::{poll, time_scale, CheckError, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ};
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::{InitialAttitude, Scenario};
 
@@ -33,11 +33,13 @@ struct PathSample {
     eta_ddot: Vector6<f64>,
 }
 
+/// Per thruster: the smallest demand (N) and when (s), the largest and when.
+pub(super) type Peaks = [(f64, f64, f64, f64); THRUSTERS];
+
 /// One sweep over the samples at one 1/k.
 pub(super) struct Sweep {
     pub first: Option<Violation>,
-    /// Per thruster (min, t_min, max, t_max).
-    pub peaks: [(f64, f64, f64, f64); THRUSTERS],
+    pub peaks: Peaks,
 }
 
 /// The plant of a case at each sample, and its roll swing there.
@@ -74,7 +76,7 @@ pub(super) struct Checker<'a> {
     nominal: Plant,
     currents: Vec<Vector3<f64>>,
     margin_allocator: Allocator,
-    margin_envelope: Envelope,
+    margin_envelope: ThrustEnvelope,
 }
 
 /// The currents the check takes (see the module docs of [`super`]).
@@ -122,7 +124,8 @@ fn state_at(
 }
 
 impl<'a> Checker<'a> {
-    pub(super) fn new(scenario: &'a Scenario, margin: f64) -> Result<Self, String> {
+    pub(super) fn new(scenario: &'a Scenario, margin: f64) -> Result<Self, CheckError> {
+        let invalid = CheckError::Invalid;
         let cfg = scenario.config();
         let controller = scenario.controller();
         // The path at k = 1, sampled over the part the scenario flies.
@@ -130,20 +133,23 @@ impl<'a> Checker<'a> {
             time_scale: 1.0,
             ..cfg.mission()
         })
-        .map_err(|e| format!("the mission at time scale 1: {e}"))?;
+        .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / time_scale(cfg.time_scale);
         let n = (span * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
         let samples = (0..=n)
             .map(|j| {
+                if j % 4096 == 0 {
+                    poll()?;
+                }
                 let d = path.sample(j, SAMPLE_RATE_HZ);
-                PathSample {
+                Ok(PathSample {
                     s: j as f64 / f64::from(SAMPLE_RATE_HZ),
                     eta: d.eta.cast::<f64>(),
                     eta_dot: d.eta_dot.cast::<f64>(),
                     eta_ddot: d.eta_ddot.cast::<f64>(),
-                }
+                })
             })
-            .collect();
+            .collect::<Result<_, CheckError>>()?;
         let bx = controller.config().uncertainty.cast(f64::from);
         let nominal = VehicleParams::auv150();
         let corners = (0..ParamBox::<f64>::CORNERS)
@@ -153,19 +159,23 @@ impl<'a> Checker<'a> {
                     p = plant::trimmed(&p);
                 }
                 Plant::new(p, PlantTerms::default())
-                    .map_err(|e| format!("parameter box corner {c}: {e}"))
+                    .map_err(|e| invalid(format!("parameter box corner {c}: {e}")))
             })
             .collect::<Result<_, _>>()?;
         let law_model = controller.params().cast(f64::from);
         let nominal = Plant::new(law_model, PlantTerms::default())
-            .map_err(|e| format!("the law's nominal model: {e}"))?;
+            .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
         let margin_envelope = controller.envelope().scaled(margin as f32);
         let margin_allocator = Allocator::new(
             controller.allocation(),
             &margin_envelope,
             &controller.config().priority,
         )
-        .map_err(|e| format!("the allocator on the {margin} margin envelope: {e}"))?;
+        .map_err(|e| {
+            invalid(format!(
+                "the allocator on the {margin} margin envelope: {e}"
+            ))
+        })?;
         Ok(Checker {
             scenario,
             samples,
@@ -262,11 +272,11 @@ impl<'a> Checker<'a> {
     }
 
     /// Every sample of every case of `scope` at 1/k = `inv_k`; stops at the first violation
-    /// unless `full` (which also collects the peaks).
-    pub(super) fn sweep(&self, scope: Scope, inv_k: f64, full: bool) -> Result<Sweep, String> {
+    /// unless `full` (which also collects the peaks), and at a stop request.
+    pub(super) fn sweep(&self, scope: Scope, inv_k: f64, full: bool) -> Result<Sweep, CheckError> {
         let times = self.times(inv_k);
         let owned = match scope {
-            Scope::AsWritten => self.profile_plants(&times)?,
+            Scope::AsWritten => self.profile_plants(&times).map_err(CheckError::Invalid)?,
             Scope::WholeBox => Vec::new(),
         };
         let cases = self.cases(scope, &times, &owned);
@@ -275,6 +285,8 @@ impl<'a> Checker<'a> {
             peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
         };
         for (j, smp) in self.samples.iter().enumerate() {
+            // One sample is every case (up to 2⁹ corners): tens of microseconds.
+            poll()?;
             let stiffness = self.pitch_stiffness(smp, inv_k);
             for case in &cases {
                 for current in &self.currents {

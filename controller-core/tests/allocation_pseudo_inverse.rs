@@ -2,8 +2,10 @@
 //! the closed form of the default geometry written here in f64, the round trip B·B₅⁻¹ on a
 //! general tilted layout, and the singular and ill-conditioned layouts it must refuse.
 
-use controller_core::allocation::{Allocation, AllocationError, MAX_CONDITION};
-use controller_core::effectiveness::{ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE};
+use controller_core::allocation::{AllocationError, PseudoInverse, MAX_CONDITION};
+use controller_core::effectiveness::{
+    ThrusterGeometry, AUV150_REVERSED, HORZ_AFT, HORZ_FORE, THRUSTERS,
+};
 use nalgebra::Vector6;
 use proptest::prelude::*;
 
@@ -13,7 +15,7 @@ const EPS: f64 = f32::EPSILON as f64;
 fn default_condition_number_by_hand() {
     // ‖B₅‖∞ = 2 · 1.8 (the M and N rows), ‖B₅⁻¹‖∞ = 1 (the main row; the tunnel rows sum to
     // 0.5 + 0.5/1.8 ≈ 0.78), so κ∞ = 3.6.
-    let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry accepted");
+    let a = PseudoInverse::new(&ThrusterGeometry::default()).expect("default geometry accepted");
     assert!((a.condition() - 3.6).abs() < 1e-5, "{}", a.condition());
 }
 
@@ -23,7 +25,7 @@ fn wrench() -> impl Strategy<Value = [f32; 6]> {
 
 /// docs/design.md §5 closed form, in f64, for every thruster along its reference axis
 /// (+x, +z, +z, +y, +y); a reversed thruster (bit i of `reversed`) gives the negated thrust.
-fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; 5] {
+fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; THRUSTERS] {
     let [x, y, z, _k, m, n] = tau.map(|v| v as f64);
     let t = [
         x,
@@ -47,7 +49,7 @@ fn default_is_the_real_vehicle_mounting() {
     // §9): a pure upward force is positive (strong) thrust fore and negative (weak) aft, a
     // nose-up moment positive thrust on both vertical tunnels, a pure force to port positive
     // thrust on both horizontal ones.
-    let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry");
+    let a = PseudoInverse::new(&ThrusterGeometry::default()).expect("default geometry");
     let up = a.thrusts(&Vector6::new(0.0, 0.0, -100.0, 0.0, 0.0, 0.0));
     assert_eq!(up, [0.0, 50.0, -50.0, 0.0, 0.0]);
     // M = Σ (z F_x − x F_z): a nose-up moment of 360 N m is +100 N up at x = +1.8 m and
@@ -64,7 +66,7 @@ fn default_is_the_real_vehicle_mounting() {
 proptest! {
     #[test]
     fn default_thrusts_equal_closed_form(tau in wrench(), reversed in 0u8..32) {
-        let a = Allocation::new(&ThrusterGeometry::auv150(reversed)).expect("AUV-150 layout");
+        let a = PseudoInverse::new(&ThrusterGeometry::auv150(reversed)).expect("AUV-150 layout");
         let t = a.thrusts(&Vector6::from(tau));
         let want = closed_form(&tau, reversed);
         let scale: f64 = tau.iter().map(|v| v.abs() as f64).sum::<f64>().max(1.0);
@@ -81,7 +83,7 @@ proptest! {
 
     #[test]
     fn wrench_of_thrusts_reproduces_actuated_rows(tau in wrench()) {
-        let a = Allocation::new(&ThrusterGeometry::default()).expect("default geometry");
+        let a = PseudoInverse::new(&ThrusterGeometry::default()).expect("default geometry");
         let back = a.wrench(&a.thrusts(&Vector6::from(tau)));
         let scale: f64 = tau.iter().map(|v| v.abs() as f64).sum::<f64>().max(1.0);
         for r in [0usize, 1, 2, 4, 5] {
@@ -111,7 +113,7 @@ proptest! {
                 [s, s, 0.0],
             ],
         };
-        let a = Allocation::new(&g).expect("tilted geometry accepted");
+        let a = PseudoInverse::new(&g).expect("tilted geometry accepted");
         let back = a.wrench(&a.thrusts(&Vector6::from(tau)));
         let scale: f64 = tau.iter().map(|v| v.abs() as f64).sum::<f64>().max(1.0);
         let tol = 8.0 * EPS * a.condition() as f64 * scale;
@@ -127,7 +129,7 @@ fn rejects_two_identical_thrusters() {
     let mut g = ThrusterGeometry::default();
     g.position[HORZ_AFT] = g.position[HORZ_FORE];
     g.direction[HORZ_AFT] = g.direction[HORZ_FORE];
-    let err = Allocation::new(&g).expect_err("duplicate thrusters must be rejected");
+    let err = PseudoInverse::new(&g).expect_err("duplicate thrusters must be rejected");
     assert!(
         matches!(
             err,
@@ -142,7 +144,7 @@ fn rejects_ill_conditioned_layout() {
     // Horizontal tunnels 0.1 mm apart: N = 1.8 T_f + 1.7999 T_a, so B₅⁻¹ has entries ≈ 1/1e-4.
     let mut g = ThrusterGeometry::default();
     g.position[HORZ_AFT] = [1.8 - 1e-4, 0.0, 0.0];
-    match Allocation::new(&g) {
+    match PseudoInverse::new(&g) {
         Err(AllocationError::IllConditioned { condition, limit }) => {
             assert_eq!(limit, MAX_CONDITION);
             assert!(

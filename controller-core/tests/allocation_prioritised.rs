@@ -1,14 +1,15 @@
-//! The saturation-aware allocator (`controller_core::allocator`, docs/design.md §9): a feasible
-//! demand gives exactly B₅⁻¹τ; the thrusts are always inside the envelope; a higher-priority
-//! axis is met exactly whenever it is feasible on its own; the weighted least-squares optimum
-//! and the lexicographic optimum are no worse than a brute-force search over a fine grid of the
-//! box; the saturation bits and the unallocated part say what was given up. Every expected
-//! value is computed here from B and the envelope, in f64.
+//! The saturation-aware allocator (`controller_core::allocation::Allocator`, docs/design.md
+//! §9): a feasible demand gives exactly B₅⁻¹τ; the thrusts are always inside the envelope; a
+//! higher-priority axis is met exactly whenever it is feasible on its own; the weighted
+//! least-squares optimum and the lexicographic optimum are no worse than a brute-force search
+//! over a fine grid of the box; the saturation bits and the unallocated part say what was given
+//! up. Every expected value is computed here from B and the envelope, in f64.
 
-use controller_core::allocation::{Allocation, AllocationError};
-use controller_core::allocator::{Allocated, Allocator, AxisPriority};
+use controller_core::allocation::{
+    Allocated, AllocationError, Allocator, AxisPriority, PseudoInverse,
+};
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
-use controller_core::thruster::{default_maps, Envelope, ThrustUnit};
+use controller_core::thruster::{default_maps, ThrustEnvelope, ThrustUnit};
 use nalgebra::Vector6;
 use proptest::prelude::*;
 
@@ -22,24 +23,28 @@ const N: usize = 5;
 /// The blocks of the AUV-150: (thrusters, axes).
 const BLOCKS: [([usize; 2], [usize; 2]); 2] = [([1, 2], [Z, M]), ([3, 4], [Y, N])];
 
-fn envelope(unit: ThrustUnit) -> Envelope {
-    Envelope::new(&default_maps(), unit, 24.0)
+fn envelope(unit: ThrustUnit) -> ThrustEnvelope {
+    ThrustEnvelope::new(&default_maps(), unit, 24.0)
 }
 
-fn allocator(reversed: u8, unit: ThrustUnit, priority: &AxisPriority) -> (Allocator, Allocation) {
-    let a = Allocation::new(&ThrusterGeometry::auv150(reversed)).expect("AUV-150 layout");
+fn allocator(
+    reversed: u8,
+    unit: ThrustUnit,
+    priority: &AxisPriority,
+) -> (Allocator, PseudoInverse) {
+    let a = PseudoInverse::new(&ThrusterGeometry::auv150(reversed)).expect("AUV-150 layout");
     let al = Allocator::new(&a, &envelope(unit), priority).expect("block geometry");
     (al, a)
 }
 
 /// B·T in f64, row `r`.
-fn row(a: &Allocation, r: usize, t: &[f32; THRUSTERS]) -> f64 {
+fn row(a: &PseudoInverse, r: usize, t: &[f32; THRUSTERS]) -> f64 {
     let b = a.matrix();
     (0..THRUSTERS).map(|c| b[(r, c)] as f64 * t[c] as f64).sum()
 }
 
 /// The range of axis `r` over the block's box (interval arithmetic in f64).
-fn reach(a: &Allocation, e: &Envelope, thrusters: [usize; 2], r: usize) -> (f64, f64) {
+fn reach(a: &PseudoInverse, e: &ThrustEnvelope, thrusters: [usize; 2], r: usize) -> (f64, f64) {
     let b = a.matrix();
     let (mut lo, mut hi) = (0.0, 0.0);
     for t in thrusters {
@@ -51,7 +56,7 @@ fn reach(a: &Allocation, e: &Envelope, thrusters: [usize; 2], r: usize) -> (f64,
     (lo, hi)
 }
 
-fn inside(e: &Envelope, out: &Allocated) -> bool {
+fn inside(e: &ThrustEnvelope, out: &Allocated) -> bool {
     e.contains(&out.thrusts)
 }
 
@@ -243,7 +248,7 @@ fn refuses_non_block_geometries_and_bad_weights() {
     // thrusters.
     let mut g = ThrusterGeometry::default();
     g.direction[0] = [0.8, 0.6, 0.0];
-    let a = Allocation::new(&g).expect("invertible");
+    let a = PseudoInverse::new(&g).expect("invertible");
     let err = Allocator::new(&a, &envelope(ThrustUnit::Kgf), &AxisPriority::default())
         .expect_err("not block diagonal");
     assert_eq!(
@@ -254,7 +259,7 @@ fn refuses_non_block_geometries_and_bad_weights() {
         }
     );
     assert!(err.to_string().contains("block-diagonal"), "{err}");
-    let a = Allocation::new(&ThrusterGeometry::default()).expect("default");
+    let a = PseudoInverse::new(&ThrusterGeometry::default()).expect("default");
     let mut p = AxisPriority::default();
     p.weight[M] = 0.0;
     assert_eq!(

@@ -26,6 +26,7 @@ use core::cell::Cell;
 use core::convert::Infallible;
 use core::ptr::{read_volatile, write_volatile};
 
+use controller_core::effectiveness::THRUSTERS;
 use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use embedded_io::{ErrorType, Read, ReadReady, Write};
@@ -147,7 +148,7 @@ pub const MAX_DUTY: u16 = 1000;
 pub struct QemuBoard {
     syst: SYST,
     uart: CmsdkUart,
-    thrusters: [MemPwm; 5],
+    thrusters: [MemPwm; THRUSTERS],
     reload: u32,
     /// Software extension of the 24-bit SysTick for `now()`: last counter value seen and the
     /// ticks accumulated so far. Correct while `now()` is called at least once per period.
@@ -163,7 +164,7 @@ impl QemuBoard {
         let mut b = QemuBoard {
             syst,
             uart,
-            thrusters: [MemPwm::neutral(MAX_DUTY); 5],
+            thrusters: [MemPwm::neutral(MAX_DUTY); THRUSTERS],
             reload: 0,
             last_cvr: Cell::new(0),
             ticks: Cell::new(0),
@@ -182,7 +183,7 @@ impl Board for QemuBoard {
     fn supply_voltage(&self) -> f32 {
         SUPPLY_VOLTAGE
     }
-    fn thrusters(&mut self) -> &mut [MemPwm; 5] {
+    fn thrusters(&mut self) -> &mut [MemPwm; THRUSTERS] {
         &mut self.thrusters
     }
     fn link(&mut self) -> &mut CmsdkUart {

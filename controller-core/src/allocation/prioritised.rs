@@ -1,0 +1,188 @@
+//! The saturation-aware allocator the board flies: thrusts inside every thruster's
+//! [`ThrustEnvelope`] that give the commanded wrench where the thrusters can, and give up the
+//! least important force first where they cannot (docs/design.md §9, §15).
+//!
+//! [`Allocator::new`] runs once at configuration time. It takes the geometric allocation
+//! ([`PseudoInverse`]: B and B₅⁻¹), the envelope [T_min, T_max] of each thruster at the supply
+//! limit, and the axis priority ([`AxisPriority`]), and splits the 5×5 allocation over
+//! (X, Y, Z, M, N) into its blocks (`blocks.rs`): groups of thrusters that share no actuated
+//! axis with any other group. For the AUV-150 these are X ← main; (Z, M) ← the vertical pair;
+//! (Y, N) ← the horizontal pair. **Choice** (§9): a geometry whose allocation is not block
+//! diagonal with blocks of one or two thrusters is refused at configuration time
+//! ([`AllocationError::NotBlockDiagonal`]); there is no general-geometry fallback.
+//!
+//! Per tick ([`Allocator::allocate`]), fixed work, no heap, no panic:
+//!
+//! 1. T = B₅⁻¹τ ([`PseudoInverse::thrusts`]). A block whose thrusts are all inside their
+//!    envelopes is *met*: it keeps exactly these thrusts, so a feasible demand gives exactly
+//!    B₅⁻¹τ.
+//! 2. Otherwise the block is solved exactly within its box, in closed form
+//!    (`box_solution.rs`):
+//!    * one thruster, one axis: the thrust clamped to its envelope;
+//!    * two axes of different priority (**lexicographic**): the higher axis is clamped to the
+//!      range it can reach over the box (so it is met exactly whenever it is feasible on its
+//!      own), then the lower axis is optimised over the segment of the box that achieves it —
+//!      on a segment the lower axis is linear in one parameter, so its optimum is one
+//!      division and one clamp;
+//!    * two axes of equal priority (**weighted least squares**): the minimum of
+//!      w_a (τ_a − g_a·T)² + w_b (τ_b − g_b·T)² over the box, found among a fixed candidate
+//!      set: the unconstrained optimum (already rejected in step 1), the optimum on each of
+//!      the four edges (a one-dimensional quadratic, clamped) and the four corners. The cost
+//!      is convex and the unconstrained optimum lies outside the box, so the box's optimum
+//!      lies on its boundary, i.e. on an edge: the set contains it.
+//! 3. Outputs ([`Allocated`]): the thrusts, the unallocated wrench τ − B·T of each block that
+//!    was not met (zero for a met block and for the unactuated roll row), and per-thruster
+//!    saturation bits: bit i is set when thruster i's block was not met and thruster i sits on
+//!    a bound of its envelope (it is one of the thrusters that limit the block).
+//!
+//! The default [`AxisPriority`] is pitch, depth, yaw, sway, surge, highest first: the vertical
+//! pair holds pitch before depth, the horizontal pair yaw before sway, and the main thruster
+//! (surge) is alone in its block.
+
+use nalgebra::Vector6;
+
+use crate::allocation::blocks::{self, Block, Rule};
+use crate::allocation::box_solution::{clamp, least_squares, lexicographic};
+use crate::allocation::error::AllocationError;
+use crate::allocation::priority::AxisPriority;
+use crate::allocation::pseudo_inverse::PseudoInverse;
+use crate::effectiveness::THRUSTERS;
+use crate::thruster::ThrustEnvelope;
+
+/// A thrust within this fraction of its envelope's width from a bound counts as on the bound
+/// (for the saturation bits: the segment solution lands on a bound up to f32 rounding).
+const ON_BOUND: f32 = 1.0e-4;
+
+/// One allocation step's result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Allocated {
+    /// Thrust per thruster (N), thruster order, always inside the envelope.
+    pub thrusts: [f32; THRUSTERS],
+    /// Bit i set: thruster i's block was not met and thruster i is on a bound of its envelope.
+    pub saturated: u8,
+    /// τ − B·T over the rows of the blocks that were not met (N, N m); zero for met blocks and
+    /// for the roll row.
+    pub unallocated: [f32; 6],
+}
+
+/// The saturation-aware allocator of a validated geometry, envelope and priority (see the
+/// module docs).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Allocator {
+    pseudo_inverse: PseudoInverse,
+    envelope: ThrustEnvelope,
+    blocks: [Block; THRUSTERS],
+    count: usize,
+}
+
+impl Allocator {
+    /// Splits `pseudo_inverse` into blocks and precomputes each block's solution. Refuses a
+    /// geometry whose 5×5 allocation is not block diagonal with blocks of at most two thrusters
+    /// ([`AllocationError::NotBlockDiagonal`]), an envelope that is not finite with
+    /// T_min < T_max, and an invalid weight.
+    pub fn new(
+        pseudo_inverse: &PseudoInverse,
+        envelope: &ThrustEnvelope,
+        priority: &AxisPriority,
+    ) -> Result<Allocator, AllocationError> {
+        for i in 0..THRUSTERS {
+            let (lo, hi) = (envelope.min[i], envelope.max[i]);
+            if !(lo.is_finite() && hi.is_finite() && lo < hi) {
+                return Err(AllocationError::ThrustEnvelope {
+                    thruster: i,
+                    min: lo,
+                    max: hi,
+                });
+            }
+        }
+        if let Some((axis, weight)) = priority.invalid_weight() {
+            return Err(AllocationError::Weight { axis, weight });
+        }
+        let (blocks, count) = blocks::split(&pseudo_inverse.matrix(), priority)?;
+        Ok(Allocator {
+            pseudo_inverse: *pseudo_inverse,
+            envelope: *envelope,
+            blocks,
+            count,
+        })
+    }
+
+    /// The envelope the thrusts are kept in (N).
+    pub fn envelope(&self) -> &ThrustEnvelope {
+        &self.envelope
+    }
+
+    /// The geometric allocation underneath.
+    pub fn pseudo_inverse(&self) -> &PseudoInverse {
+        &self.pseudo_inverse
+    }
+
+    /// Thrusts inside the envelope for the wrench `tau` = [X Y Z K M N] (N, N m); τ_K is
+    /// ignored (see the module docs). Fixed work. A non-finite τ gives 0 N on every thruster
+    /// with every saturation bit set and a zero unallocated part.
+    pub fn allocate(&self, tau: &Vector6<f32>) -> Allocated {
+        if !tau.iter().all(|x| x.is_finite()) {
+            return Allocated {
+                thrusts: [0.0; THRUSTERS],
+                saturated: (1 << THRUSTERS) - 1,
+                unallocated: [0.0; 6],
+            };
+        }
+        let exact = self.pseudo_inverse.thrusts(tau);
+        let mut out = Allocated {
+            thrusts: exact,
+            saturated: 0,
+            unallocated: [0.0; 6],
+        };
+        for block in &self.blocks[..self.count] {
+            self.solve(block, tau, &exact, &mut out);
+        }
+        out
+    }
+
+    /// One block: keep B₅⁻¹τ if it fits, else solve within the box.
+    fn solve(
+        &self,
+        block: &Block,
+        tau: &Vector6<f32>,
+        exact: &[f32; THRUSTERS],
+        out: &mut Allocated,
+    ) {
+        let n = if block.rule == Rule::Single { 1 } else { 2 };
+        let [i, j] = block.thrusters;
+        let lo = [self.envelope.min[i], self.envelope.min[j]];
+        let hi = [self.envelope.max[i], self.envelope.max[j]];
+        let fits = (0..n).all(|c| {
+            let t = exact[block.thrusters[c]];
+            t >= lo[c] && t <= hi[c]
+        });
+        if fits {
+            return;
+        }
+        let ta = tau[block.axes[0]];
+        let tb = tau[block.axes[1]];
+        let t = match block.rule {
+            Rule::Single => [clamp(ta / block.g[0][0], lo[0], hi[0]), 0.0],
+            Rule::Lexicographic(seg) => lexicographic(&block.g, &seg, ta, tb, lo, hi),
+            Rule::LeastSquares(w) => least_squares(&block.g, w, ta, tb, lo, hi),
+        };
+        for c in 0..n {
+            let k = block.thrusters[c];
+            let v = clamp(t[c], lo[c], hi[c]);
+            out.thrusts[k] = v;
+            let tol = ON_BOUND * (hi[c] - lo[c]);
+            if v - lo[c] <= tol || hi[c] - v <= tol {
+                out.saturated |= 1 << k;
+            }
+        }
+        let tk = [out.thrusts[i], out.thrusts[j]];
+        for r in 0..n {
+            let achieved = if n == 1 {
+                block.g[0][0] * tk[0]
+            } else {
+                block.g[r][0] * tk[0] + block.g[r][1] * tk[1]
+            };
+            out.unallocated[block.axes[r]] = tau[block.axes[r]] - achieved;
+        }
+    }
+}

@@ -1,0 +1,90 @@
+//! The path kinds as data: [`TrajectoryKind`], the shape and parameters of a mission, and how
+//! host-sim's scenario files spell it (the `serde` feature). Each kind's equations are its own
+//! file in `paths/`.
+
+#[cfg(any(doc, feature = "serde"))]
+use crate::trajectory::Trajectory;
+
+/// Shape and parameters of a mission (the paper's "Simulation Results"; docs/design.md §6).
+///
+/// All frequencies ω are in rad/s and must be positive; sizes in metres; z is positive down (NED).
+///
+/// With the `serde` feature it is a table tagged by `kind` (`"circle"`, `"figure-eight"`,
+/// `"lawn-mower"`, `"helix"`) with the fields by name; unknown fields are refused, and `omega`
+/// and `depth` default to the paper's values ([`Trajectory::PAPER_OMEGA`], for the lawn-mower
+/// [`Trajectory::PAPER_LAWN_MOWER_OMEGA`]; [`Trajectory::PAPER_DEPTH`]). This is the
+/// `[trajectory]` table of host-sim's scenario files. Values are not validated there: build the
+/// mission with [`Trajectory::new`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
+#[cfg_attr(
+    feature = "serde",
+    serde(tag = "kind", rename_all = "kebab-case", deny_unknown_fields)
+)]
+pub enum TrajectoryKind {
+    /// x = R sin ωt, y = R cos ωt, z = depth, ψ = ωt (paper: ω = 0.1; "10 sin(0.1)t" read as
+    /// R sin 0.1t).
+    Circle {
+        /// R (m).
+        radius: f32,
+        /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_omega"))]
+        omega: f32,
+        /// z_d (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
+        depth: f32,
+    },
+    /// x = A sin ωt, y = A cos(ωt/2), z = depth,
+    /// ψ = (8/π) Σ_{n odd ≤ N} (−1)^((n−1)/2) sin(nωt)/n² (a triangle wave of amplitude π;
+    /// paper: ω = 0.1, A = 15 or 20 for the 30×30 and 40×40 cases).
+    FigureEight {
+        /// A (m): x and y each span 2A.
+        amplitude: f32,
+        /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_omega"))]
+        omega: f32,
+        /// z_d (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
+        depth: f32,
+    },
+    /// x = s(0.25 t + 2.5 sin 2ωt), y = 15 s cos ωt, z = depth,
+    /// ψ = (8/π) Σ_{n ≤ N} [sin(nπ/4) + sin(3nπ/4)] sin(nωt)/n² (a trapezoid of amplitude π;
+    /// paper: ω = 0.05, so 2ω = 0.1; s = 1 is the paper's 30×15 case).
+    LawnMower {
+        /// s (dimensionless): loop height 30 s m, loop width ≈ 15.7 s m.
+        scale: f32,
+        /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_lawn_mower_omega"))]
+        omega: f32,
+        /// z_d (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
+        depth: f32,
+    },
+    /// A circle whose depth changes linearly: z = depth + depth_rate·t (not in the paper).
+    Helix {
+        /// R (m).
+        radius: f32,
+        /// ω (rad/s).
+        #[cfg_attr(feature = "serde", serde(default = "default_omega"))]
+        omega: f32,
+        /// z_d at t = 0 (m, positive down).
+        #[cfg_attr(feature = "serde", serde(default = "default_depth"))]
+        depth: f32,
+        /// ż_d (m/s, positive = descending).
+        depth_rate: f32,
+    },
+}
+
+// The serde defaults of `TrajectoryKind` (the paper's values).
+#[cfg(feature = "serde")]
+fn default_omega() -> f32 {
+    Trajectory::PAPER_OMEGA
+}
+#[cfg(feature = "serde")]
+fn default_lawn_mower_omega() -> f32 {
+    Trajectory::PAPER_LAWN_MOWER_OMEGA
+}
+#[cfg(feature = "serde")]
+fn default_depth() -> f32 {
+    Trajectory::PAPER_DEPTH
+}

@@ -1,0 +1,349 @@
+//! Processor in the loop: the QEMU flying image flies the simulated vehicle through
+//! `host-sim pil`. Four checks: a short lawn-mower mission must equal SIL bit for bit, on an
+//! unsigned and on a signed link (the public CI test key, [`CI_TEST_KEY`]); a short real-chain
+//! mission (kgf, tangent heading, time scale > 1, the real actuator chain, the real vehicle's
+//! mounting: [`REAL_CHAIN`]) must equal SIL bit for bit with the board reporting the
+//! scenario's thrust unit and mounting; and a link-fault case must enter and leave fail-safe
+//! at its exact ticks and drop its delayed (old) state frames.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use auv_link::FailSafeReason;
+use auv_link::DEFAULT_STALE_PERIODS;
+use controller_core::HeadingMode;
+use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
+use host_sim::board::{BoardComparison, FailSafeEventKind};
+use host_sim::cli::Cases;
+use xtask::ci::{Ci, HOST_PROFILE};
+
+/// The key the signed runs use (workspace-relative): public, for tests only.
+pub const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
+
+/// The real-chain mission PIL flies (workspace-relative): one of the real-vehicle missions
+/// (docs/design.md §9), chosen because its time scale is above 1, flown for
+/// [`REAL_CHAIN_SECONDS`] only (CI time). The check reads it with host-sim's own loader and
+/// refuses to run unless it is what the check claims to fly.
+const REAL_CHAIN: &str = "host-sim/scenarios/real/figure-eight-30x30.toml";
+/// Seconds of the real-chain mission: 300 periods, a few seconds of QEMU.
+const REAL_CHAIN_SECONDS: &str = "3";
+
+/// The link-fault case's silent ticks [from, to) and delayed ticks (see [`link_faults`]).
+const SILENT: (u64, u64) = (300, 310);
+const DELAY: (u64, u64) = (200, 202);
+
+/// Builds the `host-sim` binary the checks run and returns its path. It is the very build of
+/// the host tests (`cargo test --workspace --profile host`), so that host-sim is built once:
+/// `cargo build -p host-sim` alone resolves features differently (no dev-dependencies) and
+/// would build host-sim a second time.
+pub fn build_host_sim(ci: &mut Ci) -> Option<PathBuf> {
+    let args = ["test", "--workspace", "--profile", HOST_PROFILE, "--no-run"];
+    let what = format!("cargo {}", args.join(" "));
+    println!("{what}");
+    match ci.cargo().args(args).status() {
+        Ok(s) if s.success() => Some(ci.target_dir.join(HOST_PROFILE).join("host-sim")),
+        other => {
+            ci.fail(format!(
+                "{what} failed ({other:?}); the compiler's errors are above"
+            ));
+            None
+        }
+    }
+}
+
+/// The PIL checks with the flying image `elf`. Each runs the `host-sim` binary with `--json`
+/// and reads its report into host-sim's own types ([`Cases`]`<`[`BoardComparison`]`>`), so the
+/// check and the report cannot disagree on a field.
+pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
+    ci.step(
+        "processor in the loop: a short mission unsigned and signed, a short real-chain mission (PIL must equal SIL) and a link-fault case",
+    );
+    let pil = Pil { host_sim, elf };
+    same_as_sil(ci, &pil);
+    link_faults(ci, &pil);
+}
+
+/// `host-sim pil` with one image.
+struct Pil<'a> {
+    host_sim: &'a Path,
+    elf: &'a Path,
+}
+
+impl Pil<'_> {
+    /// Flies `args`; whether host-sim passed, and its one case.
+    fn run(&self, ci: &mut Ci, name: &str, args: &[&str]) -> Option<(bool, BoardComparison)> {
+        let out = ci.scratch().join(format!("pil-{name}"));
+        // host-sim refuses an output folder it did not write (no manifest): start afresh.
+        let _ = std::fs::remove_dir_all(&out);
+        let mut cmd = Command::new(self.host_sim);
+        cmd.current_dir(&ci.root)
+            .arg("pil")
+            .args(args)
+            .arg("--elf")
+            .arg(self.elf)
+            .arg("--json")
+            .arg("--out")
+            .arg(&out);
+        let shown = format!("{} pil {}", ci.rel(self.host_sim), args.join(" "));
+        println!("{shown}");
+        let output = match cmd.output() {
+            Ok(o) => o,
+            Err(e) => {
+                ci.fail(format!("PIL {name}: running {shown}: {e}"));
+                return None;
+            }
+        };
+        // host-sim prints its report even when it exits 1 (PIL ≠ SIL, or diverged).
+        match serde_json::from_slice::<Cases<BoardComparison>>(&output.stdout) {
+            Ok(r) if r.cases.len() == 1 => {
+                let case = r.cases.into_iter().next()?;
+                Some((output.status.success(), case))
+            }
+            Ok(r) => {
+                ci.fail(format!(
+                    "PIL {name}: expected one case, got {}",
+                    r.cases.len()
+                ));
+                None
+            }
+            Err(e) => {
+                ci.fail(format!(
+                    "PIL {name}: {shown} exited {} without a JSON report ({e}); its messages:\n{}",
+                    output.status,
+                    String::from_utf8_lossy(&output.stderr)
+                ));
+                None
+            }
+        }
+    }
+}
+
+/// 1. PIL = SIL: the same f32 core on the same inputs, bit for bit, unsigned and signed
+///    (signing changes what crosses the link, never what the board computes), and on the real
+///    chain (the board gets the thrust unit, mounting and priority through SetConfig and the
+///    heading and time scale through StartMission).
+fn same_as_sil(ci: &mut Ci, pil: &Pil) {
+    let short = [
+        "--scenario",
+        "host-sim/scenarios/lawn-mower-20x10.toml",
+        "--duration",
+        "10",
+    ];
+    let key = ci.root.join(CI_TEST_KEY);
+    let key = key.to_string_lossy().into_owned();
+    // Signed, the first half of the same mission (its PIL = SIL check is the same; CI time).
+    let signed = [&short[..3], &["5", "--link-key-file", &key]].concat();
+    let real = ["--scenario", REAL_CHAIN, "--duration", REAL_CHAIN_SECONDS];
+    let real_chain = real_chain_scenario(ci);
+    for (name, args, want_signed) in [
+        ("short", &short[..], false),
+        ("short-signed", &signed[..], true),
+        ("real-chain", &real[..], false),
+    ] {
+        let want_chain = if name == "real-chain" {
+            match &real_chain {
+                Some(c) => Some(c),
+                None => continue,
+            }
+        } else {
+            None
+        };
+        let Some((ok, c)) = pil.run(ci, name, args) else {
+            continue;
+        };
+        println!(
+            "{name}: PIL max path {:.5} m, SIL {:.5} m, {:.0} frames/s, worst update {} instructions, signed {}, board auth errors {}, telemetry refused {}",
+            c.run.metrics.max_path,
+            c.sil_max_path,
+            c.pil.frames_per_second,
+            c.pil.worst_update_instructions,
+            c.pil.signed,
+            c.pil.board_rx_auth_errors,
+            c.pil.telemetry_refused
+        );
+        whole_counts(ci, name, &c);
+        bit_for_bit(ci, name, ok, &c);
+        if let Some((unit, mounting)) = want_chain {
+            chain_taken(ci, name, unit, *mounting, &c);
+        }
+        clean_link(ci, name, want_signed, &c);
+    }
+}
+
+/// The board's worst `update` must be whole SysTick counts (instructions under `-icount`).
+fn whole_counts(ci: &mut Ci, name: &str, c: &BoardComparison) {
+    if !c
+        .pil
+        .worst_update_instructions
+        .is_multiple_of(u64::from(INSTRUCTIONS_PER_TICK))
+    {
+        ci.fail(format!(
+            "PIL {name}: worst update {} instructions is not a whole number of SysTick counts ({INSTRUCTIONS_PER_TICK} each)",
+            c.pil.worst_update_instructions
+        ));
+    }
+}
+
+/// PIL's max path error equals SIL's bit for bit, and host-sim passed.
+fn bit_for_bit(ci: &mut Ci, name: &str, ok: bool, c: &BoardComparison) {
+    if !ok || c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits() {
+        ci.fail(format!(
+            "PIL {name}: PIL max path {} m is not SIL's {} m bit for bit (host-sim {}); the board and SIL run the same f32 core on the same state frames, so look for a change in what crosses the link or in the firmware's period",
+            c.run.metrics.max_path,
+            c.sil_max_path,
+            if ok { "passed its 1 mm check" } else { "failed" }
+        ));
+    }
+}
+
+/// The board flew the scenario's thrust unit and mounting (its SetConfig took).
+fn chain_taken(ci: &mut Ci, name: &str, unit: &str, mounting: u8, c: &BoardComparison) {
+    println!(
+        "{name}: board flew thrust unit {:?}, reversed-thruster mask {:?}; peak |V| {:.2} V, saturated {:.1} % of periods",
+        c.pil.board_thrust_unit,
+        c.pil.board_reversed_thrusters,
+        c.run.metrics.peak_voltage,
+        100.0 * c.run.metrics.saturated_fraction
+    );
+    if c.pil.board_thrust_unit.as_deref() != Some(unit)
+        || c.pil.board_reversed_thrusters != Some(mounting)
+    {
+        ci.fail(format!(
+            "PIL {name}: the board reported thrust unit {:?} and mounting {:?}; the scenario flies {unit} and {mounting:#07b} (SetConfig did not take)",
+            c.pil.board_thrust_unit, c.pil.board_reversed_thrusters
+        ));
+    }
+}
+
+/// The link was signed as asked, with no receive error, dropped frame or refusal at either end.
+fn clean_link(ci: &mut Ci, name: &str, want_signed: bool, c: &BoardComparison) {
+    let clean = c.pil.board_rx_errors == 0
+        && c.pil.board_rx_stale == 0
+        && c.pil.board_refused_commands == 0
+        && c.pil.telemetry_refused == 0;
+    if c.pil.signed != want_signed || !clean {
+        ci.fail(format!(
+            "PIL {name}: expected a {} link with no receive error, dropped frame or refusal at either end; got signed {}, board rx errors {}, dropped {}, refused {} ({:?}), telemetry refused {}",
+            if want_signed { "signed" } else { "unsigned" },
+            c.pil.signed,
+            c.pil.board_rx_errors,
+            c.pil.board_rx_stale,
+            c.pil.board_refused_commands,
+            c.pil.board_last_refusal,
+            c.pil.telemetry_refused
+        ));
+    }
+}
+
+/// 2. Link faults: drop, corruption and a short delay stay within the stale limit; the delayed
+///    frames hold old states, which the board drops (off its mission clock) and counts; silence
+///    from tick SILENT.0 is fail-safe (stale state) once DEFAULT_STALE_PERIODS periods have
+///    passed without a frame, and the re-arm (and restart of the mission) on the first healthy
+///    frame (SILENT.1) ends it.
+fn link_faults(ci: &mut Ci, pil: &Pil) {
+    let silent = format!("{}..{}", SILENT.0, SILENT.1);
+    let delay = format!("{}..{}", DELAY.0, DELAY.1);
+    let args = [
+        "--scenario",
+        "host-sim/scenarios/circular-10R.toml",
+        "--duration",
+        "8",
+        "--drop",
+        "100..101",
+        "--corrupt",
+        "150..152",
+        "--delay",
+        &delay,
+        "--silent",
+        &silent,
+    ];
+    let Some((ok, c)) = pil.run(ci, "faults", &args) else {
+        return;
+    };
+    let ev = &c.pil.failsafe_events;
+    println!(
+        "fail-safe events: {:?}, board rx_errors {}",
+        ev.iter()
+            .map(|e| (e.kind.as_str(), e.tick, e.reason.as_str()))
+            .collect::<Vec<_>>(),
+        c.pil.board_rx_errors
+    );
+    whole_counts(ci, "link-fault case", &c);
+    let enter = SILENT.0 + u64::from(DEFAULT_STALE_PERIODS);
+    let as_expected = matches!(
+        &ev[..],
+        [a, b] if a.kind == FailSafeEventKind::Enter && a.tick == enter
+            && a.reason == FailSafeReason::StaleState.as_str()
+            && b.kind == FailSafeEventKind::Exit && b.tick == SILENT.1
+    );
+    if !ok || !as_expected {
+        ci.fail(format!(
+            "PIL link-fault case: expected fail-safe (stale state) entered at tick {enter} (silent from {}, stale after {DEFAULT_STALE_PERIODS} periods) and left at {} (re-armed on the first healthy frame), nothing else; got {ev:?}{}",
+            SILENT.0,
+            SILENT.1,
+            if ok { "" } else { " and host-sim failed" }
+        ));
+    }
+    if c.pil.board_rx_errors < 2 {
+        ci.fail(format!(
+            "PIL link-fault case: the board counted {} receive errors; the two corrupted frames must be counted",
+            c.pil.board_rx_errors
+        ));
+    }
+    if u64::from(c.pil.board_rx_stale) != DELAY.1 - DELAY.0 {
+        ci.fail(format!(
+            "PIL link-fault case: the board dropped {} frames as old; the {} delayed state frames (ticks {delay}) must be dropped, and nothing else",
+            c.pil.board_rx_stale,
+            DELAY.1 - DELAY.0
+        ));
+    }
+}
+
+/// The real-chain scenario's thrust unit name and reversed-thruster mask, after checking that
+/// it is a real-chain mission as [`REAL_CHAIN`] says (kgf, tangent heading, time scale > 1,
+/// the real actuator chain); `None` (and a CI failure) otherwise.
+fn real_chain_scenario(ci: &mut Ci) -> Option<(&'static str, u8)> {
+    let path = ci.root.join(REAL_CHAIN);
+    let s = match host_sim::scenario::load_scenario(&path) {
+        Ok(s) => s,
+        Err(e) => {
+            // The whole chain: an unreadable file's reason is the error's source.
+            ci.fail(format!(
+                "PIL real-chain: {REAL_CHAIN}: {:#}",
+                anyhow::Error::from(e)
+            ));
+            return None;
+        }
+    };
+    let cfg = s.config();
+    let mission = s.trajectory().mission();
+    let controller = s.controller().config();
+    let unit = controller.thrust_unit;
+    let mounting = controller.geometry.auv150_reversed();
+    let real = unit == controller_core::ThrustUnit::Kgf
+        && mission.heading == HeadingMode::Tangent
+        && mission.time_scale > 1.0
+        && !cfg.ideal_actuators;
+    match mounting {
+        Some(m) if real => {
+            println!(
+                "real-chain mission {REAL_CHAIN}: thrust unit {}, heading {}, time scale {}, ideal actuators {}, reversed-thruster mask {m:#07b}",
+                unit.as_str(),
+                mission.heading.as_str(),
+                mission.time_scale,
+                cfg.ideal_actuators
+            );
+            Some((unit.as_str(), m))
+        }
+        _ => {
+            ci.fail(format!(
+                "PIL real-chain: {REAL_CHAIN} must be a real-chain mission of the AUV-150 layout (kgf, tangent heading, time scale > 1, ideal_actuators = false); it has {}, {}, {}, ideal actuators {}, mounting {mounting:?}",
+                unit.as_str(),
+                mission.heading.as_str(),
+                mission.time_scale,
+                cfg.ideal_actuators
+            ));
+            None
+        }
+    }
+}
