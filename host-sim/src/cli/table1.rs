@@ -79,7 +79,6 @@ impl Default for Table1Args {
 /// `table1`: the paper's Table 1 (ideal actuators), then the real vehicle: the missions of
 /// `scenarios/real/` and the paper's six through the real chain, with their preflight verdicts.
 pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
-    use rayon::prelude::*;
     let jobs = paper_table1::jobs()?;
     let real_jobs = real_vehicle::real_scenarios()?;
     let chain_jobs = real_vehicle::paper_real_chain_scenarios(&real_jobs)?;
@@ -91,13 +90,8 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         return interrupted_before_runs(&dir, title, args.json, stdout);
     };
     let all: Vec<&Scenario> = jobs.iter().chain(&real_jobs).chain(&chain_jobs).collect();
-    let progress = Progress::start("Table 1", periods(all.iter().copied()), !args.json);
     let incomplete = Incomplete::default();
-    let results: Vec<RunResult> = all
-        .par_iter()
-        .map(|s| sil_into(&dir, s, &progress, &incomplete))
-        .collect();
-    progress.finish();
+    let results = fly_all(&all, &dir, &incomplete, args.json);
     let (paper_runs, rest) = results.split_at(jobs.len());
     let (real_runs, chain_runs) = rest.split_at(real_jobs.len());
     let rows: Vec<ReportRow> = paper_runs
@@ -115,15 +109,11 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         Some(campaign) => Some(contract(&campaign, args.json)?),
         None => None,
     };
-    let sections = format!(
-        "{}\n{}\n{}\n\n{}\n{}",
-        sections::REAL_NOTES,
-        output::real_table_markdown(&real_rows),
-        output::report::real_table_legend(),
-        sections::preflight(&checks, real_runs.iter().chain(chain_runs)),
-        contract
-            .as_ref()
-            .map_or(String::new(), |(_, v)| v.markdown()),
+    let sections = real_sections(
+        &real_rows,
+        &checks,
+        real_runs.iter().chain(chain_runs),
+        contract.as_ref().map(|(_, v)| v),
     );
     let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
@@ -165,6 +155,42 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         )?;
     }
     Ok(exit)
+}
+
+/// The report's sections after the paper's table: the real vehicle's table, the preflight
+/// verdicts (and any that did not hold) and the contract's campaign.
+fn real_sections<'a>(
+    real_rows: &[RealRow],
+    checks: &[Preflight],
+    real_runs: impl IntoIterator<Item = &'a RunResult>,
+    contract: Option<&Validation>,
+) -> String {
+    format!(
+        "{}\n{}\n{}\n\n{}\n{}",
+        sections::REAL_NOTES,
+        output::real_table_markdown(real_rows),
+        output::report::real_table_legend(),
+        sections::preflight(checks, real_runs),
+        contract.map_or(String::new(), Validation::markdown),
+    )
+}
+
+/// Every run of `all` in parallel, each CSV streamed into `dir`, with the progress (a bar
+/// unless `json`).
+fn fly_all(
+    all: &[&Scenario],
+    dir: &OutputDir,
+    incomplete: &Incomplete,
+    json: bool,
+) -> Vec<RunResult> {
+    use rayon::prelude::*;
+    let progress = Progress::start("Table 1", periods(all.iter().copied()), !json);
+    let results = all
+        .par_iter()
+        .map(|s| sil_into(dir, s, &progress, incomplete))
+        .collect();
+    progress.finish();
+    results
 }
 
 /// The preflight's validation campaign `campaign`, with its progress (a bar unless `json`).

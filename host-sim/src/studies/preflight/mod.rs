@@ -407,11 +407,7 @@ fn check_scopes(
 }
 
 /// The verdict over `scope` at the scenario's scale `k`, and the peaks of the full sweep there.
-fn verdict(
-    checker: &Checker,
-    scope: Scope,
-    k: f64,
-) -> Result<(ScopeVerdict, Peaks), CheckError> {
+fn verdict(checker: &Checker, scope: Scope, k: f64) -> Result<(ScopeVerdict, Peaks), CheckError> {
     let own = checker.sweep(scope, 1.0 / k, true)?;
     let at_rest = checker.sweep(scope, 0.0, false)?;
     let statically_infeasible = at_rest.first.is_some();
