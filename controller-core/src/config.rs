@@ -65,8 +65,8 @@ pub struct ControllerConfig {
     /// Parameter box the bounds are taken over (Table 3).
     pub uncertainty: ParamBox<f32>,
     /// Thruster positions and directions, the direction carrying each thruster's mounting
-    /// sign (docs/design.md §5, §9 **Choice**: the real AUV-150's, with the tunnel pairs'
-    /// strong side pushing up and to port).
+    /// sign (docs/design.md §5, §9 **Choice 105**: the real AUV-150's, the vertical pair's
+    /// strong sides pushing up fore and down aft, the horizontal pair's to port).
     pub geometry: ThrusterGeometry,
     /// The thrust unit of Eqs 31–32 (docs/design.md §9 **Choice**: kgf by default).
     pub thrust_unit: ThrustUnit,

@@ -60,23 +60,64 @@ pub const AUV150_AXES: [[f32; 3]; THRUSTERS] = [
     [0.0, 1.0, 0.0],
 ];
 
-/// The real vehicle's mounting (docs/design.md §9 **Choice**), as a reversed-thruster mask
-/// for [`ThrusterGeometry::auv150`]: bit i set ⇔ thruster i's positive (strong) thrust pushes
-/// against its reference axis [`AUV150_AXES`].
+/// The real vehicle's mounting (docs/design.md §9, **Choice 105**), as a reversed-thruster
+/// mask for [`ThrusterGeometry::auv150`]: bit i set ⇔ thruster i's positive (strong) thrust
+/// pushes against its reference axis [`AUV150_AXES`]. Chosen by flying: of the 32 masks, the
+/// one under which the six real missions (the Table-1 paths, tangent heading, the Table-3
+/// payload trimmed) fly at the smallest time scales the preflight proposes
+/// (`host-sim validate-preflight`).
 ///
-/// * Vertical pair reversed: its strong direction pushes **up** (−z). The vehicle's standing
-///   vertical demand is upward — a forward CG shift or an untrimmed payload is held by an
-///   upward push fore (and the pair's weak side, −9.2 polynomial units against +20.1, then
-///   only has to pull the other end) — and a tunnel thruster is more than twice as strong
-///   in its positive direction (§5).
+/// * Vertical fore reversed: its strong direction pushes **up** (−z); vertical aft as it is,
+///   pushing **down** (+z). A trimmed payload's standing vertical demand is the moment of its
+///   CG shift, x_G W ≥ 0 (nose down: the payload is never aft of CO), which needs the fore
+///   thruster to push up and the aft one down: both strong sides (36 % of the envelope at
+///   Table 3's corner, against 79 % when the aft one holds it on its weak side).
 /// * Horizontal pair reversed: its strong direction pushes to **port** (−y). With the
 ///   tangent heading the sway demand is the centripetal force of the turn, ≈ (m − X_u̇)·u·r;
 ///   both Table-1 circles turn to port all the time (ψ̇_d = −ω), so that is their standing
-///   demand, while the figure-eights and lawn-mowers turn both ways equally and do not
-///   prefer a side.
+///   demand, while the figure-eights and lawn-mowers turn both ways equally.
 /// * Main thruster as it is: positive thrust forward (+x).
-pub const AUV150_REVERSED: u8 =
-    (1 << VERT_FORE) | (1 << VERT_AFT) | (1 << HORZ_FORE) | (1 << HORZ_AFT);
+pub const AUV150_REVERSED: u8 = (1 << VERT_FORE) | (1 << HORZ_FORE) | (1 << HORZ_AFT);
+
+/// Which way each AUV-150 thruster's strong (positive) thrust pushes the vehicle under the
+/// reversed-thruster mask `reversed` ([`ThrusterGeometry::auv150`]), in words, thruster order:
+/// the main thruster `forward` or `aft`, the vertical pair `down` or `up`, the horizontal pair
+/// `starboard` or `port`. What scenario files, `host-sim check` and the board's log print, so
+/// that a team reads the mounting a board runs without decoding a bit mask.
+pub const fn mounting_words(reversed: u8) -> [&'static str; THRUSTERS] {
+    const WORDS: [[&str; 2]; THRUSTERS] = [
+        ["forward", "aft"],
+        ["down", "up"],
+        ["down", "up"],
+        ["starboard", "port"],
+        ["starboard", "port"],
+    ];
+    let mut out = [""; THRUSTERS];
+    let mut i = 0;
+    while i < THRUSTERS {
+        out[i] = WORDS[i][((reversed >> i) & 1) as usize];
+        i += 1;
+    }
+    out
+}
+
+/// The AUV-150 mounting `reversed` as one line: `main forward, vert fore up, vert aft down,
+/// horz fore port, horz aft port` ([`mounting_words`] after each [`THRUSTER_NAMES`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Mounting(pub u8);
+
+impl fmt::Display for Mounting {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let words = mounting_words(self.0);
+        for (i, (name, word)) in THRUSTER_NAMES.iter().zip(words).enumerate() {
+            if i > 0 {
+                f.write_str(", ")?;
+            }
+            write!(f, "{name} {word}")?;
+        }
+        Ok(())
+    }
+}
 
 /// Thruster positions (m) and unit thrust directions, body frame (origin CO, x forward,
 /// y starboard, z down), in thruster order. The direction carries the **mounting sign**:
@@ -84,7 +125,8 @@ pub const AUV150_REVERSED: u8 =
 ///
 /// [`Default`] is the real AUV-150 of docs/design.md §5 and §9 (**Choice**):
 /// [`auv150`](Self::auv150)([`AUV150_REVERSED`]) — the main thruster at x = −2.43 m along +x;
-/// the vertical tunnels at x = +1.8 m (fore) and −1.8 m (aft) along −z (pushing up); the
+/// the vertical tunnels at x = +1.8 m (fore, along −z: pushing up) and −1.8 m (aft, along +z:
+/// pushing down); the
 /// horizontal tunnels at x = ±1.8 m along −y (pushing to port); all on the centre line. It is
 /// configuration: [`effectiveness`](Self::effectiveness) accepts any geometry that passes its
 /// checks, and the allocator any whose 5×5 allocation is block diagonal

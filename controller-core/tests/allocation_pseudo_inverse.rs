@@ -45,15 +45,22 @@ fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; THRUSTERS] {
 
 #[test]
 fn default_is_the_real_vehicle_mounting() {
-    // Vertical pair pushing up, horizontal pair pushing to port (docs/design.md §9): a
-    // pure upward force is positive (strong) thrust on both vertical tunnels, a pure force to
-    // port positive thrust on both horizontal ones.
+    // Vertical fore pushing up, aft down, horizontal pair pushing to port (docs/design.md
+    // §9): a pure upward force is positive (strong) thrust fore and negative (weak) aft, a
+    // nose-up moment positive thrust on both vertical tunnels, a pure force to port positive
+    // thrust on both horizontal ones.
     let a = PseudoInverse::new(&ThrusterGeometry::default()).expect("default geometry");
     let up = a.thrusts(&Vector6::new(0.0, 0.0, -100.0, 0.0, 0.0, 0.0));
-    assert_eq!(up, [0.0, 50.0, 50.0, 0.0, 0.0]);
+    assert_eq!(up, [0.0, 50.0, -50.0, 0.0, 0.0]);
+    // M = Σ (z F_x − x F_z): a nose-up moment of 360 N m is +100 N up at x = +1.8 m and
+    // +100 N down at x = −1.8 m.
+    let nose_up = a.thrusts(&Vector6::new(0.0, 0.0, 0.0, 0.0, 360.0, 0.0));
+    for (t, want) in nose_up.iter().zip([0.0, 100.0, 100.0, 0.0, 0.0]) {
+        assert!((t - want).abs() < 1e-4, "{nose_up:?}");
+    }
     let port = a.thrusts(&Vector6::new(0.0, -100.0, 0.0, 0.0, 0.0, 0.0));
     assert_eq!(port, [0.0, 0.0, 0.0, 50.0, 50.0]);
-    assert_eq!(AUV150_REVERSED, 0b11110);
+    assert_eq!(AUV150_REVERSED, 0b11010);
 }
 
 proptest! {

@@ -10,15 +10,15 @@ use controller_core::effectiveness::{
 
 #[test]
 fn default_layout_is_the_spec_choice() {
-    // Positions docs/design.md §5; mounting §9: vertical pair pushing up (−z), horizontal
-    // pair pushing to port (−y), main forward.
+    // Positions docs/design.md §5; mounting §9: vertical fore pushing up (−z), aft down (+z),
+    // horizontal pair pushing to port (−y), main forward.
     let g = ThrusterGeometry::default();
     assert_eq!(g.position[MAIN], [-2.43, 0.0, 0.0]);
     assert_eq!(g.direction[MAIN], [1.0, 0.0, 0.0]);
     assert_eq!(g.position[VERT_FORE], [1.8, 0.0, 0.0]);
     assert_eq!(g.position[VERT_AFT], [-1.8, 0.0, 0.0]);
     assert_eq!(g.direction[VERT_FORE], [0.0, 0.0, -1.0]);
-    assert_eq!(g.direction[VERT_AFT], [0.0, 0.0, -1.0]);
+    assert_eq!(g.direction[VERT_AFT], [0.0, 0.0, 1.0]);
     assert_eq!(g.position[HORZ_FORE], [1.8, 0.0, 0.0]);
     assert_eq!(g.position[HORZ_AFT], [-1.8, 0.0, 0.0]);
     assert_eq!(g.direction[HORZ_FORE], [0.0, -1.0, 0.0]);
@@ -50,11 +50,12 @@ fn effectiveness_matrix_by_hand() {
         [0.0, 1.0, 0.0, 0.0, 0.0, 1.8],  // horizontal fore: N = +1.8·T
         [0.0, 1.0, 0.0, 0.0, 0.0, -1.8], // horizontal aft: N = −1.8·T
     ];
-    // The real vehicle (default): the four tunnels reversed, their columns negated.
+    // The real vehicle (default): the vertical fore and both horizontal tunnels reversed,
+    // their columns negated.
     let default: [[f32; 6]; THRUSTERS] = [
         [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-        [0.0, 0.0, -1.0, 0.0, 1.8, 0.0], // pushing up fore: nose up
-        [0.0, 0.0, -1.0, 0.0, -1.8, 0.0],
+        [0.0, 0.0, -1.0, 0.0, 1.8, 0.0],  // pushing up fore: nose up
+        [0.0, 0.0, 1.0, 0.0, 1.8, 0.0],   // pushing down aft: nose up
         [0.0, -1.0, 0.0, 0.0, 0.0, -1.8], // pushing to port fore: nose to port
         [0.0, -1.0, 0.0, 0.0, 0.0, 1.8],
     ];
@@ -120,5 +121,31 @@ fn rejects_non_finite_geometry() {
         Err(AllocationError::Geometry(GeometryError::NonFinite {
             thruster: MAIN
         }))
+    );
+}
+
+/// The mounting in words says, for every mask and thruster, which way the geometry's
+/// direction pushes: ±x forward/aft, ±z down/up, ±y starboard/port.
+#[test]
+fn mounting_words_follow_the_directions_of_every_mask() {
+    use controller_core::effectiveness::{mounting_words, Mounting, THRUSTER_NAMES};
+    for mask in 0..32u8 {
+        let g = ThrusterGeometry::auv150(mask);
+        let words = mounting_words(mask);
+        for (i, d) in g.direction.iter().enumerate() {
+            let expected = match d {
+                [x, _, _] if *x > 0.5 => "forward",
+                [x, _, _] if *x < -0.5 => "aft",
+                [_, _, z] if *z > 0.5 => "down",
+                [_, _, z] if *z < -0.5 => "up",
+                [_, y, _] if *y > 0.5 => "starboard",
+                _ => "port",
+            };
+            assert_eq!(words[i], expected, "mask {mask:05b}, {}", THRUSTER_NAMES[i]);
+        }
+    }
+    assert_eq!(
+        Mounting(AUV150_REVERSED).to_string(),
+        "main forward, vert fore up, vert aft down, horz fore port, horz aft port"
     );
 }

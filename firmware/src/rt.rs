@@ -50,8 +50,13 @@ pub fn fly<B: Board>(board: &mut B, mut sup: Supervisor, mut bufs: LinkBuffers) 
     let mut rate = sup.rate_hz();
     board.set_rate(rate);
     let mut last = None;
+    let mut mounting = None;
     loop {
         let step = period(board, &mut sup, &mut bufs);
+        if mounting != Some(step.telemetry.reversed_thrusters) {
+            mounting = Some(step.telemetry.reversed_thrusters);
+            log_mounting(step.telemetry.reversed_thrusters);
+        }
         if last != Some(step.telemetry.status) {
             info!(
                 "tick {}: {}",
@@ -66,6 +71,21 @@ pub fn fly<B: Board>(board: &mut B, mut sup: Supervisor, mut bufs: LinkBuffers) 
             info!("loop rate now {} Hz", rate);
         }
     }
+}
+
+/// Logs the thrusters' mounting in words (the strong side of each: docs/design.md §9), as the
+/// telemetry's reversed-thruster mask says it, so that a team reads which mounting a board
+/// flies without decoding the mask.
+fn log_mounting(mask: u8) {
+    if mask == crate::supervisor::NOT_AUV150 {
+        info!("mounting: not the AUV-150 layout");
+        return;
+    }
+    let w = controller_core::effectiveness::mounting_words(mask);
+    info!(
+        "mounting (strong side): main {=str}, vert fore {=str}, vert aft {=str}, horz fore {=str}, horz aft {=str}",
+        w[0], w[1], w[2], w[3], w[4]
+    );
 }
 
 /// Logs a panic; the image's `#[panic_handler]` then halts.

@@ -195,10 +195,7 @@ pub fn mounting_of(config: &ControllerConfig) -> u8 {
     config.geometry.auv150_reversed().unwrap_or(NOT_AUV150)
 }
 
-/// [`Telemetry::reversed_thrusters`] of a board whose geometry is not the AUV-150 layout
-/// with some thrusters reversed: every bit set, which no valid mask has (bits above the
-/// fifth).
-pub const NOT_AUV150: u8 = u8::MAX;
+pub use auv_link::NOT_AUV150;
 
 /// Bits of a valid reversed-thruster mask: one per thruster.
 const MOUNTING_BITS: u8 = (1 << THRUSTERS) - 1;

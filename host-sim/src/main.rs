@@ -2,13 +2,15 @@
 //! Parses the command line, installs the Ctrl-C/SIGTERM handler ([`host_sim::interrupt`]) and
 //! maps the outcome to the exit code; the commands are [`host_sim::cli`]'s, which documents
 //! the codes (0 done, 1 a run diverged or PIL ≠ SIL or `check` found the mission infeasible,
-//! 2 bad input, I/O error or an incomplete output, 3 an unexpected controller fault,
-//! 130 interrupted).
+//! 2 bad input, I/O error or an incomplete output, 3 an unexpected controller fault, 4 a run
+//! missed its bound, 130 interrupted).
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
-use host_sim::cli::{self, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args};
+use host_sim::cli::{
+    self, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args, ValidateArgs,
+};
 
 #[derive(Parser)]
 #[command(
@@ -41,6 +43,10 @@ enum Command {
     /// Draws the Table-3 parameters uniformly in their box, runs in parallel, reports
     /// percentiles and the worst case. Deterministic per seed.
     MonteCarlo(MonteCarloArgs),
+    /// Does the preflight's verdict hold? The real paths under every thruster mounting and
+    /// random missions, each checked, then flown at the proposed time scale; reports the
+    /// false-feasible count (exit 1 if any) and how conservative the verdict is.
+    ValidatePreflight(ValidateArgs),
 }
 
 fn main() -> ExitCode {
@@ -64,6 +70,7 @@ fn main() -> ExitCode {
         Command::Hil(args) => cli::hil(&args, stdout),
         Command::MonteCarlo(args) => cli::monte_carlo(&args, stdout),
         Command::Check(args) => cli::check(&args, stdout),
+        Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

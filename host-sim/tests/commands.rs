@@ -376,6 +376,79 @@ fn pil_duration_obeys_the_duration_cap_and_the_step_cap() {
     }
 }
 
+/// 10 s of the real 10 m circle (the real chain: its default bound is 0.05 m and 1 %).
+const REAL_CIRCLE: &str = "duration = 10\nideal_actuators = false\n\
+     [trajectory]\nkind = \"circle\"\nradius = 10\nheading = \"tangent\"\n";
+
+/// Issue 18: a run that missed its bound said `completed` and exited 0. Now it ends `missed`
+/// with which limit and by how much, everywhere the outcome is printed, and exits 4 — unless
+/// its scenario expects the miss.
+#[test]
+fn a_run_outside_its_bound_is_missed_with_its_reason_and_exits_4_unless_expected() {
+    let dir = tempdir("missed");
+    // A bound no run meets: 1 µm.
+    let tight = format!("name = \"tight\"\n{REAL_CIRCLE}[bound]\nmax_path = 1e-6\n");
+    let s = scenario(&dir, "tight", &tight);
+    let o = run(&["--json"], &s, &dir.join("out"));
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let reason = v["cases"][0]["missed"].as_str().unwrap();
+    assert!(
+        reason.contains("max path error") && reason.contains("> 0.000001 m"),
+        "{reason}"
+    );
+    let report = std::fs::read_to_string(dir.join("out/report.md")).unwrap();
+    assert!(report.contains("missed their bound"), "{report}");
+    assert!(
+        report.contains("MISSED its bound: max path error"),
+        "{report}"
+    );
+    let text = run(&[], &s, &dir.join("out-text"));
+    assert_eq!(text.status.code(), Some(4));
+    assert!(String::from_utf8_lossy(&text.stdout).contains("MISSED its bound"));
+    // Expected: reported, exit 0.
+    let expected =
+        format!("name = \"tight\"\nexpect_missed = true\n{REAL_CIRCLE}[bound]\nmax_path = 1e-6\n");
+    let s = scenario(&dir, "expected", &expected);
+    let o = run(&["--json"], &s, &dir.join("out-expected"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(v["cases"][0]["miss_expected"], true);
+    // Within its bound (the real chain's default), the same circle completes.
+    let s = scenario(&dir, "real", &format!("name = \"real\"\n{REAL_CIRCLE}"));
+    let o = run(&["--json"], &s, &dir.join("out-real"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(v["cases"][0].get("missed").is_none(), "{v}");
+}
+
+/// A saturated-fraction bound is a fraction; a path bound is a length: each refused out of
+/// range, naming its key.
+#[test]
+fn a_bound_out_of_range_is_refused_naming_its_key() {
+    let dir = tempdir("bound-keys");
+    for (bound, key) in [
+        ("max_path = 0", "bound.max_path"),
+        ("max_path = -1", "bound.max_path"),
+        ("saturated = 1.5", "bound.saturated"),
+        ("saturated = -0.1", "bound.saturated"),
+        ("within = 1", "within"),
+    ] {
+        let s = scenario(&dir, "b", &format!("{REAL_CIRCLE}[bound]\n{bound}\n"));
+        let o = run(&[], &s, &dir.join("out"));
+        assert_eq!(o.status.code(), Some(2), "{bound}");
+        assert!(stderr(&o).contains(key), "{bound}: {}", stderr(&o));
+    }
+    let s = scenario(
+        &dir,
+        "a",
+        &format!("initial_attitude = \"upright\"\n{REAL_CIRCLE}"),
+    );
+    let o = run(&[], &s, &dir.join("out"));
+    assert_eq!(o.status.code(), Some(2));
+    assert!(stderr(&o).contains("initial_attitude"), "{}", stderr(&o));
+}
+
 // Issue 22: hostile conditions on shared machines.
 
 /// A day-long circle: its preflight alone is minutes of work (1.7·10⁶ samples × 2⁹ corners).

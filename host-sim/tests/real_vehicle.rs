@@ -8,9 +8,9 @@ use std::process::Command;
 use controller_core::kinematics::Attitude;
 use controller_core::model::{self, ParamVariation, VehicleParams, GRAVITY};
 use controller_core::{HeadingMode, ThrustUnit, TrajectoryKind};
-use host_sim::plant::{self, Plant, PlantState, PlantTerms};
+use host_sim::plant::{self, Plant, PlantState, PlantTerms, VariationProfile};
 use host_sim::scenario::real_vehicle;
-use host_sim::scenario::{load_scenario, parse_scenario, Scenario, ScenarioError};
+use host_sim::scenario::{load_scenario, parse_scenario, InitialAttitude, Scenario, ScenarioError};
 use host_sim::sim::bound;
 use host_sim::studies::preflight::{self, Verdict, DEFAULT_MARGIN};
 use nalgebra::{Vector3, Vector6};
@@ -239,29 +239,62 @@ fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
 
 #[test]
 fn the_static_demand_is_the_closed_form_of_weight_and_cg_moment() {
-    // Untrimmed Table-3 payload, level: the thrusters must hold ΔW = 30·9.81 N upward and the
-    // CG moment x_G W = 0.05·520·9.81 N m; the vertical pair pushing up shares them as
-    // T_fore = (ΔW + M/1.8)/2 = 218.0 N, beyond its 80 % envelope of 157.7 N.
+    // Untrimmed Table-3 payload (held constant), started in trim: the vehicle floats at its
+    // static heel tan φ = y_G W / k₄ (k₄ = z_G W − z_B B₀ = z_G W + 296.1 − 0.012 W₀), and the
+    // thrusters must hold the body-z part of ΔW = 30·9.81 N, ΔW cos φ, and the CG moment
+    // x_G W cos φ (x_G W = 0.05·520·9.81 N m); the vertical pair shares them as
+    // T_fore = (ΔW + M/1.8) cos φ / 2 = 211.3 N up, beyond its 80 % envelope of 157.7 N. The
+    // loop's pitch offset moves it by k₅ |θ| / 3.6 at most, with k₅ ≈ 397 N m/rad and |θ| below
+    // the proportional loop's M cos φ / (M̂₅₅ k₁) = 247 / 7344 rad: less than 4 N.
+    let w = 520.0 * GRAVITY;
+    let k4 = 0.032 * w + 296.1 - 0.012 * 490.0 * GRAVITY;
+    let heel: f64 = (0.02 * w / k4).atan();
     let paper = host_sim::scenario::paper::scenario(controller_core::Table1Case::Circular10R, true)
+        .unwrap()
+        .with(|c| {
+            c.variation = VariationProfile::Constant(ParamVariation::TABLE3_MAX);
+            c.start_attitude = Some(InitialAttitude::Trim);
+        })
         .unwrap();
     let p = preflight::check(&paper, DEFAULT_MARGIN).unwrap();
     assert_eq!(p.verdict, Verdict::StaticallyInfeasible);
     assert_eq!(p.smallest_time_scale, None);
+    assert_eq!(
+        p.whole_box.as_ref().map(|b| b.verdict),
+        Some(Verdict::StaticallyInfeasible)
+    );
     let v = p.static_violation.as_ref().unwrap();
     let dw = 30.0 * GRAVITY;
     let moment = 0.05 * 520.0 * GRAVITY;
-    let fore = (dw + moment / 1.8) / 2.0;
+    let fore = (dw + moment / 1.8) * heel.cos() / 2.0;
     assert_eq!(v.thruster, "vert fore");
-    assert!((v.demand - fore).abs() < 0.5, "{} vs {fore}", v.demand);
+    assert!((v.demand - fore).abs() < 4.0, "{} vs {fore}", v.demand);
     assert!(v.given_up.contains(&"depth".to_string()), "{v:?}");
-    // Trimmed, on the real vehicle's mounting (fore up, aft down), only the moment is left:
-    // ±M/3.6 on the pair, on their strong sides, for every corner and the whole circle.
-    let r = preflight::check(&real("circular-10R"), DEFAULT_MARGIN).unwrap();
-    assert_eq!(r.verdict, Verdict::Feasible);
-    for t in &r.thrusters[1..3] {
-        assert!((t.max - moment / 3.6).abs() < 0.5, "{t:?}");
+    // Trimmed, on the real vehicle's mounting (fore up, aft down), at rest only the moment is
+    // left, on the pair's strong sides: M cos φ / 3.6 on each. At speed the demand is larger
+    // (the heel turns part of the turn's centripetal force into heave, the pitch offset brings
+    // a Munk moment: docs/design.md §9).
+    let at_rest = moment * heel.cos() / 3.6;
+    let r = real("circular-10R");
+    // At k = 40 the circle's 2 m/s are 0.05 m/s (the tangent heading needs 0.02): the
+    // velocity terms are 1/1600 of the mission's.
+    let slow = r.with(|c| {
+        c.time_scale = 40.0;
+        c.duration *= 40.0;
+    });
+    let p = preflight::check_as_written(&slow.unwrap(), DEFAULT_MARGIN).unwrap();
+    for t in &p.thrusters[1..3] {
+        assert!((t.max - at_rest).abs() < 4.0, "{t:?} vs {at_rest}");
         assert!(t.min > -1.0, "{t:?}");
     }
+    let p = preflight::check_as_written(&r, DEFAULT_MARGIN).unwrap();
+    assert_eq!(p.verdict, Verdict::Feasible);
+    // The heel turns the port turn's centripetal force partly into a downward body force:
+    // less on the fore (pushing up), more on the aft (pushing down); the Munk moment adds to
+    // both.
+    let (fore, aft) = (&p.thrusters[1], &p.thrusters[2]);
+    assert!(aft.max > at_rest + 4.0, "{aft:?}");
+    assert!(fore.max + aft.max > 2.0 * at_rest + 4.0, "{fore:?} {aft:?}");
 }
 
 #[test]
@@ -340,7 +373,12 @@ fn what_check_calls_feasible_flies_within_the_bound_and_static_infeasibility_doe
     for s in chain.iter().step_by(2) {
         let short = s.with(|c| c.duration = 8.0).unwrap();
         let p = preflight::check(&short, DEFAULT_MARGIN).unwrap();
-        assert_eq!(p.verdict, Verdict::StaticallyInfeasible, "{p}");
+        assert_ne!(p.verdict, Verdict::Feasible, "{p}");
+        assert_eq!(
+            p.whole_box.as_ref().map(|b| b.verdict),
+            Some(Verdict::StaticallyInfeasible),
+            "{p}"
+        );
         let run = host_sim::sim::run(&short);
         assert!(
             !bound::within_bound(&run),
@@ -378,4 +416,66 @@ fn check_exits_0_feasible_1_infeasible_2_bad_input() {
     assert!(String::from_utf8_lossy(&o.stderr).contains("--margin"));
     let o = code(&["--scenario", "/nonexistent/x.toml"]);
     assert_eq!(o.status.code(), Some(2));
+}
+
+/// The static heel is where g(η)'s roll moment (controller-core's `model::restoring`, Eq 1)
+/// vanishes and restores: zero there, of opposite signs either side; the Table-3 corner,
+/// trimmed, heels the vehicle by atan(y_G W / k₄) = 0.2485 rad.
+#[test]
+fn the_static_heel_is_the_roll_equilibrium_of_g() {
+    let corner =
+        plant::trimmed(&VehicleParams::auv150().with_variation(&ParamVariation::TABLE3_MAX));
+    for (params, theta) in [
+        (corner, 0.0),
+        (corner, 0.3),
+        (VehicleParams::auv150(), 0.0),
+        (
+            VehicleParams::auv150().with_variation(&ParamVariation::TABLE3_MAX),
+            -0.2,
+        ),
+    ] {
+        let heel = plant::static_heel(&params, theta).unwrap();
+        let g4 = |phi: f64| {
+            let eta = Vector6::new(0.0, 0.0, 0.0, phi, theta, 0.0);
+            model::restoring(&params, &Attitude::from_eta(&eta))[3]
+        };
+        assert!(g4(heel).abs() < 1e-9, "{heel}: {}", g4(heel));
+        assert!(g4(heel + 0.01) > 0.0 && g4(heel - 0.01) < 0.0, "{heel}");
+    }
+    let heel = plant::static_heel(&corner, 0.0).unwrap();
+    assert!((heel - 0.2485).abs() < 1e-3, "{heel}");
+    assert_eq!(plant::static_heel(&VehicleParams::auv150(), 0.0), Some(0.0));
+}
+
+/// Released in trim the vehicle floats at its heel; released level with the same payload it
+/// swings (no roll damping) between level and twice the heel.
+#[test]
+fn a_trim_start_floats_at_the_heel_and_a_level_start_swings_to_twice_it() {
+    let real = real("figure-eight-30x30"); // Table 3's maximum, held constant
+    let heel = plant::static_heel(&real.config().plant_params_at(0.0), 0.0).unwrap();
+    let fly = |attitude: InitialAttitude| {
+        let s = real
+            .with(|c| {
+                c.start_attitude = Some(attitude);
+                c.duration = 10.0;
+            })
+            .unwrap();
+        assert_eq!(s.config().initial_attitude(), attitude);
+        let start = s.initial_state();
+        (start.eta[3], host_sim::sim::run(&s).metrics.max_roll)
+    };
+    let (phi0, trim) = fly(InitialAttitude::Trim);
+    assert!((phi0 - heel).abs() < 1e-12, "{phi0} vs {heel}");
+    assert!((trim - heel).abs() < 0.1 * heel, "{trim} vs {heel}");
+    let (phi0, level) = fly(InitialAttitude::Level);
+    assert_eq!(phi0, 0.0);
+    assert!(
+        (level - 2.0 * heel).abs() < 0.1 * heel,
+        "{level} vs {}",
+        2.0 * heel
+    );
+    // The real chain starts in trim unless told; ideal actuators level.
+    assert_eq!(real.config().initial_attitude(), InitialAttitude::Trim);
+    let paper = host_sim::scenario::paper::config(controller_core::Table1Case::Circular10R, true);
+    assert_eq!(paper.initial_attitude(), InitialAttitude::Level);
 }

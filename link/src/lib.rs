@@ -105,6 +105,6 @@ pub use frame::{
 pub use msg::{
     AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Heading,
     MissionPlan, MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
-    PROTOCOL_VERSION,
+    NOT_AUV150, PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;

@@ -317,6 +317,10 @@ impl ConfigPatch {
     };
 }
 
+/// [`Telemetry::reversed_thrusters`] of a board whose geometry is not the AUV-150 layout with
+/// some thrusters reversed: every bit set, which no valid mask has (bits above the fifth).
+pub const NOT_AUV150: u8 = u8::MAX;
+
 /// The board's report.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 #[cfg_attr(feature = "defmt", derive(defmt::Format))]
@@ -377,7 +381,8 @@ pub struct Telemetry {
     // Protocol 3: appended fields.
     /// The thrust unit the board reads Eqs 31–32 in.
     pub thrust_unit: ThrustUnit,
-    /// The board's thruster mounting, as [`ConfigPatch::reversed_thrusters`].
+    /// The board's thruster mounting, as [`ConfigPatch::reversed_thrusters`]; [`NOT_AUV150`]
+    /// for a board whose geometry is not the AUV-150 layout.
     pub reversed_thrusters: u8,
     // Protocol 4: appended fields.
     /// Authentic frames refused since boot because their timestamp ran too far ahead

@@ -184,15 +184,13 @@ pub(super) fn fly(
     report_incomplete(&incomplete);
     let exit = runs_exit(runs.iter(), !incomplete.is_empty(), failed);
     if args.json {
-        let preflight = Vec::new();
-        print_json(
-            stdout,
-            &Cases {
-                cases,
-                incomplete,
-                preflight,
-            },
-        )?;
+        let cases = Cases {
+            cases,
+            incomplete,
+            preflight: Vec::new(),
+            contract: None,
+        };
+        print_json(stdout, &cases)?;
     } else {
         print_board_runs(stdout, &notes, &cases)?;
         writeln!(stdout, "report: {}", report.display())?;

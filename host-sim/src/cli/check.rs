@@ -59,12 +59,15 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
 /// The per-thruster part of `check`'s text.
 fn preflight_table(p: &Preflight) -> String {
     let mut s = format!(
-        "thrust unit {}, heading {}, trimmed {}, time scale {}, margin {:.0} %\n",
+        "thrust unit {}, heading {}, trimmed {}, start {}, time scale {}, margin {:.0} %\n\
+         mounting (strong side): {}\n",
         p.thrust_unit,
         p.heading,
         p.trimmed,
+        p.initial_attitude,
         p.time_scale,
-        100.0 * p.margin
+        100.0 * p.margin,
+        p.mounting
     );
     s.push_str(&format!(
         "{:<10} {:>18} {:>22} {:>22} {:>8}\n",

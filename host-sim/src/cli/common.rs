@@ -116,6 +116,7 @@ pub(super) fn print_runs(
             cases: runs(rows).map(RunResult::summary).collect(),
             incomplete,
             preflight: checks.to_vec(),
+            contract: None,
         };
         print_json(stdout, &cases)?;
     } else {
@@ -165,6 +166,7 @@ pub(super) fn interrupted_before_runs(
             cases: Vec::new(),
             incomplete: Vec::new(),
             preflight: Vec::new(),
+            contract: None,
         };
         print_json(stdout, &cases)?;
     } else {
@@ -185,6 +187,7 @@ pub(super) fn runs_exit<'a>(
         runs.clone().any(RunResult::interrupted) || interrupt::requested(),
         failed || runs.clone().any(RunResult::diverged),
         runs.clone().any(RunResult::faulted_unexpectedly),
+        runs.clone().any(RunResult::missed_unexpectedly),
     )
 }
 

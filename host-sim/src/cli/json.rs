@@ -6,6 +6,7 @@ use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
 use crate::studies::preflight::Preflight;
+use crate::studies::validation::ContractSummary;
 
 /// The JSON object a command prints: `{"cases": [...]}`, `"incomplete": [...]` when an
 /// output could not be written completely (each entry names the file and why), and
@@ -18,6 +19,10 @@ pub struct Cases<T> {
     /// The preflight checks of the missions (`run`, `table1`; docs/design.md §9).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub preflight: Vec<Preflight>,
+    /// Whether the preflight's verdicts held over its validation campaign (`table1`;
+    /// docs/design.md §9).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub contract: Option<ContractSummary>,
 }
 
 /// One JSON line: the value through `serde_json::Value`, so the keys come out sorted.

@@ -41,9 +41,10 @@
 //! | 1 | a run diverged (or lost its board), or PIL disagreed with SIL; `check`: the mission is infeasible |
 //! | 2 | bad input (scenario, flags, output folder, firmware image) or an I/O error; or an output could not be written completely |
 //! | 3 | a run had the controller in fail-safe (thrusters off) for some periods and its scenario does not say `expect_faults = true` |
+//! | 4 | a run completed outside its bound (`[bound]`; the real chain's default 0.05 m, 1 % saturated) and its scenario does not say `expect_missed = true` |
 //! | 130 | interrupted (Ctrl-C, SIGTERM): what was done is written and marked partial |
 //!
-//! When several apply, the first of 2, 130, 1, 3 is the exit code. In `pil`, a run with link
+//! When several apply, the first of 2, 130, 1, 3, 4 is the exit code. In `pil`, a run with link
 //! faults injected (flags or `[link_faults]`) expects the board's fail-safe. In `table1`, the
 //! paper's missions flown through the real chain are there to show what happens when the
 //! preflight says infeasible: their divergence and faults are reported, not an exit code.
@@ -57,6 +58,7 @@ mod monte_carlo;
 mod pil;
 mod run;
 mod table1;
+mod validate;
 
 pub use board_loop::LoopArgs;
 pub use check::{check, CheckArgs};
@@ -65,7 +67,8 @@ pub use json::Cases;
 pub use monte_carlo::{monte_carlo, MonteCarloArgs};
 pub use pil::{pil, PilArgs};
 pub use run::{run, RunArgs};
-pub use table1::{table1, Table1Args, DEFAULT_TABLE1_OUT};
+pub use table1::{table1, ContractRun, Table1Args, DEFAULT_TABLE1_OUT};
+pub use validate::{validate_preflight, Mountings, ValidateArgs};
 
 /// How a command ended, as the process's exit code (see the module doc).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,6 +82,9 @@ pub enum Exit {
     /// The controller was in fail-safe in some period of a run that does not expect faults:
     /// exit 3 (the outputs are written).
     Faulted,
+    /// A run completed outside its bound, and its scenario does not expect it: exit 4 (the
+    /// outputs are written, the reason is in the outcome).
+    Missed,
     /// Interrupted (Ctrl-C, SIGTERM); what was done is written, marked partial: exit 130.
     Interrupted,
     /// `check`: the mission is not feasible at its time scale: exit 1.
@@ -86,19 +92,20 @@ pub enum Exit {
 }
 
 impl Exit {
-    /// The process exit code (0, 1, 2, 3 or 130; 2 is also the binary's for an `Err`).
+    /// The process exit code (0, 1, 2, 3, 4 or 130; 2 is also the binary's for an `Err`).
     pub fn code(self) -> u8 {
         match self {
             Exit::Success => 0,
             Exit::RunFailed | Exit::Infeasible => 1,
             Exit::OutputIncomplete => 2,
             Exit::Faulted => 3,
+            Exit::Missed => 4,
             Exit::Interrupted => 130,
         }
     }
 
-    /// The exit of a command from what happened, in the order of precedence 2, 130, 1, 3.
-    fn of(incomplete: bool, interrupted: bool, failed: bool, faulted: bool) -> Self {
+    /// The exit of a command from what happened, in the order of precedence 2, 130, 1, 3, 4.
+    fn of(incomplete: bool, interrupted: bool, failed: bool, faulted: bool, missed: bool) -> Self {
         if incomplete {
             Exit::OutputIncomplete
         } else if interrupted {
@@ -107,6 +114,8 @@ impl Exit {
             Exit::RunFailed
         } else if faulted {
             Exit::Faulted
+        } else if missed {
+            Exit::Missed
         } else {
             Exit::Success
         }

@@ -121,5 +121,7 @@ pub fn monte_carlo(args: &MonteCarloArgs, stdout: &mut dyn Write) -> Result<Exit
         summary.partial,
         summary.diverged > 0,
         summary.faulted > 0 && !base.config().expect_faults,
+        // Monte Carlo reports its runs' spread, not a verdict per run (campaigns have bounds).
+        false,
     ))
 }

@@ -73,7 +73,7 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         &dir,
         &title,
         &rows,
-        &sections::preflight(&checks),
+        &sections::preflight(&checks, std::iter::once(&with).chain(&without)),
         &[],
         "",
         f64::from(cfg.controller.voltage_limit),

@@ -4,7 +4,7 @@
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{anyhow, Result};
 use clap::Args;
 use controller_core::DEFAULT_V_LIMIT;
 
@@ -20,8 +20,9 @@ use crate::scenario::Scenario;
 use crate::sim::progress::Progress;
 use crate::sim::record::RunSummary;
 use crate::sim::RunResult;
-use crate::studies::preflight::Preflight;
+use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
 use crate::studies::table1 as paper_table1;
+use crate::studies::validation::{self, Campaign, Measure, Validation, TEAM_MOUNTINGS};
 
 /// Default report folder of `table1`.
 pub const DEFAULT_TABLE1_OUT: &str = "runs/table1";
@@ -35,6 +36,33 @@ pub struct Table1Args {
     /// Report folder (CSV, PNG, report.md).
     #[arg(long, default_value = DEFAULT_TABLE1_OUT)]
     pub out: PathBuf,
+    /// The preflight's validation campaign the report gives its two numbers from: the real
+    /// paths under every mounting and 200 random missions (`full`, docs/design.md §9), the
+    /// eight mountings a team would build and no random missions (`team`), or none.
+    #[arg(long, value_enum, default_value_t = ContractRun::Full)]
+    pub contract: ContractRun,
+}
+
+/// How much of the preflight's validation campaign `table1` flies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum ContractRun {
+    Full,
+    Team,
+    None,
+}
+
+impl ContractRun {
+    fn campaign(self) -> Option<Campaign> {
+        match self {
+            ContractRun::Full => Some(Campaign::default()),
+            ContractRun::Team => Some(Campaign {
+                masks: TEAM_MOUNTINGS.to_vec(),
+                random: 0,
+                ..Campaign::default()
+            }),
+            ContractRun::None => None,
+        }
+    }
 }
 
 impl Default for Table1Args {
@@ -43,6 +71,7 @@ impl Default for Table1Args {
         Table1Args {
             json: false,
             out: PathBuf::from(DEFAULT_TABLE1_OUT),
+            contract: ContractRun::Full,
         }
     }
 }
@@ -50,7 +79,6 @@ impl Default for Table1Args {
 /// `table1`: the paper's Table 1 (ideal actuators), then the real vehicle: the missions of
 /// `scenarios/real/` and the paper's six through the real chain, with their preflight verdicts.
 pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
-    use rayon::prelude::*;
     let jobs = paper_table1::jobs()?;
     let real_jobs = real_vehicle::real_scenarios()?;
     let chain_jobs = real_vehicle::paper_real_chain_scenarios(&real_jobs)?;
@@ -62,13 +90,8 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         return interrupted_before_runs(&dir, title, args.json, stdout);
     };
     let all: Vec<&Scenario> = jobs.iter().chain(&real_jobs).chain(&chain_jobs).collect();
-    let progress = Progress::start("Table 1", periods(all.iter().copied()), !args.json);
     let incomplete = Incomplete::default();
-    let results: Vec<RunResult> = all
-        .par_iter()
-        .map(|s| sil_into(&dir, s, &progress, &incomplete))
-        .collect();
-    progress.finish();
+    let results = fly_all(&all, &dir, &incomplete, args.json);
     let (paper_runs, rest) = results.split_at(jobs.len());
     let (real_runs, chain_runs) = rest.split_at(real_jobs.len());
     let rows: Vec<ReportRow> = paper_runs
@@ -82,12 +105,15 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         .chain(chain_runs.iter().zip(chain_checks))
         .map(|(run, preflight)| RealRow { run, preflight })
         .collect();
-    let sections = format!(
-        "{}\n{}\n{}\n\n{}",
-        sections::REAL_NOTES,
-        output::real_table_markdown(&real_rows),
-        output::report::real_table_legend(),
-        sections::preflight(&checks)
+    let contract = match args.contract.campaign() {
+        Some(campaign) => Some(contract(&campaign, args.json)?),
+        None => None,
+    };
+    let sections = real_sections(
+        &real_rows,
+        &checks,
+        real_runs.iter().chain(chain_runs),
+        contract.as_ref().map(|(_, v)| v),
     );
     let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
@@ -104,31 +130,94 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     report_incomplete(&incomplete);
     // The paper's missions through the real chain are expected to fail: they show what an
     // infeasible verdict means, and do not make the command fail.
+    let broken = contract.as_ref().is_some_and(|(_, v)| v.false_feasible > 0);
     let exit = runs_exit(
         paper_runs.iter().chain(real_runs),
         !incomplete.is_empty(),
-        false,
+        broken,
     );
     if args.json {
         let cases: Cases<RunSummary> = Cases {
             cases: results.iter().map(RunResult::summary).collect(),
             incomplete,
             preflight: checks,
+            contract: contract.map(|(c, v)| v.summary(&c)),
         };
         print_json(stdout, &cases)?;
     } else {
-        print_text(stdout, &rows, &checks, &real_rows, &report)?;
+        print_text(
+            stdout,
+            &rows,
+            &checks,
+            &real_rows,
+            contract.as_ref().map(|(_, v)| v),
+            &report,
+        )?;
     }
     Ok(exit)
 }
 
+/// The report's sections after the paper's table: the real vehicle's table, the preflight
+/// verdicts (and any that did not hold) and the contract's campaign.
+fn real_sections<'a>(
+    real_rows: &[RealRow],
+    checks: &[Preflight],
+    real_runs: impl IntoIterator<Item = &'a RunResult>,
+    contract: Option<&Validation>,
+) -> String {
+    format!(
+        "{}\n{}\n{}\n\n{}\n{}",
+        sections::REAL_NOTES,
+        output::real_table_markdown(real_rows),
+        output::report::real_table_legend(),
+        sections::preflight(checks, real_runs),
+        contract.map_or(String::new(), Validation::markdown),
+    )
+}
+
+/// Every run of `all` in parallel, each CSV streamed into `dir`, with the progress (a bar
+/// unless `json`).
+fn fly_all(
+    all: &[&Scenario],
+    dir: &OutputDir,
+    incomplete: &Incomplete,
+    json: bool,
+) -> Vec<RunResult> {
+    use rayon::prelude::*;
+    let progress = Progress::start("Table 1", periods(all.iter().copied()), !json);
+    let results = all
+        .par_iter()
+        .map(|s| sil_into(dir, s, &progress, incomplete))
+        .collect();
+    progress.finish();
+    results
+}
+
+/// The preflight's validation campaign `campaign`, with its progress (a bar unless `json`).
+fn contract(campaign: &Campaign, json: bool) -> Result<(Campaign, Validation)> {
+    let missions = campaign.missions()?;
+    let progress = Progress::start(
+        "preflight contract (missions)",
+        missions.len() as u64,
+        !json,
+    );
+    let counter = progress.observer();
+    let v = validation::validate(&missions, DEFAULT_MARGIN, Measure::Conservativeness, || {
+        counter.add(1)
+    })
+    .map_err(|e| anyhow!(e))?;
+    progress.finish();
+    Ok((campaign.clone(), v))
+}
+
 /// The text `table1` prints: the paper's table, the real vehicle's verdicts and table, the
-/// report's path.
+/// preflight contract's two numbers, the report's path.
 fn print_text(
     stdout: &mut dyn Write,
     rows: &[ReportRow],
     checks: &[Preflight],
     real_rows: &[RealRow],
+    contract: Option<&Validation>,
     report: &Path,
 ) -> Result<()> {
     writeln!(stdout, "{}", output::table_text(rows))?;
@@ -142,6 +231,9 @@ fn print_text(
     writeln!(stdout)?;
     write!(stdout, "{}", output::real_table_text(real_rows))?;
     writeln!(stdout, "{}\n", output::report::real_table_legend())?;
+    if let Some(v) = contract {
+        writeln!(stdout, "{}\n", v.headline())?;
+    }
     writeln!(stdout, "report: {}", report.display())?;
     Ok(())
 }

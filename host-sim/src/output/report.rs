@@ -135,7 +135,14 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
                     };
                     format!("{}{expected}", r.faults)
                 }),
-                run.map_or("not run".to_string(), |r| r.outcome.to_string()),
+                run.map_or("not run".to_string(), |r| {
+                    let expected = if r.missed() && r.miss_expected {
+                        " (expected)"
+                    } else {
+                        ""
+                    };
+                    format!("{}{expected}", r.outcome)
+                }),
             ]);
         }
     }
@@ -317,8 +324,73 @@ pub fn report_markdown(
     s
 }
 
+/// A warning about some runs: its heading (from how many) and, per run it applies to, what to
+/// say of it.
+struct RunWarning {
+    heading: fn(usize) -> String,
+    detail: fn(&RunResult) -> Option<String>,
+}
+
+/// The report's warnings about runs, in the order they are given.
+const RUN_WARNINGS: [RunWarning; 6] = [
+    RunWarning {
+        heading: |n| {
+            format!(
+                "**Partial: {n} run(s) were interrupted** — their metrics and files cover only \
+                 the time before they stopped:"
+            )
+        },
+        detail: |r| r.interrupted().then(|| r.outcome.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "**Warning: {n} run(s) diverged** — their metrics cover only the time before \
+                 they stopped:"
+            )
+        },
+        detail: |r| r.diverged().then(|| r.outcome.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "**Warning: {n} run(s) had the controller in fail-safe** (every thruster off) \
+                 for some periods, which the scenario does not expect (`expect_faults`):"
+            )
+        },
+        detail: |r| r.faulted_unexpectedly().then(|| r.faults.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "**Warning: {n} run(s) missed their bound** (`[bound]`; the real chain's \
+                 default 0.05 m and 1 % saturated periods):"
+            )
+        },
+        detail: |r| r.missed_unexpectedly().then(|| r.outcome.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "{n} run(s) missed their bound, as their scenario expects \
+                 (`expect_missed = true`):"
+            )
+        },
+        detail: |r| (r.missed() && r.miss_expected).then(|| r.outcome.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "{n} run(s) had the controller in fail-safe for some periods, as their \
+                 scenario expects (`expect_faults = true`):"
+            )
+        },
+        detail: |r| (r.faults_expected && !r.faults.is_empty()).then(|| r.faults.to_string()),
+    },
+];
+
 /// The report's warnings, each a heading and a list, for what the reader must not miss: outputs
-/// not written, runs interrupted, diverged or in fail-safe (expected or not).
+/// not written, runs interrupted, diverged, missed or in fail-safe (expected or not).
 fn warnings(runs: &[&RunResult], incomplete: &[String]) -> String {
     let mut s = String::new();
     let mut warn = |head: String, items: Vec<String>| {
@@ -338,49 +410,13 @@ fn warnings(runs: &[&RunResult], incomplete: &[String]) -> String {
         ),
         incomplete.to_vec(),
     );
-    let named = |r: &RunResult, what: String| format!("{} ({}): {what}", r.name, r.du_label());
-    let pick = |f: &dyn Fn(&RunResult) -> Option<String>| -> Vec<String> {
-        runs.iter()
-            .filter_map(|r| f(r).map(|w| named(r, w)))
-            .collect()
-    };
-    let interrupted = pick(&|r| r.interrupted().then(|| r.outcome.to_string()));
-    warn(
-        format!(
-            "**Partial: {} run(s) were interrupted** — their metrics and files cover only the \
-             time before they stopped:",
-            interrupted.len()
-        ),
-        interrupted,
-    );
-    let diverged = pick(&|r| r.diverged().then(|| r.outcome.to_string()));
-    warn(
-        format!(
-            "**Warning: {} run(s) diverged** — their metrics cover only the time before \
-             they stopped:",
-            diverged.len()
-        ),
-        diverged,
-    );
-    let faulted = pick(&|r| r.faulted_unexpectedly().then(|| r.faults.to_string()));
-    warn(
-        format!(
-            "**Warning: {} run(s) had the controller in fail-safe** (every thruster off) for \
-             some periods, which the scenario does not expect (`expect_faults`):",
-            faulted.len()
-        ),
-        faulted,
-    );
-    let expected =
-        pick(&|r| (r.faults_expected && !r.faults.is_empty()).then(|| r.faults.to_string()));
-    warn(
-        format!(
-            "{} run(s) had the controller in fail-safe for some periods, as their scenario \
-             expects (`expect_faults = true`):",
-            expected.len()
-        ),
-        expected,
-    );
+    for w in &RUN_WARNINGS {
+        let items: Vec<String> = runs
+            .iter()
+            .filter_map(|r| Some(format!("{} ({}): {}", r.name, r.du_label(), (w.detail)(r)?)))
+            .collect();
+        warn((w.heading)(items.len()), items);
+    }
     s
 }
 

@@ -1,7 +1,11 @@
 //! Report sections built from the studies' and the board's results: the preflight verdicts,
 //! the real vehicle's introduction, and the board against SIL.
 
+use auv_link::NOT_AUV150;
+use controller_core::effectiveness::Mounting;
+
 use crate::board::{BoardComparison, Mode};
+use crate::sim::RunResult;
 use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
 
 /// What the report says about the real-vehicle table.
@@ -17,16 +21,42 @@ calls infeasible, flown anyway.
 ";
 
 /// The report section of preflight verdicts: one line each.
-pub fn preflight(checks: &[Preflight]) -> String {
+pub fn preflight<'a>(
+    checks: &[Preflight],
+    runs: impl IntoIterator<Item = &'a RunResult>,
+) -> String {
     let mut s = format!(
         "## Preflight (docs/design.md §9)\n\nWhether the real thrusters can fly each mission \
-         (`host-sim check --scenario FILE`): the force the reference needs at every corner of \
-         the parameter box, through the board's allocator, against {:.0} % of each thruster's \
-         envelope.\n\n",
+         (`host-sim check --scenario FILE`): the force the reference needs along the path at \
+         the attitude the vehicle holds (heel, pitch offset), through the board's allocator, \
+         against {:.0} % of each thruster's envelope; for the mission as written (its payload \
+         and current), and over the whole configured parameter box.\n\n",
         100.0 * DEFAULT_MARGIN
     );
     for c in checks {
         s.push_str(&format!("- {}\n", c.to_string().replace('|', "\\|")));
+    }
+    let broken: Vec<String> = runs
+        .into_iter()
+        .filter(|r| r.missed())
+        .filter_map(|r| {
+            let c = checks.iter().find(|c| c.name == r.name && c.feasible())?;
+            Some(format!(
+                "- {} ({}): the preflight said FEASIBLE at time scale {}, and the run {}\n",
+                r.name,
+                r.du_label(),
+                c.time_scale,
+                r.outcome
+            ))
+        })
+        .collect();
+    if !broken.is_empty() {
+        s += &format!(
+            "\n**The preflight's verdict did not hold for {} run(s)** (called feasible, missed \
+             the bound when flown):\n\n{}",
+            broken.len(),
+            broken.concat()
+        );
     }
     s
 }
@@ -37,11 +67,11 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
         "## Board in the loop vs software in the loop\n\n\
          | case | link | pacing | board max path (m) | SIL max path (m) | board − SIL (m) | frames/s | \
          worst update (PIL: instructions; HIL: board timer ticks) | fail-safe events | re-arms | signed | board drops (old / auth) | \
-         board refusals |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
+         board refusals | board's mounting (strong side) |\n|---|---|---|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for c in cases {
         notes += &format!(
-            "| {} | {} | {} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} / {} | {} |\n",
+            "| {} | {} | {} | {} | {} | {} | {:.0} | {} | {} | {} | {} | {} / {} | {} | {} |\n",
             c.run.name,
             c.pil.link,
             c.pil.pacing.as_str(),
@@ -63,6 +93,11 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
             match &c.pil.board_last_refusal {
                 Some(r) => format!("{} (last: {r})", c.pil.board_refused_commands),
                 None => c.pil.board_refused_commands.to_string(),
+            },
+            match c.pil.board_reversed_thrusters {
+                Some(NOT_AUV150) => "not the AUV-150 layout".to_string(),
+                Some(mask) => Mounting(mask).to_string(),
+                None => "—".to_string(),
             },
         );
     }

@@ -18,7 +18,7 @@ mod trim;
 mod variation;
 
 pub use current::{CurrentModel, OceanCurrent};
-pub use trim::trimmed;
+pub use trim::{roll_moments, static_heel, trimmed};
 pub use variation::VariationProfile;
 
 /// Position and velocity of the vehicle.

@@ -22,3 +22,24 @@ pub fn trimmed(p: &VehicleParams<f64>) -> VehicleParams<f64> {
         ..*p
     }
 }
+
+/// The heel φ (rad) at which the vehicle with parameters `p`, pitched by θ = `theta`, floats
+/// in roll equilibrium with no roll moment applied: the restoring roll moment of Eq (1)'s g(η),
+/// g₄ = cθ (k₄ sφ − m_y cφ) with m_y = y_G W − y_B B and k₄ = z_G W − z_B,roll B, vanishes at
+/// tan φ = m_y / k₄. The AUV-150's thrusters all sit on the centre line, so none of them rolls
+/// the vehicle: this is where a lateral CG shift leaves it (docs/design.md §9, "Attitude").
+/// `None` when the vehicle has no roll stability (k₄ ≤ 0: no heel is an equilibrium it returns
+/// to) or when |cos θ| is 0.
+pub fn static_heel(p: &VehicleParams<f64>, theta: f64) -> Option<f64> {
+    let (my, k4) = roll_moments(p);
+    (k4 > 0.0 && theta.cos().abs() > 0.0).then(|| my.atan2(k4))
+}
+
+/// The two roll moments of g(η) (N m): the heeling moment m_y = y_G W − y_B B and the
+/// righting coefficient k₄ = z_G W − z_B,roll B (`controller_core::model::restoring`).
+pub fn roll_moments(p: &VehicleParams<f64>) -> (f64, f64) {
+    let w = p.weight();
+    let my = p.r_g[1] * w - p.r_b_xy[1] * p.buoyancy;
+    let k4 = p.r_g[2] * w - p.z_b_roll * p.buoyancy;
+    (my, k4)
+}

@@ -6,7 +6,48 @@
 
 use controller_core::{ControllerConfig, HeadingMode, Mission, Table1Case, TrajectoryKind};
 
-use crate::plant::{CurrentModel, VariationProfile};
+use controller_core::model::VehicleParams;
+
+use crate::plant::{self, CurrentModel, VariationProfile};
+
+/// The attitude a run starts in (scenario key `initial_attitude`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum InitialAttitude {
+    /// Roll and pitch of the reference (0): the vehicle released level, whatever its payload.
+    Level,
+    /// **Choice 102** (docs/design.md §9): at the static heel of the payload present at
+    /// t = 0 ([`crate::plant::static_heel`]; roll is not actuated, so a lateral CG shift leaves
+    /// the vehicle heeled), pitch as the reference (pitch is controlled).
+    Trim,
+}
+
+impl InitialAttitude {
+    /// `level` or `trim` (the scenario key's values).
+    pub fn as_str(self) -> &'static str {
+        match self {
+            InitialAttitude::Level => "level",
+            InitialAttitude::Trim => "trim",
+        }
+    }
+}
+
+/// The bound a run must fly within (scenario table `[bound]`, docs/design.md §9): a run that
+/// completes outside it has missed.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Bound {
+    /// Largest max path error (m).
+    pub max_path: f64,
+    /// Largest fraction of control periods with a thruster saturated.
+    pub saturated: f64,
+}
+
+impl Bound {
+    /// The real vehicle's bound (**Choice 103**, docs/design.md §9): 0.05 m, 1 % of periods.
+    pub const REAL_VEHICLE: Bound = Bound {
+        max_path: 0.05,
+        saturated: 0.01,
+    };
+}
 
 /// Gaussian noise added to the measured η and ν the controller sees (seeded).
 #[derive(Clone, Debug, PartialEq)]
@@ -129,6 +170,9 @@ pub struct SimConfig {
     pub ideal_actuators: bool,
     /// Added to η(0) = η_d(0) (m, rad).
     pub initial_offset: [f64; 6],
+    /// The attitude the run starts in (scenario key `initial_attitude`); `None`: the default
+    /// for the actuators, [`SimConfig::initial_attitude`].
+    pub start_attitude: Option<InitialAttitude>,
     /// A position error beyond this (m) is a runaway: the run stops and says so.
     pub divergence_limit: f64,
     /// Faults on the board link (PIL only).
@@ -137,6 +181,12 @@ pub struct SimConfig {
     /// fail-safe periods are still counted and reported, but do not make the command fail
     /// (exit 3, [`crate::cli::Exit::Faulted`]).
     pub expect_faults: bool,
+    /// The bound the run must fly within (scenario table `[bound]`); `None`: the default for
+    /// the actuators, [`SimConfig::bound`].
+    pub bound_setting: Option<Bound>,
+    /// The run is expected to miss its bound (scenario key `expect_missed`): the miss is still
+    /// reported, but does not make the command fail (exit 4).
+    pub expect_missed: bool,
     /// Lift the step cap ([`crate::scenario::MAX_CONTROL_PERIODS`],
     /// [`crate::scenario::MAX_PLANT_STEPS`]). Not a scenario key: the explicit override is the
     /// CLI's `--allow-long-run`.
@@ -151,6 +201,33 @@ impl SimConfig {
             path: self.trajectory,
             heading: self.heading,
             time_scale: self.time_scale,
+        }
+    }
+
+    /// The attitude the run starts in: as configured, else **trim** for the real actuator
+    /// chain (a real vehicle is released in the attitude its payload gives it, docs/design.md
+    /// §9) and **level** for ideal actuators (the paper's Table 1, bit for bit as before).
+    pub fn initial_attitude(&self) -> InitialAttitude {
+        self.start_attitude.unwrap_or(match self.ideal_actuators {
+            true => InitialAttitude::Level,
+            false => InitialAttitude::Trim,
+        })
+    }
+
+    /// The bound the run must fly within: as configured, else the real vehicle's
+    /// ([`Bound::REAL_VEHICLE`]) for the real actuator chain, and none for ideal actuators.
+    pub fn bound(&self) -> Option<Bound> {
+        self.bound_setting
+            .or((!self.ideal_actuators).then_some(Bound::REAL_VEHICLE))
+    }
+
+    /// The plant's parameters at time `t` (s): the nominal AUV-150 with the profile's Δp,
+    /// trimmed if the scenario says so (plant only; the controller keeps the nominal model).
+    pub fn plant_params_at(&self, t: f64) -> VehicleParams<f64> {
+        let params = VehicleParams::auv150().with_variation(&self.variation.at(t));
+        match self.trimmed {
+            true => plant::trimmed(&params),
+            false => params,
         }
     }
 
@@ -175,9 +252,12 @@ impl SimConfig {
             thruster_lag: None,
             ideal_actuators: true,
             initial_offset: [0.0; 6],
+            start_attitude: None,
             divergence_limit: 50.0,
             link_faults: LinkFaults::default(),
             expect_faults: false,
+            bound_setting: None,
+            expect_missed: false,
             allow_long_run: false,
         }
     }

@@ -38,6 +38,9 @@
 //! thruster_lag = 0.1          # s, (0, 10]; leave out for no lag
 //! expect_faults = false       # true: periods with the controller in fail-safe are reported but
 //!                             # do not fail the command (else exit 3); default false
+//! initial_attitude = "trim"   # "trim" (the payload's static heel) | "level"; default trim for
+//!                             # the real chain, level for ideal actuators
+//! expect_missed = false       # true: a miss of [bound] is reported, no exit 4; default false
 //!
 //! [trajectory]                # required
 //! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix"
@@ -105,9 +108,14 @@
 //! b_bound = "controlled-rows" # "controlled-rows" | "literal"
 //! thrust_unit = "kgf"         # "kgf" | "newton": the unit of Eqs 31–32; default "kgf"
 //! axis_priority = ["pitch", "depth", "yaw", "sway", "surge"]  # the five axes, highest first
-//! reversed_thrusters = ["vert fore", "vert aft", "horz fore", "horz aft"]  # strong side
-//!                             # against the reference axis (+x main, +z vertical, +y
-//!                             # horizontal); default: the core's (this list)
+//! reversed_thrusters = ["vert fore", "horz fore", "horz aft"]  # strong side against the
+//!                             # reference axis (+x main, +z vertical, +y horizontal); default:
+//!                             # the core's (this list: fore up, aft down, both to port)
+//!
+//! [bound]                     # a run completing outside it is "missed" (exit 4); default these
+//!                             # two for the real chain (ideal_actuators = false), none for ideal
+//! max_path = 0.05             # m, > 0
+//! saturated = 0.01            # fraction of control periods with a thruster saturated, [0, 1]
 //!
 //! [link_faults]               # processor in the loop only: tick ranges "A..B" (A included)
 //! drop = ["100..101"]         # state frames not sent
@@ -157,7 +165,7 @@ use std::path::{Path, PathBuf};
 
 use controller_core::{Controller, Trajectory};
 
-use crate::plant::PlantState;
+use crate::plant::{static_heel, PlantState};
 
 mod config;
 mod fixed_arrays;
@@ -167,7 +175,7 @@ pub mod real_vehicle;
 mod start;
 mod validate;
 
-pub use config::{LinkFaults, SensorNoise, SimConfig, TickRange};
+pub use config::{Bound, InitialAttitude, LinkFaults, SensorNoise, SimConfig, TickRange};
 pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
 pub use start::start_state;
 pub use validate::{
@@ -324,13 +332,20 @@ impl Scenario {
         1.0 / f64::from(self.config.controller.rate_hz)
     }
 
-    /// Where the run starts: on the reference plus the configured offset ([`start_state`]).
+    /// Where the run starts ([`start_state`]): on the reference plus the configured offset,
+    /// heeled to the payload's static heel if it starts in trim
+    /// ([`SimConfig::initial_attitude`]).
     pub fn initial_state(&self) -> PlantState {
-        start_state(
-            &self.trajectory,
-            self.config.controller.rate_hz,
-            &self.config.initial_offset,
-        )
+        let rate = self.config.controller.rate_hz;
+        let mut offset = self.config.initial_offset;
+        if self.config.initial_attitude() == InitialAttitude::Trim {
+            let d0 = self.trajectory.sample(0, rate);
+            let params = self.config.plant_params_at(0.0);
+            if let Some(heel) = static_heel(&params, f64::from(d0.eta[4])) {
+                offset[3] += heel - f64::from(d0.eta[3]);
+            }
+        }
+        start_state(&self.trajectory, rate, &offset)
     }
 }
 

@@ -17,7 +17,7 @@ use controller_core::effectiveness::THRUSTER_NAMES;
 
 use super::validate::invalid;
 use super::{fixed_arrays, paper};
-use super::{LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
+use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
 use crate::plant::{CurrentModel, VariationProfile};
 
 /// Default `seed` of `[noise]` and of the Gauss–Markov current.
@@ -49,6 +49,9 @@ struct RawScenario {
     divergence_limit: Option<f64>,
     thruster_lag: Option<f64>,
     expect_faults: Option<bool>,
+    initial_attitude: Option<AttitudeName>,
+    expect_missed: Option<bool>,
+    bound: Option<RawBound>,
     trajectory: RawTrajectory,
     variation: Option<RawVariation>,
     current: Option<RawCurrent>,
@@ -72,6 +75,21 @@ struct RawTrajectory {
 enum HeadingName {
     Paper,
     Tangent,
+}
+
+#[derive(Clone, Copy, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+enum AttitudeName {
+    Level,
+    Trim,
+}
+
+/// `[bound]`: the bound a run must fly within; a key left out takes the real vehicle's.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct RawBound {
+    max_path: Option<f64>,
+    saturated: Option<f64>,
 }
 
 #[derive(Clone, Copy, Deserialize)]
@@ -369,6 +387,15 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
     }
     config.thruster_lag = raw.thruster_lag;
     config.expect_faults = raw.expect_faults.unwrap_or(false);
+    config.expect_missed = raw.expect_missed.unwrap_or(false);
+    config.start_attitude = raw.initial_attitude.map(|a| match a {
+        AttitudeName::Level => InitialAttitude::Level,
+        AttitudeName::Trim => InitialAttitude::Trim,
+    });
+    config.bound_setting = raw.bound.map(|b| Bound {
+        max_path: b.max_path.unwrap_or(Bound::REAL_VEHICLE.max_path),
+        saturated: b.saturated.unwrap_or(Bound::REAL_VEHICLE.saturated),
+    });
     if let Some(raw) = raw.variation {
         config.variation = build_variation(&raw)?;
         config.trimmed = raw.trimmed.unwrap_or(false);

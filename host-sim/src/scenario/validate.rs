@@ -134,6 +134,16 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
         ));
     }
     each("initial_offset", &config.initial_offset, finite)?;
+    if let Some(b) = config.bound_setting {
+        positive("bound.max_path", b.max_path)?;
+        let s = non_negative("bound.saturated", b.saturated)?;
+        if s > 1.0 {
+            return Err(invalid(
+                "bound.saturated",
+                format!("is a fraction of the control periods, in [0, 1], got {s}"),
+            ));
+        }
+    }
     let limit = at_most(
         "divergence_limit",
         positive("divergence_limit", config.divergence_limit)?,

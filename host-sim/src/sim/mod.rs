@@ -120,6 +120,11 @@ pub fn fly(
         }
     }
     let (metrics, faults, samples) = recorder.finish();
+    if outcome == Outcome::Completed {
+        if let Some(reason) = cfg.bound().and_then(|b| bound::miss(&b, &metrics)) {
+            outcome = Outcome::Missed { reason };
+        }
+    }
     RunResult {
         name: cfg.name.clone(),
         case: cfg.case,
@@ -128,6 +133,7 @@ pub fn fly(
         outcome,
         faults,
         faults_expected: cfg.expect_faults,
+        miss_expected: cfg.expect_missed,
         samples,
         plant_factorisations: vehicle.factorisations(),
     }

@@ -33,6 +33,13 @@ pub struct Progress {
 #[derive(Clone)]
 pub struct Counter(Arc<AtomicU64>);
 
+impl Counter {
+    /// Counts `n` more (for work counted in other units than periods, e.g. missions).
+    pub fn add(&self, n: u64) {
+        self.0.fetch_add(n, Ordering::Relaxed);
+    }
+}
+
 impl Observer for Counter {
     fn sample(&mut self, _: &Sample) {
         self.0.fetch_add(1, Ordering::Relaxed);

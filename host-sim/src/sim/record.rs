@@ -101,11 +101,16 @@ pub enum Outcome {
     Interrupted {
         t: f64,
     },
+    /// Ran to its end outside its bound ([`crate::scenario::SimConfig::bound`]): `reason` says
+    /// which limit and by how much.
+    Missed {
+        reason: String,
+    },
 }
 
 impl fmt::Display for Outcome {
-    /// "completed", "DIVERGED at t = … s: reason" (the reason on one line) or
-    /// "INTERRUPTED at t = … s (partial)".
+    /// "completed", "DIVERGED at t = … s: reason" (the reason on one line),
+    /// "INTERRUPTED at t = … s (partial)" or "MISSED its bound: reason".
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Outcome::Completed => f.write_str("completed"),
@@ -114,6 +119,7 @@ impl fmt::Display for Outcome {
                 write!(f, "DIVERGED at t = {t:.2} s: {reason}")
             }
             Outcome::Interrupted { t } => write!(f, "INTERRUPTED at t = {t:.2} s (partial)"),
+            Outcome::Missed { reason } => write!(f, "MISSED its bound: {reason}"),
         }
     }
 }
@@ -246,6 +252,9 @@ pub struct RunResult {
     /// The scenario expects faults ([`crate::scenario::SimConfig::expect_faults`]): they are
     /// reported but do not fail the command.
     pub faults_expected: bool,
+    /// The scenario expects to miss its bound ([`crate::scenario::SimConfig::expect_missed`]):
+    /// the miss is reported but does not fail the command.
+    pub miss_expected: bool,
     /// The samples the plots draw: every sample of a run of at most
     /// [`super::decimate::PLOT_SAMPLES`] periods, else a decimated series (see
     /// [`super::decimate`]). The CSV has every period (it is written as the run goes).
@@ -272,6 +281,12 @@ pub struct RunSummary {
     /// The time the run was interrupted at (Ctrl-C), if it was: its metrics cover [0, t).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interrupted: Option<f64>,
+    /// Why the run missed its bound, if it did (which limit, by how much).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub missed: Option<String>,
+    /// Whether the scenario expected the miss.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
+    pub miss_expected: bool,
     /// The periods in fail-safe, per status (`{"periods": {}, "first_t": null}` for none).
     #[serde(default)]
     pub faults: FaultCounts,
@@ -305,6 +320,11 @@ impl RunResult {
                 Outcome::Interrupted { t } => Some(t),
                 _ => None,
             },
+            missed: match &self.outcome {
+                Outcome::Missed { reason } => Some(reason.clone()),
+                _ => None,
+            },
+            miss_expected: self.miss_expected,
             faults: self.faults.clone(),
             faults_expected: self.faults_expected,
         }
@@ -318,6 +338,16 @@ impl RunResult {
     /// True if the run was interrupted (its outputs are partial).
     pub fn interrupted(&self) -> bool {
         matches!(self.outcome, Outcome::Interrupted { .. })
+    }
+
+    /// True if the run ended outside its bound.
+    pub fn missed(&self) -> bool {
+        matches!(self.outcome, Outcome::Missed { .. })
+    }
+
+    /// True if the run missed its bound and the scenario did not expect it.
+    pub fn missed_unexpectedly(&self) -> bool {
+        self.missed() && !self.miss_expected
     }
 
     /// True if the controller was in fail-safe in some period and the scenario did not expect

@@ -5,17 +5,15 @@
 //! profile that does not vary in time is not evaluated again (**Choice 80**,
 //! [`Plant::set_params`]).
 
-use controller_core::model::VehicleParams;
 use nalgebra::Vector6;
 
 use crate::plant::VariationProfile;
-use crate::plant::{self, OceanCurrent, Plant, PlantError, PlantState, PlantTerms};
+use crate::plant::{OceanCurrent, Plant, PlantError, PlantState, PlantTerms};
 use crate::scenario::{Scenario, SimConfig};
 
 /// The plant of one run, its current and its state.
 pub struct Vehicle<'a> {
     config: &'a SimConfig,
-    nominal: VehicleParams<f64>,
     /// The profile does not vary in time: the plant's parameters are set once.
     params_fixed: bool,
     plant: Option<Plant>,
@@ -30,7 +28,6 @@ impl<'a> Vehicle<'a> {
         let config = scenario.config();
         Vehicle {
             config,
-            nominal: VehicleParams::auv150(),
             params_fixed: matches!(
                 config.variation,
                 VariationProfile::None | VariationProfile::Constant(_)
@@ -43,7 +40,7 @@ impl<'a> Vehicle<'a> {
 
     /// One RK4 step of `h` from time `t` with the body force `tau` held, then the current's.
     pub fn step(&mut self, t: f64, tau: &Vector6<f64>, h: f64) -> Result<(), PlantError> {
-        let params_at = |t: f64| params_at(self.config, &self.nominal, t);
+        let params_at = |t: f64| self.config.plant_params_at(t);
         let plant = match &mut self.plant {
             Some(p) if self.params_fixed => &*p,
             Some(p) => {
@@ -62,15 +59,5 @@ impl<'a> Vehicle<'a> {
     /// How many times the plant formed and factorised M ([`Plant::factorisations`]).
     pub fn factorisations(&self) -> u64 {
         self.plant.as_ref().map_or(0, Plant::factorisations)
-    }
-}
-
-/// The plant's parameters at time `t`: the nominal vehicle with the profile's Δp, trimmed if
-/// the scenario says so.
-fn params_at(config: &SimConfig, nominal: &VehicleParams<f64>, t: f64) -> VehicleParams<f64> {
-    let params = nominal.with_variation(&config.variation.at(t));
-    match config.trimmed {
-        true => plant::trimmed(&params),
-        false => params,
     }
 }

@@ -1,0 +1,87 @@
+//! `host-sim validate-preflight`: does the preflight's verdict hold? Missions checked, then
+//! flown ([`crate::studies::validation`]).
+
+use std::io::Write;
+use std::path::PathBuf;
+
+use anyhow::{anyhow, bail, Context, Result};
+use clap::{Args, ValueEnum};
+
+use super::json::print_json;
+use super::Exit;
+use crate::output::{atomic, OutputDir};
+use crate::sim::progress::Progress;
+use crate::studies::preflight::DEFAULT_MARGIN;
+use crate::studies::validation::{self, Campaign, Measure, DEFAULT_RANDOM, TEAM_MOUNTINGS};
+
+/// Which thruster mountings the matrix flies.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, ValueEnum)]
+pub enum Mountings {
+    /// The vertical × horizontal ones a team would build (8).
+    Team,
+    /// Every reversed-thruster mask of the AUV-150 layout (32).
+    All,
+}
+
+/// `validate-preflight`: the six real paths under each mounting, and random missions, each
+/// checked and flown; prints the false-feasible count and the conservativeness.
+#[derive(Args, Clone, Debug, PartialEq)]
+pub struct ValidateArgs {
+    #[arg(long, value_enum, default_value_t = Mountings::All)]
+    pub mountings: Mountings,
+    /// Random missions besides the matrix.
+    #[arg(long, default_value_t = DEFAULT_RANDOM)]
+    pub random: usize,
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    #[arg(long, default_value_t = DEFAULT_MARGIN)]
+    pub margin: f64,
+    #[arg(long)]
+    pub json: bool,
+    #[arg(long, default_value = "runs/validate-preflight")]
+    pub out: PathBuf,
+}
+
+/// `validate-preflight`: exit 0 when no mission was falsely feasible, 1 otherwise.
+pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    if !(args.margin > 0.0 && args.margin <= 1.0) {
+        bail!(
+            "--margin must be a fraction of the envelope in (0, 1], got {}",
+            args.margin
+        );
+    }
+    let campaign = Campaign {
+        masks: match args.mountings {
+            Mountings::Team => TEAM_MOUNTINGS.to_vec(),
+            Mountings::All => validation::all_mountings(),
+        },
+        random: args.random,
+        seed: args.seed,
+    };
+    let missions = campaign.missions()?;
+    let dir = OutputDir::prepare(&args.out)?;
+    let progress = Progress::start("missions", missions.len() as u64, !args.json);
+    let counter = progress.observer();
+    let v = validation::validate(&missions, args.margin, Measure::Conservativeness, || {
+        counter.add(1)
+    })
+    .map_err(|e| anyhow!(e))?;
+    progress.finish();
+    let md = v.markdown();
+    let report = dir.claim("report.md")?;
+    atomic::write(&report, md.as_bytes())
+        .with_context(|| format!("writing {}", report.display()))?;
+    if args.json {
+        print_json(stdout, &v)?;
+    } else {
+        writeln!(stdout, "{md}")?;
+        writeln!(stdout, "report: {}", report.display())?;
+    }
+    Ok(if v.partial {
+        Exit::Interrupted
+    } else if v.false_feasible > 0 {
+        Exit::RunFailed
+    } else {
+        Exit::Success
+    })
+}

@@ -1,0 +1,495 @@
+//! Preflight feasibility (docs/design.md §9 "Preflight"): before any simulation, can the real
+//! thrusters fly this scenario's mission, and if not, why not and how slowly could they?
+//!
+//! For the mission's reference η_d, η̇_d, η̈_d (the path the scenario flies, sampled every
+//! [`SAMPLE_PERIOD`] of the path's own time), the body force the vehicle needs is Eq (1) solved
+//! for τ ([`Plant::required_force`](crate::plant::Plant::required_force)) with
+//! ν = J⁻¹η̇ and ν̇ = J⁻¹(η̈_d − J̇ν) **at the attitude the vehicle holds there**
+//! ([`attitude`]: the heel of its payload's lateral CG, which roll — not actuated — cannot
+//! remove, and its swing; the pitch offset at which the law holds its model mismatch, and the
+//! Munk moment of that angle of attack at speed), under the configured current (constant: that
+//! velocity; Gauss–Markov: every corner of mean ± [`GAUSS_MARKOV_SIGMAS`]·σ). Each τ goes
+//! through **the board's own allocator** (`controller_core::allocator::Allocator`, the
+//! scenario's geometry, unit and axis priority) built on the envelope shrunk to the margin
+//! (default [`DEFAULT_MARGIN`] = 80 % of [T_min, T_max]): feasible when every block of every τ
+//! is met, i.e. every thruster's demand lies inside the margin envelope. The rest of the
+//! envelope is left to the feedback (the tracking transients, noise), which this check does
+//! not model.
+//!
+//! **Two verdicts** ([`Scope`]): for the mission **as written** — the scenario's own payload
+//! profile (its roll swings included) and current — which decides `check`'s exit code and the
+//! proposed time scale; and over **the whole configured box**, every corner of the
+//! controller's parameter box held constant (2⁹ plants, trimmed if the scenario is): what the
+//! law is certified for, reported beside it.
+//!
+//! **Time scale.** With k the time scale, η̇_d scales as 1/k and η̈_d (and with it every
+//! velocity-squared term: Coriolis, damping, Munk) as 1/k², so the check is run at any k from
+//! the path sampled once at k = 1. At k = ∞ (`1/k = 0`) only g(η) and the current's drag
+//! remain: a mission infeasible there is **statically infeasible** — payload weight or CG
+//! moment beyond what the thrusters can hold at zero speed, which no time scale cures.
+//! Otherwise the smallest feasible k in [1, [`Trajectory::MAX_TIME_SCALE`]] is found by
+//! doubling, then bisection to a relative [`TIME_SCALE_TOLERANCE`], rounded up to
+//! [`TIME_SCALE_STEP`], and checked again (the attitude terms make feasibility only nearly
+//! monotone in k: a rounded scale that fails is raised by steps until one passes). The
+//! proposed scale flies the same path: the scenario's duration D covers the path up to
+//! D/k_scenario, which at scale k takes D·k/k_scenario.
+//!
+//! **Choices** (docs/design.md §9): the box is the controller's `uncertainty` box; the margin
+//! is 80 %; the path is sampled at 20 Hz of its own time; Gauss–Markov currents are taken at
+//! ±3σ; the attitude model is [`attitude`]'s (**Choice 104**).
+
+use std::fmt;
+
+use controller_core::effectiveness::{Mounting, THRUSTERS, THRUSTER_NAMES};
+use controller_core::readable::Readable;
+use controller_core::Trajectory;
+use serde::{Deserialize, Serialize};
+
+use crate::interrupt;
+use crate::scenario::Scenario;
+
+pub mod attitude;
+mod sweep;
+
+use sweep::{Checker, Peaks};
+
+/// Default fraction of each thruster's envelope the reference may use (the rest is left to
+/// the feedback): 80 %.
+pub const DEFAULT_MARGIN: f64 = 0.8;
+/// Spacing of the check's samples along the path, in the path's own time (s, at k = 1).
+pub const SAMPLE_PERIOD: f64 = 0.05;
+/// The bisection stops when the feasible and the infeasible time scale differ by less than
+/// this fraction.
+pub const TIME_SCALE_TOLERANCE: f64 = 0.005;
+/// The proposed time scale is rounded up to a multiple of this.
+pub const TIME_SCALE_STEP: f64 = 0.01;
+/// A Gauss–Markov current is checked at the corners of mean ± this many σ per axis.
+pub const GAUSS_MARKOV_SIGMAS: f64 = 3.0;
+
+/// Samples per second of path time ([`SAMPLE_PERIOD`]).
+const SAMPLE_RATE_HZ: u32 = 20;
+
+/// Why [`check`] gave no verdict.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum CheckError {
+    /// The check cannot be made: a margin outside (0, 1], or a scenario whose allocator or
+    /// plants cannot be built.
+    Invalid(String),
+    /// A stop was requested ([`crate::interrupt`]) before the check was done: a day-long
+    /// mission is 1.7·10⁶ samples of the path at each of the 2⁹ corners, minutes of work, so
+    /// the check polls the request at every sample (**Choice 120**).
+    Interrupted,
+}
+
+impl fmt::Display for CheckError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self {
+            CheckError::Invalid(e) => f.write_str(e),
+            CheckError::Interrupted => f.write_str("interrupted before the check was done"),
+        }
+    }
+}
+
+impl std::error::Error for CheckError {}
+
+/// Stops a long loop of the check when a stop was requested.
+pub(super) fn poll() -> Result<(), CheckError> {
+    if interrupt::requested() {
+        Err(CheckError::Interrupted)
+    } else {
+        Ok(())
+    }
+}
+
+/// Which payloads and currents a verdict covers.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Scope {
+    /// The scenario's own payload profile and current.
+    AsWritten,
+    /// Every corner of the controller's parameter box, held constant, under the configured
+    /// current.
+    WholeBox,
+}
+
+/// What one thruster is asked for over the mission (at the scenario's time scale).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ThrusterDemand {
+    /// The thruster's name ([`THRUSTER_NAMES`]).
+    pub thruster: String,
+    /// Its envelope [T_min, T_max] at the supply limit (N).
+    pub envelope: [f64; 2],
+    /// The smallest thrust the reference needs (N), and when (s).
+    pub min: f64,
+    pub t_min: f64,
+    /// The largest thrust the reference needs (N), and when (s).
+    pub max: f64,
+    pub t_max: f64,
+    /// The largest share of the envelope used on either side: max(max/T_max, min/T_min),
+    /// feasible when ≤ the margin.
+    pub usage: f64,
+}
+
+/// The first sample (in time) at which some corner's τ cannot be allocated inside the margin
+/// envelope.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Violation {
+    /// Time (s) at the time scale checked (for the static check: where on the path, at the
+    /// scenario's time scale).
+    pub t: f64,
+    /// The thruster that exceeds its margin envelope the most (relative to its width).
+    pub thruster: String,
+    /// What it would need (N) and the margin envelope (N).
+    pub demand: f64,
+    pub limit: [f64; 2],
+    /// The axes the allocator gives up, the lowest priority first.
+    pub given_up: Vec<String>,
+}
+
+/// The verdict of [`Preflight`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Verdict {
+    /// The mission fits the margin envelope at its own time scale.
+    Feasible,
+    /// Not at its time scale, but at [`Preflight::smallest_time_scale`].
+    NeedsTimeScale,
+    /// Not even at rest: weight, CG moment or current beyond the thrusters.
+    StaticallyInfeasible,
+    /// Feasible at rest, but not at any time scale up to [`Trajectory::MAX_TIME_SCALE`].
+    Infeasible,
+}
+
+impl Verdict {
+    /// `feasible`, `needs-time-scale`, `statically-infeasible`, `infeasible`.
+    pub fn as_str(self) -> &'static str {
+        match self {
+            Verdict::Feasible => "feasible",
+            Verdict::NeedsTimeScale => "needs-time-scale",
+            Verdict::StaticallyInfeasible => "statically-infeasible",
+            Verdict::Infeasible => "infeasible",
+        }
+    }
+}
+
+/// A verdict over one [`Scope`]: whether the mission fits at its own time scale, the smallest
+/// scale at which it does, and the first violations.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ScopeVerdict {
+    pub verdict: Verdict,
+    /// The smallest feasible time scale in [1, 100] (rounded up to 0.01); `None` if there is
+    /// none.
+    pub smallest_time_scale: Option<f64>,
+    /// The first violation at the scenario's time scale.
+    pub first_violation: Option<Violation>,
+    /// The first violation at rest (k = ∞), if the mission is statically infeasible.
+    pub static_violation: Option<Violation>,
+}
+
+/// The preflight check of one scenario (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Preflight {
+    /// The scenario's name.
+    pub name: String,
+    /// The verdict for the mission as written (its own payload profile and current): the one
+    /// `check`'s exit code and the proposed time scale follow.
+    pub verdict: Verdict,
+    /// The scenario's own time scale.
+    pub time_scale: f64,
+    /// The scenario's duration (s): it flies the path up to duration/time_scale of path time.
+    pub duration: f64,
+    /// The smallest feasible time scale in [1, 100] (rounded up to 0.01); `None` if there is
+    /// none.
+    pub smallest_time_scale: Option<f64>,
+    /// The fraction of the envelope the reference may use.
+    pub margin: f64,
+    /// Thrust unit of Eqs 31–32, heading mode, trim, start attitude: what was checked.
+    pub thrust_unit: String,
+    pub heading: String,
+    pub trimmed: bool,
+    pub initial_attitude: String,
+    /// The thrusters' mounting in words (`main forward, vert fore up, …`), and as the link's
+    /// reversed-thruster mask (`None`: not the AUV-150 layout).
+    pub mounting: String,
+    pub reversed_thrusters: Option<u8>,
+    /// Per thruster, at the scenario's time scale, the mission as written.
+    pub thrusters: Vec<ThrusterDemand>,
+    /// The first violation at the scenario's time scale (as written).
+    pub first_violation: Option<Violation>,
+    /// The first violation at rest (k = ∞), if the mission as written is statically
+    /// infeasible.
+    pub static_violation: Option<Violation>,
+    /// The same check over every corner of the configured parameter box (`None`: not asked
+    /// for, [`check_as_written`]).
+    pub whole_box: Option<ScopeVerdict>,
+}
+
+impl Preflight {
+    /// True when the mission is feasible at its own time scale.
+    pub fn feasible(&self) -> bool {
+        self.verdict == Verdict::Feasible
+    }
+}
+
+fn fmt_violation(v: &Violation) -> String {
+    format!(
+        "{} needs {:.0} N, margin envelope [{:.0}, {:.0}] N ({} given up)",
+        v.thruster,
+        v.demand,
+        v.limit[0],
+        v.limit[1],
+        v.given_up.join(", ")
+    )
+}
+
+impl fmt::Display for Preflight {
+    /// The one-line verdict, e.g. `preflight real-circular-10R: FEASIBLE at time scale 1 for
+    /// this mission (margin 80 %: peak 77 % of vert aft's envelope; smallest feasible time
+    /// scale 1); over the whole configured box: feasible from time scale 1.2`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let pct = 100.0 * self.margin;
+        write!(f, "preflight {}: ", self.name)?;
+        match self.verdict {
+            Verdict::Feasible => {
+                let peak = self
+                    .thrusters
+                    .iter()
+                    .max_by(|a, b| a.usage.total_cmp(&b.usage));
+                write!(
+                    f,
+                    "FEASIBLE at time scale {} for this mission",
+                    self.time_scale
+                )?;
+                if let Some(p) = peak {
+                    write!(
+                        f,
+                        " (margin {pct:.0} %: peak {:.0} % of {}'s envelope",
+                        100.0 * p.usage,
+                        p.thruster
+                    )?;
+                }
+                if let Some(k) = self.smallest_time_scale {
+                    write!(f, "; smallest feasible time scale {k}")?;
+                }
+                f.write_str(")")?;
+            }
+            Verdict::StaticallyInfeasible => {
+                write!(
+                    f,
+                    "STATICALLY INFEASIBLE for this mission (margin {pct:.0} %): at rest"
+                )?;
+                if let Some(v) = &self.static_violation {
+                    write!(f, ", at t = {:.2} s, {}", v.t, fmt_violation(v))?;
+                }
+                f.write_str("; no time scale helps")?;
+            }
+            Verdict::NeedsTimeScale | Verdict::Infeasible => {
+                write!(
+                    f,
+                    "INFEASIBLE at time scale {} for this mission (margin {pct:.0} %)",
+                    self.time_scale
+                )?;
+                if let Some(v) = &self.first_violation {
+                    write!(f, ": first at t = {:.2} s, {}", v.t, fmt_violation(v))?;
+                }
+                match self.smallest_time_scale {
+                    Some(k) => write!(f, "; feasible from time scale {k}")?,
+                    None => write!(
+                        f,
+                        "; not feasible at any time scale up to {}",
+                        Trajectory::MAX_TIME_SCALE
+                    )?,
+                }
+            }
+        }
+        match &self.whole_box {
+            Some(b) => write!(
+                f,
+                "; over the whole configured box: {}",
+                b.short(self.time_scale)
+            ),
+            None => Ok(()),
+        }
+    }
+}
+
+impl ScopeVerdict {
+    /// The verdict in a few words: `feasible`, `feasible from time scale 2.35`, `statically
+    /// infeasible`, `infeasible at any time scale up to 100`.
+    pub fn short(&self, time_scale: f64) -> String {
+        match (self.verdict, self.smallest_time_scale) {
+            (Verdict::Feasible, _) => format!("feasible at time scale {time_scale}"),
+            (Verdict::NeedsTimeScale, Some(k)) => format!("feasible from time scale {k}"),
+            (Verdict::StaticallyInfeasible, _) => "STATICALLY INFEASIBLE".to_string(),
+            _ => format!(
+                "INFEASIBLE at any time scale up to {}",
+                Trajectory::MAX_TIME_SCALE
+            ),
+        }
+    }
+}
+
+/// The preflight check of `scenario` at `margin` (a fraction of the envelope, in (0, 1]): the
+/// mission as written and the whole configured box.
+///
+/// # Errors
+/// [`CheckError::Invalid`]: a margin outside (0, 1], or a scenario whose allocator or plants
+/// cannot be built; [`CheckError::Interrupted`]: a stop was requested.
+pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
+    check_scopes(scenario, margin, true)
+}
+
+/// [`check`] of the mission as written only (no [`Preflight::whole_box`]): what flying it
+/// needs, at a 2⁹th of the work.
+///
+/// # Errors
+/// As [`check`].
+pub fn check_as_written(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
+    check_scopes(scenario, margin, false)
+}
+
+fn check_scopes(
+    scenario: &Scenario,
+    margin: f64,
+    whole_box: bool,
+) -> Result<Preflight, CheckError> {
+    if !(margin > 0.0 && margin <= 1.0) {
+        return Err(CheckError::Invalid(format!(
+            "the margin must be a fraction of the envelope in (0, 1], got {}",
+            Readable(margin)
+        )));
+    }
+    let checker = Checker::new(scenario, margin)?;
+    let cfg = scenario.config();
+    let k = time_scale(cfg.time_scale);
+    let (as_written, peaks) = verdict(&checker, Scope::AsWritten, k)?;
+    let whole_box = match whole_box {
+        true => Some(verdict(&checker, Scope::WholeBox, k)?.0),
+        false => None,
+    };
+    let envelope = scenario.controller().envelope();
+    let thrusters = (0..THRUSTERS)
+        .map(|i| {
+            let (min, t_min, max, t_max) = peaks[i];
+            let (lo, hi) = (f64::from(envelope.min[i]), f64::from(envelope.max[i]));
+            ThrusterDemand {
+                thruster: THRUSTER_NAMES[i].to_string(),
+                envelope: [lo, hi],
+                min,
+                t_min,
+                max,
+                t_max,
+                usage: (max / hi).max(min / lo),
+            }
+        })
+        .collect();
+    let mask = cfg.controller.geometry.auv150_reversed();
+    Ok(Preflight {
+        name: cfg.name.clone(),
+        verdict: as_written.verdict,
+        time_scale: k,
+        duration: cfg.duration,
+        smallest_time_scale: as_written.smallest_time_scale,
+        margin,
+        thrust_unit: cfg.controller.thrust_unit.to_string(),
+        heading: cfg.heading.to_string(),
+        trimmed: cfg.trimmed,
+        initial_attitude: cfg.initial_attitude().as_str().to_string(),
+        mounting: mask.map_or_else(
+            || "not the AUV-150 layout".to_string(),
+            |m| Mounting(m).to_string(),
+        ),
+        reversed_thrusters: mask,
+        thrusters,
+        first_violation: as_written.first_violation,
+        static_violation: as_written.static_violation,
+        whole_box,
+    })
+}
+
+/// The verdict over `scope` at the scenario's scale `k`, and the peaks of the full sweep there.
+fn verdict(checker: &Checker, scope: Scope, k: f64) -> Result<(ScopeVerdict, Peaks), CheckError> {
+    let own = checker.sweep(scope, 1.0 / k, true)?;
+    let at_rest = checker.sweep(scope, 0.0, false)?;
+    let statically_infeasible = at_rest.first.is_some();
+    let smallest = if statically_infeasible {
+        None
+    } else {
+        smallest_time_scale(checker, scope, own.first.is_none().then_some(k))?
+    };
+    let verdict = if own.first.is_none() {
+        Verdict::Feasible
+    } else if statically_infeasible {
+        Verdict::StaticallyInfeasible
+    } else if smallest.is_some() {
+        Verdict::NeedsTimeScale
+    } else {
+        Verdict::Infeasible
+    };
+    Ok((
+        ScopeVerdict {
+            verdict,
+            smallest_time_scale: smallest,
+            first_violation: own.first,
+            static_violation: at_rest.first,
+        },
+        own.peaks,
+    ))
+}
+
+/// The scenario's f32 time scale as the decimal it was written as (1.3, not 1.2999999523).
+pub(super) fn time_scale(k: f32) -> f64 {
+    (f64::from(k) * 1e6).round() / 1e6
+}
+
+/// The smallest feasible time scale of `scope` in [1, MAX_TIME_SCALE] (see the module docs),
+/// given a scale already known to be feasible, if any.
+fn smallest_time_scale(
+    checker: &Checker,
+    scope: Scope,
+    known: Option<f64>,
+) -> Result<Option<f64>, CheckError> {
+    let max = f64::from(Trajectory::MAX_TIME_SCALE);
+    let feasible_at = |k: f64| -> Result<bool, CheckError> {
+        Ok(checker.sweep(scope, 1.0 / k, false)?.first.is_none())
+    };
+    if known == Some(1.0) || feasible_at(1.0)? {
+        return Ok(Some(1.0));
+    }
+    // Doubling to a feasible upper end.
+    let (mut lo, mut hi) = (1.0, known.unwrap_or(max).min(max));
+    let mut k = 2.0f64;
+    while k < hi {
+        if feasible_at(k)? {
+            hi = k;
+            break;
+        }
+        lo = k;
+        k *= 2.0;
+    }
+    if known.is_none() && hi == max && !feasible_at(max)? {
+        return Ok(None);
+    }
+    while hi / lo > 1.0 + TIME_SCALE_TOLERANCE {
+        let mid = (lo * hi).sqrt();
+        if feasible_at(mid)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    // Rounded up to the step, and checked: feasibility is only nearly monotone in k.
+    let mut rounded = (hi / TIME_SCALE_STEP).ceil() * TIME_SCALE_STEP;
+    for _ in 0..MAX_ROUNDING_STEPS {
+        rounded = ((rounded.min(max)) * 100.0).round() / 100.0;
+        if feasible_at(rounded)? {
+            return Ok(Some(rounded));
+        }
+        rounded += TIME_SCALE_STEP;
+    }
+    // No rounded scale passed: the bisection's own feasible end, to a millionth.
+    Ok(Some((hi * 1e6).ceil() / 1e6))
+}
+
+/// Steps of [`TIME_SCALE_STEP`] a rounded time scale is raised by, at most, until it is
+/// feasible; beyond them the mission has no feasible scale the check can name.
+const MAX_ROUNDING_STEPS: usize = 20;

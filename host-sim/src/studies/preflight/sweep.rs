@@ -1,0 +1,411 @@
+//! The preflight's work: the path sampled once, the plants of every case (the mission as
+//! written, or every corner of the parameter box), and one sweep of every sample at a time
+//! scale — the attitude the vehicle holds there ([`super::attitude`]), the force it needs,
+//! the board's allocator on the margin envelope.
+
+use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
+use controller_core::kinematics::{self, Attitude};
+use controller_core::model::VehicleParams;
+use controller_core::thruster::ThrustEnvelope;
+use controller_core::uncertainty::ParamBox;
+use controller_core::{allocation::Allocator, allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
+use controller_core::{Mission, Trajectory};
+use nalgebra::{Vector3, Vector6};
+
+use super::attitude::{self, Swing};
+use super::{poll, time_scale, CheckError, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ};
+use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
+use crate::scenario::{InitialAttitude, Scenario};
+
+/// An unallocated part above this (relative to 1 + |τ|) means the axis was given up; below it
+/// is the f32 rounding of an axis met on its bound.
+const GIVEN_UP: f32 = 1.0e-4;
+/// Index of roll and pitch in η.
+const ROLL: usize = 3;
+const PITCH: usize = 4;
+
+/// The reference at one sample of the path, at k = 1.
+struct PathSample {
+    /// Path time (s, at k = 1).
+    s: f64,
+    eta: Vector6<f64>,
+    eta_dot: Vector6<f64>,
+    eta_ddot: Vector6<f64>,
+}
+
+/// Per thruster: the smallest demand (N) and when (s), the largest and when.
+pub(super) type Peaks = [(f64, f64, f64, f64); THRUSTERS];
+
+/// One sweep over the samples at one 1/k.
+pub(super) struct Sweep {
+    pub first: Option<Violation>,
+    pub peaks: Peaks,
+}
+
+/// The plant of a case at each sample, and its roll swing there.
+struct CasePlants<'p> {
+    /// Index into `plants` per sample (one entry: the same plant throughout).
+    at: Vec<usize>,
+    plants: Vec<&'p Plant>,
+    /// The swing's amplitude per sample (one entry: the same throughout), and its ω.
+    amplitude: Vec<f64>,
+    omega: f64,
+}
+
+impl CasePlants<'_> {
+    fn plant(&self, j: usize) -> &Plant {
+        self.plants[self.at[j.min(self.at.len() - 1)]]
+    }
+    fn swing(&self, j: usize) -> Swing {
+        Swing {
+            amplitude: self.amplitude[j.min(self.amplitude.len() - 1)],
+            omega: self.omega,
+        }
+    }
+}
+
+/// Everything the check needs, built once per scenario.
+pub(super) struct Checker<'a> {
+    scenario: &'a Scenario,
+    samples: Vec<PathSample>,
+    /// K_d of the path at k = 1.
+    accel_bound: f64,
+    /// Every corner of the controller's parameter box (trimmed if the scenario is).
+    corners: Vec<Plant>,
+    /// The law's nominal model, as a plant: what its feedforward gives.
+    nominal: Plant,
+    currents: Vec<Vector3<f64>>,
+    margin_allocator: Allocator,
+    margin_envelope: ThrustEnvelope,
+}
+
+/// The currents the check takes (see the module docs of [`super`]).
+fn currents(model: &CurrentModel) -> Vec<Vector3<f64>> {
+    match model {
+        CurrentModel::None => vec![Vector3::zeros()],
+        CurrentModel::Constant(v) => vec![Vector3::from(*v)],
+        CurrentModel::GaussMarkov { mean, sigma, .. } => {
+            let mut out: Vec<Vector3<f64>> = Vec::new();
+            for corner in 0..8u32 {
+                let mut v = Vector3::from(*mean);
+                for axis in 0..3 {
+                    let sign = if corner & (1 << axis) != 0 { 1.0 } else { -1.0 };
+                    v[axis] += sign * GAUSS_MARKOV_SIGMAS * sigma[axis];
+                }
+                if !out.contains(&v) {
+                    out.push(v);
+                }
+            }
+            out
+        }
+    }
+}
+
+/// The state of the vehicle on the reference sample `smp` at 1/k = `inv_k`, with roll `phi`
+/// and pitch offset `d_theta`: η, ν = J⁻¹(η) η̇_d, ν̇ = J⁻¹(η̈_d − J̇ν) plus the roll
+/// acceleration `p_dot` of a swing.
+fn state_at(
+    smp: &PathSample,
+    inv_k: f64,
+    phi: f64,
+    d_theta: f64,
+    p_dot: f64,
+) -> (PlantState, Vector6<f64>) {
+    let mut eta = smp.eta;
+    eta[ROLL] = phi;
+    eta[PITCH] += d_theta;
+    let att = Attitude::from_eta(&eta);
+    let jinv = kinematics::jacobian_inv(&att);
+    let nu = jinv * (smp.eta_dot * inv_k);
+    let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
+    let mut nu_dot = jinv * (smp.eta_ddot * (inv_k * inv_k)) - jjn;
+    nu_dot[ROLL] += p_dot;
+    (PlantState { eta, nu }, nu_dot)
+}
+
+impl<'a> Checker<'a> {
+    pub(super) fn new(scenario: &'a Scenario, margin: f64) -> Result<Self, CheckError> {
+        let invalid = CheckError::Invalid;
+        let cfg = scenario.config();
+        let controller = scenario.controller();
+        // The path at k = 1, sampled over the part the scenario flies.
+        let path = Trajectory::new(Mission {
+            time_scale: 1.0,
+            ..cfg.mission()
+        })
+        .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
+        let span = cfg.duration / time_scale(cfg.time_scale);
+        let n = (span * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
+        let samples = (0..=n)
+            .map(|j| {
+                if j % 4096 == 0 {
+                    poll()?;
+                }
+                let d = path.sample(j, SAMPLE_RATE_HZ);
+                Ok(PathSample {
+                    s: j as f64 / f64::from(SAMPLE_RATE_HZ),
+                    eta: d.eta.cast::<f64>(),
+                    eta_dot: d.eta_dot.cast::<f64>(),
+                    eta_ddot: d.eta_ddot.cast::<f64>(),
+                })
+            })
+            .collect::<Result<_, CheckError>>()?;
+        let bx = controller.config().uncertainty.cast(f64::from);
+        let nominal = VehicleParams::auv150();
+        let corners = (0..ParamBox::<f64>::CORNERS)
+            .map(|c| {
+                let mut p = nominal.with_variation(&bx.corner(c));
+                if cfg.trimmed {
+                    p = plant::trimmed(&p);
+                }
+                Plant::new(p, PlantTerms::default())
+                    .map_err(|e| invalid(format!("parameter box corner {c}: {e}")))
+            })
+            .collect::<Result<_, _>>()?;
+        let law_model = controller.params().cast(f64::from);
+        let nominal = Plant::new(law_model, PlantTerms::default())
+            .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
+        let margin_envelope = controller.envelope().scaled(margin as f32);
+        let margin_allocator = Allocator::new(
+            controller.allocation(),
+            &margin_envelope,
+            &controller.config().priority,
+        )
+        .map_err(|e| {
+            invalid(format!(
+                "the allocator on the {margin} margin envelope: {e}"
+            ))
+        })?;
+        Ok(Checker {
+            scenario,
+            samples,
+            accel_bound: f64::from(path.accel_bound()),
+            corners,
+            nominal,
+            currents: currents(&cfg.current),
+            margin_allocator,
+            margin_envelope,
+        })
+    }
+
+    /// The real time of each sample at 1/k = `inv_k` (at rest: at the scenario's scale).
+    fn times(&self, inv_k: f64) -> Vec<f64> {
+        let k = match inv_k > 0.0 {
+            true => 1.0 / inv_k,
+            false => time_scale(self.scenario.config().time_scale),
+        };
+        self.samples.iter().map(|s| s.s * k).collect()
+    }
+
+    /// The swing left by the start: none from trim, the static heel's from level.
+    fn start(&self) -> Option<f64> {
+        match self.scenario.config().initial_attitude() {
+            InitialAttitude::Level => Some(0.0),
+            InitialAttitude::Trim => None,
+        }
+    }
+
+    /// The static heel of `plant` on sample `smp` (0 without a righting moment).
+    fn static_heel(plant: &Plant, smp: &PathSample) -> f64 {
+        plant::static_heel(plant.params(), smp.eta[PITCH]).unwrap_or(0.0)
+    }
+
+    /// The cases of `scope` at the sample times `times`: the mission as written (its own
+    /// payload profile, a plant per distinct parameter set, the swing its start and payload
+    /// jumps leave), or every corner of the box (constant payload, the start's swing).
+    fn cases<'p>(&'p self, scope: Scope, times: &[f64], owned: &'p [Plant]) -> Vec<CasePlants<'p>> {
+        let start = self.start();
+        match scope {
+            Scope::WholeBox => self
+                .corners
+                .iter()
+                .map(|p| {
+                    let heel = Self::static_heel(p, &self.samples[0]);
+                    CasePlants {
+                        at: vec![0],
+                        plants: vec![p],
+                        amplitude: vec![start.map_or(0.0, |s| (heel - s).abs())],
+                        omega: attitude::roll_frequency(p, self.samples[0].eta[PITCH]),
+                    }
+                })
+                .collect(),
+            Scope::AsWritten => {
+                let cfg = self.scenario.config();
+                let at: Vec<usize> = times
+                    .iter()
+                    .map(|&t| {
+                        let p = cfg.plant_params_at(t);
+                        owned.iter().position(|q| *q.params() == p).unwrap_or(0)
+                    })
+                    .collect();
+                let heel = |t: f64| {
+                    let params = cfg.plant_params_at(t);
+                    plant::static_heel(&params, self.samples[0].eta[PITCH]).unwrap_or(0.0)
+                };
+                let omega = attitude::roll_frequency(&owned[at[0]], self.samples[0].eta[PITCH]);
+                let amplitude = attitude::swing_amplitudes(times, omega, start, &heel);
+                vec![CasePlants {
+                    at,
+                    plants: owned.iter().collect(),
+                    amplitude,
+                    omega,
+                }]
+            }
+        }
+    }
+
+    /// The plants the mission as written meets at the sample times `times`, one per distinct
+    /// parameter set.
+    fn profile_plants(&self, times: &[f64]) -> Result<Vec<Plant>, String> {
+        let cfg = self.scenario.config();
+        let mut out: Vec<Plant> = Vec::new();
+        for &t in times {
+            let p = cfg.plant_params_at(t);
+            if !out.iter().any(|q| *q.params() == p) {
+                out.push(
+                    Plant::new(p, PlantTerms::default())
+                        .map_err(|e| format!("the payload at t = {t:.2} s: {e}"))?,
+                );
+            }
+        }
+        Ok(out)
+    }
+
+    /// Every sample of every case of `scope` at 1/k = `inv_k`; stops at the first violation
+    /// unless `full` (which also collects the peaks), and at a stop request.
+    pub(super) fn sweep(&self, scope: Scope, inv_k: f64, full: bool) -> Result<Sweep, CheckError> {
+        let times = self.times(inv_k);
+        let owned = match scope {
+            Scope::AsWritten => self.profile_plants(&times).map_err(CheckError::Invalid)?,
+            Scope::WholeBox => Vec::new(),
+        };
+        let cases = self.cases(scope, &times, &owned);
+        let mut out = Sweep {
+            first: None,
+            peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
+        };
+        for (j, smp) in self.samples.iter().enumerate() {
+            // One sample is every case (up to 2⁹ corners): tens of microseconds.
+            poll()?;
+            let stiffness = self.pitch_stiffness(smp, inv_k);
+            for case in &cases {
+                for current in &self.currents {
+                    let at = Point {
+                        smp,
+                        t: times[j],
+                        inv_k,
+                        plant: case.plant(j),
+                        swing: case.swing(j),
+                        current,
+                        stiffness,
+                    };
+                    self.check_point(&at, full, &mut out);
+                    if out.first.is_some() && !full {
+                        return Ok(out);
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The law's pitch stiffness on the reference at sample `smp` ([`attitude::pitch_stiffness`]).
+    fn pitch_stiffness(&self, smp: &PathSample, inv_k: f64) -> f64 {
+        let (state, _) = state_at(smp, inv_k, smp.eta[ROLL], 0.0, 0.0);
+        let att = Attitude::from_eta(&state.eta);
+        let jjn = kinematics::jinv_jdot_nu(&att, &state.nu).unwrap_or_else(|_| Vector6::zeros());
+        attitude::pitch_stiffness(
+            self.scenario.controller(),
+            &state.nu,
+            &jjn,
+            att.ctheta,
+            self.accel_bound * inv_k * inv_k,
+        )
+    }
+
+    /// One point: the attitude the vehicle holds there, the force it needs at each extreme of
+    /// its roll swing, each through the margin allocator.
+    fn check_point(&self, at: &Point, full: bool, out: &mut Sweep) {
+        let (smp, inv_k, plant, current) = (at.smp, at.inv_k, at.plant, at.current);
+        let level = Self::static_heel(plant, smp);
+        let (state, nu_dot) = state_at(smp, inv_k, level, 0.0, 0.0);
+        let heel = attitude::heel(plant, &state, &nu_dot, current).unwrap_or(level);
+        // The pitch error that holds the law's model mismatch in pitch, at the heel.
+        let (state, nu_dot) = state_at(smp, inv_k, heel, 0.0, 0.0);
+        let needed = plant.required_force(&state, &nu_dot, current)[PITCH];
+        let modelled = self
+            .nominal
+            .required_force(&state, &nu_dot, &Vector3::zeros())[PITCH];
+        let d_theta = attitude::pitch_offset(needed - modelled, at.stiffness);
+        for (phi, p_dot) in at.swing.extremes(heel) {
+            let (state, nu_dot) = state_at(smp, inv_k, phi, d_theta, p_dot);
+            let tau = plant.required_force(&state, &nu_dot, current).cast::<f32>();
+            self.judge(at.t, &tau, full, out);
+        }
+    }
+
+    /// The body force `tau` at time `t` through the allocator: the peaks (if `full`) and the
+    /// first violation of the margin envelope.
+    fn judge(&self, t: f64, tau: &Vector6<f32>, full: bool, out: &mut Sweep) {
+        let allocation = self.scenario.controller().allocation();
+        if full {
+            let thrusts = allocation.thrusts(tau);
+            for (i, p) in out.peaks.iter_mut().enumerate() {
+                let x = f64::from(thrusts[i]);
+                if x < p.0 {
+                    *p = (x, t, p.2, p.3);
+                }
+                if x > p.2 {
+                    *p = (p.0, p.1, x, t);
+                }
+            }
+        }
+        if out.first.is_none() {
+            let a = self.margin_allocator.allocate(tau);
+            let lost = |r: usize| a.unallocated[r].abs() > GIVEN_UP * (1.0 + tau[r].abs());
+            if (0..6).any(lost) {
+                let priority = &self.scenario.controller().config().priority;
+                out.first = Some(self.violation(t, tau, priority, &lost));
+            }
+        }
+    }
+
+    fn violation(
+        &self,
+        t: f64,
+        tau: &Vector6<f32>,
+        priority: &AxisPriority,
+        lost: &dyn Fn(usize) -> bool,
+    ) -> Violation {
+        let demand = self.scenario.controller().allocation().thrusts(tau);
+        let env = &self.margin_envelope;
+        let excess = |i: usize| {
+            let (lo, hi) = (env.min[i], env.max[i]);
+            (demand[i] - hi).max(lo - demand[i]) / (hi - lo)
+        };
+        let worst = (0..THRUSTERS)
+            .max_by(|&a, &b| excess(a).total_cmp(&excess(b)))
+            .unwrap_or(0);
+        let mut axes: Vec<usize> = (0..6).filter(|&r| lost(r)).collect();
+        axes.sort_by_key(|&r| priority.rank[r]);
+        Violation {
+            t,
+            thruster: THRUSTER_NAMES[worst].to_string(),
+            demand: f64::from(demand[worst]),
+            limit: [f64::from(env.min[worst]), f64::from(env.max[worst])],
+            given_up: axes.iter().map(|&r| AXIS_NAMES[r].to_string()).collect(),
+        }
+    }
+}
+
+/// One point of a sweep: a sample, the case's plant and swing there, a current, and the law's
+/// pitch stiffness there.
+struct Point<'s> {
+    smp: &'s PathSample,
+    t: f64,
+    inv_k: f64,
+    plant: &'s Plant,
+    swing: Swing,
+    current: &'s Vector3<f64>,
+    stiffness: f64,
+}

@@ -1,0 +1,434 @@
+//! Does the preflight's verdict hold? (docs/design.md §9 "The preflight's contract"). A
+//! campaign that checks missions and then flies them: for each mission `check`'s verdict and
+//! proposed time scale (the mission as written), the flight at that scale through the real
+//! chain, and — by flying — the smallest scale that actually stays within the bound.
+//!
+//! Two numbers come out: **false feasible**, missions the preflight called feasible at its
+//! proposed scale that missed the bound when flown (it must be 0: a team flies on that
+//! verdict), and **conservativeness**, the median over the flown missions of the proposed
+//! scale over the smallest scale that flies (≥ 1: how much slower than necessary the verdict
+//! makes a team fly).
+//!
+//! The missions: the Table-1 paths of `scenarios/real/` under each thruster mounting of a
+//! list ([`matrix`]: the AUV-150 layout's reversed-thruster masks), and random missions
+//! ([`random`]: path kind, size, speed, mounting, a payload inside the box with a constant,
+//! abs-sin or staircase profile, a constant current), each deterministic from (seed, index).
+
+use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
+use controller_core::uncertainty::ParamBox;
+use controller_core::{HeadingMode, TrajectoryKind};
+use rand::{RngExt, SeedableRng};
+use rayon::prelude::*;
+use serde::{Deserialize, Serialize};
+
+use super::preflight::{self, CheckError, Verdict};
+use crate::interrupt;
+use crate::plant::{CurrentModel, VariationProfile};
+use crate::scenario::{real_vehicle, Scenario, ScenarioError, SimConfig};
+use crate::sim::{self, bound, LocalController, Recording};
+
+/// The vertical × horizontal mountings a team would build: each vertical pair combination
+/// (down, fore up, aft up, both up) with both horizontal thrusters to starboard or to port,
+/// the main thruster forward. Bits as [`ThrusterGeometry::auv150`].
+pub const TEAM_MOUNTINGS: [u8; 8] = [0, 24, 2, 26, 4, 28, 6, 30];
+
+/// Every mask of the AUV-150 layout (every one is a valid, invertible geometry).
+pub fn all_mountings() -> Vec<u8> {
+    (0..1u8 << THRUSTERS).collect()
+}
+
+/// Largest current speed of a random mission (m/s).
+pub const RANDOM_MAX_CURRENT: f64 = 0.3;
+/// Relative resolution of the smallest flying time scale, found by bisection.
+pub const FLYING_TOLERANCE: f64 = 0.02;
+
+/// Which missions a campaign flies: the real paths under each mounting of `masks`, and
+/// `random` random missions from `seed`.
+#[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub struct Campaign {
+    pub masks: Vec<u8>,
+    pub random: usize,
+    pub seed: u64,
+}
+
+impl Default for Campaign {
+    /// The contract's campaign (docs/design.md §9): every mounting, 200 random missions, seed 1.
+    fn default() -> Self {
+        Campaign {
+            masks: all_mountings(),
+            random: DEFAULT_RANDOM,
+            seed: 1,
+        }
+    }
+}
+
+impl Campaign {
+    /// Its missions: the matrix, then the random ones.
+    pub fn missions(&self) -> Result<Vec<Scenario>, ScenarioError> {
+        let mut out = matrix(&self.masks)?;
+        out.extend(random(self.random, self.seed)?);
+        Ok(out)
+    }
+}
+
+/// Random missions of the contract's campaign.
+pub const DEFAULT_RANDOM: usize = 200;
+
+/// The campaign's two numbers and what they count, for reports and JSON.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ContractSummary {
+    pub campaign: Campaign,
+    pub missions: usize,
+    pub flown: usize,
+    pub refused: usize,
+    pub false_feasible: usize,
+    pub median_ratio: f64,
+    pub partial: bool,
+}
+
+/// One mission of the campaign, and what became of it.
+#[derive(Clone, Debug, Serialize)]
+pub struct MissionResult {
+    pub name: String,
+    /// The reversed-thruster mask.
+    pub mounting: u8,
+    /// The preflight's verdict at time scale 1 (as written).
+    pub verdict: Verdict,
+    /// The time scale the preflight proposes (`None`: it proposes none — refused).
+    pub proposed: Option<f64>,
+    /// The flight at the proposed scale: max path error (m), saturated fraction, and whether
+    /// it stayed within the bound.
+    pub max_path: Option<f64>,
+    pub saturated: Option<f64>,
+    pub within: Option<bool>,
+    /// The smallest time scale (to [`FLYING_TOLERANCE`]) at which a flight stays within the
+    /// bound, when the proposed one does.
+    pub smallest_flying: Option<f64>,
+}
+
+impl MissionResult {
+    /// Called feasible at its proposed scale, and missed there.
+    pub fn false_feasible(&self) -> bool {
+        self.within == Some(false)
+    }
+
+    /// Proposed scale over the smallest that flies (≥ 1).
+    pub fn ratio(&self) -> Option<f64> {
+        Some(self.proposed? / self.smallest_flying?)
+    }
+}
+
+/// The campaign's outcome.
+#[derive(Clone, Debug, Serialize)]
+pub struct Validation {
+    pub missions: Vec<MissionResult>,
+    /// Missions flown (the preflight proposed a scale).
+    pub flown: usize,
+    /// Missions the preflight refused (no feasible scale).
+    pub refused: usize,
+    pub false_feasible: usize,
+    /// Median of [`MissionResult::ratio`] over the flown missions within bound.
+    pub median_ratio: f64,
+    /// Interrupted: the missions not yet done are missing.
+    pub partial: bool,
+}
+
+/// The six real missions of `scenarios/real/` under each mounting of `masks`.
+pub fn matrix(masks: &[u8]) -> Result<Vec<Scenario>, ScenarioError> {
+    let real = real_vehicle::real_scenarios()?;
+    let mut out = Vec::with_capacity(masks.len() * real.len());
+    for &mask in masks {
+        for s in &real {
+            out.push(s.with(|c| {
+                c.name = format!("{}-m{mask:02}", c.name);
+                c.controller.geometry = ThrusterGeometry::auv150(mask);
+                // The file's time scale is its own mounting's; the campaign asks anew.
+                c.duration /= f64::from(c.time_scale);
+                c.time_scale = 1.0;
+            })?);
+        }
+    }
+    Ok(out)
+}
+
+/// `n` random missions from `seed` (see the module docs); mission i depends only on
+/// (seed, i). A draw the core refuses (a tangent heading too slow somewhere) is drawn again.
+pub fn random(n: usize, seed: u64) -> Result<Vec<Scenario>, ScenarioError> {
+    (0..n).map(|i| random_mission(seed, i)).collect()
+}
+
+fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
+    let mut rng =
+        rand::rngs::StdRng::seed_from_u64(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+    let base = real_vehicle::real_scenarios()?.remove(0);
+    loop {
+        let speed = 0.5 + 2.0 * rng.random::<f64>();
+        // The size, and ω from the speed: R ω (circle), A ω (figure-eight), 15 s ω (the
+        // lawn-mower's cross-track legs).
+        let path = match rng.random_range(0..3u32) {
+            0 => {
+                let radius = 8.0 + 32.0 * rng.random::<f64>();
+                let omega = (speed / radius) as f32;
+                TrajectoryKind::Circle {
+                    radius: radius as f32,
+                    omega,
+                    depth: 5.0,
+                }
+            }
+            1 => {
+                let amplitude = 10.0 + 30.0 * rng.random::<f64>();
+                let omega = (speed / amplitude) as f32;
+                TrajectoryKind::FigureEight {
+                    amplitude: amplitude as f32,
+                    omega,
+                    depth: 5.0,
+                }
+            }
+            _ => {
+                let scale = 0.5 + rng.random::<f64>();
+                let omega = (speed / (15.0 * scale)).clamp(0.02, 0.08) as f32;
+                TrajectoryKind::LawnMower {
+                    scale: scale as f32,
+                    omega,
+                    depth: 5.0,
+                }
+            }
+        };
+        let mask = rng.random_range(0..1u8 << THRUSTERS);
+        let payload = ParamBox::table3().lerp(&std::array::from_fn(|_| rng.random::<f64>()));
+        let variation = match rng.random_range(0..3u32) {
+            0 => VariationProfile::Constant(payload),
+            1 => VariationProfile::AbsSin {
+                max: payload,
+                omega: 0.05 + 0.1 * rng.random::<f64>(),
+            },
+            _ => {
+                let t1 = 10.0 + 30.0 * rng.random::<f64>();
+                let t2 = t1 + 10.0 + 30.0 * rng.random::<f64>();
+                VariationProfile::Staircase(vec![
+                    (t1, payload),
+                    (t2, payload.scaled(0.6)),
+                    (f64::INFINITY, payload.scaled(0.3)),
+                ])
+            }
+        };
+        let current_speed = RANDOM_MAX_CURRENT * rng.random::<f64>();
+        let dir = std::f64::consts::TAU * rng.random::<f64>();
+        let made = base.with(|c: &mut SimConfig| {
+            c.name = format!("random-{i:03}");
+            c.trajectory = path;
+            c.heading = HeadingMode::Tangent;
+            c.time_scale = 1.0;
+            c.duration = 70.0;
+            c.controller.geometry = ThrusterGeometry::auv150(mask);
+            c.variation = variation.clone();
+            c.trimmed = true;
+            c.current =
+                CurrentModel::Constant([current_speed * dir.cos(), current_speed * dir.sin(), 0.0]);
+        });
+        match made {
+            Ok(s) => return Ok(s),
+            // Too slow for the tangent heading somewhere: draw again.
+            Err(ScenarioError::Invalid { key, .. }) if key.starts_with("trajectory") => continue,
+            Err(e) => return Err(e),
+        }
+    }
+}
+
+/// `base` at time scale `k`: the same path (its duration scaled).
+fn at_scale(base: &Scenario, k: f64) -> Result<Scenario, ScenarioError> {
+    let cfg = base.config();
+    let span = cfg.duration / f64::from(cfg.time_scale);
+    base.with(|c| {
+        c.time_scale = k as f32;
+        c.duration = span * k;
+    })
+}
+
+/// Flies `scenario` (metrics only); within the bound?
+fn flies(scenario: &Scenario) -> (bool, sim::Metrics) {
+    let run = sim::fly(
+        scenario,
+        &mut LocalController::new(scenario),
+        &mut (),
+        Recording::MetricsOnly,
+    );
+    (bound::within_bound(&run), run.metrics)
+}
+
+/// What a campaign measures besides the false-feasible count.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Measure {
+    /// Only whether each proposed scale flies within the bound.
+    Verdicts,
+    /// Also the smallest scale that flies, by bisection (about six flights more a mission).
+    Conservativeness,
+}
+
+/// Checks and flies one mission (see the module docs); `None` if a stop was requested
+/// ([`crate::interrupt`]) during its check.
+pub fn validate_one(
+    base: &Scenario,
+    margin: f64,
+    measure: Measure,
+) -> Result<Option<MissionResult>, String> {
+    let p = match preflight::check_as_written(base, margin) {
+        Ok(p) => p,
+        Err(CheckError::Interrupted) => return Ok(None),
+        Err(CheckError::Invalid(e)) => return Err(e),
+    };
+    let mounting = base
+        .config()
+        .controller
+        .geometry
+        .auv150_reversed()
+        .unwrap_or(u8::MAX);
+    let proposed = match p.verdict {
+        Verdict::Feasible => Some(p.time_scale),
+        _ => p.smallest_time_scale,
+    };
+    let mut out = MissionResult {
+        name: base.config().name.clone(),
+        mounting,
+        verdict: p.verdict,
+        proposed,
+        max_path: None,
+        saturated: None,
+        within: None,
+        smallest_flying: None,
+    };
+    let Some(k) = proposed else {
+        return Ok(Some(out));
+    };
+    let scenario = |k: f64| at_scale(base, k).map_err(|e| e.to_string());
+    let (within, m) = flies(&scenario(k)?);
+    (out.max_path, out.saturated, out.within) =
+        (Some(m.max_path), Some(m.saturated_fraction), Some(within));
+    if within && measure == Measure::Conservativeness {
+        out.smallest_flying = Some(smallest_flying(k, &mut |k| Ok(flies(&scenario(k)?).0))?);
+    }
+    Ok(Some(out))
+}
+
+/// The smallest scale in [1, `k`] at which `flies_at` holds, given that it holds at `k`, by
+/// bisection to [`FLYING_TOLERANCE`] (assuming it holds from some scale on).
+fn smallest_flying(
+    k: f64,
+    flies_at: &mut dyn FnMut(f64) -> Result<bool, String>,
+) -> Result<f64, String> {
+    if k <= 1.0 || flies_at(1.0)? {
+        return Ok(1.0);
+    }
+    let (mut lo, mut hi) = (1.0, k);
+    while hi / lo > 1.0 + FLYING_TOLERANCE && !interrupt::requested() {
+        let mid = (lo * hi).sqrt();
+        if flies_at(mid)? {
+            hi = mid;
+        } else {
+            lo = mid;
+        }
+    }
+    Ok(hi)
+}
+
+/// The campaign over `missions`, in parallel; `on_done` is called after each mission.
+pub fn validate(
+    missions: &[Scenario],
+    margin: f64,
+    measure: Measure,
+    on_done: impl Fn() + Sync,
+) -> Result<Validation, String> {
+    let results: Result<Vec<Option<MissionResult>>, String> = missions
+        .par_iter()
+        .map(|m| {
+            if interrupt::requested() {
+                return Ok(None);
+            }
+            let r = validate_one(m, margin, measure);
+            on_done();
+            r
+        })
+        .collect();
+    let done: Vec<MissionResult> = results?.into_iter().flatten().collect();
+    let mut ratios: Vec<f64> = done.iter().filter_map(MissionResult::ratio).collect();
+    ratios.sort_by(f64::total_cmp);
+    Ok(Validation {
+        flown: done.iter().filter(|m| m.within.is_some()).count(),
+        refused: done.iter().filter(|m| m.proposed.is_none()).count(),
+        false_feasible: done.iter().filter(|m| m.false_feasible()).count(),
+        median_ratio: ratios.get(ratios.len() / 2).copied().unwrap_or(f64::NAN),
+        partial: done.len() < missions.len(),
+        missions: done,
+    })
+}
+
+impl Validation {
+    /// Its two numbers, for `campaign`.
+    pub fn summary(&self, campaign: &Campaign) -> ContractSummary {
+        ContractSummary {
+            campaign: campaign.clone(),
+            missions: self.missions.len(),
+            flown: self.flown,
+            refused: self.refused,
+            false_feasible: self.false_feasible,
+            median_ratio: self.median_ratio,
+            partial: self.partial,
+        }
+    }
+
+    /// The two numbers in a sentence.
+    pub fn headline(&self) -> String {
+        format!(
+            "preflight contract: {} missions{}, {} flown at the proposed time scale, {} refused; \
+             false feasible {}; conservativeness median {:.2}× (proposed / smallest flying scale)",
+            self.missions.len(),
+            if self.partial { " (PARTIAL)" } else { "" },
+            self.flown,
+            self.refused,
+            self.false_feasible,
+            self.median_ratio
+        )
+    }
+
+    /// The report: the two numbers, then one row per mission.
+    pub fn markdown(&self) -> String {
+        let mut s = format!(
+            "## The preflight's contract (docs/design.md §9)\n\n\
+             {} missions{}: {} flown at the time scale `check` proposes, {} refused (no feasible \
+             scale). **False feasible: {}** (called feasible, missed the bound when flown). \
+             **Conservativeness: median {:.2}×** (the proposed scale over the smallest that \
+             flies within the bound, found by flying).\n\n\
+             | mission | mounting | verdict at k = 1 | proposed k | max path (m) | saturated | \
+             within bound | smallest flying k |\n|---|---|---|---:|---:|---:|---|---:|\n",
+            self.missions.len(),
+            if self.partial {
+                " (PARTIAL: interrupted)"
+            } else {
+                ""
+            },
+            self.flown,
+            self.refused,
+            self.false_feasible,
+            self.median_ratio
+        );
+        let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("—".to_string(), f);
+        for m in &self.missions {
+            s += &format!(
+                "| {} | {:05b} | {} | {} | {} | {} | {} | {} |\n",
+                m.name,
+                m.mounting,
+                m.verdict.as_str(),
+                opt(m.proposed, &|k| format!("{k}")),
+                opt(m.max_path, &|v| format!("{v:.4}")),
+                opt(m.saturated, &|v| format!("{:.1} %", 100.0 * v)),
+                match m.within {
+                    Some(true) => "yes",
+                    Some(false) => "**NO**",
+                    None => "—",
+                },
+                opt(m.smallest_flying, &|k| format!("{k:.2}")),
+            );
+        }
+        s
+    }
+}
