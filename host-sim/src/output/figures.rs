@@ -13,11 +13,11 @@ use super::atomic::Pending;
 use super::plot::{
     figure, min_max, render, usable, Line, Panel, Stroke, C_DESIRED, C_LIMIT, C_WITH, C_WITHOUT,
 };
-use controller_core::effectiveness::THRUSTER_NAMES;
+use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 
 use crate::sim::{RunResult, Sample};
 
-const C_THRUSTERS: [RGBColor; 5] = [
+const C_THRUSTERS: [RGBColor; THRUSTERS] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
     RGBColor(44, 160, 44),

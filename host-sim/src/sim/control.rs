@@ -2,6 +2,7 @@
 //! ([`LocalController`]: software in the loop) or on a board ([`crate::board`]: processor or
 //! hardware in the loop), a period's answer is a [`ControlOut`].
 
+use controller_core::effectiveness::THRUSTERS;
 use controller_core::{Controller, Trajectory};
 
 use super::record::ControlStatus;
@@ -15,7 +16,7 @@ pub struct ControlOut {
     /// Commanded body force (used by ideal actuators).
     pub tau: [f32; 6],
     /// Voltages (used by the real actuator chain).
-    pub voltage: [f32; 5],
+    pub voltage: [f32; THRUSTERS],
     pub saturated: u8,
     pub delta: f32,
     pub delta_clamped: bool,
