@@ -1,0 +1,460 @@
+//! `host-sim campaign`: shards that merge bit for bit whatever the sharding, restart after a
+//! kill, the merge's refusals, the campaign file's errors, worst cases that replay bit for bit,
+//! the engines' environment, and the shipped Kubernetes manifest.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use controller_core::model::ParamVariation;
+use host_sim::cli::resolve_shard;
+use host_sim::studies::campaign::{Campaign, Record};
+
+fn host_sim() -> Command {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+}
+
+fn tempdir(tag: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("host-sim-campaign-{}-{tag}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+/// A 2 s real-chain circle with sensor noise: short, and every drawn value acts.
+const BASE: &str = r#"
+name = "short-base"
+duration = 2.0
+ideal_actuators = false
+[trajectory]
+kind = "circle"
+radius = 10.0
+heading = "tangent"
+[variation]
+profile = "none"
+trimmed = true
+[noise]
+eta_sigma = [0.01, 0.01, 0.01, 0.002, 0.002, 0.002]
+nu_sigma = [0.005, 0.005, 0.005, 0.001, 0.001, 0.001]
+"#;
+
+/// A campaign of `runs` runs that draws everything it can.
+fn campaign_text(runs: u64, seed: u64) -> String {
+    format!(
+        r#"
+name = "t"
+runs = {runs}
+seed = {seed}
+bases = ["base.toml"]
+metrics = ["max_path", "rms_path", "saturated_fraction"]
+[draw]
+parameters = "uniform"
+current = 0.2
+noise_seed = true
+initial_offset = [0.02, 0.02, 0.02, 0.0, 0.0, 0.02]
+time_scale = [1.0, 1.5]
+[bound]
+max_path = 0.2
+saturated = 0.5
+"#
+    )
+}
+
+/// Writes the base and a campaign file into `dir`; returns the campaign's path.
+fn write_campaign(dir: &Path, text: &str) -> PathBuf {
+    std::fs::write(dir.join("base.toml"), BASE).unwrap();
+    let p = dir.join("c.campaign.toml");
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+fn ok(out: Output) -> Output {
+    assert!(
+        out.status.success(),
+        "exit {:?}\nstdout: {}\nstderr: {}",
+        out.status.code(),
+        String::from_utf8_lossy(&out.stdout),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn run_shard(file: &Path, shard: &str, out: &Path) -> Output {
+    host_sim()
+        .args(["campaign", "run"])
+        .arg(file)
+        .args(["--shard", shard, "--out"])
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+fn merge(shards: &[PathBuf], out: &Path) -> Output {
+    host_sim()
+        .args(["campaign", "merge"])
+        .args(shards)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
+
+/// Runs the campaign in `n` shards (one process each) and merges them into `dir/merged-n`.
+fn sharded(dir: &Path, file: &Path, n: u64) -> PathBuf {
+    let shards: Vec<PathBuf> = (0..n)
+        .map(|i| {
+            let out = dir.join(format!("n{n}-shard{i}"));
+            ok(run_shard(file, &format!("{i}/{n}"), &out));
+            out
+        })
+        .collect();
+    let merged = dir.join(format!("merged-{n}"));
+    ok(merge(&shards, &merged));
+    merged
+}
+
+/// Every file of a merged report but the folder's lock (which names the process).
+fn report_files(dir: &Path) -> Vec<(String, Vec<u8>)> {
+    let mut v: Vec<(String, Vec<u8>)> = std::fs::read_dir(dir)
+        .unwrap()
+        .map(|e| e.unwrap())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n != "host-sim.lock")
+        .map(|n| {
+            let bytes = std::fs::read(dir.join(&n)).unwrap();
+            (n, bytes)
+        })
+        .collect();
+    v.sort();
+    v
+}
+
+fn records(path: &Path) -> Vec<Record> {
+    std::fs::read_to_string(path)
+        .unwrap()
+        .lines()
+        .skip(1)
+        .map(|l| Record::parse(l).unwrap_or_else(|| panic!("bad record {l:?}")))
+        .collect()
+}
+
+#[test]
+fn one_three_and_seven_shards_merge_to_the_same_bytes() {
+    let dir = tempdir("shards");
+    let file = write_campaign(&dir, &campaign_text(21, 5));
+    let one = report_files(&sharded(&dir, &file, 1));
+    let names: Vec<&str> = one.iter().map(|f| f.0.as_str()).collect();
+    for expected in [
+        "records.csv",
+        "report.md",
+        "histograms.png",
+        "scatter.png",
+        "worst-max_path.toml",
+        "worst-rms_path.toml",
+        "worst-saturated_fraction.toml",
+    ] {
+        assert!(names.contains(&expected), "{expected} missing: {names:?}");
+    }
+    for n in [3, 7] {
+        let other = report_files(&sharded(&dir, &file, n));
+        assert_eq!(
+            other.iter().map(|f| &f.0).collect::<Vec<_>>(),
+            one.iter().map(|f| &f.0).collect::<Vec<_>>()
+        );
+        for (a, b) in one.iter().zip(&other) {
+            assert!(a.1 == b.1, "{} differs between 1 and {n} shards", a.0);
+        }
+    }
+    // The merged records are every index once, in order.
+    let r = records(&dir.join("merged-1/records.csv"));
+    assert_eq!(
+        r.iter().map(|r| r.index).collect::<Vec<_>>(),
+        (0..21).collect::<Vec<_>>()
+    );
+}
+
+#[test]
+fn a_run_depends_on_seed_and_index_only_not_on_the_run_count() {
+    let dir = tempdir("independent");
+    let small = write_campaign(&dir, &campaign_text(6, 9));
+    ok(run_shard(&small, "0/1", &dir.join("small")));
+    let big_dir = dir.join("big-campaign");
+    std::fs::create_dir_all(&big_dir).unwrap();
+    let big = write_campaign(&big_dir, &campaign_text(13, 9));
+    ok(run_shard(&big, "0/1", &dir.join("big")));
+    let sorted = |p: PathBuf| {
+        let mut r = records(&p);
+        r.sort_by_key(|r| r.index);
+        r
+    };
+    let a = sorted(dir.join("small/records.csv"));
+    let b = sorted(dir.join("big/records.csv"));
+    assert_eq!(a.len(), 6);
+    assert_eq!(a[..], b[..6]);
+    // Another seed draws something else.
+    let other_dir = dir.join("other-seed");
+    std::fs::create_dir_all(&other_dir).unwrap();
+    let other = write_campaign(&other_dir, &campaign_text(6, 10));
+    ok(run_shard(&other, "0/1", &dir.join("other")));
+    let c = sorted(dir.join("other/records.csv"));
+    assert!(a.iter().zip(&c).all(|(x, y)| x.draw != y.draw));
+}
+
+#[test]
+fn drawn_values_lie_in_their_boxes() {
+    let dir = tempdir("boxes");
+    let file = write_campaign(&dir, &campaign_text(50, 3));
+    let c = Campaign::load(&file).unwrap();
+    let max = ParamVariation::TABLE3_MAX.to_array();
+    let corners_file = write_campaign(
+        &dir,
+        &campaign_text(50, 3).replace("\"uniform\"", "\"corners\""),
+    );
+    let corners = Campaign::load(&corners_file).unwrap();
+    for i in 0..50 {
+        let d = c.draw(i);
+        for (x, m) in d.variation.iter().zip(max) {
+            assert!((0.0..=m).contains(x), "run {i}: {x} outside [0, {m}]");
+        }
+        let speed = d.current[0].hypot(d.current[1]);
+        assert!(speed <= 0.2 + 1e-15 && d.current[2] == 0.0);
+        assert!(d.initial_offset[3] == 0.0 && d.initial_offset[4] == 0.0);
+        assert!(d.initial_offset[0].abs() <= 0.02);
+        assert!((1.0..=1.5).contains(&d.time_scale));
+        for (x, m) in corners.draw(i).variation.iter().zip(max) {
+            assert!(
+                *x == 0.0 || *x == m,
+                "run {i}: {x} not a corner of [0, {m}]"
+            );
+        }
+    }
+}
+
+#[test]
+fn a_rerun_skips_recorded_runs_and_redoes_a_torn_last_line() {
+    let dir = tempdir("restart");
+    let file = write_campaign(&dir, &campaign_text(12, 4));
+    let whole = dir.join("whole");
+    ok(run_shard(&file, "0/1", &whole));
+    let full = std::fs::read_to_string(whole.join("records.csv")).unwrap();
+    // A shard killed after five runs, half-way through writing the sixth line.
+    let part = dir.join("part");
+    ok(run_shard(&file, "0/1", &part));
+    let lines: Vec<&str> = full.lines().collect();
+    let torn = format!(
+        "{}\n{}",
+        lines[..6].join("\n"),
+        &lines[6][..lines[6].len() / 2]
+    );
+    std::fs::write(part.join("records.csv"), torn).unwrap();
+    let out = ok(run_shard(&file, "0/1", &part));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(stdout.contains("shard 0/1: 7 runs in"), "{stdout}");
+    assert!(stderr.contains("cut short"), "{stderr}");
+    let mut a = records(&whole.join("records.csv"));
+    let mut b = records(&part.join("records.csv"));
+    a.sort_by_key(|r| r.index);
+    b.sort_by_key(|r| r.index);
+    assert_eq!(a, b);
+    // Complete: a rerun does nothing.
+    let out = ok(run_shard(&file, "0/1", &part));
+    assert!(String::from_utf8_lossy(&out.stdout).contains("shard 0/1: 0 runs in"));
+    // A shard folder of another shard is refused.
+    let out = run_shard(&file, "1/2", &part);
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("holds shard 0/1"));
+}
+
+#[test]
+fn merge_names_missing_and_duplicate_shards_and_foreign_ones() {
+    let dir = tempdir("merge-errors");
+    let file = write_campaign(&dir, &campaign_text(9, 2));
+    let s: Vec<PathBuf> = (0..3)
+        .map(|i| {
+            let out = dir.join(format!("s{i}"));
+            ok(run_shard(&file, &format!("{i}/3"), &out));
+            out
+        })
+        .collect();
+    let out = merge(&[s[0].clone(), s[2].clone(), s[2].clone()], &dir.join("m"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("shard(s) missing: 1/3"), "{err}");
+    assert!(err.contains("shard 2/3 given twice"), "{err}");
+    assert!(
+        err.contains("3 of 9 runs missing (indices 1, 4, 7)"),
+        "{err}"
+    );
+    // A shard of the same name and shape but another seed: another campaign.
+    let other_dir = dir.join("other");
+    std::fs::create_dir_all(&other_dir).unwrap();
+    let other = write_campaign(&other_dir, &campaign_text(9, 3));
+    let foreign = dir.join("foreign1");
+    ok(run_shard(&other, "1/3", &foreign));
+    let out = merge(
+        &[s[0].clone(), foreign.clone(), s[2].clone()],
+        &dir.join("m"),
+    );
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("foreign1 is a shard of another campaign"),
+        "{err}"
+    );
+    // The three shards merge.
+    ok(merge(&s, &dir.join("m")));
+}
+
+#[test]
+fn a_bad_campaign_file_is_refused_naming_the_key() {
+    let dir = tempdir("bad");
+    let cases: [(&str, String, &str); 6] = [
+        (
+            "unknown key",
+            campaign_text(5, 1).replace("current = 0.2", "currnet = 0.2"),
+            "currnet",
+        ),
+        ("no runs", campaign_text(0, 1), "`runs`"),
+        (
+            "current too fast",
+            campaign_text(5, 1).replace("current = 0.2", "current = 7.0"),
+            "`draw.current`",
+        ),
+        (
+            "time scale below 1",
+            campaign_text(5, 1).replace("[1.0, 1.5]", "[0.5, 1.5]"),
+            "`draw.time_scale`",
+        ),
+        (
+            "unknown metric",
+            campaign_text(5, 1).replace("\"rms_path\"", "\"rms\""),
+            "`metrics`",
+        ),
+        (
+            "bound fraction",
+            campaign_text(5, 1).replace("saturated = 0.5", "saturated = 0.5\nfraction = 2"),
+            "`bound.fraction`",
+        ),
+    ];
+    for (what, text, key) in cases {
+        let file = write_campaign(&dir, &text);
+        let out = run_shard(&file, "0/1", &dir.join("out"));
+        assert_eq!(out.status.code(), Some(2), "{what}");
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert!(err.contains(key), "{what}: {err}");
+    }
+    // A base with its own [variation] when the campaign draws Δp.
+    let file = write_campaign(&dir, &campaign_text(5, 1));
+    std::fs::write(
+        dir.join("base.toml"),
+        BASE.replace("profile = \"none\"", "profile = \"abs-sin\""),
+    )
+    .unwrap();
+    let out = run_shard(&file, "0/1", &dir.join("out"));
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("`draw.parameters`"));
+    // A base that is not a scenario: its key named, through the campaign.
+    std::fs::write(dir.join("base.toml"), BASE.replace("radius", "radios")).unwrap();
+    let out = run_shard(&file, "0/1", &dir.join("out"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(err.contains("base.toml") && err.contains("radios"), "{err}");
+}
+
+#[test]
+fn every_worst_case_replays_bit_for_bit_from_its_printed_command() {
+    let dir = tempdir("worst");
+    let file = write_campaign(&dir, &campaign_text(10, 11));
+    let merged = sharded(&dir, &file, 2);
+    let all = records(&merged.join("records.csv"));
+    let report = std::fs::read_to_string(merged.join("report.md")).unwrap();
+    for (m, metric) in [(3, "max_path"), (4, "rms_path"), (9, "saturated_fraction")] {
+        // The worst run, found here from the records: the largest value, the first run with
+        // it (records are in index order).
+        let top = all.iter().map(|r| r.metrics[m]).fold(f64::MIN, f64::max);
+        let worst = all.iter().find(|r| r.metrics[m] == top).unwrap();
+        let f = format!("worst-{metric}.toml");
+        let cmd = format!("`host-sim run --scenario {f} --out runs/t-{}`", worst.index);
+        assert!(report.contains(&cmd), "{cmd} not in the report");
+        let pil = format!(
+            "`host-sim pil --scenario {f} --out runs/t-{}-pil`",
+            worst.index
+        );
+        assert!(report.contains(&pil), "{pil} not in the report");
+        // The command as printed, from the report's folder.
+        let out = ok(host_sim()
+            .current_dir(&merged)
+            .args(["run", "--scenario", &f, "--json", "--out"])
+            .arg(dir.join(format!("replay-{metric}")))
+            .output()
+            .unwrap());
+        let text = String::from_utf8_lossy(&out.stdout);
+        for (k, name) in host_sim::studies::campaign::METRIC_NAMES.iter().enumerate() {
+            let x = json_number(&text, name);
+            assert_eq!(
+                x.to_bits(),
+                worst.metrics[k].to_bits(),
+                "{metric}'s worst run {}: {name} replayed {x}, campaign {}",
+                worst.index,
+                worst.metrics[k]
+            );
+        }
+    }
+}
+
+/// The first number at `"key":` in `json`, read with Rust's correctly rounded parser
+/// (serde_json's default float parsing may be one ulp off).
+fn json_number(json: &str, key: &str) -> f64 {
+    let at = json.find(&format!("\"{key}\":")).unwrap() + key.len() + 3;
+    let end = json[at..].find([',', '}']).unwrap() + at;
+    json[at..end].trim().parse().unwrap()
+}
+
+#[test]
+fn the_shard_comes_from_the_flag_or_the_engines_environment() {
+    let env = |pairs: &'static [(&'static str, &'static str)]| {
+        move |k: &str| pairs.iter().find(|p| p.0 == k).map(|p| p.1.to_string())
+    };
+    assert_eq!(resolve_shard(Some("2/5"), None, env(&[])).unwrap(), (2, 5));
+    assert_eq!(resolve_shard(None, None, env(&[])).unwrap(), (0, 1));
+    // Slurm: an array 1-4 is shards 0..4.
+    let slurm: &'static [(&str, &str)] = &[
+        ("SLURM_ARRAY_TASK_ID", "3"),
+        ("SLURM_ARRAY_TASK_MIN", "1"),
+        ("SLURM_ARRAY_TASK_COUNT", "4"),
+    ];
+    assert_eq!(resolve_shard(None, None, env(slurm)).unwrap(), (2, 4));
+    // The flag wins over the environment.
+    assert_eq!(
+        resolve_shard(Some("0/2"), None, env(slurm)).unwrap(),
+        (0, 2)
+    );
+    // Kubernetes: the index, and the count from the flag or HOST_SIM_SHARDS.
+    let k8s: &'static [(&str, &str)] = &[("JOB_COMPLETION_INDEX", "4")];
+    assert_eq!(resolve_shard(None, Some(6), env(k8s)).unwrap(), (4, 6));
+    let k8s_env: &'static [(&str, &str)] =
+        &[("JOB_COMPLETION_INDEX", "4"), ("HOST_SIM_SHARDS", "5")];
+    assert_eq!(resolve_shard(None, None, env(k8s_env)).unwrap(), (4, 5));
+    assert!(resolve_shard(None, None, env(k8s)).is_err());
+    assert!(resolve_shard(None, Some(4), env(k8s)).is_err());
+    assert!(resolve_shard(Some("3/3"), None, env(&[])).is_err());
+    assert!(resolve_shard(Some("1-3"), None, env(&[])).is_err());
+    // Through the binary: a Slurm array task.
+    let dir = tempdir("env");
+    let file = write_campaign(&dir, &campaign_text(4, 1));
+    ok(host_sim()
+        .args(["campaign", "run"])
+        .arg(&file)
+        .arg("--out")
+        .arg(dir.join("shard-{shard}"))
+        .env("SLURM_ARRAY_TASK_ID", "1")
+        .env("SLURM_ARRAY_TASK_COUNT", "2")
+        .env_remove("SLURM_ARRAY_TASK_MIN")
+        .env_remove("JOB_COMPLETION_INDEX")
+        .output()
+        .unwrap());
+    let r = records(&dir.join("shard-1/records.csv"));
+    let mut idx: Vec<u64> = r.iter().map(|r| r.index).collect();
+    idx.sort();
+    assert_eq!(idx, [1, 3]);
+}
