@@ -186,24 +186,25 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
     );
     let log = RecordLog::open(&dir)?;
     let new = AtomicU64::new(0);
-    let t0 = Instant::now();
+    let (t0, cpu0) = (Instant::now(), cpu_seconds());
     c.run_indices(&todo, |r| {
         log.push(&r);
         new.fetch_add(1, Ordering::Relaxed);
     });
     let wall = t0.elapsed().as_secs_f64();
+    let cpu = cpu_seconds() - cpu0;
     log.finish()?;
     let new = new.into_inner();
     let m = Manifest::of(&c, shard, shards, done.len() as u64 + new);
     out::write_manifest(&dir, &m)?;
-    let threads = rayon::current_num_threads() as f64;
     writeln!(
         stdout,
-        "shard {shard}/{shards}: {new} runs in {} ({:.1} runs/s, {:.1} runs/s per thread); {} of \
-         {} recorded{}\nrecords: {}",
+        "shard {shard}/{shards}: {new} runs in {} ({:.1} runs/s; {:.1} runs per CPU-second, \
+         {:.2} ms of CPU per run); {} of {} recorded{}\nrecords: {}",
         duration_text(wall),
         new as f64 / wall.max(1e-9),
-        new as f64 / wall.max(1e-9) / threads,
+        new as f64 / cpu.max(1e-9),
+        1e3 * cpu / (new.max(1) as f64),
         m.done,
         m.owned,
         if m.complete {
@@ -218,6 +219,18 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
     } else {
         Exit::Interrupted
     })
+}
+
+/// CPU time of this process so far (user + system, every thread), s: the per-run cost on a
+/// machine shared with others, where the wall time is not ours.
+fn cpu_seconds() -> f64 {
+    // SAFETY: getrusage writes the struct it is given, nothing else.
+    let mut u: libc::rusage = unsafe { std::mem::zeroed() };
+    if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut u) } != 0 {
+        return f64::NAN;
+    }
+    let t = |v: libc::timeval| v.tv_sec as f64 + v.tv_usec as f64 * 1e-6;
+    t(u.ru_utime) + t(u.ru_stime)
 }
 
 /// `campaign merge`.
