@@ -52,6 +52,7 @@ current = 0.2
 noise_seed = true
 initial_offset = [0.02, 0.02, 0.02, 0.0, 0.0, 0.02]
 time_scale = [1.0, 1.5]
+mountings = [["vert fore", "horz fore", "horz aft"], ["vert fore", "horz fore"]]
 [bound]
 max_path = 0.2
 saturated = 0.5
@@ -220,6 +221,8 @@ fn drawn_values_lie_in_their_boxes() {
         assert!(d.initial_offset[3] == 0.0 && d.initial_offset[4] == 0.0);
         assert!(d.initial_offset[0].abs() <= 0.02);
         assert!((1.0..=1.5).contains(&d.time_scale));
+        // The two mountings: fore vertical and both horizontals reversed, or without the aft.
+        assert!([0b11010, 0b01010].contains(&d.mounting), "{}", d.mounting);
         for (x, m) in corners.draw(i).variation.iter().zip(max) {
             assert!(
                 *x == 0.0 || *x == m,
@@ -308,7 +311,7 @@ fn merge_names_missing_and_duplicate_shards_and_foreign_ones() {
 #[test]
 fn a_bad_campaign_file_is_refused_naming_the_key() {
     let dir = tempdir("bad");
-    let cases: [(&str, String, &str); 6] = [
+    let cases: [(&str, String, &str); 7] = [
         (
             "unknown key",
             campaign_text(5, 1).replace("current = 0.2", "currnet = 0.2"),
@@ -329,6 +332,14 @@ fn a_bad_campaign_file_is_refused_naming_the_key() {
             "unknown metric",
             campaign_text(5, 1).replace("\"rms_path\"", "\"rms\""),
             "`metrics`",
+        ),
+        (
+            "unknown thruster",
+            campaign_text(5, 1).replace(
+                "\"vert fore\", \"horz fore\"]",
+                "\"vert fore\", \"rudder\"]",
+            ),
+            "`draw.mountings[1][1]`",
         ),
         (
             "bound fraction",

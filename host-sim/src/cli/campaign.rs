@@ -187,9 +187,20 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let log = RecordLog::open(&dir)?;
     let new = AtomicU64::new(0);
     let (t0, cpu0) = (Instant::now(), cpu_seconds());
+    // A progress line every 5 % (a batch job's log has no terminal for a bar).
+    let every = (todo.len() as u64).div_ceil(20).max(1);
     c.run_indices(&todo, |r| {
         log.push(&r);
-        new.fetch_add(1, Ordering::Relaxed);
+        let k = new.fetch_add(1, Ordering::Relaxed) + 1;
+        if k.is_multiple_of(every) && k < todo.len() as u64 {
+            let s = t0.elapsed().as_secs_f64();
+            eprintln!(
+                "host-sim: shard {shard}/{shards}: {k} of {} runs, {} ({:.1} runs/s)",
+                todo.len(),
+                duration_text(s),
+                k as f64 / s.max(1e-9)
+            );
+        }
     });
     let wall = t0.elapsed().as_secs_f64();
     let cpu = cpu_seconds() - cpu0;
@@ -235,12 +246,12 @@ fn cpu_seconds() -> f64 {
 
 /// `campaign merge`.
 fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
-    let shards = a
+    let mut shards = a
         .shards
         .iter()
         .map(|d| out::read_shard(d))
         .collect::<Result<Vec<_>>>()?;
-    let records = merge::check(&shards).map_err(|e| anyhow::anyhow!("cannot merge:\n{e}"))?;
+    let records = merge::check(&mut shards).map_err(|e| anyhow::anyhow!("cannot merge:\n{e}"))?;
     let m = &shards[0].manifest;
     let c = Campaign::from_manifest(m)
         .with_context(|| format!("the campaign kept in {}", shards[0].label))?;

@@ -3,7 +3,7 @@
 //! Markdown, every record, histograms and scatter plots, a scenario file per worst case).
 
 use std::fs::{self, File, OpenOptions};
-use std::io::{Read, Seek, SeekFrom, Write};
+use std::io::{Seek, SeekFrom, Write};
 use std::path::{Path, PathBuf};
 use std::sync::Mutex;
 
@@ -12,7 +12,9 @@ use anyhow::{bail, Context, Result};
 use super::plot::{self, Line, Panel, Stroke, C_WITH};
 use super::{atomic, OutputDir};
 use crate::studies::campaign::merge::{self, Manifest, MetricStats, ShardInput};
-use crate::studies::campaign::record::{self, Record, DRAWN_COLUMNS, TIME_SCALE_COLUMN};
+use crate::studies::campaign::record::{
+    self, Record, DRAWN_COLUMNS, MOUNTING_COLUMN, TIME_SCALE_COLUMN,
+};
 use crate::studies::campaign::{Campaign, Outcome, METRIC_NAMES};
 
 /// A shard's manifest file.
@@ -45,61 +47,67 @@ pub fn read_manifest(dir: &Path) -> Result<Option<Manifest>> {
 /// back to the line before it (the run is redone), else it is left out. A bad line before the
 /// last is an error naming it (the file was edited, or is not a records file).
 pub fn read_records(path: &Path, repair: bool) -> Result<Vec<Record>> {
+    use std::io::BufRead;
     let shown = path.display();
-    let mut text = String::new();
-    match File::open(path) {
-        Ok(mut f) => f
-            .read_to_string(&mut text)
-            .with_context(|| format!("cannot read {shown}"))?,
+    let file = match File::open(path) {
+        Ok(f) => f,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(e).with_context(|| format!("cannot read {shown}")),
     };
+    let total = file.metadata().map(|m| m.len()).unwrap_or(0);
+    // Line by line: a merge of 10⁶ runs holds the records, not their text as well.
+    let mut reader = std::io::BufReader::new(file);
     let header = record::header();
     let mut records = Vec::new();
-    let mut good = 0usize;
-    let mut rest = text.as_str();
-    let mut line_no = 0usize;
-    while !rest.is_empty() {
-        line_no += 1;
-        let (line, complete) = match rest.find('\n') {
-            Some(k) => (&rest[..k], true),
-            None => (rest, false),
-        };
-        let next = &rest[(line.len() + usize::from(complete)).min(rest.len())..];
-        let ok = if line_no == 1 {
-            complete && line == header
-        } else {
-            complete
-                && Record::parse(line).is_some_and(|r| {
-                    records.push(r);
-                    true
-                })
-        };
-        if !ok {
-            if !next.is_empty() || (line_no == 1 && complete) {
-                bail!(
-                    "{shown} line {line_no} is not a campaign record (the file was edited, or \
-                     is not host-sim's); move it away to rerun the shard"
-                );
-            }
-            if repair {
-                eprintln!(
-                    "host-sim: {shown}: the last line was cut short (a killed run): removed, \
-                     its run is done again"
-                );
-                let f = OpenOptions::new()
-                    .write(true)
-                    .open(path)
-                    .with_context(|| format!("cannot repair {shown}"))?;
-                f.set_len(good as u64)
-                    .with_context(|| format!("cannot repair {shown}"))?;
-            }
+    let (mut good, mut line_no, mut line) = (0u64, 0usize, String::new());
+    loop {
+        line.clear();
+        let n = reader
+            .read_line(&mut line)
+            .with_context(|| format!("cannot read {shown}"))?;
+        if n == 0 {
             break;
         }
-        good += line.len() + 1;
-        rest = next;
+        line_no += 1;
+        let complete = line.ends_with('\n');
+        let text = line.trim_end_matches('\n');
+        let parsed = match (line_no, complete) {
+            (_, false) => None,
+            (1, true) => (text == header).then_some(None),
+            (_, true) => Record::parse(text).map(Some),
+        };
+        match parsed {
+            Some(Some(r)) => records.push(r),
+            Some(None) => {}
+            None if good + n as u64 == total && (!complete || line_no > 1) => {
+                // The last line, torn (see the doc).
+                if repair {
+                    cut(path, good)?;
+                }
+                break;
+            }
+            None => bail!(
+                "{shown} line {line_no} is not a campaign record (the file was edited, or is \
+                 not host-sim's); move it away to rerun the shard"
+            ),
+        }
+        good += n as u64;
     }
     Ok(records)
+}
+
+/// Cuts the records file `path` back to its first `len` bytes (a torn last line removed).
+fn cut(path: &Path, len: u64) -> Result<()> {
+    eprintln!(
+        "host-sim: {}: the last line was cut short (a killed run): removed, its run is done \
+         again",
+        path.display()
+    );
+    OpenOptions::new()
+        .write(true)
+        .open(path)
+        .and_then(|f| f.set_len(len))
+        .with_context(|| format!("cannot repair {}", path.display()))
 }
 
 /// The records file of a shard, open for appending: one whole line per `write`, flushed, so a
@@ -190,10 +198,7 @@ pub struct Merged {
 pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result<Merged> {
     let metrics = selected_metrics(c);
     let stats: Vec<MetricStats> = metrics.iter().map(|m| merge::stats(records, *m)).collect();
-    let path = dir.claim(RECORDS)?;
-    let mut text = format!("{}\n", record::header());
-    records.iter().for_each(|r| text.push_str(&r.line()));
-    atomic::write(&path, text.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
+    write_records(&dir.claim(RECORDS)?, records)?;
     for s in &stats {
         let Some(i) = s.worst else { continue };
         let body = c
@@ -209,9 +214,16 @@ pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result
         ("scatter.png", scatter),
     ] {
         let p = dir.claim(name)?;
-        match draw(&p, c, records, &metrics) {
-            Ok(true) => plots.push(name),
-            Ok(false) => {}
+        let mut drawn = false;
+        let written = super::figures::write_plot(&p, |tmp| {
+            drawn = draw(tmp, c, records, &metrics)?;
+            Ok(())
+        });
+        match written {
+            Ok(_) if drawn => plots.push(name),
+            Ok(_) => {
+                let _ = fs::remove_file(&p);
+            }
             Err(e) => incomplete.push(format!("{name}: {e:#}")),
         }
     }
@@ -230,6 +242,28 @@ pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result
         .with_context(|| format!("writing {}", merged.report.display()))?;
     Ok(merged)
 }
+
+/// Writes every record (header first) to `path`, whole or not at all, streamed: a merge of
+/// 10⁶ runs does not hold the 530 MB of text in memory.
+fn write_records(path: &Path, records: &[Record]) -> Result<()> {
+    let ctx = || format!("writing {}", path.display());
+    let (pending, file) = atomic::Pending::create(path).with_context(ctx)?;
+    let mut w = std::io::BufWriter::new(file);
+    writeln!(w, "{}", record::header()).with_context(ctx)?;
+    for r in records {
+        w.write_all(r.line().as_bytes()).with_context(ctx)?;
+    }
+    w.into_inner()
+        .map_err(|e| e.into_error())
+        .and_then(|mut f| f.flush())
+        .with_context(ctx)?;
+    pending.commit().with_context(ctx)?;
+    Ok(())
+}
+
+/// Most runs drawn in a scatter plot: every k-th run by index beyond it (a plot of 10⁶ dots in
+/// 20 panels takes minutes and shows no more than 20 000).
+pub const SCATTER_RUNS: usize = 20_000;
 
 type PlotFn = fn(&Path, &Campaign, &[Record], &[usize]) -> Result<bool>;
 
@@ -400,8 +434,10 @@ fn scatter(path: &Path, c: &Campaign, records: &[Record], metrics: &[usize]) -> 
     let names: Vec<&str> = DRAWN_COLUMNS
         .iter()
         .copied()
-        .chain([TIME_SCALE_COLUMN])
+        .chain([TIME_SCALE_COLUMN, MOUNTING_COLUMN])
         .collect();
+    let step = records.len().div_ceil(SCATTER_RUNS).max(1);
+    let shown: Vec<&Record> = records.iter().step_by(step).collect();
     let panels: Vec<Panel> = (0..names.len())
         .filter(|&k| {
             records
@@ -414,10 +450,7 @@ fn scatter(path: &Path, c: &Campaign, records: &[Record], metrics: &[usize]) -> 
                 label: None,
                 color: C_WITH,
                 stroke: Stroke::Dots,
-                pts: records
-                    .iter()
-                    .map(|r| (r.drawn()[k], r.metrics[m]))
-                    .collect(),
+                pts: shown.iter().map(|r| (r.drawn()[k], r.metrics[m])).collect(),
             });
             p
         })
@@ -425,10 +458,15 @@ fn scatter(path: &Path, c: &Campaign, records: &[Record], metrics: &[usize]) -> 
     if panels.is_empty() {
         return Ok(false);
     }
+    let every = match step {
+        1 => String::new(),
+        k => format!(", every {k}th"),
+    };
     let title = format!(
-        "Campaign {}: {} against each drawn value",
+        "Campaign {}: {} against each drawn value ({} runs{every})",
         c.spec.name(),
-        METRIC_NAMES[m]
+        METRIC_NAMES[m],
+        shown.len()
     );
     plot::panel_grid(path, &title, grid(panels.len()), &panels)?;
     Ok(true)

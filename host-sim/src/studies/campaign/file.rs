@@ -18,6 +18,8 @@
 //! noise_seed = true            # the base's [noise] seed, drawn (the base must have [noise])
 //! initial_offset = [0.05, 0.05, 0.05, 0.0, 0.0, 0.05]  # uniform in ±w, added to the base's
 //! time_scale = [1.0, 1.5]      # the mission's time scale k, uniform in [lo, hi] ⊂ [1, 100]
+//! mountings = [["vert fore", "horz fore", "horz aft"], []]  # thruster mountings, one drawn
+//!                              # per run with equal chance, each a controller.reversed_thrusters
 //!
 //! [bound]                      # replaces each base's bound; default: each base's own
 //! max_path = 0.05              # m, > 0
@@ -32,6 +34,7 @@
 
 use std::path::{Path, PathBuf};
 
+use controller_core::effectiveness::THRUSTER_NAMES;
 use serde::{Deserialize, Serialize};
 
 use super::METRIC_NAMES;
@@ -118,6 +121,8 @@ pub struct DrawSpec {
     pub noise_seed: bool,
     pub initial_offset: Option<[f64; 6]>,
     pub time_scale: Option<[f64; 2]>,
+    /// Thruster mountings to draw from, each the `controller.reversed_thrusters` list of one.
+    pub mountings: Option<Vec<Vec<String>>>,
 }
 
 fn no_parameters() -> ParameterDraw {
@@ -132,6 +137,7 @@ impl Default for DrawSpec {
             noise_seed: false,
             initial_offset: None,
             time_scale: None,
+            mountings: None,
         }
     }
 }
@@ -337,6 +343,9 @@ fn check_draw(d: &DrawSpec) -> Result<(), CampaignError> {
             }
         }
     }
+    if let Some(m) = &d.mountings {
+        mounting_masks(m)?;
+    }
     if let Some([lo, hi]) = d.time_scale {
         if !(lo.is_finite() && hi.is_finite() && 1.0 <= lo && lo <= hi && hi <= 100.0) {
             return Err(invalid(
@@ -346,6 +355,49 @@ fn check_draw(d: &DrawSpec) -> Result<(), CampaignError> {
         }
     }
     Ok(())
+}
+
+/// The reversed-thruster masks (`ThrusterGeometry::auv150`) of `draw.mountings`: each list
+/// names thrusters of [`THRUSTER_NAMES`], each at most once; at least one list.
+pub fn mounting_masks(lists: &[Vec<String>]) -> Result<Vec<u8>, CampaignError> {
+    if lists.is_empty() {
+        return Err(invalid("draw.mountings", "give at least one mounting"));
+    }
+    lists
+        .iter()
+        .enumerate()
+        .map(|(k, names)| {
+            names.iter().enumerate().try_fold(0u8, |mask, (j, name)| {
+                let key = format!("draw.mountings[{k}][{j}]");
+                let t = THRUSTER_NAMES
+                    .iter()
+                    .position(|n| n == name)
+                    .ok_or_else(|| {
+                        invalid(
+                            &key,
+                            format!(
+                                "{name:?} is not a thruster: one of `{}`",
+                                THRUSTER_NAMES.join("`, `")
+                            ),
+                        )
+                    })?;
+                if mask & (1 << t) != 0 {
+                    return Err(invalid(&key, format!("{name:?} is named twice")));
+                }
+                Ok(mask | (1 << t))
+            })
+        })
+        .collect()
+}
+
+/// The names of the thrusters reversed in `mask` (the inverse of [`mounting_masks`]).
+pub fn mounting_names(mask: u8) -> Vec<&'static str> {
+    THRUSTER_NAMES
+        .iter()
+        .enumerate()
+        .filter(|(i, _)| mask & (1 << i) != 0)
+        .map(|(_, n)| *n)
+        .collect()
 }
 
 fn positive(key: &str, v: Option<f64>) -> Result<(), CampaignError> {

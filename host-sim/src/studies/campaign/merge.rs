@@ -3,7 +3,6 @@
 //! indices), then the statistics of the whole.
 
 use std::collections::BTreeMap;
-use std::fmt::Write as _;
 
 use serde::{Deserialize, Serialize};
 
@@ -65,14 +64,14 @@ pub struct ShardInput {
     pub records: Vec<Record>,
 }
 
-/// Checks the shards (see the module doc) and returns every record sorted by index; an error
-/// lists every problem found, each naming the shard folders concerned.
-pub fn check(shards: &[ShardInput]) -> Result<Vec<Record>, String> {
+/// Checks the shards (see the module doc) and returns every record sorted by index (taken out
+/// of `shards`); an error lists every problem found, each naming the shard folders concerned.
+pub fn check(shards: &mut [ShardInput]) -> Result<Vec<Record>, String> {
     let Some(first) = shards.first() else {
         return Err("no shard folder given".into());
     };
     let mut problems = Vec::new();
-    for s in shards {
+    for s in shards.iter() {
         if s.manifest.campaign_hash != first.manifest.campaign_hash {
             problems.push(format!(
                 "{} is a shard of another campaign (hash {}…, {} has {}…; a different campaign \
@@ -87,28 +86,47 @@ pub fn check(shards: &[ShardInput]) -> Result<Vec<Record>, String> {
     if !problems.is_empty() {
         return Err(problems.join("\n"));
     }
-    shard_problems(shards, &mut problems);
     let runs = first.manifest.runs;
-    let mut by_index: BTreeMap<u64, Vec<(usize, &Record)>> = BTreeMap::new();
-    for (k, s) in shards.iter().enumerate() {
-        for r in &s.records {
-            by_index.entry(r.index).or_default().push((k, r));
+    shard_problems(shards, &mut problems);
+    // Every record with its shard, sorted by index: duplicates are neighbours, gaps are missing
+    // runs. The records are moved, not copied (a merge of 10⁶ runs holds them once).
+    let mut order: Vec<(u64, usize, Record)> = shards
+        .iter_mut()
+        .enumerate()
+        .flat_map(|(k, s)| {
+            std::mem::take(&mut s.records)
+                .into_iter()
+                .map(move |r| (r.index, k, r))
+        })
+        .collect();
+    order.sort_unstable_by_key(|o| (o.0, o.1));
+    let mut dup: Vec<String> = Vec::new();
+    let mut dup_count = 0usize;
+    let labels: Vec<&str> = shards.iter().map(|s| s.label.as_str()).collect();
+    for w in order.windows(2).filter(|w| w[0].0 == w[1].0) {
+        dup_count += 1;
+        if dup.len() < 5 {
+            let (a, b) = (labels[w[0].1], labels[w[1].1]);
+            dup.push(format!(" run {} in {a} and {b};", w[0].0));
         }
     }
-    let dup: Vec<_> = by_index.iter().filter(|(_, v)| v.len() > 1).collect();
-    if !dup.is_empty() {
-        let mut m = format!("{} run(s) recorded more than once:", dup.len());
-        for (i, v) in dup.iter().take(5) {
-            let dirs: Vec<&str> = v.iter().map(|(k, _)| shards[*k].label.as_str()).collect();
-            let _ = write!(m, " run {i} in {};", dirs.join(" and "));
-        }
-        problems.push(m);
+    if dup_count > 0 {
+        problems.push(format!(
+            "{dup_count} run(s) recorded more than once:{}",
+            dup.concat()
+        ));
     }
-    let outside: Vec<u64> = by_index.keys().copied().filter(|i| *i >= runs).collect();
+    let outside: Vec<u64> = order.iter().map(|o| o.0).filter(|i| *i >= runs).collect();
     if !outside.is_empty() {
         problems.push(format!("runs {outside:?} are beyond the campaign's {runs}"));
     }
-    let missing: Vec<u64> = (0..runs).filter(|i| !by_index.contains_key(i)).collect();
+    let mut present = order.iter().map(|o| o.0).peekable();
+    let missing: Vec<u64> = (0..runs)
+        .filter(|i| {
+            while present.next_if(|p| p < i).is_some() {}
+            present.peek() != Some(i)
+        })
+        .collect();
     if !missing.is_empty() {
         problems.push(format!(
             "{} of {runs} runs missing (indices {}{})",
@@ -125,7 +143,7 @@ pub fn check(shards: &[ShardInput]) -> Result<Vec<Record>, String> {
     if !problems.is_empty() {
         return Err(problems.join("\n"));
     }
-    Ok(by_index.into_values().map(|v| v[0].1.clone()).collect())
+    Ok(order.into_iter().map(|o| o.2).collect())
 }
 
 /// Missing, duplicate and incomplete shards, by their manifests.

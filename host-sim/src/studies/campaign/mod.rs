@@ -11,6 +11,7 @@
 //! scheduling enters, so the records of any sharding, sorted by index, are the same bytes as
 //! the one-machine run's, and so is the report made from them.
 
+use controller_core::effectiveness::ThrusterGeometry;
 use controller_core::model::{ParamVariation, VARIED_PARAMETERS};
 use controller_core::uncertainty::ParamBox;
 use rand::rngs::ChaCha8Rng;
@@ -58,7 +59,8 @@ pub fn metric_values(m: &Metrics) -> [f64; 10] {
     ]
 }
 
-/// What run i drew. Everything is drawn for every run, in a fixed order, whether the campaign
+/// What run i drew. Everything is drawn for every run, in a fixed order (new keys draw after
+/// the old ones), whether the campaign
 /// uses it or not, so that what one key draws never shifts another's numbers.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Draw {
@@ -72,7 +74,14 @@ pub struct Draw {
     pub initial_offset: [f64; 6],
     /// The mission's time scale (the base's when not drawn).
     pub time_scale: f32,
+    /// The reversed-thruster mask of the mounting ([`ThrusterGeometry::auv150`]); the base's
+    /// when not drawn ([`NOT_AUV150_LAYOUT`] if its geometry is not the AUV-150 layout).
+    pub mounting: u8,
 }
+
+/// [`Draw::mounting`] of a base whose geometry is not the AUV-150 layout with some thrusters
+/// reversed.
+pub const NOT_AUV150_LAYOUT: u8 = u8::MAX;
 
 /// A campaign, loaded and checked: its spec, its bases, and its hash.
 #[derive(Clone, Debug)]
@@ -83,6 +92,8 @@ pub struct Campaign {
     pub text: String,
     /// sha256 (hex) of the canonical campaign, the bases' texts and the program version.
     pub hash: String,
+    /// The masks of `draw.mountings`, checked.
+    masks: Option<Vec<u8>>,
 }
 
 /// The program version in the campaign's hash (a shard of another build does not merge).
@@ -92,11 +103,18 @@ impl Campaign {
     /// A campaign from its file's text, its spec and its bases.
     pub fn new(text: String, spec: CampaignSpec, bases: Vec<Base>) -> Self {
         let hash = hash(&spec, &bases);
+        // Checked when the file was parsed.
+        let masks = spec
+            .draw
+            .mountings
+            .as_deref()
+            .and_then(|m| file::mounting_masks(m).ok());
         Campaign {
             spec,
             bases,
             text,
             hash,
+            masks,
         }
     }
 
@@ -134,6 +152,7 @@ impl Campaign {
         let noise_seed = rng.random::<u64>() >> 1;
         let offset: [f64; 6] = std::array::from_fn(|_| rng.random::<f64>());
         let k = rng.random::<f64>();
+        let m = rng.random::<u64>();
         let variation = match d.parameters {
             ParameterDraw::None => [0.0; VARIED_PARAMETERS],
             ParameterDraw::Uniform => ParamBox::table3().lerp(&f).to_array(),
@@ -167,6 +186,14 @@ impl Campaign {
                 Some([lo, hi]) => (lo + (hi - lo) * k).clamp(lo, hi) as f32,
                 None => base.time_scale,
             },
+            mounting: match &self.masks {
+                Some(masks) => masks[(m % masks.len() as u64) as usize],
+                None => base
+                    .controller
+                    .geometry
+                    .auv150_reversed()
+                    .unwrap_or(NOT_AUV150_LAYOUT),
+            },
         }
     }
 
@@ -191,6 +218,9 @@ impl Campaign {
             }
             c.initial_offset = d.initial_offset;
             c.time_scale = d.time_scale;
+            if spec.draw.mountings.is_some() {
+                c.controller.geometry = ThrusterGeometry::auv150(d.mounting);
+            }
             if let Some(b) = spec.bound() {
                 c.bound_setting = Some(b);
             }
@@ -285,6 +315,16 @@ impl Campaign {
             n.insert("seed".into(), Value::Integer(seed));
         }
         t.insert("initial_offset".into(), floats(&d.initial_offset));
+        if self.spec.draw.mountings.is_some() {
+            let names = file::mounting_names(d.mounting);
+            let list = Value::Array(names.iter().map(|n| Value::String(n.to_string())).collect());
+            let controller = t
+                .entry("controller")
+                .or_insert_with(|| Value::Table(Table::new()));
+            if let Value::Table(c) = controller {
+                c.insert("reversed_thrusters".into(), list);
+            }
+        }
         if let Some(Value::Table(tr)) = t.get_mut("trajectory") {
             tr.insert("time_scale".into(), Value::Float(f64::from(d.time_scale)));
         }

@@ -78,12 +78,15 @@ pub const DRAWN_COLUMNS: [&str; 18] = [
 
 /// The time-scale column (after [`DRAWN_COLUMNS`]).
 pub const TIME_SCALE_COLUMN: &str = "time_scale";
+/// The mounting column (after the time scale): the reversed-thruster mask, 0–31
+/// ([`super::NOT_AUV150_LAYOUT`]: another geometry).
+pub const MOUNTING_COLUMN: &str = "mounting";
 
 /// The CSV header line (no newline).
 pub fn header() -> String {
     let mut cols = vec!["index", "base"];
     cols.extend(DRAWN_COLUMNS);
-    cols.push(TIME_SCALE_COLUMN);
+    cols.extend([TIME_SCALE_COLUMN, MOUNTING_COLUMN]);
     cols.extend(METRIC_NAMES);
     cols.extend(["faulted", "outcome"]);
     cols.join(",")
@@ -124,16 +127,18 @@ impl Record {
         }
     }
 
-    /// The drawn values as numbers, in the order of [`DRAWN_COLUMNS`] then the time scale.
-    pub fn drawn(&self) -> [f64; 19] {
+    /// The drawn values as numbers, in the order of [`DRAWN_COLUMNS`], then the time scale
+    /// and the mounting.
+    pub fn drawn(&self) -> [f64; 20] {
         let d = &self.draw;
-        let mut v = [0.0; 19];
+        let mut v = [0.0; 20];
         v[..9].copy_from_slice(&d.variation);
         v[9] = d.current[0];
         v[10] = d.current[1];
         v[11] = d.noise_seed as f64;
         v[12..18].copy_from_slice(&d.initial_offset);
         v[18] = f64::from(d.time_scale);
+        v[19] = f64::from(d.mounting);
         v
     }
 
@@ -148,7 +153,7 @@ impl Record {
         for x in d.initial_offset {
             let _ = write!(s, ",{x}");
         }
-        let _ = write!(s, ",{}", d.time_scale);
+        let _ = write!(s, ",{},{}", d.time_scale, d.mounting);
         for x in self.metrics {
             let _ = write!(s, ",{x}");
         }
@@ -160,7 +165,7 @@ impl Record {
     /// (a torn line, another format).
     pub fn parse(line: &str) -> Option<Self> {
         let f: Vec<&str> = line.split(',').collect();
-        if f.len() != 2 + DRAWN_COLUMNS.len() + 1 + METRIC_NAMES.len() + 2 {
+        if f.len() != 2 + DRAWN_COLUMNS.len() + 2 + METRIC_NAMES.len() + 2 {
             return None;
         }
         let num = |k: usize| f[k].parse::<f64>().ok();
@@ -169,9 +174,10 @@ impl Record {
         let noise_seed = f[13].parse().ok()?;
         let initial_offset: [f64; 6] = array(|j| num(14 + j))?;
         let time_scale = f[20].parse::<f32>().ok()?;
-        let metrics: [f64; 10] = array(|j| num(21 + j))?;
-        let faulted = f[31].parse().ok()?;
-        let outcome = *Outcome::ALL.iter().find(|o| o.as_str() == f[32])?;
+        let mounting = f[21].parse().ok()?;
+        let metrics: [f64; 10] = array(|j| num(22 + j))?;
+        let faulted = f[32].parse().ok()?;
+        let outcome = *Outcome::ALL.iter().find(|o| o.as_str() == f[33])?;
         Some(Record {
             index: f[0].parse().ok()?,
             base: f[1].parse().ok()?,
@@ -181,6 +187,7 @@ impl Record {
                 noise_seed,
                 initial_offset,
                 time_scale,
+                mounting,
             },
             metrics,
             faulted,
