@@ -100,7 +100,7 @@ echo "slurm-ci: $shards shards and the merge ran on Slurm in $((SECONDS - t0)) s
 
 # The same campaign on one machine, without Slurm; the reports must be the same bytes (but the
 # folder's lock file, which names its process).
-"$host_sim" campaign run "$campaign" --shard 0/1 --out "$work/one/shard-0" >/dev/null
+"$host_sim" campaign run "$campaign" --shard 0/1 --out "$work/one/shard-0" >"$work/one.log" 2>&1
 "$host_sim" campaign merge "$work/one/shard-0" --out "$work/one/report" >/dev/null
 diff -r -x host-sim.lock "$work/one/report" "$work/cluster/report" \
   || fail "the report merged from Slurm's shards differs from the one-machine run's"
