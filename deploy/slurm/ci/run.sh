@@ -12,11 +12,15 @@
 set -euo pipefail
 root=$(cd "$(dirname "$0")/../../.." && pwd)
 cd "$root"
-host_sim=$(realpath "${1:-target/host/host-sim}")
+host_sim=$(realpath -m "${1:-target/host/host-sim}")
 campaign="$root/host-sim/campaigns/ci-small.campaign.toml"
 shards=4
 
 fail() { echo "slurm-ci: FAILED: $*" >&2; exit 1; }
+if [ ! -x "$host_sim" ] && [ "$host_sim" = "$root/target/host/host-sim" ]; then
+  echo "slurm-ci: building host-sim (cargo build --profile host -p host-sim)"
+  cargo build --profile host -p host-sim
+fi
 if [ "$(id -u)" -ne 0 ]; then
   # slurmd runs each job as its user: it needs root.
   command -v sudo >/dev/null || fail "needs root (slurmd runs jobs as their user), and there is no sudo"
@@ -75,7 +79,7 @@ wait_for munged 15 "$dir/munge/munged.log" munge --socket="$dir/munge/munge.sock
 slurmctld -D -i -f "$SLURM_CONF" >"$dir/slurmctld.stdout" 2>&1 &
 pids+=($!)
 wait_for slurmctld 30 "$dir/slurmctld.log" scontrol ping
-slurmd -D -f "$SLURM_CONF" >"$dir/slurmd.stdout" 2>&1 &
+slurmd -D -N localhost -f "$SLURM_CONF" >"$dir/slurmd.stdout" 2>&1 &
 pids+=($!)
 idle() { sinfo -h -n localhost -o %t | grep -qx idle; }
 wait_for slurmd 30 "$dir/slurmd.log" idle
