@@ -702,3 +702,53 @@ impl CloneEnv for Vec<k8s::EnvVar> {
             .collect()
     }
 }
+
+#[test]
+fn a_shard_killed_mid_run_resumes_to_the_same_records() {
+    let dir = tempdir("kill");
+    // Short runs, many: the kill lands while records are being appended.
+    let text = campaign_text(3000, 8).replace("mountings", "# mountings");
+    let file = write_campaign(&dir, &text);
+    std::fs::write(
+        dir.join("base.toml"),
+        BASE.replace("duration = 2.0", "duration = 0.3"),
+    )
+    .unwrap();
+    let whole = dir.join("whole");
+    ok(run_shard(&file, "0/1", &whole));
+    let part = dir.join("part");
+    let mut child = host_sim()
+        .args(["campaign", "run"])
+        .arg(&file)
+        .args(["--shard", "0/1", "--out"])
+        .arg(&part)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::null())
+        .spawn()
+        .unwrap();
+    // Wait for some records (or the end), then SIGKILL: no code of the shard runs after it.
+    let records_file = part.join("records.csv");
+    loop {
+        let lines = std::fs::read(&records_file)
+            .map(|b| b.iter().filter(|c| **c == b'\n').count())
+            .unwrap_or(0);
+        if lines > 100 || child.try_wait().unwrap().is_some() {
+            break;
+        }
+        std::thread::sleep(std::time::Duration::from_millis(1));
+    }
+    let _ = child.kill();
+    let _ = child.wait();
+    let before = std::fs::read_to_string(&records_file)
+        .unwrap()
+        .lines()
+        .count();
+    eprintln!("killed with {before} lines of 3001 written");
+    ok(run_shard(&file, "0/1", &part));
+    let mut a = records(&whole.join("records.csv"));
+    let mut b = records(&records_file);
+    a.sort_by_key(|r| r.index);
+    b.sort_by_key(|r| r.index);
+    assert_eq!(a.len(), 3000);
+    assert!(a == b, "resumed after {before} lines: the records differ");
+}
