@@ -304,8 +304,57 @@ fn merge_names_missing_and_duplicate_shards_and_foreign_ones() {
         err.contains("foreign1 is a shard of another campaign"),
         "{err}"
     );
+    // A shard cut short (its last two runs lost, its manifest saying so) is named incomplete,
+    // and its runs missing.
+    let cut = dir.join("cut1");
+    ok(run_shard(&file, "1/3", &cut));
+    let text = std::fs::read_to_string(cut.join("records.csv")).unwrap();
+    let kept: Vec<&str> = text.lines().take(2).collect();
+    std::fs::write(cut.join("records.csv"), kept.join("\n") + "\n").unwrap();
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(cut.join("shard.json")).unwrap()).unwrap();
+    m["done"] = 1.into();
+    m["complete"] = false.into();
+    std::fs::write(cut.join("shard.json"), m.to_string()).unwrap();
+    let out = merge(&[s[0].clone(), cut, s[2].clone()], &dir.join("m"));
+    assert_eq!(out.status.code(), Some(2));
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        err.contains("shard 1/3") && err.contains("is incomplete: 1 of its 3"),
+        "{err}"
+    );
+    assert!(err.contains("2 of 9 runs missing"), "{err}");
     // The three shards merge.
     ok(merge(&s, &dir.join("m")));
+}
+
+#[test]
+fn plan_prints_the_runs_the_cost_and_a_layout_for_the_workers() {
+    let dir = tempdir("plan");
+    let file = write_campaign(&dir, &campaign_text(10, 1));
+    for workers in [1u64, 3, 4] {
+        let out = ok(host_sim()
+            .args(["campaign", "plan"])
+            .arg(&file)
+            .args(["--workers", &workers.to_string()])
+            .output()
+            .unwrap());
+        let text = String::from_utf8_lossy(&out.stdout);
+        assert!(text.contains("runs: 10\n"), "{text}");
+        assert!(text.contains("runs/s per core"), "{text}");
+        let shards: u64 = text
+            .split("suggested shards: ")
+            .nth(1)
+            .and_then(|t| t.split_whitespace().next())
+            .and_then(|n| n.parse().ok())
+            .unwrap_or_else(|| panic!("no layout in {text}"));
+        // Tiny runs: one shard a worker, never more shards than runs.
+        assert_eq!(shards, workers.min(10), "{text}");
+        assert!(
+            text.contains(&format!("--array=0-{}%{workers}", shards - 1)),
+            "{text}"
+        );
+    }
 }
 
 #[test]
