@@ -377,7 +377,9 @@ fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
     };
     let file = report.join(host_sim::output::campaign::worst_file("max_path"));
     let file = file.to_string_lossy().into_owned();
-    let Some((ok, c)) = pil.run(ci, "campaign-worst", &["--scenario", &file]) else {
+    // A worst case may well miss its bound (host-sim then exits 4): what is checked is that
+    // the board flies the campaign's run, to the bit.
+    let Some((_, c)) = pil.run(ci, "campaign-worst", &["--scenario", &file]) else {
         return;
     };
     let recorded = worst.metrics[metric];
@@ -385,11 +387,12 @@ fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
         "campaign worst case (run {}): PIL max path {} m, SIL {} m, the campaign's record {recorded} m",
         worst.index, c.run.metrics.max_path, c.sil_max_path
     );
-    bit_for_bit(ci, "campaign worst case", ok, &c);
-    if c.run.metrics.max_path.to_bits() != recorded.to_bits() {
+    if c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits()
+        || c.run.metrics.max_path.to_bits() != recorded.to_bits()
+    {
         ci.fail(format!(
-            "PIL campaign worst case: the board flew run {} to a max path of {} m, the campaign recorded {recorded} m: the worst case's scenario file does not replay the run",
-            worst.index, c.run.metrics.max_path
+            "PIL campaign worst case: the board flew run {} to a max path of {} m, SIL {} m, the campaign recorded {recorded} m: all three must be the same bits (the worst case's scenario file replays the run)",
+            worst.index, c.run.metrics.max_path, c.sil_max_path
         ));
     }
 }
