@@ -244,7 +244,7 @@ pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result
 }
 
 /// Writes every record (header first) to `path`, whole or not at all, streamed: a merge of
-/// 10⁶ runs does not hold the 530 MB of text in memory.
+/// 10⁶ runs does not hold the 490 MB of text in memory.
 fn write_records(path: &Path, records: &[Record]) -> Result<()> {
     let ctx = || format!("writing {}", path.display());
     let (pending, file) = atomic::Pending::create(path).with_context(ctx)?;
