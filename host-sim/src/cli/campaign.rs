@@ -149,29 +149,7 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
         bail!("{shards} shards for {} runs: some would be empty", c.runs());
     }
     let out = PathBuf::from(a.out.replace("{shard}", &shard.to_string()));
-    let dir = OutputDir::resume(&out)?;
-    if let Some(m) = out::read_manifest(&out)? {
-        if (m.campaign_hash.as_str(), m.shard, m.shards) != (c.hash.as_str(), shard, shards) {
-            bail!(
-                "{} holds shard {}/{} of campaign {} (hash {}…), not shard {shard}/{shards} of \
-                 this one; give another --out",
-                out.display(),
-                m.shard,
-                m.shards,
-                m.name,
-                &m.campaign_hash[..12]
-            );
-        }
-    }
-    let done = out::read_records(&out.join(out::RECORDS), true)?;
-    if let Some(r) = done.iter().find(|r| r.index % shards != shard) {
-        bail!(
-            "{} records run {}, which is not shard {shard}/{shards}'s",
-            out.display(),
-            r.index
-        );
-    }
-    let done: HashSet<u64> = done.iter().map(|r| r.index).collect();
+    let (dir, done) = resume_shard(&c, shard, shards, &out)?;
     let todo: Vec<u64> = shard_indices(c.runs(), shard, shards)
         .filter(|i| !done.contains(i))
         .collect();
@@ -185,27 +163,11 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
         rayon::current_num_threads()
     );
     let log = RecordLog::open(&dir)?;
-    let new = AtomicU64::new(0);
     let (t0, cpu0) = (Instant::now(), cpu_seconds());
-    // A progress line every 5 % (a batch job's log has no terminal for a bar).
-    let every = (todo.len() as u64).div_ceil(20).max(1);
-    c.run_indices(&todo, |r| {
-        log.push(&r);
-        let k = new.fetch_add(1, Ordering::Relaxed) + 1;
-        if k.is_multiple_of(every) && k < todo.len() as u64 {
-            let s = t0.elapsed().as_secs_f64();
-            eprintln!(
-                "host-sim: shard {shard}/{shards}: {k} of {} runs, {} ({:.1} runs/s)",
-                todo.len(),
-                duration_text(s),
-                k as f64 / s.max(1e-9)
-            );
-        }
-    });
+    let new = fly_logged(&c, &todo, &log, &format!("{shard}/{shards}"));
     let wall = t0.elapsed().as_secs_f64();
     let cpu = cpu_seconds() - cpu0;
     log.finish()?;
-    let new = new.into_inner();
     let m = Manifest::of(&c, shard, shards, done.len() as u64 + new);
     out::write_manifest(&dir, &m)?;
     writeln!(
@@ -230,6 +192,62 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
     } else {
         Exit::Interrupted
     })
+}
+
+/// The shard folder `out`, locked and kept (Choice 135): it must hold nothing or this shard of
+/// this campaign; its records read (a torn last line cut, Choice 136) and checked to be this
+/// shard's. Returns the folder and the indices recorded.
+fn resume_shard(
+    c: &Campaign,
+    shard: u64,
+    shards: u64,
+    out: &Path,
+) -> Result<(OutputDir, HashSet<u64>)> {
+    let dir = OutputDir::resume(out)?;
+    if let Some(m) = out::read_manifest(out)? {
+        if (m.campaign_hash.as_str(), m.shard, m.shards) != (c.hash.as_str(), shard, shards) {
+            bail!(
+                "{} holds shard {}/{} of campaign {} (hash {}…), not shard {shard}/{shards} of \
+                 this one; give another --out",
+                out.display(),
+                m.shard,
+                m.shards,
+                m.name,
+                &m.campaign_hash[..12.min(m.campaign_hash.len())]
+            );
+        }
+    }
+    let done = out::read_records(&out.join(out::RECORDS), true)?;
+    if let Some(r) = done.iter().find(|r| r.index % shards != shard) {
+        bail!(
+            "{} records run {}, which is not shard {shard}/{shards}'s",
+            out.display(),
+            r.index
+        );
+    }
+    Ok((dir, done.iter().map(|r| r.index).collect()))
+}
+
+/// Flies `todo` in parallel into `log`, with a progress line on stderr every 5 % (a batch
+/// job's log has no terminal for a bar); returns how many runs were recorded.
+fn fly_logged(c: &Campaign, todo: &[u64], log: &RecordLog, shard: &str) -> u64 {
+    let new = AtomicU64::new(0);
+    let t0 = Instant::now();
+    let every = (todo.len() as u64).div_ceil(20).max(1);
+    c.run_indices(todo, |r| {
+        log.push(&r);
+        let k = new.fetch_add(1, Ordering::Relaxed) + 1;
+        if k.is_multiple_of(every) && k < todo.len() as u64 {
+            let s = t0.elapsed().as_secs_f64();
+            eprintln!(
+                "host-sim: shard {shard}: {k} of {} runs, {} ({:.1} runs/s)",
+                todo.len(),
+                duration_text(s),
+                k as f64 / s.max(1e-9)
+            );
+        }
+    });
+    new.into_inner()
 }
 
 /// CPU time of this process so far (user + system, every thread), s: the per-run cost on a

@@ -305,16 +305,14 @@ fn link_faults(ci: &mut Ci, pil: &Pil) {
 /// The CI's small campaign (docs/design.md §26), run and merged here.
 const CAMPAIGN: &str = "host-sim/campaigns/ci-small.campaign.toml";
 
-/// 5. A worst case found in SIL, replayed on the board: the small campaign is run (one shard)
-///    and merged, and the merge's `worst-max_path.toml` is flown through `pil` as its report
-///    prints it. The board's max path error must equal the campaign's record of that run bit
-///    for bit (and SIL's).
-fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
+/// Runs the CI's small campaign in one shard and merges it, in the scratch folder; the merged
+/// report's folder, or `None` (and a CI failure).
+fn run_campaign(ci: &mut Ci, host_sim: &Path) -> Option<PathBuf> {
     let dir = ci.scratch().join("campaign");
     let _ = std::fs::remove_dir_all(&dir);
     let (shard, report) = (dir.join("shard"), dir.join("report"));
     let run = |args: &[&std::ffi::OsStr]| {
-        Command::new(pil.host_sim)
+        Command::new(host_sim)
             .current_dir(&ci.root)
             .args(args)
             .output()
@@ -343,12 +341,25 @@ fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
             report.as_os_str(),
         ])
     });
-    if let Err(e) = made {
-        ci.fail(format!(
-            "PIL campaign worst case: the campaign {CAMPAIGN}: {e}"
-        ));
-        return;
+    match made {
+        Ok(()) => Some(report),
+        Err(e) => {
+            ci.fail(format!(
+                "PIL campaign worst case: the campaign {CAMPAIGN}: {e}"
+            ));
+            None
+        }
     }
+}
+
+/// 5. A worst case found in SIL, replayed on the board: the small campaign is run (one shard)
+///    and merged, and the merge's `worst-max_path.toml` is flown through `pil` as its report
+///    prints it. The board's max path error must equal the campaign's record of that run bit
+///    for bit (and SIL's).
+fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
+    let Some(report) = run_campaign(ci, pil.host_sim) else {
+        return;
+    };
     let records = match host_sim::output::campaign::read_records(
         &report.join(host_sim::output::campaign::RECORDS),
         false,
