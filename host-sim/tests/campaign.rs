@@ -752,40 +752,86 @@ impl CloneEnv for Vec<k8s::EnvVar> {
     }
 }
 
-#[test]
-fn a_shard_killed_mid_run_resumes_to_the_same_records() {
-    let dir = tempdir("kill");
-    // Short runs, many: the kill lands while records are being appended.
-    let text = campaign_text(3000, 8).replace("mountings", "# mountings");
-    let file = write_campaign(&dir, &text);
-    std::fs::write(
-        dir.join("base.toml"),
-        BASE.replace("duration = 2.0", "duration = 0.3"),
-    )
-    .unwrap();
-    let whole = dir.join("whole");
-    ok(run_shard(&file, "0/1", &whole));
-    let part = dir.join("part");
+/// Starts a shard of `file` into `out` and returns it once it has recorded more than 100 runs
+/// (or ended).
+fn shard_under_way(file: &Path, out: &Path) -> std::process::Child {
     let mut child = host_sim()
         .args(["campaign", "run"])
-        .arg(&file)
+        .arg(file)
         .args(["--shard", "0/1", "--out"])
-        .arg(&part)
-        .stdout(std::process::Stdio::null())
+        .arg(out)
+        .stdout(std::process::Stdio::piped())
         .stderr(std::process::Stdio::null())
         .spawn()
         .unwrap();
-    // Wait for some records (or the end), then SIGKILL: no code of the shard runs after it.
-    let records_file = part.join("records.csv");
+    let records_file = out.join("records.csv");
     loop {
         let lines = std::fs::read(&records_file)
             .map(|b| b.iter().filter(|c| **c == b'\n').count())
             .unwrap_or(0);
         if lines > 100 || child.try_wait().unwrap().is_some() {
-            break;
+            return child;
         }
         std::thread::sleep(std::time::Duration::from_millis(1));
     }
+}
+
+/// A campaign of 3000 short runs (0.3 s each) in `dir`: a shard of it takes long enough to be
+/// stopped half-way.
+fn many_short_runs(dir: &Path) -> PathBuf {
+    let text = campaign_text(3000, 8).replace("mountings", "# mountings");
+    let file = write_campaign(dir, &text);
+    std::fs::write(
+        dir.join("base.toml"),
+        BASE.replace("duration = 2.0", "duration = 0.3"),
+    )
+    .unwrap();
+    file
+}
+
+#[test]
+fn an_interrupted_shard_says_partial_exits_130_and_finishes_on_a_rerun() {
+    let dir = tempdir("sigint");
+    let file = many_short_runs(&dir);
+    let part = dir.join("part");
+    let child = shard_under_way(&file, &part);
+    // SAFETY: a signal to the child this test started.
+    unsafe { libc::kill(child.id() as i32, libc::SIGINT) };
+    let out = child.wait_with_output().unwrap();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    eprintln!("interrupted shard: exit {:?}: {stdout}", out.status.code());
+    let m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(part.join("shard.json")).unwrap()).unwrap();
+    if out.status.code() == Some(0) {
+        // The shard ended before the signal came: nothing to check but completeness.
+        assert_eq!(m["complete"], true);
+    } else {
+        assert_eq!(out.status.code(), Some(130), "{stdout}");
+        assert!(stdout.contains("PARTIAL: rerun to finish"), "{stdout}");
+        assert_eq!(m["complete"], false);
+        let done = m["done"].as_u64().unwrap();
+        assert_eq!(records(&part.join("records.csv")).len() as u64, done);
+    }
+    let rerun = ok(run_shard(&file, "0/1", &part));
+    assert!(String::from_utf8_lossy(&rerun.stdout).contains("3000 of 3000 recorded"));
+    let mut idx: Vec<u64> = records(&part.join("records.csv"))
+        .iter()
+        .map(|r| r.index)
+        .collect();
+    idx.sort();
+    assert_eq!(idx, (0..3000).collect::<Vec<_>>());
+}
+
+#[test]
+fn a_shard_killed_mid_run_resumes_to_the_same_records() {
+    let dir = tempdir("kill");
+    let file = many_short_runs(&dir);
+    let whole = dir.join("whole");
+    ok(run_shard(&file, "0/1", &whole));
+    let part = dir.join("part");
+    // SIGKILL once records are being appended: no code of the shard runs after it.
+    let mut child = shard_under_way(&file, &part);
+    let records_file = part.join("records.csv");
     let _ = child.kill();
     let _ = child.wait();
     let before = std::fs::read_to_string(&records_file)
