@@ -56,15 +56,24 @@ sed -e "s|@DIR@|$dir|g" -e "s|@USER@|$(id -un)|g" -e "s|@CPUS@|$(nproc)|g" \
   deploy/slurm/ci/slurm.conf.in > "$dir/slurm.conf"
 export SLURM_CONF="$dir/slurm.conf"
 
-# Waits up to $2 s for the command $3… to succeed; else names daemon $1 with its log's end.
+# Waits up to $2 s for the command $5… to succeed while daemon $1 (pid $3) lives; else names
+# the daemon, says whether it died, and shows the end of its log and of its output ($4: both
+# files, `log:out`).
 wait_for() {
-  local what=$1 secs=$2 log=$3; shift 3
-  local end=$((SECONDS + secs))
+  local what=$1 secs=$2 pid=$3 files=$4; shift 4
+  local end=$((SECONDS + secs)) why=""
   until "$@" >/dev/null 2>&1; do
-    if [ "$SECONDS" -ge "$end" ]; then
-      echo "slurm-ci: $what did not come up within ${secs} s; the end of $log:" >&2
-      tail -n 20 "$log" >&2 || true
-      fail "$what did not come up"
+    if ! kill -0 "$pid" 2>/dev/null; then
+      why="exited"
+    elif [ "$SECONDS" -ge "$end" ]; then
+      why="did not come up within ${secs} s"
+    fi
+    if [ -n "$why" ]; then
+      echo "slurm-ci: $what $why; the end of its log and output:" >&2
+      for f in ${files//:/ }; do
+        [ -s "$f" ] && { echo "--- $f" >&2; tail -n 20 "$f" >&2; }
+      done
+      fail "$what $why"
     fi
     sleep 0.2
   done
@@ -75,14 +84,15 @@ munged --foreground --force --socket="$dir/munge/munge.socket" --key-file="$dir/
   --pid-file="$dir/munge/munged.pid" --seed-file="$dir/munge/munged.seed" \
   --log-file="$dir/munge/munged.log" 2>"$dir/munge/munged.stderr" &
 pids+=($!)
-wait_for munged 15 "$dir/munge/munged.log" munge --socket="$dir/munge/munge.socket" -n
+wait_for munged 15 "${pids[-1]}" "$dir/munge/munged.log:$dir/munge/munged.stderr" \
+  munge --socket="$dir/munge/munge.socket" -n
 slurmctld -D -i -f "$SLURM_CONF" >"$dir/slurmctld.stdout" 2>&1 &
 pids+=($!)
-wait_for slurmctld 30 "$dir/slurmctld.log" scontrol ping
+wait_for slurmctld 30 "${pids[-1]}" "$dir/slurmctld.log:$dir/slurmctld.stdout" scontrol ping
 slurmd -D -N localhost -f "$SLURM_CONF" >"$dir/slurmd.stdout" 2>&1 &
 pids+=($!)
 idle() { sinfo -h -n localhost -o %t | grep -qx idle; }
-wait_for slurmd 30 "$dir/slurmd.log" idle
+wait_for slurmd 30 "${pids[-1]}" "$dir/slurmd.log:$dir/slurmd.stdout" idle
 echo "slurm-ci: munged, slurmctld and slurmd up in $((SECONDS - t0)) s ($(sinfo -h -o '%P %D %c %t'))"
 
 # The campaign on the cluster: the array (one shard per task), then its merge.
