@@ -152,6 +152,7 @@ fn one_three_and_seven_shards_merge_to_the_same_bytes() {
         "worst-max_path.toml",
         "worst-rms_path.toml",
         "worst-saturated_fraction.toml",
+        "summary.json",
     ] {
         assert!(names.contains(&expected), "{expected} missing: {names:?}");
     }
@@ -171,6 +172,51 @@ fn one_three_and_seven_shards_merge_to_the_same_bytes() {
         r.iter().map(|r| r.index).collect::<Vec<_>>(),
         (0..21).collect::<Vec<_>>()
     );
+}
+
+#[test]
+fn the_merge_verdict_is_the_required_fraction_within_bound() {
+    let dir = tempdir("verdict");
+    // A bound of 1 mm, which runs miss (the drawn current and payload push them off the path).
+    let tight = campaign_text(12, 6).replace("max_path = 0.2", "max_path = 0.001");
+    for (fraction, exit) in [("", 0), ("fraction = 0.0", 0), ("fraction = 1.0", 4)] {
+        let file = write_campaign(
+            &dir,
+            &tight.replace("saturated = 0.5", &format!("saturated = 0.5\n{fraction}")),
+        );
+        let shard = dir.join(format!("s{exit}{}", fraction.len()));
+        ok(run_shard(&file, "0/1", &shard));
+        let out = host_sim()
+            .args(["campaign", "merge"])
+            .arg(&shard)
+            .arg("--out")
+            .arg(dir.join("m"))
+            .arg("--json")
+            .output()
+            .unwrap();
+        assert_eq!(out.status.code(), Some(exit), "{fraction:?}");
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        // Against the records: outcomes add up, within = completed.
+        let r = records(&dir.join("m/records.csv"));
+        let completed = r.iter().filter(|r| r.within()).count() as u64;
+        assert_eq!(v["runs"], 12);
+        assert_eq!(v["within_bound"].as_u64(), Some(completed));
+        assert_eq!(v["outcomes"]["completed"].as_u64(), Some(completed));
+        let total: u64 = v["outcomes"]
+            .as_object()
+            .unwrap()
+            .values()
+            .map(|x| x.as_u64().unwrap())
+            .sum();
+        assert_eq!(total, 12);
+        assert!(completed < 12, "the bound should be missed by some run");
+        assert_eq!(
+            v["required_met"].as_bool(),
+            (exit == 4)
+                .then_some(false)
+                .or((!fraction.is_empty()).then_some(true))
+        );
+    }
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! ```text
 //! host-sim campaign plan FILE [--workers N]
 //! host-sim campaign run FILE [--shard I/N] [--shards N] --out DIR
-//! host-sim campaign merge SHARD_DIR… --out DIR
+//! host-sim campaign merge SHARD_DIR… --out DIR [--json]
 //! ```
 //!
 //! `run` without `--shard` takes the shard from the engine (**Choice 137**): Slurm's
@@ -78,6 +78,9 @@ pub struct MergeArgs {
     pub shards: Vec<PathBuf>,
     #[arg(long)]
     pub out: PathBuf,
+    /// Print the summary (summary.json) on stdout instead of the text.
+    #[arg(long)]
+    pub json: bool,
 }
 
 /// `campaign`.
@@ -286,6 +289,16 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
     for e in &merged.incomplete {
         eprintln!("host-sim: error: {e}");
     }
+    let missed = merged
+        .required
+        .is_some_and(|f| (merged.within as f64) < f * merged.runs as f64);
+    let exit = Exit::of(!merged.incomplete.is_empty(), false, false, false, missed);
+    if a.json {
+        let text = std::fs::read_to_string(a.out.join(out::SUMMARY))
+            .with_context(|| format!("reading {}", a.out.join(out::SUMMARY).display()))?;
+        writeln!(stdout, "{}", text.trim_end())?;
+        return Ok(exit);
+    }
     writeln!(
         stdout,
         "campaign {}: {} runs from {} shard(s); within bound {} ({:.4} %), diverged {}",
@@ -308,16 +321,7 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
         )?;
     }
     writeln!(stdout, "report: {}", merged.report.display())?;
-    let missed = merged
-        .required
-        .is_some_and(|f| (merged.within as f64) < f * merged.runs as f64);
-    Ok(Exit::of(
-        !merged.incomplete.is_empty(),
-        false,
-        false,
-        false,
-        missed,
-    ))
+    Ok(exit)
 }
 
 /// `campaign plan`.

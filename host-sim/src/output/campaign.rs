@@ -240,7 +240,61 @@ pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result
     let md = markdown(c, records, &merged, &plots);
     atomic::write(&merged.report, md.as_bytes())
         .with_context(|| format!("writing {}", merged.report.display()))?;
+    let json = serde_json::to_string_pretty(&summary(c, records, &merged))
+        .context("serialising the summary")?;
+    let path = dir.claim(SUMMARY)?;
+    atomic::write(&path, json.as_bytes()).with_context(|| format!("writing {}", path.display()))?;
     Ok(merged)
+}
+
+/// The merged report's summary for programs (`summary.json`, and `campaign merge --json`).
+pub const SUMMARY: &str = "summary.json";
+
+/// What `summary.json` holds: the campaign, the outcomes, the statistics, the worst cases'
+/// files. NaN statistics (no run has the metric) are `null`.
+#[derive(serde::Serialize)]
+pub struct Summary<'a> {
+    pub campaign: &'a str,
+    pub hash: &'a str,
+    pub runs: usize,
+    /// Runs of each outcome, by name.
+    pub outcomes: std::collections::BTreeMap<&'static str, usize>,
+    pub faulted: usize,
+    pub within_bound: usize,
+    pub fraction_within_bound: f64,
+    /// The campaign's `bound.fraction`, and whether it is met.
+    pub required_fraction: Option<f64>,
+    pub required_met: Option<bool>,
+    pub metrics: &'a [MetricStats],
+    /// Each metric's worst case: its scenario file beside the report.
+    pub worst_files: std::collections::BTreeMap<&'static str, String>,
+}
+
+fn summary<'a>(c: &'a Campaign, records: &[Record], m: &'a Merged) -> Summary<'a> {
+    let fraction = m.within as f64 / records.len().max(1) as f64;
+    Summary {
+        campaign: c.spec.name(),
+        hash: &c.hash,
+        runs: records.len(),
+        outcomes: Outcome::ALL
+            .iter()
+            .map(|o| (o.as_str(), count(records, *o)))
+            .collect(),
+        faulted: records.iter().filter(|r| r.faulted).count(),
+        within_bound: m.within,
+        fraction_within_bound: fraction,
+        required_fraction: m.required,
+        required_met: m
+            .required
+            .map(|f| m.within as f64 >= f * records.len() as f64),
+        metrics: &m.stats,
+        worst_files: m
+            .stats
+            .iter()
+            .filter(|s| s.worst.is_some())
+            .map(|s| (s.name, worst_file(s.name)))
+            .collect(),
+    }
 }
 
 /// Writes every record (header first) to `path`, whole or not at all, streamed: a merge of
