@@ -4,6 +4,9 @@
 #  - rustup: the toolchain, rustfmt, clippy and the thumbv7em-none-eabihf target
 #  - Debian: fontconfig + a font (host-sim's plots), qemu-system-arm from bookworm-backports
 #    (QEMU 10 with mps2-an386; plain bookworm's 7.2 would remove the image's qemu-utils)
+#  - Debian: slurm-wlm and munge (the CI's single-node Slurm cluster on localhost that runs
+#    deploy/slurm/campaign.sbatch: deploy/slurm/ci/run.sh); installed, not started (the
+#    packages' services are left stopped; run.sh starts its own daemons and stops them)
 #  - cargo: defmt-print (decodes the firmware's defmt log)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -15,7 +18,7 @@ rustup target add thumbv7em-none-eabihf >/dev/null 2>&1
 SUDO=""
 [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 need=()
-for pkg in libfontconfig1-dev fonts-dejavu-core; do
+for pkg in libfontconfig1-dev fonts-dejavu-core slurm-wlm munge; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if ! command -v qemu-system-arm >/dev/null || ! qemu-system-arm -machine help | grep -q mps2-an386; then

@@ -48,6 +48,24 @@ fn bench(c: &mut Criterion) {
         b.iter(|| host_sim::sim::run(black_box(&scenario)))
     });
     group.finish();
+    // The per-run cost that sizes a cluster (docs/design.md §26): one run of the shipped
+    // real-chain campaign (70 s, real thrusters, current, noise), as a shard flies it.
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("campaigns/real-circle.campaign.toml");
+    let campaign = host_sim::studies::campaign::Campaign::load(&file).expect("the campaign");
+    let mut group = c.benchmark_group("campaign");
+    group.sample_size(20);
+    let mut i = 0;
+    group.bench_function(
+        "real-circle run (70 s, real chain, drawn Δp, current, noise)",
+        |b| {
+            b.iter(|| {
+                i += 1;
+                campaign.fly(black_box(i))
+            })
+        },
+    );
+    group.finish();
 }
 
 criterion_group!(benches, bench);

@@ -13,8 +13,8 @@
 //! | 2 | [`scenario`] | what a run is: [`scenario::SimConfig`], TOML files, the one validation, the paper's cases, the real vehicle's missions |
 //! | 3 | [`sim`] | the one closed loop (measure, control, actuate, integrate), what a run records, its metrics, bound and progress |
 //! | 4 | [`board`] | a board in the loop over any byte transport: the runner, pacing, QEMU launch, PIL/HIL vs SIL |
-//! | 4 | [`studies`] | Table 1, preflight feasibility, Monte Carlo |
-//! | 5 | [`output`] | output folders, CSV, plots, reports |
+//! | 4 | [`studies`] | Table 1, preflight feasibility, Monte Carlo, campaigns in shards |
+//! | 5 | [`output`] | output folders, CSV, plots, reports, campaign shards and merged reports |
 //! | 6 | [`cli`] | the `host-sim` commands, one file each |
 //!
 //! [`board`] and [`studies`] share layer 4 and do not use each other.

@@ -9,7 +9,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
-    self, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args, ValidateArgs,
+    self, CampaignArgs, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args,
+    ValidateArgs,
 };
 
 #[derive(Parser)]
@@ -47,6 +48,10 @@ enum Command {
     /// random missions, each checked, then flown at the proposed time scale; reports the
     /// false-feasible count (exit 1 if any) and how conservative the verdict is.
     ValidatePreflight(ValidateArgs),
+    /// Monte Carlo campaigns beyond one machine: `plan` a campaign file, `run` one shard of it
+    /// (Slurm array task, Kubernetes Indexed Job, laptop; restartable), `merge` the shards into
+    /// one report whose worst cases replay bit for bit.
+    Campaign(CampaignArgs),
 }
 
 fn main() -> ExitCode {
@@ -71,6 +76,7 @@ fn main() -> ExitCode {
         Command::MonteCarlo(args) => cli::monte_carlo(&args, stdout),
         Command::Check(args) => cli::check(&args, stdout),
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
+        Command::Campaign(args) => cli::campaign(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

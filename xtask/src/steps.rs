@@ -144,6 +144,10 @@ pub const STEPS: &[Step] = &[
         ]),
     },
     Step {
+        name: "campaigns on a real Slurm: a one-node cluster on localhost runs deploy/slurm/campaign.sbatch (4 shards + the merge), merged = one machine byte for byte",
+        run: Run::Command("bash", &["deploy/slurm/ci/run.sh", "target/host/host-sim"]),
+    },
+    Step {
         name: "controller-core cross-build",
         run: Run::Cargo(&["build", "-p", "controller-core", "--release", "--target", TARGET]),
     },

@@ -11,6 +11,7 @@
 //! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
+//! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! ```
 //!
 //! `check` is the preflight feasibility check ([`crate::studies::preflight`]): it simulates nothing, and
@@ -50,6 +51,7 @@
 //! preflight says infeasible: their divergence and faults are reported, not an exit code.
 
 mod board_loop;
+mod campaign;
 mod check;
 mod common;
 mod hil;
@@ -61,6 +63,7 @@ mod table1;
 mod validate;
 
 pub use board_loop::LoopArgs;
+pub use campaign::{campaign, resolve_shard, CampaignArgs, CampaignCommand};
 pub use check::{check, CheckArgs};
 pub use hil::{hil, HilArgs, DEFAULT_HIL_BAUD, DEFAULT_HIL_REPLY_TIMEOUT};
 pub use json::Cases;

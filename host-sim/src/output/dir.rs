@@ -60,6 +60,17 @@ impl OutputDir {
     /// an empty manifest (see the module doc). Every error names the folder and says what to
     /// do.
     pub fn prepare(path: &Path) -> Result<OutputDir> {
+        Self::open(path, false)
+    }
+
+    /// [`OutputDir::prepare`] for a run that resumes the folder's previous run (a campaign
+    /// shard, **Choice 135**): the same checks and lock, but the files of the previous run are
+    /// kept (and stay in the manifest); only stale temporary files are removed.
+    pub fn resume(path: &Path) -> Result<OutputDir> {
+        Self::open(path, true)
+    }
+
+    fn open(path: &Path, keep: bool) -> Result<OutputDir> {
         let shown = path.display();
         match fs::symlink_metadata(path) {
             Ok(m) if m.file_type().is_symlink() => bail!(
@@ -81,7 +92,11 @@ impl OutputDir {
             files: Mutex::new(Vec::new()),
             _lock: lock(path)?,
         };
-        for name in &previous_files(path)? {
+        let previous = previous_files(path)?;
+        if keep {
+            *dir.files.lock().unwrap_or_else(|e| e.into_inner()) = previous.clone();
+        }
+        for name in previous.iter().filter(|_| !keep) {
             dir.remove_entry(name)?;
             // What a run that ended before finishing this CSV kept of it (Choice 126).
             if name.ends_with(".csv") {
@@ -97,7 +112,7 @@ impl OutputDir {
                 dir.remove_entry(&name)?;
             }
         }
-        dir.write_manifest(&[])
+        dir.write_manifest(&dir.files())
             .with_context(|| format!("output folder {shown} is not writable"))?;
         Ok(dir)
     }

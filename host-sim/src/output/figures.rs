@@ -348,7 +348,7 @@ pub fn plot_names(name: &str) -> Vec<String> {
 
 /// Draws into a temporary file next to `dest` and renames it into place
 /// ([`super::atomic`]): a failed plot leaves no file under its name.
-fn write_plot(dest: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<PathBuf> {
+pub(super) fn write_plot(dest: &Path, draw: impl FnOnce(&Path) -> Result<()>) -> Result<PathBuf> {
     let ctx = || format!("writing {}", dest.display());
     let (pending, file) = Pending::create(dest).with_context(ctx)?;
     drop(file);

@@ -1,6 +1,7 @@
 //! What a run leaves on disk: the per-period CSV ([`csv`], streamed as the run goes), PNG plots
 //! in the manner of the paper's Figs 2–5 ([`figures`], drawn with the plotting layer [`plot`]),
-//! and the Table-1 report, Markdown file and terminal text ([`report`]); all of it in an
+//! and the Table-1 report, Markdown file and terminal text ([`report`]), a campaign's shards and
+//! merged report ([`campaign`]); all of it in an
 //! output folder checked before the computation and holding only its last run's files
 //! ([`dir`]), each file written whole or not at all ([`atomic`]).
 //!
@@ -14,6 +15,7 @@ use std::path::PathBuf;
 use anyhow::{Context, Result};
 
 pub mod atomic;
+pub mod campaign;
 pub mod csv;
 pub mod dir;
 pub mod figures;

@@ -457,3 +457,20 @@ pub(super) fn figure(
     }
     Ok(())
 }
+
+/// A 1200×900 PNG at `path` of `panels` in a `grid` (rows, columns) under `title`, without a
+/// run's subtitle or legend (a campaign's histograms and scatter plots).
+pub(super) fn panel_grid(
+    path: &Path,
+    title: &str,
+    grid: (usize, usize),
+    panels: &[Panel],
+) -> Result<()> {
+    render(path, |root| {
+        let area = root.titled(title, (FONT, 24)).map_err(plot_err)?;
+        for (cell, p) in area.split_evenly(grid).iter().zip(panels) {
+            draw_panel(cell, p)?;
+        }
+        Ok(())
+    })
+}

@@ -6,9 +6,11 @@
 //! |---|---|
 //! | [`table1`] | the paper's printed Table 1, the notes on how our runs were made, the twelve runs |
 //! | [`preflight`] | can the real thrusters fly a scenario, and at what time scale (`host-sim check`) |
-//! | [`montecarlo`] | Monte Carlo over the Table-3 box |
+//! | [`montecarlo`] | Monte Carlo over the Table-3 box, on one machine |
+//! | [`campaign`] | Monte Carlo campaigns in shards on any engine (Slurm, Kubernetes), merged, worst cases reproducible |
 //! | [`validation`] | does the preflight's verdict hold: missions checked, then flown |
 
+pub mod campaign;
 pub mod montecarlo;
 pub mod preflight;
 pub mod table1;

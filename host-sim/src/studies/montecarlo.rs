@@ -109,8 +109,8 @@ fn variation(d: &Draw) -> ParamVariation<f64> {
     ParamBox::table3().lerp(&d.variation)
 }
 
-/// Nearest-rank percentile of sorted values.
-fn percentile(sorted: &[f64], p: f64) -> f64 {
+/// Nearest-rank percentile of sorted values (NaN for none): the value of rank ⌈p·n/100⌉.
+pub fn percentile(sorted: &[f64], p: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
     }

@@ -1,10 +1,12 @@
 //! Processor in the loop: the QEMU flying image flies the simulated vehicle through
-//! `host-sim pil`. Four checks: a short lawn-mower mission must equal SIL bit for bit, on an
+//! `host-sim pil`. Five checks: a short lawn-mower mission must equal SIL bit for bit, on an
 //! unsigned and on a signed link (the public CI test key, [`CI_TEST_KEY`]); a short real-chain
 //! mission (kgf, tangent heading, time scale > 1, the real actuator chain, the real vehicle's
 //! mounting: [`REAL_CHAIN`]) must equal SIL bit for bit with the board reporting the
-//! scenario's thrust unit and mounting; and a link-fault case must enter and leave fail-safe
-//! at its exact ticks and drop its delayed (old) state frames.
+//! scenario's thrust unit and mounting; a link-fault case must enter and leave fail-safe
+//! at its exact ticks and drop its delayed (old) state frames; and the worst case of a small
+//! campaign (docs/design.md §26), found in SIL, flown on the board from the merge's scenario
+//! file, must equal the campaign's record bit for bit.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
@@ -56,11 +58,12 @@ pub fn build_host_sim(ci: &mut Ci) -> Option<PathBuf> {
 /// check and the report cannot disagree on a field.
 pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     ci.step(
-        "processor in the loop: a short mission unsigned and signed, a short real-chain mission (PIL must equal SIL) and a link-fault case",
+        "processor in the loop: a short mission unsigned and signed, a short real-chain mission (PIL must equal SIL), a link-fault case, and a campaign's worst case replayed on the board",
     );
     let pil = Pil { host_sim, elf };
     same_as_sil(ci, &pil);
     link_faults(ci, &pil);
+    campaign_worst_case(ci, &pil);
 }
 
 /// `host-sim pil` with one image.
@@ -295,6 +298,112 @@ fn link_faults(ci: &mut Ci, pil: &Pil) {
             "PIL link-fault case: the board dropped {} frames as old; the {} delayed state frames (ticks {delay}) must be dropped, and nothing else",
             c.pil.board_rx_stale,
             DELAY.1 - DELAY.0
+        ));
+    }
+}
+
+/// The CI's small campaign (docs/design.md §26), run and merged here.
+const CAMPAIGN: &str = "host-sim/campaigns/ci-small.campaign.toml";
+
+/// Runs the CI's small campaign in one shard and merges it, in the scratch folder; the merged
+/// report's folder, or `None` (and a CI failure).
+fn run_campaign(ci: &mut Ci, host_sim: &Path) -> Option<PathBuf> {
+    let dir = ci.scratch().join("campaign");
+    let _ = std::fs::remove_dir_all(&dir);
+    let (shard, report) = (dir.join("shard"), dir.join("report"));
+    let run = |args: &[&std::ffi::OsStr]| {
+        Command::new(host_sim)
+            .current_dir(&ci.root)
+            .args(args)
+            .output()
+            .map_err(|e| e.to_string())
+            .and_then(|o| match o.status.success() {
+                true => Ok(()),
+                false => Err(String::from_utf8_lossy(&o.stderr).into_owned()),
+            })
+    };
+    let os = |s: &str| std::ffi::OsString::from(s);
+    let made = run(&[
+        &os("campaign"),
+        &os("run"),
+        &os(CAMPAIGN),
+        &os("--shard"),
+        &os("0/1"),
+        &os("--out"),
+        shard.as_os_str(),
+    ])
+    .and_then(|()| {
+        run(&[
+            &os("campaign"),
+            &os("merge"),
+            shard.as_os_str(),
+            &os("--out"),
+            report.as_os_str(),
+        ])
+    });
+    match made {
+        Ok(()) => Some(report),
+        Err(e) => {
+            ci.fail(format!(
+                "PIL campaign worst case: the campaign {CAMPAIGN}: {e}"
+            ));
+            None
+        }
+    }
+}
+
+/// 5. A worst case found in SIL, replayed on the board: the small campaign is run (one shard)
+///    and merged, and the merge's `worst-max_path.toml` is flown through `pil` as its report
+///    prints it. The board's max path error must equal the campaign's record of that run bit
+///    for bit (and SIL's).
+fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
+    let Some(report) = run_campaign(ci, pil.host_sim) else {
+        return;
+    };
+    let records = match host_sim::output::campaign::read_records(
+        &report.join(host_sim::output::campaign::RECORDS),
+        false,
+    ) {
+        Ok(r) => r,
+        Err(e) => {
+            ci.fail(format!("PIL campaign worst case: {e:#}"));
+            return;
+        }
+    };
+    // The worst max path error: the largest, the first run with it (records in index order).
+    let metric = host_sim::studies::campaign::METRIC_NAMES
+        .iter()
+        .position(|m| *m == "max_path")
+        .unwrap_or(3);
+    let worst = records.iter().filter(|r| !r.metrics[metric].is_nan()).fold(
+        None::<&host_sim::studies::campaign::Record>,
+        |w, r| match w {
+            Some(w) if w.metrics[metric] >= r.metrics[metric] => Some(w),
+            _ => Some(r),
+        },
+    );
+    let Some(worst) = worst else {
+        ci.fail("PIL campaign worst case: the merged campaign has no records");
+        return;
+    };
+    let file = report.join(host_sim::output::campaign::worst_file("max_path"));
+    let file = file.to_string_lossy().into_owned();
+    // A worst case may well miss its bound (host-sim then exits 4): what is checked is that
+    // the board flies the campaign's run, to the bit.
+    let Some((_, c)) = pil.run(ci, "campaign-worst", &["--scenario", &file]) else {
+        return;
+    };
+    let recorded = worst.metrics[metric];
+    println!(
+        "campaign worst case (run {}): PIL max path {} m, SIL {} m, the campaign's record {recorded} m",
+        worst.index, c.run.metrics.max_path, c.sil_max_path
+    );
+    if c.run.metrics.max_path.to_bits() != c.sil_max_path.to_bits()
+        || c.run.metrics.max_path.to_bits() != recorded.to_bits()
+    {
+        ci.fail(format!(
+            "PIL campaign worst case: the board flew run {} to a max path of {} m, SIL {} m, the campaign recorded {recorded} m: all three must be the same bits (the worst case's scenario file replays the run)",
+            worst.index, c.run.metrics.max_path, c.sil_max_path
         ));
     }
 }
