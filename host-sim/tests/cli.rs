@@ -46,18 +46,7 @@ fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
                 .iter()
                 .find(|c| c["case"] == name && c["robust"] == robust)
                 .unwrap_or_else(|| panic!("{name} robust={robust} missing"));
-            for key in [
-                "max_x",
-                "max_y",
-                "max_z",
-                "max_path",
-                "rms_path",
-                "max_roll",
-                "max_pitch",
-                "max_yaw",
-                "peak_voltage",
-                "saturated_fraction",
-            ] {
+            for key in host_sim::sim::Metrics::NAMES {
                 assert!(c[key].is_f64(), "{name}: {key}");
             }
             // The paper's path definition.

@@ -225,6 +225,37 @@ impl Metrics {
         saturated_fraction: f64::NAN,
     };
 
+    /// The metrics' names, as the JSON, the CSVs and the campaign files write them, in the
+    /// order of [`Metrics::values`] (the field order; a test ties the two to serde's names).
+    pub const NAMES: [&'static str; 10] = [
+        "max_x",
+        "max_y",
+        "max_z",
+        "max_path",
+        "rms_path",
+        "max_roll",
+        "max_pitch",
+        "max_yaw",
+        "peak_voltage",
+        "saturated_fraction",
+    ];
+
+    /// The metrics in the order of [`Metrics::NAMES`].
+    pub fn values(&self) -> [f64; 10] {
+        [
+            self.max_x,
+            self.max_y,
+            self.max_z,
+            self.max_path,
+            self.rms_path,
+            self.max_roll,
+            self.max_pitch,
+            self.max_yaw,
+            self.peak_voltage,
+            self.saturated_fraction,
+        ]
+    }
+
     /// False for [`Metrics::NONE`]: the run recorded no period.
     pub fn recorded(&self) -> bool {
         !self.max_path.is_nan()
@@ -384,5 +415,34 @@ pub fn du_label(robust: bool) -> &'static str {
         "with Δu"
     } else {
         "without Δu"
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Metrics;
+
+    /// The name table is the struct's: each name is the key serde writes for the value at the
+    /// same index (ten distinct values, so a swapped or misspelt name cannot pass).
+    #[test]
+    fn metric_names_are_the_json_keys_in_the_order_of_values() {
+        let m = Metrics {
+            max_x: 1.0,
+            max_y: 2.0,
+            max_z: 3.0,
+            max_path: 4.0,
+            rms_path: 5.0,
+            max_roll: 6.0,
+            max_pitch: 7.0,
+            max_yaw: 8.0,
+            peak_voltage: 9.0,
+            saturated_fraction: 10.0,
+        };
+        let json = serde_json::to_value(m).expect("metrics serialise");
+        let object = json.as_object().expect("an object");
+        assert_eq!(object.len(), Metrics::NAMES.len());
+        for (name, value) in Metrics::NAMES.iter().zip(m.values()) {
+            assert_eq!(object[*name].as_f64(), Some(value), "{name}");
+        }
     }
 }

@@ -118,24 +118,50 @@ pub fn percentile(sorted: &[f64], p: f64) -> f64 {
     sorted[rank.min(sorted.len()) - 1]
 }
 
+/// The plant steps a run of `s` takes (its control periods × RK4 steps per period).
+fn plant_steps(s: &Scenario) -> f64 {
+    (s.steps() * s.substeps() as u64).max(1) as f64
+}
+
+/// One calibration run of a base: [`CALIBRATION_SECONDS`] of it (or less), flown as the runs
+/// go (metrics only) and timed; its time per plant step scaled to the base's whole duration.
+pub struct Calibration {
+    /// Simulated seconds the calibration flew.
+    pub duration: f64,
+    /// Its wall time, s.
+    pub wall: f64,
+    /// The estimated wall time of one whole run of the base on one thread, s.
+    pub seconds_per_run: f64,
+}
+
+impl Calibration {
+    /// Flies and times the calibration run of `base`.
+    pub fn of(base: &Scenario) -> Result<Calibration, ScenarioError> {
+        let short = base.with(|c| c.duration = c.duration.min(CALIBRATION_SECONDS))?;
+        let t0 = Instant::now();
+        sim::fly(
+            &short,
+            &mut LocalController::new(&short),
+            &mut (),
+            Recording::MetricsOnly,
+        );
+        let wall = t0.elapsed().as_secs_f64();
+        Ok(Calibration {
+            duration: short.config().duration,
+            wall,
+            seconds_per_run: wall / plant_steps(&short) * plant_steps(base),
+        })
+    }
+}
+
 /// How long `opts.runs` runs around `base` should take, as a sentence: a calibration run of
 /// the base ([`CALIBRATION_SECONDS`] of simulated time) is timed, its time per plant step
 /// scaled to every plant step of every run and divided by the threads (rayon's).
 pub fn estimate(base: &Scenario, opts: &MonteCarloOptions) -> Result<String, ScenarioError> {
-    let short = base.with(|c| c.duration = c.duration.min(CALIBRATION_SECONDS))?;
-    let t0 = Instant::now();
-    // Timed as the runs go: metrics only.
-    sim::fly(
-        &short,
-        &mut LocalController::new(&short),
-        &mut (),
-        Recording::MetricsOnly,
-    );
-    let wall = t0.elapsed().as_secs_f64();
-    let plant_steps = |s: &Scenario| (s.steps() * s.substeps() as u64).max(1) as f64;
-    let per_step = wall / plant_steps(&short);
+    let calibration = Calibration::of(base)?;
+    let (short, wall) = (calibration.duration, calibration.wall);
     let threads = rayon::current_num_threads().max(1);
-    let total = per_step * plant_steps(base) * opts.runs as f64 / threads as f64;
+    let total = calibration.seconds_per_run * opts.runs as f64 / threads as f64;
     Ok(format!(
         "{} runs of {} ({} s, {} plant steps each): about {} on {threads} thread(s) (a {} s \
          calibration run took {:.3} s; scaled by plant steps)",
@@ -144,7 +170,7 @@ pub fn estimate(base: &Scenario, opts: &MonteCarloOptions) -> Result<String, Sce
         base.config().duration,
         plant_steps(base),
         duration_text(total),
-        short.config().duration,
+        short,
         wall
     ))
 }
@@ -208,24 +234,14 @@ pub fn run<O: Observer>(
 
 /// The percentiles of every metric over the runs, and the run with each maximum.
 fn summaries(results: &[(Draw, Metrics, bool, bool)]) -> Vec<MetricSummary> {
-    type Getter = (&'static str, fn(&Metrics) -> f64);
-    let getters: [Getter; 10] = [
-        ("max_x", |m| m.max_x),
-        ("max_y", |m| m.max_y),
-        ("max_z", |m| m.max_z),
-        ("max_path", |m| m.max_path),
-        ("rms_path", |m| m.rms_path),
-        ("max_roll", |m| m.max_roll),
-        ("max_pitch", |m| m.max_pitch),
-        ("max_yaw", |m| m.max_yaw),
-        ("peak_voltage", |m| m.peak_voltage),
-        ("saturated_fraction", |m| m.saturated_fraction),
-    ];
-    getters
+    Metrics::NAMES
         .iter()
-        .map(|(name, get)| {
-            let mut v: Vec<(f64, usize)> =
-                results.iter().map(|(d, m, ..)| (get(m), d.run)).collect();
+        .enumerate()
+        .map(|(k, &name)| {
+            let mut v: Vec<(f64, usize)> = results
+                .iter()
+                .map(|(d, m, ..)| (m.values()[k], d.run))
+                .collect();
             v.sort_by(|a, b| a.0.total_cmp(&b.0));
             let sorted: Vec<f64> = v.iter().map(|x| x.0).collect();
             MetricSummary {

@@ -29,35 +29,9 @@ pub mod record;
 pub use file::{Base, CampaignError, CampaignSpec, ParameterDraw};
 pub use record::{Outcome, Record};
 
-/// The metrics a campaign can report, in the order of the records' columns.
-pub const METRIC_NAMES: [&str; 10] = [
-    "max_x",
-    "max_y",
-    "max_z",
-    "max_path",
-    "rms_path",
-    "max_roll",
-    "max_pitch",
-    "max_yaw",
-    "peak_voltage",
-    "saturated_fraction",
-];
-
-/// The metrics of [`METRIC_NAMES`], in that order.
-pub fn metric_values(m: &Metrics) -> [f64; 10] {
-    [
-        m.max_x,
-        m.max_y,
-        m.max_z,
-        m.max_path,
-        m.rms_path,
-        m.max_roll,
-        m.max_pitch,
-        m.max_yaw,
-        m.peak_voltage,
-        m.saturated_fraction,
-    ]
-}
+/// The metrics a campaign can report, in the order of the records' columns (the one name
+/// table, [`Metrics::NAMES`]).
+pub const METRIC_NAMES: [&str; 10] = Metrics::NAMES;
 
 /// What run i drew. Everything is drawn for every run, in a fixed order (new keys draw after
 /// the old ones), whether the campaign
@@ -368,22 +342,7 @@ impl Campaign {
     pub fn calibrate(&self) -> Result<f64, ScenarioError> {
         let mut total = 0.0;
         for b in &self.bases {
-            let s = &b.scenario;
-            let short = s.with(|c| {
-                c.duration = c
-                    .duration
-                    .min(crate::studies::montecarlo::CALIBRATION_SECONDS)
-            })?;
-            let t0 = std::time::Instant::now();
-            sim::fly(
-                &short,
-                &mut LocalController::new(&short),
-                &mut (),
-                Recording::MetricsOnly,
-            );
-            let wall = t0.elapsed().as_secs_f64();
-            let steps = |s: &Scenario| (s.steps() * s.substeps() as u64).max(1) as f64;
-            total += wall / steps(&short) * steps(s);
+            total += crate::studies::montecarlo::Calibration::of(&b.scenario)?.seconds_per_run;
         }
         Ok(total / self.bases.len() as f64)
     }

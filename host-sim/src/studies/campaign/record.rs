@@ -6,7 +6,7 @@ use std::fmt::Write as _;
 
 use controller_core::model::{VARIED_PARAMETERS, VARIED_PARAMETER_NAMES};
 
-use super::{metric_values, Draw, METRIC_NAMES};
+use super::{Draw, METRIC_NAMES};
 use crate::sim::RunResult;
 
 /// How a run ended.
@@ -108,7 +108,7 @@ impl Record {
             index,
             base,
             draw,
-            metrics: metric_values(&r.metrics),
+            metrics: r.metrics.values(),
             faulted: !r.faults.is_empty(),
             outcome,
         }
