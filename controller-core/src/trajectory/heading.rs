@@ -53,7 +53,7 @@ impl fmt::Display for HeadingMode {
 /// Samples per period of the path in the sampled bound on the tangent heading's |ψ̈_d|.
 const TANGENT_BOUND_SAMPLES: u32 = 1024;
 /// Margin on the sampled maximum of the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**).
-const TANGENT_BOUND_MARGIN: f32 = 1.1;
+pub(super) const TANGENT_BOUND_MARGIN: f32 = 1.1;
 
 impl Trajectory {
     /// An upper bound on the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**). On the

@@ -69,6 +69,10 @@ pub use error::TrajectoryError;
 pub use heading::HeadingMode;
 pub use kind::TrajectoryKind;
 pub use mission::Mission;
+pub use paths::waypoints::{
+    turn_radius, PathPoint, Route, WaypointList, MAX_SEGMENTS, MAX_SLOPE, MAX_SPEED,
+    MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG, MIN_TURN_RADIUS, TURN_ACCEL,
+};
 pub use table1::Table1Case;
 
 use nalgebra::Vector6;
@@ -116,6 +120,8 @@ pub struct Trajectory {
     accel_bound: f32,
     /// The smallest horizontal speed along the path (m/s), in closed form.
     min_speed: f32,
+    /// The waypoint path's legs and blends ([`Route::EMPTY`] for the other kinds).
+    route: Route,
 }
 
 impl Trajectory {
@@ -203,7 +209,17 @@ impl Trajectory {
             Some(series) => series_coefficients(series, omega),
             None => [[0.0; 3]; ODD_TERMS],
         };
+        let route = match mission.path {
+            TrajectoryKind::Waypoints {
+                points,
+                speed,
+                turn_radius,
+            } => Route::new(&points, paths::waypoints::turn_radius(speed, turn_radius))
+                .unwrap_or(Route::EMPTY),
+            _ => Route::EMPTY,
+        };
         let mut t = Self {
+            route,
             mission,
             omega,
             theta: Frequency::from_rad_per_s(omega_f64),
@@ -218,6 +234,15 @@ impl Trajectory {
         // Assumption 1 (Eq 19): per component Σ |amplitude|·frequency² over its harmonics
         // (|sin|, |cos| ≤ 1), then the Euclidean norm over the components. Linear-in-t terms
         // (lawn-mower 0.25 s t, helix z) and the circle's ψ = ωt have no acceleration.
+        if let TrajectoryKind::Waypoints { .. } = mission.path {
+            // The route's sampled bounds at σ̇ = 1, times σ̇² (σ̈ = 0) and the sampled bound's
+            // margin; the heading is the course in both modes (Choice 154).
+            let (_, path, heading) = paths::waypoints::bounds(&t.route);
+            let r2 = t.rate * t.rate * heading::TANGENT_BOUND_MARGIN;
+            let (path, heading) = (path * r2, heading * r2);
+            t.accel_bound = sqrt_upper(path * path + heading * heading);
+            return t;
+        }
         let heading_bound = match mission.heading {
             HeadingMode::Paper => {
                 let mut series_bound = 0.0f32;
@@ -280,6 +305,11 @@ impl Trajectory {
         self.min_speed
     }
 
+    /// The waypoint path's legs and blends ([`Route::EMPTY`] for the other kinds).
+    pub fn route(&self) -> &Route {
+        &self.route
+    }
+
     /// K_d of Assumption 1 (Eq 19): an upper bound on ‖η̈_d(t)‖ for all t.
     ///
     /// Computed from the amplitudes: for each component of η̈_d the sum of |amplitude|·(frequency)²
@@ -324,9 +354,10 @@ impl Trajectory {
         eta_dot[2] = p.z_dot;
         eta_ddot[0] = p.d[1][0];
         eta_ddot[1] = p.d[1][1];
+        eta_ddot[2] = p.z_ddot;
         let (psi, rate, accel) = match self.mission.heading {
             HeadingMode::Tangent => tangent(&p),
-            HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h),
+            HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h, &p),
         };
         eta[5] = psi;
         eta_dot[5] = rate;

@@ -37,13 +37,14 @@ impl Harmonics {
     }
 }
 
-/// The horizontal path and its first three derivatives, and z_d, ż_d.
+/// The horizontal path and its first three derivatives, and z_d, ż_d, z̈_d.
 #[derive(Clone, Copy)]
 pub(super) struct Planar {
     pub(super) x: f32,
     pub(super) y: f32,
     pub(super) z: f32,
     pub(super) z_dot: f32,
+    pub(super) z_ddot: f32,
     /// (ẋ, ẏ), (ẍ, ÿ), (x⃛, y⃛).
     pub(super) d: [[f32; 2]; 3],
 }
