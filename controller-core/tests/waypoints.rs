@@ -46,6 +46,8 @@ fn kind(points: &[[f32; 3]], speed: f32, turn_radius: Option<f32>) -> Trajectory
         points: WaypointList::new(points).expect("≤ 32 points"),
         speed,
         turn_radius,
+        speeds: None,
+        speed_change: None,
     }
 }
 

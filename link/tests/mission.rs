@@ -215,6 +215,8 @@ fn a_waypoint_mission_is_refused_by_the_one_frame_conversion() {
         points,
         speed: 0.5,
         turn_radius: None,
+        speeds: None,
+        speed_change: None,
     };
     assert_eq!(
         MissionSpec::try_from(kind),

@@ -71,6 +71,22 @@ pub enum TrajectoryError {
         /// Its length (m).
         has: f32,
     },
+    /// A time law whose speed count is not the path's parts (2n − 3: each leg and each turn).
+    SpeedCount {
+        /// How many speeds were given.
+        count: usize,
+        /// How many the path has.
+        expected: usize,
+    },
+    /// A part of the path too short for the speed changes at its two ends.
+    SpeedChangeTooLong {
+        /// The part (2j: leg j, 2j − 1: the turn at waypoint j).
+        part: usize,
+        /// The path the changes need (m).
+        needs: f32,
+        /// The part's length (m).
+        has: f32,
+    },
     /// A leg steeper than [`MAX_SLOPE`] (|Δz| over its horizontal length).
     TooSteep {
         /// The leg (0-based).
@@ -94,6 +110,7 @@ impl TrajectoryError {
             | Self::TurnTooSharp { .. }
             | Self::LegTooShort { .. }
             | Self::TooSteep { .. } => "points",
+            Self::SpeedCount { .. } | Self::SpeedChangeTooLong { .. } => "speeds",
         }
     }
 }
@@ -145,6 +162,16 @@ impl fmt::Display for TrajectoryError {
                 f,
                 "leg {leg} (waypoints {leg} to {}) is {} m long but its turns need {} m at this turn radius (lower turn_radius or speed, or space the waypoints)",
                 leg + 1,
+                Readable(has),
+                Readable(needs)
+            ),
+            Self::SpeedCount { count, expected } => write!(
+                f,
+                "the time law has {count} speeds; this path has {expected} parts (each leg and each turn, in path order)"
+            ),
+            Self::SpeedChangeTooLong { part, needs, has } => write!(
+                f,
+                "part {part} of the path is {} m long but its speed changes need {} m (lower its speed, or raise speed_change)",
                 Readable(has),
                 Readable(needs)
             ),

@@ -4,9 +4,9 @@
 
 #[cfg(any(doc, feature = "serde"))]
 use crate::trajectory::Trajectory;
-use crate::trajectory::WaypointList;
+use crate::trajectory::{SpeedList, WaypointList};
 #[cfg(doc)]
-use crate::trajectory::TURN_ACCEL;
+use crate::trajectory::{DEFAULT_SPEED_CHANGE, TURN_ACCEL};
 
 /// Shape and parameters of a mission (the paper's "Simulation Results"; docs/design.md §6).
 ///
@@ -89,6 +89,13 @@ pub enum TrajectoryKind {
         /// The smallest radius of a turn (m); `None`: speed²/[`TURN_ACCEL`] (Choice 151).
         #[cfg_attr(feature = "serde", serde(default))]
         turn_radius: Option<f32>,
+        /// The time law: a speed per leg and turn in path order (m/s; Choice 156), the
+        /// profile `host-sim check` proposes; `None`: `speed` everywhere.
+        #[cfg_attr(feature = "serde", serde(default))]
+        speeds: Option<SpeedList>,
+        /// The largest |σ̈| of a change of speed (m/s²); `None`: [`DEFAULT_SPEED_CHANGE`].
+        #[cfg_attr(feature = "serde", serde(default))]
+        speed_change: Option<f32>,
     },
 }
 

@@ -69,6 +69,7 @@ pub use error::TrajectoryError;
 pub use heading::HeadingMode;
 pub use kind::TrajectoryKind;
 pub use mission::Mission;
+pub use paths::time_law::{SpeedList, TimeLaw, DEFAULT_SPEED_CHANGE, MAX_PARTS, MAX_SPEED_CHANGE};
 pub use paths::waypoints::{
     turn_radius, PathPoint, Route, WaypointList, MAX_SEGMENTS, MAX_SLOPE, MAX_SPEED,
     MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG, MIN_TURN_RADIUS, TURN_ACCEL,
@@ -122,6 +123,8 @@ pub struct Trajectory {
     min_speed: f32,
     /// The waypoint path's legs and blends ([`Route::EMPTY`] for the other kinds).
     route: Route,
+    /// The waypoint path's time law ([`TimeLaw::EMPTY`]: constant speed, or another kind).
+    law: TimeLaw,
 }
 
 impl Trajectory {
@@ -209,17 +212,10 @@ impl Trajectory {
             Some(series) => series_coefficients(series, omega),
             None => [[0.0; 3]; ODD_TERMS],
         };
-        let route = match mission.path {
-            TrajectoryKind::Waypoints {
-                points,
-                speed,
-                turn_radius,
-            } => Route::new(&points, paths::waypoints::turn_radius(speed, turn_radius))
-                .unwrap_or(Route::EMPTY),
-            _ => Route::EMPTY,
-        };
+        let (route, law) = paths::waypoints::route_and_law(&mission.path);
         let mut t = Self {
             route,
+            law,
             mission,
             omega,
             theta: Frequency::from_rad_per_s(omega_f64),
@@ -235,12 +231,19 @@ impl Trajectory {
         // (|sin|, |cos| ≤ 1), then the Euclidean norm over the components. Linear-in-t terms
         // (lawn-mower 0.25 s t, helix z) and the circle's ψ = ωt have no acceleration.
         if let TrajectoryKind::Waypoints { .. } = mission.path {
-            // The route's sampled bounds at σ̇ = 1, times σ̇² (σ̈ = 0) and the sampled bound's
-            // margin; the heading is the course in both modes (Choice 154).
-            let (_, path, heading) = paths::waypoints::bounds(&t.route);
-            let r2 = t.rate * t.rate * heading::TANGENT_BOUND_MARGIN;
-            let (path, heading) = (path * r2, heading * r2);
-            t.accel_bound = sqrt_upper(path * path + heading * heading);
+            if t.law.is_set() {
+                // The time law's σ̇ is over k: its derivatives are evaluated per unit time.
+                t.rate = (1.0 / k) as f32;
+                t.position_rate = LinearRate::new(1.0 / k);
+            }
+            let (min_speed, accel) = paths::waypoints::speed_and_accel_bound(
+                &t.route,
+                &t.law,
+                t.rate,
+                heading::TANGENT_BOUND_MARGIN,
+            );
+            t.min_speed = min_speed;
+            t.accel_bound = sqrt_upper(accel);
             return t;
         }
         let heading_bound = match mission.heading {
@@ -308,6 +311,11 @@ impl Trajectory {
     /// The waypoint path's legs and blends ([`Route::EMPTY`] for the other kinds).
     pub fn route(&self) -> &Route {
         &self.route
+    }
+
+    /// The waypoint path's time law ([`TimeLaw::EMPTY`]: constant speed, or another kind).
+    pub fn time_law(&self) -> &TimeLaw {
+        &self.law
     }
 
     /// K_d of Assumption 1 (Eq 19): an upper bound on ‖η̈_d(t)‖ for all t.

@@ -231,7 +231,8 @@ impl SimConfig {
         }
     }
 
-    /// Defaults around a path: the paper's heading at time scale 1, 70 s, 1 ms plant step, the
+    /// Defaults around a path: the paper's heading (the tangent heading for waypoints, which
+    /// have no other: docs/design.md §27) at time scale 1, 70 s, 1 ms plant step, the
     /// paper's controller at 100 Hz, no variation (untrimmed), no current, no noise, ideal
     /// actuators, starting on the reference, no Table-1 case, no faults expected, the step cap
     /// in force.
@@ -240,7 +241,10 @@ impl SimConfig {
             name: name.into(),
             case: None,
             trajectory,
-            heading: HeadingMode::Paper,
+            heading: match trajectory {
+                TrajectoryKind::Waypoints { .. } => HeadingMode::Tangent,
+                _ => HeadingMode::Paper,
+            },
             time_scale: 1.0,
             duration: 70.0,
             plant_step: 0.001,

@@ -8,6 +8,7 @@ mod circle;
 mod figure_eight;
 mod helix;
 mod lawn_mower;
+pub(super) mod time_law;
 pub(super) mod waypoints;
 
 use crate::math;
@@ -45,7 +46,9 @@ pub(super) fn check(path: &TrajectoryKind) -> Result<(), TrajectoryError> {
             points,
             speed,
             turn_radius,
-        } => waypoints::check(&points, speed, turn_radius),
+            speeds,
+            speed_change,
+        } => waypoints::check(&points, speed, turn_radius, speeds, speed_change),
     }
 }
 
@@ -156,9 +159,10 @@ pub(super) fn planar(t: &Trajectory, ph: &Phases) -> Planar {
             amplitude, depth, ..
         } => figure_eight::planar(amplitude, depth, t.omega, ph),
         TrajectoryKind::LawnMower { scale, depth, .. } => lawn_mower::planar(scale, depth, t, ph),
-        TrajectoryKind::Waypoints { .. } => {
-            waypoints::planar(&t.route, &ph.time, &t.position_rate, t.rate)
-        }
+        TrajectoryKind::Waypoints { .. } => match t.law.is_set() {
+            true => waypoints::timed(&t.route, &t.law, &ph.time, &t.position_rate, t.rate),
+            false => waypoints::planar(&t.route, &ph.time, &t.position_rate, t.rate),
+        },
     }
 }
 

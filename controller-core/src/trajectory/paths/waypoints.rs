@@ -35,11 +35,12 @@
 //! [`SEARCH_STEPS`]-step binary search finds the segment (the same work for any point count).
 //! After the last waypoint the path continues straight along the last leg (C³ there too).
 
+use super::time_law::{SpeedList, TimeLaw, DEFAULT_SPEED_CHANGE, MAX_SPEED_CHANGE};
 use crate::math;
 use crate::phase::{LinearRate, MissionTime};
 use crate::trajectory::error::{positive, TrajectoryError};
 use crate::trajectory::phases::Planar;
-use crate::trajectory::Trajectory;
+use crate::trajectory::{Trajectory, TrajectoryKind};
 
 /// Most waypoints in one mission (Choice 152).
 pub const MAX_WAYPOINTS: usize = 32;
@@ -109,24 +110,115 @@ pub fn turn_radius(speed: f32, configured: Option<f32>) -> f32 {
 }
 
 /// speed in (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then
-/// the points ([`Route::new`]).
+/// the points ([`Route::new`]), then the time law if there is one ([`TimeLaw::new`]).
 pub(super) fn check(
     points: &WaypointList,
     speed: f32,
     radius: Option<f32>,
+    speeds: Option<SpeedList>,
+    speed_change: Option<f32>,
 ) -> Result<(), TrajectoryError> {
     positive("speed", speed, MAX_SPEED)?;
     if let Some(r) = radius {
         positive("turn_radius", r, Trajectory::MAX_SIZE)?;
     }
-    Route::new(points, turn_radius(speed, radius)).map(|_| ())
+    let route = Route::new(points, turn_radius(speed, radius))?;
+    if let Some(s) = speeds {
+        TimeLaw::new(&route, &s, speed_change.unwrap_or(DEFAULT_SPEED_CHANGE))?;
+    } else if let Some(a) = speed_change {
+        positive("speed_change", a, MAX_SPEED_CHANGE)?;
+    }
+    Ok(())
+}
+
+/// The route and the time law of a validated waypoint path (empty for the other kinds).
+pub(crate) fn route_and_law(path: &TrajectoryKind) -> (Route, TimeLaw) {
+    let TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius: radius,
+        speeds,
+        speed_change,
+    } = *path
+    else {
+        return (Route::EMPTY, TimeLaw::EMPTY);
+    };
+    let route = Route::new(&points, turn_radius(speed, radius)).unwrap_or(Route::EMPTY);
+    let law = match speeds {
+        Some(s) => TimeLaw::new(&route, &s, speed_change.unwrap_or(DEFAULT_SPEED_CHANGE))
+            .unwrap_or(TimeLaw::EMPTY),
+        None => TimeLaw::EMPTY,
+    };
+    (route, law)
+}
+
+/// The smallest horizontal speed and the square of K_d (Assumption 1) of the path flown at
+/// the constant `rate` or by `law` (at 1/k = `rate`): per segment, its sampled bounds
+/// ([`segment_bounds`]) times `margin`, with the segment's largest σ̇ and the law's largest
+/// |σ̈| = A/k²: ‖η̈‖ ≤ ‖p″‖σ̇² + A, |ψ̈| ≤ |ψ″|σ̇² + |ψ′|·A.
+pub(crate) fn speed_and_accel_bound(
+    route: &Route,
+    law: &TimeLaw,
+    rate: f32,
+    margin: f32,
+) -> (f32, f32) {
+    let mut min_speed = f32::INFINITY;
+    let mut kd2 = 0.0f32;
+    let law_accel = law.max_accel() * rate * rate;
+    for i in 0..route.segment_count() {
+        let b = segment_bounds(route, i);
+        let (v, a, v_min) = match law.is_set() {
+            true => (
+                law.segment_speed(i) * rate,
+                law_accel,
+                law.min_speed() * rate,
+            ),
+            false => (rate, 0.0, rate),
+        };
+        min_speed = min_speed.min(b.min_speed * v_min);
+        let path = margin * b.accel * v * v + a;
+        let heading = margin * (b.heading_accel * v * v + b.heading_rate * a);
+        kd2 = kd2.max(path * path + heading * heading);
+    }
+    (min_speed, kd2)
+}
+
+/// The path flown by `law` at the mission time `time` (its time over k: `time_rate` = 1/k,
+/// `inv_k`): x_d, y_d and three time derivatives, z_d, ż_d, z̈_d, by the chain rule
+/// η̇ = p′σ̇, η̈ = p″σ̇² + p′σ̈, η⃛ = p‴σ̇³ + 3p″σ̇σ̈ + p′σ⃛.
+#[inline]
+pub(super) fn timed(
+    route: &Route,
+    law: &TimeLaw,
+    time: &MissionTime,
+    time_rate: &LinearRate,
+    inv_k: f32,
+) -> Planar {
+    let (pp, [v, a, j]) = law.at(route, time, time_rate, inv_k);
+    let [d1, d2, d3] = pp.d;
+    let v2 = v * v;
+    let vel = |c: usize| d1[c] * v;
+    let acc = |c: usize| d2[c] * v2 + d1[c] * a;
+    let jerk = |c: usize| d3[c] * v2 * v + 3.0 * d2[c] * v * a + d1[c] * j;
+    Planar {
+        x: pp.p[0],
+        y: pp.p[1],
+        z: pp.p[2],
+        z_dot: vel(2),
+        z_ddot: acc(2),
+        d: [[vel(0), vel(1)], [acc(0), acc(1)], [jerk(0), jerk(1)]],
+    }
 }
 
 /// One segment: p(σ) = p0 + dir·(σ − s0) + e·q(u), u = (σ − s0)/len (e = 0 on a leg).
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub(crate) struct Segment {
     s0: f32,
+    len: f32,
     inv_len: f32,
+    /// Which part of the path it is: 2i for (the straight part of) leg i, 2i − 1 for the turn
+    /// at waypoint i: the index of its speed in a [`SpeedList`](super::time_law::SpeedList).
+    part: u8,
     p0: [f32; 3],
     dir: [f32; 3],
     e: [f32; 3],
@@ -187,6 +279,8 @@ impl Route {
         count: 0,
         segments: [Segment {
             s0: 0.0,
+            len: 0.0,
+            part: 0,
             inv_len: 0.0,
             p0: [0.0; 3],
             dir: [0.0; 3],
@@ -281,6 +375,8 @@ impl Route {
                 let len = 2.0 * a;
                 self.segments[count] = Segment {
                     s0: s,
+                    len,
+                    part: (2 * i - 1) as u8,
                     inv_len: 1.0 / len,
                     p0: sub(pts[i], scale(dirs[i - 1], a)),
                     dir: dirs[i - 1],
@@ -293,6 +389,8 @@ impl Route {
             if straight >= MIN_SEGMENT {
                 self.segments[count] = Segment {
                     s0: s,
+                    len: straight,
+                    part: (2 * i) as u8,
                     inv_len: 1.0 / straight,
                     p0: add(pts[i], scale(dirs[i], self.cuts[i])),
                     dir: dirs[i],
@@ -323,6 +421,16 @@ impl Route {
     /// The parameter σ at which segment `i` starts (i < [`Route::segment_count`]).
     pub fn segment_start(&self, i: usize) -> f32 {
         self.segments[i].s0
+    }
+
+    /// Segment `i`'s parameter length (m).
+    pub fn segment_length(&self, i: usize) -> f32 {
+        self.segments[i].len
+    }
+
+    /// Which part of the path segment `i` is: 2j for leg j, 2j − 1 for the turn at waypoint j.
+    pub fn segment_part(&self, i: usize) -> usize {
+        self.segments[i].part as usize
     }
 
     /// The cut distance a at waypoint `i` (m; 0 at the first and last).
@@ -448,7 +556,7 @@ pub(super) fn planar(
 
 /// A path point flown at σ̇ = `rate`, σ̈ = 0.
 #[inline]
-fn from_path(pp: &PathPoint, rate: f32) -> Planar {
+pub(super) fn from_path(pp: &PathPoint, rate: f32) -> Planar {
     let r2 = rate * rate;
     let r3 = r2 * rate;
     Planar {
@@ -468,28 +576,54 @@ fn from_path(pp: &PathPoint, rate: f32) -> Planar {
 /// Samples per segment for the configuration-time bounds ([`bounds`]).
 const BOUND_SAMPLES: u32 = 64;
 
-/// At σ̇ = 1: the smallest horizontal parameter speed |p'_h(σ)| over the path, the largest
-/// |p''(σ)| and the largest |ψ''(σ)| of the tangent heading (sampled at [`BOUND_SAMPLES`] points
-/// per segment and both ends; the caller scales by σ̇ and σ̇² and adds a margin). Fixed work.
-pub(crate) fn bounds(route: &Route) -> (f32, f32, f32) {
-    let mut min_speed = f32::INFINITY;
-    let mut max_accel = 0.0f32;
-    let mut max_heading = 0.0f32;
-    for i in 0..route.count as usize {
-        let seg = route.segments[i];
-        let len = 1.0 / seg.inv_len;
-        for j in 0..=BOUND_SAMPLES {
-            let sigma = seg.s0 + len * (j as f32 / BOUND_SAMPLES as f32);
-            let p = from_path(&route.at(sigma.min(route.length)), 1.0);
-            let speed = math::exact_sqrt(p.d[0][0] * p.d[0][0] + p.d[0][1] * p.d[0][1]);
-            min_speed = min_speed.min(speed);
-            let [ax, ay] = p.d[1];
-            max_accel = max_accel.max(math::exact_sqrt(ax * ax + ay * ay + p.z_ddot * p.z_ddot));
-            let (_, _, psi_ddot) = crate::trajectory::heading::tangent(&p);
-            max_heading = max_heading.max(psi_ddot.abs());
-        }
+/// What one segment asks at σ̇ = 1, σ̈ = 0 (sampled at [`BOUND_SAMPLES`] points and both ends;
+/// the caller scales by the speeds and adds a margin): the smallest horizontal parameter speed
+/// |p′_h|, the largest ‖p″‖, and the tangent heading's largest |ψ′| and |ψ″|.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(crate) struct SegmentBounds {
+    pub(crate) min_speed: f32,
+    pub(crate) accel: f32,
+    pub(crate) heading_rate: f32,
+    pub(crate) heading_accel: f32,
+}
+
+/// [`SegmentBounds`] of segment `i`. Fixed work.
+pub(crate) fn segment_bounds(route: &Route, i: usize) -> SegmentBounds {
+    let seg = route.segments[i];
+    let mut b = SegmentBounds {
+        min_speed: f32::INFINITY,
+        accel: 0.0,
+        heading_rate: 0.0,
+        heading_accel: 0.0,
+    };
+    for j in 0..=BOUND_SAMPLES {
+        let local = seg.len * (j as f32 / BOUND_SAMPLES as f32);
+        let p = from_path(&route.at_local(Some(i), local), 1.0);
+        let speed = math::exact_sqrt(p.d[0][0] * p.d[0][0] + p.d[0][1] * p.d[0][1]);
+        b.min_speed = b.min_speed.min(speed);
+        let [ax, ay] = p.d[1];
+        b.accel = b
+            .accel
+            .max(math::exact_sqrt(ax * ax + ay * ay + p.z_ddot * p.z_ddot));
+        let (_, rate, accel) = crate::trajectory::heading::tangent(&p);
+        b.heading_rate = b.heading_rate.max(rate.abs());
+        b.heading_accel = b.heading_accel.max(accel.abs());
     }
-    (min_speed, max_accel, max_heading)
+    b
+}
+
+/// At σ̇ = 1 over the whole path: the smallest |p′_h|, the largest ‖p″‖ and |ψ″|.
+pub(crate) fn bounds(route: &Route) -> (f32, f32, f32) {
+    let mut out = (f32::INFINITY, 0.0f32, 0.0f32);
+    for i in 0..route.count as usize {
+        let b = segment_bounds(route, i);
+        out = (
+            out.0.min(b.min_speed),
+            out.1.max(b.accel),
+            out.2.max(b.heading_accel),
+        );
+    }
+    out
 }
 
 /// `points = [[x, y, z], …]`: a sequence of at most [`MAX_WAYPOINTS`] triples (the error of a
