@@ -470,3 +470,160 @@ fn default_radius_and_heading() {
         assert_eq!(paper.sample(t, 100), tan.sample(t, 100));
     }
 }
+
+// ---------------------------------------------------------------------------------------------
+// The time law: a speed per leg and turn.
+
+/// The survey with fast legs and slow turns: 21 parts (11 legs, 10 turns).
+fn profiled(speeds: &[f32], speed_change: Option<f32>) -> Result<Trajectory, TrajectoryError> {
+    let TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius,
+        ..
+    } = kind(&survey(), 0.5, None)
+    else {
+        unreachable!()
+    };
+    Trajectory::new(Mission {
+        path: TrajectoryKind::Waypoints {
+            points,
+            speed,
+            turn_radius,
+            speeds: Some(controller_core::trajectory::SpeedList::new(speeds).expect("≤ 61")),
+            speed_change,
+        },
+        heading: HeadingMode::Tangent,
+        time_scale: 1.0,
+    })
+}
+
+fn survey_speeds() -> Vec<f32> {
+    // Long legs fast, the 20 m legs between two turns and the turns slow.
+    (0..21)
+        .map(|p| match p {
+            p if p % 2 == 1 => 0.3,
+            p if (p / 2) % 2 == 0 => 0.9,
+            _ => 0.3,
+        })
+        .collect()
+}
+
+/// With a time law: η̇_d, η̈_d, ψ̇_d, ψ̈_d against central differences, K_d holds, the speed on
+/// each cruise is the part's, and the path's end is reached at the law's duration.
+#[test]
+fn a_time_law_is_smooth_and_flies_each_part_at_its_speed() {
+    const RATE: u32 = 1000;
+    let tr = profiled(&survey_speeds(), Some(0.05)).expect("valid");
+    let law = tr.time_law();
+    assert!(law.is_set());
+    let end = law.duration() as f64;
+    let (h, dt) = (20u64, 0.04);
+    let mut worst = [0.0f64; 4];
+    let mut jump = 0.0f64;
+    let kd = tr.accel_bound() as f64;
+    let mut peak_acc = 0.0f64;
+    for k in (h..((end + 30.0) * RATE as f64) as u64).step_by(499) {
+        let (lo, mid, hi) = (
+            tr.sample(k - h, RATE),
+            tr.sample(k, RATE),
+            tr.sample(k + h, RATE),
+        );
+        for (n, c) in [0usize, 1].into_iter().enumerate() {
+            let fd_v = (hi.eta[c] as f64 - lo.eta[c] as f64) / dt;
+            let fd_a = (hi.eta_dot[c] as f64 - lo.eta_dot[c] as f64) / dt;
+            worst[n] = worst[n].max((fd_v - mid.eta_dot[c] as f64).abs());
+            worst[2 + n] = worst[2 + n].max((fd_a - mid.eta_ddot[c] as f64).abs());
+        }
+        let next = tr.sample(k + 1, RATE);
+        for c in [0, 1, 5] {
+            jump = jump.max((next.eta_ddot[c] - mid.eta_ddot[c]).abs() as f64);
+        }
+        let a: f64 = mid
+            .eta_ddot
+            .iter()
+            .map(|x| (*x as f64).powi(2))
+            .sum::<f64>()
+            .sqrt();
+        peak_acc = peak_acc.max(a);
+    }
+    assert!(worst.iter().all(|&w| w < 3e-3), "{worst:?}");
+    // σ̈ continuous: η̈ moves by little in one 1 ms tick (a step in σ̈ of A = 0.05 would show).
+    assert!(jump < 5e-3, "η̈ jumps by {jump} in a tick");
+    assert!(peak_acc <= kd, "‖η̈‖ {peak_acc} > K_d {kd}");
+    // The end: the last waypoint at the law's duration.
+    let d = tr.sample((end * RATE as f64).round() as u64, RATE);
+    assert!(
+        (d.eta[0] - 0.0).abs() < 2e-3 && (d.eta[1] - 100.0).abs() < 2e-3,
+        "{:?}",
+        d.eta
+    );
+    // Mid-leg 0 (100 m along it) at 0.9 m/s, mid-turn 1 at 0.3·cos 45° m/s.
+    let route = tr.route();
+    let speed_at = |sigma: f64| {
+        // The first time the path reaches σ, found by sampling (independent of the pieces).
+        let mut k = 0u64;
+        loop {
+            let s = tr.sample(k, 100);
+            let p = route.at(sigma as f32).p;
+            if ((s.eta[0] - p[0]).powi(2) + (s.eta[1] - p[1]).powi(2)).sqrt() < 0.01 {
+                return (s.eta_dot[0].powi(2) + s.eta_dot[1].powi(2)).sqrt();
+            }
+            k += 1;
+            assert!(k < 400_000, "σ = {sigma} never reached");
+        }
+    };
+    assert!((speed_at(100.0) - 0.9).abs() < 1e-3);
+    let turn_mid = route.segment_start(1) as f64 + route.cut(1) as f64;
+    assert!((speed_at(turn_mid) - 0.3 * 0.5f32.sqrt()).abs() < 2e-3);
+    // The duration: at least Σ length/speed over the parts (instant changes), at most that plus
+    // one change's duration, (15/8)·0.6/0.05 = 22.5 s, per change (ten of them).
+    let instant: f64 = (0..route.segment_count())
+        .map(|i| route.segment_length(i) as f64 / survey_speeds()[route.segment_part(i)] as f64)
+        .sum();
+    assert!(
+        end >= instant && end <= instant + 10.0 * 22.5,
+        "{end} vs {instant}"
+    );
+}
+
+#[test]
+fn a_time_law_that_cannot_be_flown_is_refused() {
+    let mut speeds = survey_speeds();
+    speeds.pop();
+    assert_eq!(
+        profiled(&speeds, None).expect_err("20 of 21"),
+        TrajectoryError::SpeedCount {
+            count: 20,
+            expected: 21
+        }
+    );
+    // The 6.7 m leg between two turns (part 2) at 2 m/s, turns at 0.3: the changes need more.
+    let mut speeds = survey_speeds();
+    speeds[2] = 2.0;
+    match profiled(&speeds, Some(0.05)).expect_err("too short") {
+        TrajectoryError::SpeedChangeTooLong {
+            part: 2,
+            needs,
+            has,
+        } => {
+            assert!(
+                needs > has && (has - (20.0 - 2.0 * 6.629)).abs() < 0.01,
+                "{needs} {has}"
+            )
+        }
+        e => panic!("{e:?}"),
+    }
+    assert_eq!(
+        profiled(&survey_speeds(), Some(0.0))
+            .expect_err("A = 0")
+            .parameter(),
+        "speed_change"
+    );
+    let mut speeds = survey_speeds();
+    speeds[3] = -1.0;
+    assert_eq!(
+        profiled(&speeds, None).expect_err("v < 0").parameter(),
+        "speeds"
+    );
+}
