@@ -818,3 +818,29 @@ fn waypoint_errors_name_their_key_and_reason() {
     ));
     assert!(msg.contains("unknown field `radius`"), "{msg}");
 }
+
+#[test]
+fn a_pinned_speed_profile_parses_and_its_errors_name_speeds() {
+    let three = "[[0, 0, 5], [80, 0, 5], [80, 60, 5]]";
+    let s = parse_scenario(&waypoints_with(
+        three,
+        "speed = 0.5\nspeeds = [1.2, 0.5, 1.0]\nspeed_change = 0.04\n",
+    ))
+    .expect("valid");
+    assert!(s.trajectory().time_law().is_set());
+    let (key, msg) = invalid_key(&waypoints_with(three, "speed = 0.5\nspeeds = [1.2, 0.5]\n"));
+    assert_eq!(key, "trajectory.speeds");
+    assert!(msg.contains("2 speeds") && msg.contains("3 parts"), "{msg}");
+    let (key, _) = invalid_key(&waypoints_with(
+        three,
+        "speed = 0.5\nspeeds = [1.2, 0.5, 1.0]\nspeed_change = 0\n",
+    ));
+    assert_eq!(key, "trajectory.speed_change");
+    // A 6 m/s leg needs ≈ 1 000 m to slow to 0.5 at 0.04 m/s²: the 80 m leg cannot.
+    let (key, msg) = invalid_key(&waypoints_with(
+        three,
+        "speed = 0.5\nspeeds = [6, 0.5, 1.0]\nspeed_change = 0.04\n",
+    ));
+    assert_eq!(key, "trajectory.speeds");
+    assert!(msg.contains("part 0"), "{msg}");
+}

@@ -195,6 +195,16 @@ impl TimeLaw {
         self.duration
     }
 
+    /// The time (s, at time scale 1) at which segment `i` of the route begins.
+    pub fn segment_time(&self, i: usize) -> f32 {
+        for p in &self.pieces[..self.count as usize] {
+            if p.segment as usize == i {
+                return p.t0;
+            }
+        }
+        self.duration
+    }
+
     /// The largest σ̇ on segment `i` (its own speed: changes happen in the faster part).
     pub(crate) fn segment_speed(&self, i: usize) -> f32 {
         let mut v = 0.0f32;
