@@ -80,7 +80,7 @@ use nalgebra::Vector6;
 
 use crate::math;
 use crate::phase::{Frequency, LinearRate, MissionTime};
-use heading::tangent;
+use phases::tangent;
 use phases::{Harmonics, Phases};
 use series::{series_coefficients, ODD_TERMS};
 use table1::{circle_kind, figure_eight_kind, lawn_mower_kind};
@@ -212,7 +212,7 @@ impl Trajectory {
             Some(series) => series_coefficients(series, omega),
             None => [[0.0; 3]; ODD_TERMS],
         };
-        let (route, law) = paths::waypoints::route_and_law(&mission.path);
+        let (route, law) = paths::time_law::route_and_law(&mission.path);
         let mut t = Self {
             route,
             law,
@@ -236,7 +236,7 @@ impl Trajectory {
                 t.rate = (1.0 / k) as f32;
                 t.position_rate = LinearRate::new(1.0 / k);
             }
-            let (min_speed, accel) = paths::waypoints::speed_and_accel_bound(
+            let (min_speed, accel) = paths::time_law::speed_and_accel_bound(
                 &t.route,
                 &t.law,
                 t.rate,

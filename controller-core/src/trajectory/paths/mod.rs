@@ -48,7 +48,7 @@ pub(super) fn check(path: &TrajectoryKind) -> Result<(), TrajectoryError> {
             turn_radius,
             speeds,
             speed_change,
-        } => waypoints::check(&points, speed, turn_radius, speeds, speed_change),
+        } => time_law::check(&points, speed, turn_radius, speeds, speed_change),
     }
 }
 
@@ -160,7 +160,7 @@ pub(super) fn planar(t: &Trajectory, ph: &Phases) -> Planar {
         } => figure_eight::planar(amplitude, depth, t.omega, ph),
         TrajectoryKind::LawnMower { scale, depth, .. } => lawn_mower::planar(scale, depth, t, ph),
         TrajectoryKind::Waypoints { .. } => match t.law.is_set() {
-            true => waypoints::timed(&t.route, &t.law, &ph.time, &t.position_rate, t.rate),
+            true => time_law::timed(&t.route, &t.law, &ph.time, &t.position_rate, t.rate),
             false => waypoints::planar(&t.route, &ph.time, &t.position_rate, t.rate),
         },
     }
@@ -183,6 +183,6 @@ pub(super) fn paper_heading(
         TrajectoryKind::FigureEight { .. } | TrajectoryKind::LawnMower { .. } => {
             t.heading_series(h)
         }
-        TrajectoryKind::Waypoints { .. } => crate::trajectory::heading::tangent(p),
+        TrajectoryKind::Waypoints { .. } => crate::trajectory::phases::tangent(p),
     }
 }

@@ -35,12 +35,10 @@
 //! [`SEARCH_STEPS`]-step binary search finds the segment (the same work for any point count).
 //! After the last waypoint the path continues straight along the last leg (C³ there too).
 
-use super::time_law::{SpeedList, TimeLaw, DEFAULT_SPEED_CHANGE, MAX_SPEED_CHANGE};
 use crate::math;
 use crate::phase::{LinearRate, MissionTime};
-use crate::trajectory::error::{positive, TrajectoryError};
+use crate::trajectory::error::TrajectoryError;
 use crate::trajectory::phases::Planar;
-use crate::trajectory::{Trajectory, TrajectoryKind};
 
 /// Most waypoints in one mission (Choice 152).
 pub const MAX_WAYPOINTS: usize = 32;
@@ -107,107 +105,6 @@ impl WaypointList {
 /// [`MIN_TURN_RADIUS`] (Choice 151).
 pub fn turn_radius(speed: f32, configured: Option<f32>) -> f32 {
     configured.unwrap_or((speed * speed / TURN_ACCEL).max(MIN_TURN_RADIUS))
-}
-
-/// speed in (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then
-/// the points ([`Route::new`]), then the time law if there is one ([`TimeLaw::new`]).
-pub(super) fn check(
-    points: &WaypointList,
-    speed: f32,
-    radius: Option<f32>,
-    speeds: Option<SpeedList>,
-    speed_change: Option<f32>,
-) -> Result<(), TrajectoryError> {
-    positive("speed", speed, MAX_SPEED)?;
-    if let Some(r) = radius {
-        positive("turn_radius", r, Trajectory::MAX_SIZE)?;
-    }
-    let route = Route::new(points, turn_radius(speed, radius))?;
-    if let Some(s) = speeds {
-        TimeLaw::new(&route, &s, speed_change.unwrap_or(DEFAULT_SPEED_CHANGE))?;
-    } else if let Some(a) = speed_change {
-        positive("speed_change", a, MAX_SPEED_CHANGE)?;
-    }
-    Ok(())
-}
-
-/// The route and the time law of a validated waypoint path (empty for the other kinds).
-pub(crate) fn route_and_law(path: &TrajectoryKind) -> (Route, TimeLaw) {
-    let TrajectoryKind::Waypoints {
-        points,
-        speed,
-        turn_radius: radius,
-        speeds,
-        speed_change,
-    } = *path
-    else {
-        return (Route::EMPTY, TimeLaw::EMPTY);
-    };
-    let route = Route::new(&points, turn_radius(speed, radius)).unwrap_or(Route::EMPTY);
-    let law = match speeds {
-        Some(s) => TimeLaw::new(&route, &s, speed_change.unwrap_or(DEFAULT_SPEED_CHANGE))
-            .unwrap_or(TimeLaw::EMPTY),
-        None => TimeLaw::EMPTY,
-    };
-    (route, law)
-}
-
-/// The smallest horizontal speed and the square of K_d (Assumption 1) of the path flown at
-/// the constant `rate` or by `law` (at 1/k = `rate`): per segment, its sampled bounds
-/// ([`segment_bounds`]) times `margin`, with the segment's largest σ̇ and the law's largest
-/// |σ̈| = A/k²: ‖η̈‖ ≤ ‖p″‖σ̇² + A, |ψ̈| ≤ |ψ″|σ̇² + |ψ′|·A.
-pub(crate) fn speed_and_accel_bound(
-    route: &Route,
-    law: &TimeLaw,
-    rate: f32,
-    margin: f32,
-) -> (f32, f32) {
-    let mut min_speed = f32::INFINITY;
-    let mut kd2 = 0.0f32;
-    let law_accel = law.max_accel() * rate * rate;
-    for i in 0..route.segment_count() {
-        let b = segment_bounds(route, i);
-        let (v, a, v_min) = match law.is_set() {
-            true => (
-                law.segment_speed(i) * rate,
-                law_accel,
-                law.min_speed() * rate,
-            ),
-            false => (rate, 0.0, rate),
-        };
-        min_speed = min_speed.min(b.min_speed * v_min);
-        let path = margin * b.accel * v * v + a;
-        let heading = margin * (b.heading_accel * v * v + b.heading_rate * a);
-        kd2 = kd2.max(path * path + heading * heading);
-    }
-    (min_speed, kd2)
-}
-
-/// The path flown by `law` at the mission time `time` (its time over k: `time_rate` = 1/k,
-/// `inv_k`): x_d, y_d and three time derivatives, z_d, ż_d, z̈_d, by the chain rule
-/// η̇ = p′σ̇, η̈ = p″σ̇² + p′σ̈, η⃛ = p‴σ̇³ + 3p″σ̇σ̈ + p′σ⃛.
-#[inline]
-pub(super) fn timed(
-    route: &Route,
-    law: &TimeLaw,
-    time: &MissionTime,
-    time_rate: &LinearRate,
-    inv_k: f32,
-) -> Planar {
-    let (pp, [v, a, j]) = law.at(route, time, time_rate, inv_k);
-    let [d1, d2, d3] = pp.d;
-    let v2 = v * v;
-    let vel = |c: usize| d1[c] * v;
-    let acc = |c: usize| d2[c] * v2 + d1[c] * a;
-    let jerk = |c: usize| d3[c] * v2 * v + 3.0 * d2[c] * v * a + d1[c] * j;
-    Planar {
-        x: pp.p[0],
-        y: pp.p[1],
-        z: pp.p[2],
-        z_dot: vel(2),
-        z_ddot: acc(2),
-        d: [[vel(0), vel(1)], [acc(0), acc(1)], [jerk(0), jerk(1)]],
-    }
 }
 
 /// One segment: p(σ) = p0 + dir·(σ − s0) + e·q(u), u = (σ − s0)/len (e = 0 on a leg).
@@ -605,7 +502,7 @@ pub(crate) fn segment_bounds(route: &Route, i: usize) -> SegmentBounds {
         b.accel = b
             .accel
             .max(math::exact_sqrt(ax * ax + ay * ay + p.z_ddot * p.z_ddot));
-        let (_, rate, accel) = crate::trajectory::heading::tangent(&p);
+        let (_, rate, accel) = crate::trajectory::phases::tangent(&p);
         b.heading_rate = b.heading_rate.max(rate.abs());
         b.heading_accel = b.heading_accel.max(accel.abs());
     }
