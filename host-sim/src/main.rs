@@ -9,7 +9,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
-    self, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args, ValidateArgs,
+    self, CheckArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args,
+    ValidateArgs,
 };
 
 #[derive(Parser)]
@@ -47,6 +48,9 @@ enum Command {
     /// random missions, each checked, then flown at the proposed time scale; reports the
     /// false-feasible count (exit 1 if any) and how conservative the verdict is.
     ValidatePreflight(ValidateArgs),
+    /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
+    /// frame of the plan's home position. Exit 2 if the file is not a plan of waypoints
+    ImportPlan(ImportPlanArgs),
 }
 
 fn main() -> ExitCode {
@@ -71,6 +75,7 @@ fn main() -> ExitCode {
         Command::MonteCarlo(args) => cli::monte_carlo(&args, stdout),
         Command::Check(args) => cli::check(&args, stdout),
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
+        Command::ImportPlan(args) => cli::import_plan(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

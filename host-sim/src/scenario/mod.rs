@@ -176,6 +176,7 @@ mod config;
 mod fixed_arrays;
 pub mod paper;
 mod parse;
+pub mod plan;
 pub mod real_vehicle;
 mod start;
 mod validate;
