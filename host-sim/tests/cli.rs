@@ -26,15 +26,16 @@ fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
     let v: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
     let cases = v["cases"].as_array().unwrap();
-    // The twelve Table-1 runs, then the six real missions and the waypoint survey, and the
-    // paper's six through the real chain (with Δu), each of the thirteen missions with its
+    // The twelve Table-1 runs, then the six real missions and the two waypoint missions, and
+    // the paper's six through the real chain (with Δu), each of the fourteen missions with its
     // preflight check.
-    assert_eq!(cases.len(), 25);
-    assert_eq!(v["preflight"].as_array().unwrap().len(), 13);
-    for c in &cases[12..19] {
+    assert_eq!(cases.len(), 26);
+    assert_eq!(v["preflight"].as_array().unwrap().len(), 14);
+    for c in &cases[12..20] {
         assert!(c["case"].as_str().unwrap().starts_with("real-"), "{c}");
     }
     assert_eq!(cases[18]["case"], "real-survey-200x100");
+    assert_eq!(cases[19]["case"], "real-harbour-wall");
     for name in [
         "circular-10R",
         "circular-20R",

@@ -41,10 +41,16 @@ pub const REAL_SCENARIOS: [(&str, &str); 6] = [
 
 /// The real vehicle's waypoint missions (docs/design.md §27), flown in the same table after
 /// [`REAL_SCENARIOS`]: (file name, its text).
-pub const WAYPOINT_SCENARIOS: [(&str, &str); 1] = [(
-    "survey-200x100.toml",
-    include_str!("../../scenarios/real/survey-200x100.toml"),
-)];
+pub const WAYPOINT_SCENARIOS: [(&str, &str); 2] = [
+    (
+        "survey-200x100.toml",
+        include_str!("../../scenarios/real/survey-200x100.toml"),
+    ),
+    (
+        "harbour-wall.toml",
+        include_str!("../../scenarios/real/harbour-wall.toml"),
+    ),
+];
 
 /// The waypoint missions, validated ([`WAYPOINT_SCENARIOS`]).
 pub fn waypoint_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
