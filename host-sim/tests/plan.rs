@@ -103,3 +103,54 @@ fn the_shipped_plan_imports_as_a_valid_waypoint_scenario() {
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("survey-200x100.toml"));
 }
+
+/// The imported plan flown (`run`, 40 s): the flown path is written as GeoJSON around the
+/// plan's home, starting on the first waypoint; a bad origin names `trajectory.origin`.
+#[test]
+fn a_run_with_an_origin_writes_the_flown_path_as_geojson() {
+    let dir = std::env::temp_dir().join(format!("host-sim-plan-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["import-plan", "--speed", "0.4", "--name", "wall"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/plans/harbour-wall.plan"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let scenario = dir.join("wall.toml");
+    std::fs::write(&scenario, format!("duration = 40.0\n{text}")).unwrap();
+    let run_dir = dir.join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["run", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&run_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let g: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("wall-flown.geojson")).unwrap())
+            .unwrap();
+    let c = g["geometry"]["coordinates"].as_array().unwrap();
+    assert!(c.len() > 10);
+    // The first waypoint is the plan's home, 3 m deep: [lon, lat, alt].
+    let first = &c[0];
+    assert!((first[0].as_f64().unwrap() - 5.362).abs() < 1e-6, "{first}");
+    assert!(
+        (first[1].as_f64().unwrap() - 43.295).abs() < 1e-6,
+        "{first}"
+    );
+    assert!((first[2].as_f64().unwrap() + 3.0).abs() < 0.01, "{first}");
+    let bad = text.replace("origin = [43.295", "origin = [143.295");
+    match parse_scenario(&bad) {
+        Err(host_sim::scenario::ScenarioError::Invalid { key, .. }) => {
+            assert_eq!(key, "trajectory.origin")
+        }
+        other => panic!("{other:?}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}

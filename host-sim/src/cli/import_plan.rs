@@ -38,14 +38,17 @@ pub fn import_plan(args: &ImportPlanArgs, stdout: &mut dyn Write) -> Result<Exit
         "# Imported from {} (docs/design.md §27): NED in the tangent plane at the plan's home\n\
          # position lat {}, lon {}, alt {} m (WGS-84 flat earth; error under 1 cm within 250 m).\n\
          name = \"{}\"\n\n[trajectory]\nkind = \"waypoints\"\npoints = [\n{}\n]\nspeed = {}\n\
-         heading = \"tangent\"",
+         heading = \"tangent\"\norigin = [{}, {}, {}]",
         args.plan.display(),
         origin.lat,
         origin.lon,
         origin.alt,
         args.name,
         pts.join("\n"),
-        args.speed
+        args.speed,
+        origin.lat,
+        origin.lon,
+        origin.alt
     )?;
     Ok(Exit::Success)
 }

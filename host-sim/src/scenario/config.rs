@@ -150,6 +150,10 @@ pub struct SimConfig {
     /// The mission's time scale k ≥ 1: the reference is η_d(t/k) (`trajectory.time_scale`,
     /// default 1; docs/design.md §9).
     pub time_scale: f32,
+    /// The mission frame's origin on the earth, [latitude, longitude (degrees), altitude (m)]
+    /// (`trajectory.origin`, e.g. a QGroundControl plan's home): `run` then writes the flown
+    /// path as GeoJSON (docs/design.md §27). `None`: the frame is not placed on the earth.
+    pub origin: Option<[f64; 3]>,
     /// Simulated time (s). Paper: 70.
     pub duration: f64,
     /// Plant RK4 step (s). Default 1 ms.
@@ -246,6 +250,7 @@ impl SimConfig {
                 _ => HeadingMode::Paper,
             },
             time_scale: 1.0,
+            origin: None,
             duration: 70.0,
             plant_step: 0.001,
             controller: ControllerConfig::default(),

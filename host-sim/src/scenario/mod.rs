@@ -57,6 +57,8 @@
 //! heading = "paper"           # "paper" | "tangent" (ψ_d along the course); default "paper",
 //!                             # "tangent" for waypoints (their only heading)
 //! time_scale = 1.0            # k in [1, 100]: the reference is η_d(t/k); default 1
+//! origin = [43.295, 5.362, 0.0]  # the frame's origin: lat, lon (deg), alt (m); run then writes
+//!                             # the flown path as GeoJSON; default none
 //!
 //! [variation]                 # Table-3 parameter variation of the plant (not the controller)
 //! profile = "abs-sin"         # "none" | "constant" | "abs-sin" | "staircase" | "table3-staircase"
