@@ -23,4 +23,6 @@ pub use config::{BBound, ConfigError, ControllerConfig};
 pub use controller::{Controller, Fault, Output, Stage, Status};
 pub use law::RobustLaw;
 pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};
-pub use trajectory::{Desired, HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
+pub use trajectory::{
+    Desired, HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind, WaypointList,
+};

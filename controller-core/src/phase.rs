@@ -162,6 +162,36 @@ impl MissionTime {
     }
 }
 
+impl MissionTime {
+    /// rate·t − `start` where the result is small beside rate·t (the waypoint path's parameter
+    /// within its segment, docs/design.md §27): the exact products rate·q of
+    /// [`linear`](Self::linear) are summed with their rounding errors kept (Knuth's two-sum),
+    /// `start` is subtracted from the rounded sum (exact by Sterbenz's lemma when the result is
+    /// at most `start`), and the errors and the fraction of a second are added last. So the
+    /// result is good to a few ulps of itself, not of rate·t: 1.5e-5 m on a 200 m leg at any
+    /// distance along the path (σ itself as an f32 is good to 1.2e-4 m at 1.3 km).
+    #[inline]
+    pub fn linear_since(&self, rate: &LinearRate, start: f32) -> f32 {
+        let q = self.seconds;
+        let q_hi = (q & !0xfff) as f32;
+        let q_lo = (q & 0xfff) as f32;
+        let frac = self.sub_ticks as f32 / self.rate_hz as f32;
+        let (s1, e1) = two_sum(rate.hi * q_hi, rate.hi * q_lo);
+        let (s2, e2) = two_sum(s1, rate.mid * q_hi);
+        let small = rate.mid * q_lo + rate.lo * (q_hi + q_lo) + (rate.hi + rate.mid) * frac;
+        (s2 - start) + ((e1 + e2) + small)
+    }
+}
+
+/// a + b = s + e exactly (Knuth's two-sum, six additions; no fused operations in Rust).
+#[inline]
+fn two_sum(a: f32, b: f32) -> (f32, f32) {
+    let s = a + b;
+    let bb = s - a;
+    let e = (a - (s - bb)) + (b - bb);
+    (s, e)
+}
+
 /// A rate (configuration time, f64) as three f32s hi + mid + lo for [`MissionTime::linear`]:
 /// hi and mid the high and low 12 significant bits of the rate rounded to f32 (so hi·q and
 /// mid·q are exact for 12-bit parts of q), lo the f32 of what the f32 rounding left.

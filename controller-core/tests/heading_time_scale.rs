@@ -160,6 +160,9 @@ fn path_f64(kind: TrajectoryKind, t: f64) -> ([[f64; 4]; 2], f64, f64) {
                 0.0,
             )
         }
+        TrajectoryKind::Waypoints { .. } => {
+            unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
+        }
     }
 }
 
@@ -180,6 +183,9 @@ fn base_omega(kind: TrajectoryKind) -> f64 {
         | TrajectoryKind::Helix { omega, .. }
         | TrajectoryKind::FigureEight { omega, .. }
         | TrajectoryKind::LawnMower { omega, .. } => omega as f64,
+        TrajectoryKind::Waypoints { .. } => {
+            unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
+        }
     }
 }
 

@@ -80,6 +80,9 @@ fn fd_half_step(kind: TrajectoryKind) -> u64 {
         | TrajectoryKind::Helix { omega, .. }
         | TrajectoryKind::FigureEight { omega, .. }
         | TrajectoryKind::LawnMower { omega, .. } => omega as f64,
+        TrajectoryKind::Waypoints { .. } => {
+            unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
+        }
     };
     (0.005 / omega * FD_RATE as f64).round() as u64
 }
@@ -259,6 +262,9 @@ fn figure_eight_and_lawn_mower_paper_values() {
                 | TrajectoryKind::FigureEight { depth, .. }
                 | TrajectoryKind::LawnMower { depth, .. } => Some(depth),
                 TrajectoryKind::Helix { .. } => None,
+                TrajectoryKind::Waypoints { .. } => {
+                    unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
+                }
             };
             if let Some(depth) = depth {
                 assert_eq!(d.eta[2], depth, "{name}");
@@ -613,6 +619,9 @@ fn reference(kind: TrajectoryKind, t: f64) -> (f64, f64, f64) {
                 wrap(psi),
             )
         }
+        TrajectoryKind::Waypoints { .. } => {
+            unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
+        }
     }
 }
 
@@ -628,6 +637,9 @@ fn reference_tol(kind: TrajectoryKind) -> (f64, f64) {
         TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => radius,
         TrajectoryKind::FigureEight { amplitude, .. } => amplitude,
         TrajectoryKind::LawnMower { scale, .. } => 15.0 * scale,
+        TrajectoryKind::Waypoints { .. } => {
+            unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
+        }
     } as f64;
     (2e-3 * amp, SERIES_TOL)
 }

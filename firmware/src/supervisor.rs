@@ -517,7 +517,10 @@ impl Supervisor {
     fn control(&mut self, overrun: bool, now: &dyn Fn() -> u32) -> (BoardStatus, Control) {
         let off = Control::default();
         let stale = self.periods_since_state > u32::from(self.stale_periods);
-        match (self.armed, self.latched, self.mission, self.state) {
+        // The mission's start tick only: the trajectory (8.6 kB with a waypoint path's route and
+        // time law, docs/design.md §27) is borrowed in `fly`, not copied every period.
+        let mission = self.mission.as_ref().map(|&(_, start)| ((), start));
+        match (self.armed, self.latched, mission, self.state) {
             (false, _, _, _) => (BoardStatus::Disarmed, off),
             (true, Some(l), _, _) => (BoardStatus::FailSafe(l.reason), off),
             (true, None, None, _) => (BoardStatus::Armed, off),
@@ -535,18 +538,15 @@ impl Supervisor {
             (true, None, Some(_), Some(_)) if stale => {
                 (self.latch(FailSafeReason::StaleState, 0), off)
             }
-            (true, None, Some((traj, start)), Some(s)) => self.fly(&traj, start, &s, now),
+            (true, None, Some(((), start)), Some(s)) => self.fly(start, &s, now),
         }
     }
 
     /// `update` on the latest state frame, timed; a fault latches the fail-safe.
-    fn fly(
-        &mut self,
-        traj: &Trajectory,
-        start: u64,
-        s: &StateFrame,
-        now: &dyn Fn() -> u32,
-    ) -> (BoardStatus, Control) {
+    fn fly(&mut self, start: u64, s: &StateFrame, now: &dyn Fn() -> u32) -> (BoardStatus, Control) {
+        let Some((traj, _)) = &self.mission else {
+            return (BoardStatus::Armed, Control::default());
+        };
         // Mission time: the board's own ticks since StartMission; in lock-step the state
         // frame's t_ticks, on the mission clock (so PIL does not depend on host speed).
         let mission_ticks = if self.lockstep {

@@ -9,7 +9,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
-    self, CampaignArgs, CheckArgs, HilArgs, MonteCarloArgs, PilArgs, RunArgs, Table1Args,
+    self, CampaignArgs, CheckArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs, RunArgs,
+    Table1Args,
     ValidateArgs,
 };
 
@@ -52,6 +53,9 @@ enum Command {
     /// (Slurm array task, Kubernetes Indexed Job, laptop; restartable), `merge` the shards into
     /// one report whose worst cases replay bit for bit.
     Campaign(CampaignArgs),
+    /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
+    /// frame of the plan's home position. Exit 2 if the file is not a plan of waypoints
+    ImportPlan(ImportPlanArgs),
 }
 
 fn main() -> ExitCode {
@@ -77,6 +81,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cli::check(&args, stdout),
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
         Command::Campaign(args) => cli::campaign(&args, stdout),
+        Command::ImportPlan(args) => cli::import_plan(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

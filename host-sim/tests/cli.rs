@@ -26,13 +26,16 @@ fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
     let v: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
     let cases = v["cases"].as_array().unwrap();
-    // The twelve Table-1 runs, then the six real missions and the paper's six through the
-    // real chain (with Δu), each of the twelve missions with its preflight check.
-    assert_eq!(cases.len(), 24);
-    assert_eq!(v["preflight"].as_array().unwrap().len(), 12);
-    for c in &cases[12..18] {
+    // The twelve Table-1 runs, then the six real missions and the two waypoint missions, and
+    // the paper's six through the real chain (with Δu), each of the fourteen missions with its
+    // preflight check.
+    assert_eq!(cases.len(), 26);
+    assert_eq!(v["preflight"].as_array().unwrap().len(), 14);
+    for c in &cases[12..20] {
         assert!(c["case"].as_str().unwrap().starts_with("real-"), "{c}");
     }
+    assert_eq!(cases[18]["case"], "real-survey-200x100");
+    assert_eq!(cases[19]["case"], "real-harbour-wall");
     for name in [
         "circular-10R",
         "circular-20R",

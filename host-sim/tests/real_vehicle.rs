@@ -235,6 +235,20 @@ fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
         // The whole 70 s path of the paper, at the mission's time scale.
         assert!((c.duration - 70.0 * f64::from(c.time_scale)).abs() < 0.01);
     }
+    // The waypoint surveys too, each flown to its last waypoint (its time law's duration).
+    let surveys = real_vehicle::waypoint_scenarios().unwrap();
+    for ((file, _), s) in real_vehicle::WAYPOINT_SCENARIOS.iter().zip(&surveys) {
+        let loaded = load_scenario(&scenarios_dir().join("real").join(file)).unwrap();
+        assert_eq!(loaded.config(), s.config(), "{file}");
+        let c = s.config();
+        assert!(c.trimmed && !c.ideal_actuators && c.heading == HeadingMode::Tangent);
+        let law = s.trajectory().time_law();
+        assert!(law.is_set(), "{file}: the speed profile is pinned");
+        assert!(
+            (c.duration - f64::from(law.duration())).abs() < 0.1,
+            "{file}"
+        );
+    }
 }
 
 #[test]

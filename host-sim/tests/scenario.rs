@@ -723,3 +723,124 @@ fn the_schema_and_the_all_knobs_example_name_the_same_keys() {
     // Every key the example shows is one the parser takes: the example parses as written.
     load_scenario(&scenarios_dir().join("example-all-knobs.toml")).unwrap();
 }
+
+/// A waypoint `[trajectory]` with `points` and `extra` keys.
+fn waypoints_with(points: &str, extra: &str) -> String {
+    format!("name = \"w\"\n[trajectory]\nkind = \"waypoints\"\npoints = {points}\n{extra}")
+}
+
+#[test]
+fn waypoint_missions_parse_with_the_tangent_heading_by_default() {
+    let s = parse_scenario(&waypoints_with(
+        "[[0, 0, 5], [60, 0, 5], [60, 30, 5]]",
+        "speed = 0.5\n",
+    ))
+    .expect("valid");
+    let c = s.config();
+    assert_eq!(c.heading, controller_core::HeadingMode::Tangent);
+    let TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius,
+        ..
+    } = c.trajectory
+    else {
+        panic!("{:?}", c.trajectory)
+    };
+    assert_eq!(
+        points.as_slice(),
+        &[[0.0, 0.0, 5.0], [60.0, 0.0, 5.0], [60.0, 30.0, 5.0]]
+    );
+    assert_eq!((speed, turn_radius), (0.5, None));
+    // turn_radius and an explicit paper heading are taken.
+    let s = parse_scenario(&waypoints_with(
+        "[[0, 0, 5], [60, 0, 5], [60, 30, 5]]",
+        "speed = 0.5\nturn_radius = 3\nheading = \"paper\"\n",
+    ))
+    .expect("valid");
+    assert!(matches!(
+        s.config().trajectory,
+        TrajectoryKind::Waypoints {
+            turn_radius: Some(3.0),
+            ..
+        }
+    ));
+}
+
+#[test]
+fn waypoint_errors_name_their_key_and_reason() {
+    // Repeated point, sharp turn, short leg: `trajectory.points`, with the waypoint's index.
+    let (key, msg) = invalid_key(&waypoints_with(
+        "[[0, 0, 5], [60, 0, 5], [60, 0, 5]]",
+        "speed = 0.5\n",
+    ));
+    assert_eq!(key, "trajectory.points");
+    assert!(msg.contains("waypoint 2 repeats waypoint 1"), "{msg}");
+    let (key, msg) = invalid_key(&waypoints_with(
+        "[[0, 0, 5], [60, 0, 5], [10, 5, 5]]",
+        "speed = 0.5\n",
+    ));
+    assert_eq!(key, "trajectory.points");
+    assert!(
+        msg.contains("turn at waypoint 1") && msg.contains("120"),
+        "{msg}"
+    );
+    let (key, msg) = invalid_key(&waypoints_with(
+        "[[0, 0, 5], [60, 0, 5], [60, 5, 5], [0, 5, 5]]",
+        "speed = 0.5\n",
+    ));
+    assert_eq!(key, "trajectory.points");
+    assert!(
+        msg.contains("leg 1") && msg.contains("turn_radius"),
+        "{msg}"
+    );
+    let (key, _) = invalid_key(&waypoints_with("[[0, 0, 5]]", "speed = 0.5\n"));
+    assert_eq!(key, "trajectory.points");
+    let (key, _) = invalid_key(&waypoints_with("[[0, 0, 5], [9, 0, 5]]", "speed = 0\n"));
+    assert_eq!(key, "trajectory.speed");
+    let (key, _) = invalid_key(&waypoints_with(
+        "[[0, 0, 5], [9, 0, 5]]",
+        "speed = 1\nturn_radius = -2\n",
+    ));
+    assert_eq!(key, "trajectory.turn_radius");
+    // More than 32 points: the TOML error says the limit; a missing speed names the field.
+    let many: Vec<String> = (0..33).map(|i| format!("[{}, 0, 5]", 10 * i)).collect();
+    let msg = toml_error(&waypoints_with(
+        &format!("[{}]", many.join(", ")),
+        "speed = 1\n",
+    ));
+    assert!(msg.contains("more than 32 waypoints"), "{msg}");
+    let msg = toml_error(&waypoints_with("[[0, 0, 5], [9, 0, 5]]", ""));
+    assert!(msg.contains("missing field `speed`"), "{msg}");
+    let msg = toml_error(&waypoints_with(
+        "[[0, 0, 5], [9, 0, 5]]",
+        "speed = 1\nradius = 3\n",
+    ));
+    assert!(msg.contains("unknown field `radius`"), "{msg}");
+}
+
+#[test]
+fn a_pinned_speed_profile_parses_and_its_errors_name_speeds() {
+    let three = "[[0, 0, 5], [80, 0, 5], [80, 60, 5]]";
+    let s = parse_scenario(&waypoints_with(
+        three,
+        "speed = 0.5\nspeeds = [1.2, 0.5, 1.0]\nspeed_change = 0.04\n",
+    ))
+    .expect("valid");
+    assert!(s.trajectory().time_law().is_set());
+    let (key, msg) = invalid_key(&waypoints_with(three, "speed = 0.5\nspeeds = [1.2, 0.5]\n"));
+    assert_eq!(key, "trajectory.speeds");
+    assert!(msg.contains("2 speeds") && msg.contains("3 parts"), "{msg}");
+    let (key, _) = invalid_key(&waypoints_with(
+        three,
+        "speed = 0.5\nspeeds = [1.2, 0.5, 1.0]\nspeed_change = 0\n",
+    ));
+    assert_eq!(key, "trajectory.speed_change");
+    // A 6 m/s leg needs ≈ 1 000 m to slow to 0.5 at 0.04 m/s²: the 80 m leg cannot.
+    let (key, msg) = invalid_key(&waypoints_with(
+        three,
+        "speed = 0.5\nspeeds = [6, 0.5, 1.0]\nspeed_change = 0.04\n",
+    ));
+    assert_eq!(key, "trajectory.speeds");
+    assert!(msg.contains("part 0"), "{msg}");
+}

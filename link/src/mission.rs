@@ -12,7 +12,9 @@
 //! `MissionSpec` stays its own type because its layout *is* the wire format (variant order and
 //! field order fix the postcard bytes; see [`crate::msg`]), while `TrajectoryKind` may grow
 //! without a protocol change. A kind added to the core fails to compile here until the link
-//! carries it.
+//! carries it, or is listed as one that does not fit one frame: the waypoint path
+//! (docs/design.md §27) is up to 32 points, so core → wire is a `TryFrom` that refuses it
+//! ([`NotOneFrame`]) until the chunked mission upload carries it.
 
 use controller_core::{HeadingMode, Mission, TrajectoryKind};
 
@@ -22,11 +24,13 @@ use crate::msg::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
 /// apart. A variant or field missing from the list is a compile error (non-exhaustive match,
 /// or a pattern that does not mention a field).
 macro_rules! field_for_field {
-    ($($variant:ident { $($field:ident),+ $(,)? }),+ $(,)?) => {
-        impl From<TrajectoryKind> for MissionSpec {
-            fn from(kind: TrajectoryKind) -> Self {
+    ($($variant:ident { $($field:ident),+ $(,)? }),+ ; not one frame: $($big:ident),+ $(,)?) => {
+        impl TryFrom<TrajectoryKind> for MissionSpec {
+            type Error = NotOneFrame;
+            fn try_from(kind: TrajectoryKind) -> Result<Self, NotOneFrame> {
                 match kind {
-                    $(TrajectoryKind::$variant { $($field),+ } => MissionSpec::$variant { $($field),+ },)+
+                    $(TrajectoryKind::$variant { $($field),+ } => Ok(MissionSpec::$variant { $($field),+ }),)+
+                    $(TrajectoryKind::$big { .. } => Err(NotOneFrame),)+
                 }
             }
         }
@@ -45,7 +49,19 @@ field_for_field! {
     Circle { radius, omega, depth },
     FigureEight { amplitude, omega, depth },
     LawnMower { scale, omega, depth },
-    Helix { radius, omega, depth, depth_rate },
+    Helix { radius, omega, depth, depth_rate };
+    not one frame: Waypoints,
+}
+
+/// A path that does not fit one `StartMission` frame (the waypoint path, docs/design.md §27):
+/// it is flown in SIL until the chunked mission upload carries it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct NotOneFrame;
+
+impl core::fmt::Display for NotOneFrame {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("a waypoint mission does not fit one StartMission frame (no mission upload yet: fly it in SIL)")
+    }
 }
 
 /// Both `From` impls of a field-less enum pair from one list of variants.
@@ -72,13 +88,14 @@ macro_rules! variant_for_variant {
 variant_for_variant!(Heading, HeadingMode, Paper, Tangent);
 variant_for_variant!(ThrustUnit, controller_core::ThrustUnit, Kgf, Newton);
 
-impl From<Mission> for MissionPlan {
-    fn from(m: Mission) -> Self {
-        MissionPlan {
-            path: m.path.into(),
+impl TryFrom<Mission> for MissionPlan {
+    type Error = NotOneFrame;
+    fn try_from(m: Mission) -> Result<Self, NotOneFrame> {
+        Ok(MissionPlan {
+            path: m.path.try_into()?,
             heading: m.heading.into(),
             time_scale: m.time_scale,
-        }
+        })
     }
 }
 
@@ -92,17 +109,22 @@ impl From<MissionPlan> for Mission {
     }
 }
 
-impl From<TrajectoryKind> for MissionPlan {
+impl TryFrom<TrajectoryKind> for MissionPlan {
+    type Error = NotOneFrame;
     /// The paper's mission on this path ([`Mission::paper`]).
-    fn from(kind: TrajectoryKind) -> Self {
-        Mission::paper(kind).into()
+    fn try_from(kind: TrajectoryKind) -> Result<Self, NotOneFrame> {
+        Mission::paper(kind).try_into()
     }
 }
 
 impl From<MissionSpec> for MissionPlan {
     /// The paper's mission on this path ([`Mission::paper`]).
     fn from(path: MissionSpec) -> Self {
-        Mission::paper(path.into()).into()
+        MissionPlan {
+            path,
+            heading: HeadingMode::Paper.into(),
+            time_scale: 1.0,
+        }
     }
 }
 

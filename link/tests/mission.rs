@@ -16,8 +16,11 @@ fn kind_index(k: &TrajectoryKind) -> usize {
         TrajectoryKind::FigureEight { .. } => 1,
         TrajectoryKind::LawnMower { .. } => 2,
         TrajectoryKind::Helix { .. } => 3,
+        // Does not fit one frame: refused by the conversion (tested below).
+        TrajectoryKind::Waypoints { .. } => KINDS,
     }
 }
+/// The kinds that cross in one `StartMission` frame.
 const KINDS: usize = 4;
 
 /// Missions of every kind: the six Table-1 cases, a helix, and odd values (negative depth,
@@ -86,6 +89,7 @@ fn fields(k: &TrajectoryKind) -> [f32; 4] {
             depth,
             depth_rate,
         } => [radius, omega, depth, depth_rate],
+        TrajectoryKind::Waypoints { .. } => unreachable!("not a one-frame kind"),
     }
 }
 
@@ -110,7 +114,9 @@ fn every_kind_round_trips_through_a_frame() {
             };
             let env = Envelope::new(
                 seq as u16,
-                Msg::Command(Command::StartMission(MissionPlan::from(mission))),
+                Msg::Command(Command::StartMission(
+                    MissionPlan::try_from(mission).expect("one frame"),
+                )),
             );
             let mut wire = [0u8; MAX_FRAME];
             let n = encode(&env, &mut wire).expect("a mission fits a frame");
@@ -132,7 +138,7 @@ fn every_kind_round_trips_through_a_frame() {
     assert_eq!(seen, [true; KINDS], "some kind never crossed the link");
     // A bare path is the paper's mission.
     assert_eq!(
-        Mission::from(MissionPlan::from(Table1Case::Circular10R.kind())),
+        Mission::from(MissionPlan::try_from(Table1Case::Circular10R.kind()).expect("one frame")),
         Mission::paper(Table1Case::Circular10R.kind())
     );
     for u in controller_core::ThrustUnit::ALL {
@@ -159,12 +165,13 @@ fn wire_bytes_are_the_documented_layout() {
             want.extend(x.to_le_bytes());
         }
         let mut buf = [0u8; MissionSpec::MAX_SIZE];
-        let got = postcard::to_slice(&MissionSpec::from(kind), &mut buf).expect("fits MAX_SIZE");
+        let got = postcard::to_slice(&MissionSpec::try_from(kind).expect("one frame"), &mut buf)
+            .expect("fits MAX_SIZE");
         assert_eq!(got, &want[..], "{kind:?}");
         // A plan: the path's bytes, the heading's variant index (paper 0, tangent 1), then the
         // time scale as an f32 little-endian.
         let plan = MissionPlan {
-            path: kind.into(),
+            path: kind.try_into().expect("one frame"),
             heading: Heading::Tangent,
             time_scale: 2.5,
         };
@@ -186,7 +193,7 @@ fn the_receiver_validates_what_it_converts() {
         depth: 5.0,
         depth_rate: 0.2,
     };
-    let spec = MissionSpec::from(helix);
+    let spec = MissionSpec::try_from(helix).expect("one frame");
     assert_eq!(
         Trajectory::new(TrajectoryKind::from(spec)),
         Trajectory::new(helix)
@@ -197,4 +204,26 @@ fn the_receiver_validates_what_it_converts() {
         depth: 5.0,
     };
     assert!(Trajectory::new(TrajectoryKind::from(bad)).is_err());
+}
+
+#[test]
+fn a_waypoint_mission_is_refused_by_the_one_frame_conversion() {
+    // 32 points do not fit a frame: the conversion says so instead of truncating.
+    let points = controller_core::WaypointList::new(&[[0.0, 0.0, 5.0], [50.0, 0.0, 5.0]])
+        .expect("two points");
+    let kind = TrajectoryKind::Waypoints {
+        points,
+        speed: 0.5,
+        turn_radius: None,
+        speeds: None,
+        speed_change: None,
+    };
+    assert_eq!(
+        MissionSpec::try_from(kind),
+        Err(auv_link::mission::NotOneFrame)
+    );
+    assert_eq!(
+        MissionPlan::try_from(Mission::paper(kind)),
+        Err(auv_link::mission::NotOneFrame)
+    );
 }

@@ -56,7 +56,7 @@ fn deliver(sup: &mut Supervisor, dec: &mut FrameDecoder, seq: u16, msg: Msg) {
 #[test]
 fn the_board_builds_the_same_mission_from_the_link() {
     for (name, tr) in missions() {
-        let spec = MissionSpec::from(tr.kind());
+        let spec = MissionSpec::try_from(tr.kind()).expect("one frame");
         let on_board = Trajectory::new(TrajectoryKind::from(spec)).expect("valid mission");
         assert_eq!(on_board, tr, "{name}");
         for k in [0u64, 777, 6999, 1 << 40] {
@@ -82,7 +82,9 @@ fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
             &mut sup,
             &mut dec,
             1,
-            Msg::Command(Command::StartMission(tr.kind().into())),
+            Msg::Command(Command::StartMission(
+                tr.kind().try_into().expect("one frame"),
+            )),
         );
         for k in 0..50u64 {
             // A plant state near the reference, in f64 as the simulator holds it.

@@ -6,7 +6,9 @@ use core::fmt;
 use crate::readable::Readable;
 
 #[cfg(doc)]
-use crate::trajectory::{Mission, Trajectory, TrajectoryKind};
+use crate::trajectory::{
+    Mission, Trajectory, TrajectoryKind, MAX_SLOPE, MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG,
+};
 
 /// Why a [`TrajectoryKind`] was rejected by [`Trajectory::new`].
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -43,6 +45,55 @@ pub enum TrajectoryError {
         /// [`Trajectory::MIN_TANGENT_SPEED`].
         threshold: f32,
     },
+    /// A waypoint path with fewer than 2 or more than [`MAX_WAYPOINTS`] points.
+    WaypointCount {
+        /// How many points were given.
+        count: usize,
+    },
+    /// Two consecutive waypoints closer than [`MIN_LEG`]: one point repeated.
+    RepeatedWaypoint {
+        /// The second of the two (0-based).
+        index: usize,
+    },
+    /// A turn sharper than [`MAX_TURN_DEGREES`] at a waypoint.
+    TurnTooSharp {
+        /// The waypoint (0-based).
+        index: usize,
+        /// Its turn angle (degrees).
+        degrees: f32,
+    },
+    /// A leg too short for the blends of the turns at its two ends (at this turn radius).
+    LegTooShort {
+        /// The leg (0-based: leg i joins points i and i + 1).
+        leg: usize,
+        /// The cut distances of its two turns, added (m).
+        needs: f32,
+        /// Its length (m).
+        has: f32,
+    },
+    /// A time law whose speed count is not the path's parts (2n − 3: each leg and each turn).
+    SpeedCount {
+        /// How many speeds were given.
+        count: usize,
+        /// How many the path has.
+        expected: usize,
+    },
+    /// A part of the path too short for the speed changes at its two ends.
+    SpeedChangeTooLong {
+        /// The part (2j: leg j, 2j − 1: the turn at waypoint j).
+        part: usize,
+        /// The path the changes need (m).
+        needs: f32,
+        /// The part's length (m).
+        has: f32,
+    },
+    /// A leg steeper than [`MAX_SLOPE`] (|Δz| over its horizontal length).
+    TooSteep {
+        /// The leg (0-based).
+        leg: usize,
+        /// Its slope.
+        slope: f32,
+    },
 }
 
 impl TrajectoryError {
@@ -54,6 +105,12 @@ impl TrajectoryError {
             | Self::NotPositive { parameter, .. }
             | Self::OutOfRange { parameter, .. } => parameter,
             Self::TooSlowForTangent { .. } => "heading",
+            Self::WaypointCount { .. }
+            | Self::RepeatedWaypoint { .. }
+            | Self::TurnTooSharp { .. }
+            | Self::LegTooShort { .. }
+            | Self::TooSteep { .. } => "points",
+            Self::SpeedCount { .. } | Self::SpeedChangeTooLong { .. } => "speeds",
         }
     }
 }
@@ -83,6 +140,47 @@ impl fmt::Display for TrajectoryError {
             } => write!(
                 f,
                 "tangent heading needs a horizontal speed of at least {threshold} m/s everywhere; this path slows to {min_speed} m/s (lower the time scale, or fly the paper's heading)"
+            ),
+            Self::WaypointCount { count } => write!(
+                f,
+                "a waypoint path needs 2 to {} points; this one has {count}",
+                crate::trajectory::MAX_WAYPOINTS
+            ),
+            Self::RepeatedWaypoint { index } => write!(
+                f,
+                "waypoint {index} repeats waypoint {} (closer than {} m)",
+                index - 1,
+                crate::trajectory::MIN_LEG
+            ),
+            Self::TurnTooSharp { index, degrees } => write!(
+                f,
+                "the turn at waypoint {index} is {}°, sharper than the {}° the path allows (add a waypoint to split it)",
+                Readable(degrees),
+                crate::trajectory::MAX_TURN_DEGREES
+            ),
+            Self::LegTooShort { leg, needs, has } => write!(
+                f,
+                "leg {leg} (waypoints {leg} to {}) is {} m long but its turns need {} m at this turn radius (lower turn_radius or speed, or space the waypoints)",
+                leg + 1,
+                Readable(has),
+                Readable(needs)
+            ),
+            Self::SpeedCount { count, expected } => write!(
+                f,
+                "the time law has {count} speeds; this path has {expected} parts (each leg and each turn, in path order)"
+            ),
+            Self::SpeedChangeTooLong { part, needs, has } => write!(
+                f,
+                "part {part} of the path is {} m long but its speed changes need {} m (lower its speed, or raise speed_change)",
+                Readable(has),
+                Readable(needs)
+            ),
+            Self::TooSteep { leg, slope } => write!(
+                f,
+                "leg {leg} (waypoints {leg} to {}) climbs or dives at slope {}, steeper than {} (the heading needs horizontal motion)",
+                leg + 1,
+                Readable(slope),
+                crate::trajectory::MAX_SLOPE
             ),
         }
     }

@@ -5,9 +5,8 @@
 
 use core::fmt;
 
-use crate::math;
 use crate::trajectory::paths;
-use crate::trajectory::phases::Planar;
+use crate::trajectory::phases::tangent;
 use crate::trajectory::Trajectory;
 
 /// How a mission's desired heading ψ_d is formed (docs/design.md §6, §9).
@@ -53,7 +52,7 @@ impl fmt::Display for HeadingMode {
 /// Samples per period of the path in the sampled bound on the tangent heading's |ψ̈_d|.
 const TANGENT_BOUND_SAMPLES: u32 = 1024;
 /// Margin on the sampled maximum of the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**).
-const TANGENT_BOUND_MARGIN: f32 = 1.1;
+pub(super) const TANGENT_BOUND_MARGIN: f32 = 1.1;
 
 impl Trajectory {
     /// An upper bound on the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**). On the
@@ -79,19 +78,4 @@ impl Trajectory {
         }
         max * TANGENT_BOUND_MARGIN
     }
-}
-
-/// The tangent heading of a path sample (see [`HeadingMode::Tangent`]): ψ_d = atan2(ẏ, ẋ),
-/// ψ̇_d = N/D, ψ̈_d = (Ṅ − ψ̇_d Ḋ)/D. One `atan2` and one division.
-#[inline]
-pub(super) fn tangent(p: &Planar) -> (f32, f32, f32) {
-    let [[xd, yd], [xdd, ydd], [xddd, yddd]] = p.d;
-    let d = xd * xd + yd * yd;
-    let inv_d = 1.0 / d;
-    let n = xd * ydd - yd * xdd;
-    let n_dot = xd * yddd - yd * xddd;
-    let d_dot = 2.0 * (xd * xdd + yd * ydd);
-    let rate = n * inv_d;
-    let accel = (n_dot - rate * d_dot) * inv_d;
-    (math::atan2(yd, xd), rate, accel)
 }

@@ -4,6 +4,9 @@
 
 #[cfg(any(doc, feature = "serde"))]
 use crate::trajectory::Trajectory;
+use crate::trajectory::{SpeedList, WaypointList};
+#[cfg(doc)]
+use crate::trajectory::{DEFAULT_SPEED_CHANGE, TURN_ACCEL};
 
 /// Shape and parameters of a mission (the paper's "Simulation Results"; docs/design.md §6).
 ///
@@ -15,6 +18,9 @@ use crate::trajectory::Trajectory;
 /// [`Trajectory::PAPER_LAWN_MOWER_OMEGA`]; [`Trajectory::PAPER_DEPTH`]). This is the
 /// `[trajectory]` table of host-sim's scenario files. Values are not validated there: build the
 /// mission with [`Trajectory::new`].
+// The waypoint list is ~390 bytes beside the closed forms' 16: no heap on the board (no `Box`),
+// and a mission is copied at configuration only (`Trajectory::new`), never per sample.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(
@@ -72,6 +78,24 @@ pub enum TrajectoryKind {
         depth: f32,
         /// ż_d (m/s, positive = descending).
         depth_rate: f32,
+    },
+    /// Straight legs through the waypoints, each corner turned on a septic blend, flown at
+    /// `speed` along the path (not in the paper; docs/design.md §27).
+    Waypoints {
+        /// The points in the mission frame (m, z positive down): `points = [[x, y, z], …]`.
+        points: WaypointList,
+        /// σ̇, the path speed on the legs (m/s; slower in the turns).
+        speed: f32,
+        /// The smallest radius of a turn (m); `None`: speed²/[`TURN_ACCEL`] (Choice 151).
+        #[cfg_attr(feature = "serde", serde(default))]
+        turn_radius: Option<f32>,
+        /// The time law: a speed per leg and turn in path order (m/s; Choice 156), the
+        /// profile `host-sim check` proposes; `None`: `speed` everywhere.
+        #[cfg_attr(feature = "serde", serde(default))]
+        speeds: Option<SpeedList>,
+        /// The largest |σ̈| of a change of speed (m/s²); `None`: [`DEFAULT_SPEED_CHANGE`].
+        #[cfg_attr(feature = "serde", serde(default))]
+        speed_change: Option<f32>,
     },
 }
 

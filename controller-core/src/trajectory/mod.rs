@@ -69,13 +69,18 @@ pub use error::TrajectoryError;
 pub use heading::HeadingMode;
 pub use kind::TrajectoryKind;
 pub use mission::Mission;
+pub use paths::time_law::{SpeedList, TimeLaw, DEFAULT_SPEED_CHANGE, MAX_PARTS, MAX_SPEED_CHANGE};
+pub use paths::waypoints::{
+    turn_radius, PathPoint, Route, WaypointList, MAX_SEGMENTS, MAX_SLOPE, MAX_SPEED,
+    MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG, MIN_TURN_RADIUS, TURN_ACCEL,
+};
 pub use table1::Table1Case;
 
 use nalgebra::Vector6;
 
 use crate::math;
 use crate::phase::{Frequency, LinearRate, MissionTime};
-use heading::tangent;
+use phases::tangent;
 use phases::{Harmonics, Phases};
 use series::{series_coefficients, ODD_TERMS};
 use table1::{circle_kind, figure_eight_kind, lawn_mower_kind};
@@ -116,6 +121,10 @@ pub struct Trajectory {
     accel_bound: f32,
     /// The smallest horizontal speed along the path (m/s), in closed form.
     min_speed: f32,
+    /// The waypoint path's legs and blends ([`Route::EMPTY`] for the other kinds).
+    route: Route,
+    /// The waypoint path's time law ([`TimeLaw::EMPTY`]: constant speed, or another kind).
+    law: TimeLaw,
 }
 
 impl Trajectory {
@@ -203,7 +212,10 @@ impl Trajectory {
             Some(series) => series_coefficients(series, omega),
             None => [[0.0; 3]; ODD_TERMS],
         };
+        let (route, law) = paths::time_law::route_and_law(&mission.path);
         let mut t = Self {
+            route,
+            law,
             mission,
             omega,
             theta: Frequency::from_rad_per_s(omega_f64),
@@ -218,6 +230,22 @@ impl Trajectory {
         // Assumption 1 (Eq 19): per component Σ |amplitude|·frequency² over its harmonics
         // (|sin|, |cos| ≤ 1), then the Euclidean norm over the components. Linear-in-t terms
         // (lawn-mower 0.25 s t, helix z) and the circle's ψ = ωt have no acceleration.
+        if let TrajectoryKind::Waypoints { .. } = mission.path {
+            if t.law.is_set() {
+                // The time law's σ̇ is over k: its derivatives are evaluated per unit time.
+                t.rate = (1.0 / k) as f32;
+                t.position_rate = LinearRate::new(1.0 / k);
+            }
+            let (min_speed, accel) = paths::time_law::speed_and_accel_bound(
+                &t.route,
+                &t.law,
+                t.rate,
+                heading::TANGENT_BOUND_MARGIN,
+            );
+            t.min_speed = min_speed;
+            t.accel_bound = sqrt_upper(accel);
+            return t;
+        }
         let heading_bound = match mission.heading {
             HeadingMode::Paper => {
                 let mut series_bound = 0.0f32;
@@ -280,6 +308,16 @@ impl Trajectory {
         self.min_speed
     }
 
+    /// The waypoint path's legs and blends ([`Route::EMPTY`] for the other kinds).
+    pub fn route(&self) -> &Route {
+        &self.route
+    }
+
+    /// The waypoint path's time law ([`TimeLaw::EMPTY`]: constant speed, or another kind).
+    pub fn time_law(&self) -> &TimeLaw {
+        &self.law
+    }
+
     /// K_d of Assumption 1 (Eq 19): an upper bound on ‖η̈_d(t)‖ for all t.
     ///
     /// Computed from the amplitudes: for each component of η̈_d the sum of |amplitude|·(frequency)²
@@ -324,9 +362,10 @@ impl Trajectory {
         eta_dot[2] = p.z_dot;
         eta_ddot[0] = p.d[1][0];
         eta_ddot[1] = p.d[1][1];
+        eta_ddot[2] = p.z_ddot;
         let (psi, rate, accel) = match self.mission.heading {
             HeadingMode::Tangent => tangent(&p),
-            HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h),
+            HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h, &p),
         };
         eta[5] = psi;
         eta_dot[5] = rate;

@@ -37,13 +37,29 @@ impl Harmonics {
     }
 }
 
-/// The horizontal path and its first three derivatives, and z_d, ż_d.
+/// The horizontal path and its first three derivatives, and z_d, ż_d, z̈_d.
 #[derive(Clone, Copy)]
 pub(super) struct Planar {
     pub(super) x: f32,
     pub(super) y: f32,
     pub(super) z: f32,
     pub(super) z_dot: f32,
+    pub(super) z_ddot: f32,
     /// (ẋ, ẏ), (ẍ, ÿ), (x⃛, y⃛).
     pub(super) d: [[f32; 2]; 3],
+}
+
+/// The tangent heading of a path sample (see [`HeadingMode::Tangent`](crate::trajectory::HeadingMode::Tangent)): ψ_d = atan2(ẏ, ẋ),
+/// ψ̇_d = N/D, ψ̈_d = (Ṅ − ψ̇_d Ḋ)/D. One `atan2` and one division.
+#[inline]
+pub(super) fn tangent(p: &Planar) -> (f32, f32, f32) {
+    let [[xd, yd], [xdd, ydd], [xddd, yddd]] = p.d;
+    let d = xd * xd + yd * yd;
+    let inv_d = 1.0 / d;
+    let n = xd * ydd - yd * xdd;
+    let n_dot = xd * yddd - yd * xddd;
+    let d_dot = 2.0 * (xd * xdd + yd * ydd);
+    let rate = n * inv_d;
+    let accel = (n_dot - rate * d_dot) * inv_d;
+    (math::atan2(yd, xd), rate, accel)
 }

@@ -191,7 +191,9 @@ impl BoardInTheLoop {
         let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
             "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
         })?;
-        let mut b = Self::new(wire, scenario, faults, pacing, reply_timeout, key);
+        let mission =
+            MissionPlan::try_from(scenario.trajectory().mission()).map_err(|e| e.to_string())?;
+        let mut b = Self::new(wire, scenario, faults, pacing, reply_timeout, key, mission);
         let (arm_seq, refused_before) = b.configure(c, mounting)?;
         b.wait_armed(arm_seq, refused_before, mounting)?;
         if b.rt.is_some() {
@@ -209,6 +211,7 @@ impl BoardInTheLoop {
         pacing: Pacing,
         reply_timeout: Duration,
         key: Option<&LinkKey>,
+        mission: MissionPlan,
     ) -> Self {
         let c = scenario.controller().config();
         BoardInTheLoop {
@@ -231,7 +234,7 @@ impl BoardInTheLoop {
             seq: 0,
             rate_hz: c.rate_hz,
             faults,
-            mission: MissionPlan::from(scenario.trajectory().mission()),
+            mission,
             thrust_unit: ThrustUnit::from(c.thrust_unit),
             started: false,
             history: VecDeque::new(),

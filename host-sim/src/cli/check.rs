@@ -10,6 +10,7 @@ use controller_core::readable::Readable;
 use super::common::load;
 use super::json::print_json;
 use super::Exit;
+use crate::studies::preflight::profile::{self, SpeedProfile};
 use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 
 /// `check`: the preflight feasibility check of one scenario (nothing is simulated).
@@ -48,6 +49,16 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
     } else {
         writeln!(stdout, "{p}")?;
         writeln!(stdout, "{}", preflight_table(&p))?;
+        // A waypoint mission: the fastest speed profile (docs/design.md §27).
+        match profile::propose(&scenario, args.margin) {
+            Ok(Some(s)) => writeln!(stdout, "{}", profile_table(&s))?,
+            Ok(None) => {}
+            Err(CheckError::Interrupted) => {
+                eprintln!("host-sim: check: interrupted before the speed profile");
+                return Ok(Exit::Interrupted);
+            }
+            Err(e) => return Err(anyhow!(e)),
+        }
     }
     Ok(if p.feasible() {
         Exit::Success
@@ -89,5 +100,49 @@ fn preflight_table(p: &Preflight) -> String {
             p.duration * k / p.time_scale
         ));
     }
+    s
+}
+
+/// The speed profile's part of `check`'s text: time per part, the limiting thruster, the totals
+/// against the uniform time scale, and the keys that pin it.
+fn profile_table(p: &SpeedProfile) -> String {
+    let mut s = format!(
+        "speed profile over the whole box (margin envelope, speed changes at {} m/s²):\n\
+         {:<12} {:>10} {:>12} {:>10}  limiting thruster\n",
+        Readable(p.speed_change),
+        "part",
+        "length (m)",
+        "speed (m/s)",
+        "time (s)"
+    );
+    for part in &p.parts {
+        s.push_str(&format!(
+            "{:<12} {:>10.1} {:>12.2} {:>10.1}  {}\n",
+            part.name, part.length, part.speed, part.time, part.limiting
+        ));
+    }
+    s.push_str(&format!(
+        "total {:.1} s with the profile; {:.1} s at the fastest uniform speed {:.3} m/s \
+         ({:.1} % less with the profile); {:.1} s at the file's speed\n",
+        p.total_time,
+        p.uniform_time,
+        p.uniform_speed,
+        100.0 * (1.0 - p.total_time / p.uniform_time),
+        p.nominal_time
+    ));
+    if p.shrink_rounds > 0 {
+        s.push_str(&format!(
+            "(every speed lowered {} time(s) by {} to pass the check as flown)\n",
+            p.shrink_rounds,
+            profile::VERIFY_SHRINK
+        ));
+    }
+    let speeds: Vec<String> = p.speeds.iter().map(|v| format!("{v:.2}")).collect();
+    s.push_str(&format!(
+        "to pin it, in [trajectory]: speeds = [{}]\nspeed_change = {}  # and duration = {:.1}\n",
+        speeds.join(", "),
+        Readable(p.speed_change),
+        p.total_time
+    ));
     s
 }

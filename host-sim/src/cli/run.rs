@@ -79,5 +79,20 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         f64::from(cfg.controller.voltage_limit),
         &mut incomplete,
     )?;
+    if let Some([lat, lon, alt]) = cfg.origin {
+        // The flown path on a map (docs/design.md §27): the run with Δu, its plotted samples.
+        let origin = crate::scenario::plan::Origin { lat, lon, alt };
+        let path: Vec<[f64; 3]> = with
+            .samples
+            .iter()
+            .map(|s| [s.eta[0], s.eta[1], s.eta[2]])
+            .collect();
+        let file = dir.claim(&format!("{}-flown.geojson", cfg.name))?;
+        std::fs::write(
+            &file,
+            crate::scenario::plan::geojson_line(&origin, &cfg.name, &path),
+        )
+        .with_context(|| format!("cannot write {}", file.display()))?;
+    }
     print_runs(stdout, args.json, &rows, &checks, &report, incomplete)
 }

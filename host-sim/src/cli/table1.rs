@@ -77,11 +77,14 @@ impl Default for Table1Args {
 }
 
 /// `table1`: the paper's Table 1 (ideal actuators), then the real vehicle: the missions of
-/// `scenarios/real/` and the paper's six through the real chain, with their preflight verdicts.
+/// `scenarios/real/` (the paper's paths, then the waypoint surveys) and the paper's six through
+/// the real chain, with their preflight verdicts.
 pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     let jobs = paper_table1::jobs()?;
-    let real_jobs = real_vehicle::real_scenarios()?;
+    let mut real_jobs = real_vehicle::real_scenarios()?;
     let chain_jobs = real_vehicle::paper_real_chain_scenarios(&real_jobs)?;
+    // The waypoint surveys fly in the same table, after the paper's paths (no chain twin).
+    real_jobs.extend(real_vehicle::waypoint_scenarios()?);
     let dir = OutputDir::prepare(&args.out)?;
     // The paper's missions' verdicts (the Table-1 cases, with Δu: the same mission as the
     // real-chain runs), then the real ones.

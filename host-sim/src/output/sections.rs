@@ -15,7 +15,11 @@ pub const REAL_NOTES: &str = "\
 The missions of `scenarios/real/` fly the Table-1 paths as a vehicle team would: heading along
 the course, the Table-3 payload trimmed to neutral buoyancy, Eqs 31–32 in kgf, and the real
 actuator chain (the board's voltages, clamped at ±24 V, turned back into thrust by Eqs 31–32),
-each at the time scale the preflight check proposes. Below them, the paper's own six missions
+each at the time scale the preflight check proposes; then missions planned as waypoints, on
+the speed profile the check proposes (docs/design.md §27): `survey-200x100`, a 200 m × 100 m
+lawn-mower at 5 m depth, and `harbour-wall`, a descending inspection imported from a
+QGroundControl plan. Below them, the
+paper's own six missions
 (its headings, untrimmed payload, time scale 1) through the same real chain: what the preflight
 calls infeasible, flown anyway.
 ";

@@ -150,6 +150,10 @@ pub struct SimConfig {
     /// The mission's time scale k ≥ 1: the reference is η_d(t/k) (`trajectory.time_scale`,
     /// default 1; docs/design.md §9).
     pub time_scale: f32,
+    /// The mission frame's origin on the earth, [latitude, longitude (degrees), altitude (m)]
+    /// (`trajectory.origin`, e.g. a QGroundControl plan's home): `run` then writes the flown
+    /// path as GeoJSON (docs/design.md §27). `None`: the frame is not placed on the earth.
+    pub origin: Option<[f64; 3]>,
     /// Simulated time (s). Paper: 70.
     pub duration: f64,
     /// Plant RK4 step (s). Default 1 ms.
@@ -231,7 +235,8 @@ impl SimConfig {
         }
     }
 
-    /// Defaults around a path: the paper's heading at time scale 1, 70 s, 1 ms plant step, the
+    /// Defaults around a path: the paper's heading (the tangent heading for waypoints, which
+    /// have no other: docs/design.md §27) at time scale 1, 70 s, 1 ms plant step, the
     /// paper's controller at 100 Hz, no variation (untrimmed), no current, no noise, ideal
     /// actuators, starting on the reference, no Table-1 case, no faults expected, the step cap
     /// in force.
@@ -240,8 +245,12 @@ impl SimConfig {
             name: name.into(),
             case: None,
             trajectory,
-            heading: HeadingMode::Paper,
+            heading: match trajectory {
+                TrajectoryKind::Waypoints { .. } => HeadingMode::Tangent,
+                _ => HeadingMode::Paper,
+            },
             time_scale: 1.0,
+            origin: None,
             duration: 70.0,
             plant_step: 0.001,
             controller: ControllerConfig::default(),

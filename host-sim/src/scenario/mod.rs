@@ -43,15 +43,22 @@
 //! expect_missed = false       # true: a miss of [bound] is reported, no exit 4; default false
 //!
 //! [trajectory]                # required
-//! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix"
+//! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix" | "waypoints"
 //! radius = 10.0               # circle, helix (required)
 //! amplitude = 15.0            # figure-eight (required)
 //! scale = 1.0                 # lawn-mower (required)
 //! depth_rate = 0.05           # helix (required), m/s, positive descends
 //! omega = 0.1                 # rad/s; default 0.1, lawn-mower 0.05
 //! depth = 5.0                 # m, positive down; default 5
-//! heading = "paper"           # "paper" | "tangent" (ψ_d along the course); default "paper"
+//! points = [[0.0, 0.0, 5.0], [50.0, 0.0, 5.0]]  # waypoints (required): 2 to 32 points
+//!                             # as [x, y, z] in the mission frame (m, z down; design §27)
+//! speed = 0.5                 # waypoints (required): m/s along the legs, (0, 10]
+//! turn_radius = 2.5           # waypoints, m: the corners' smallest radius; default speed²/0.1
+//! heading = "paper"           # "paper" | "tangent" (ψ_d along the course); default "paper",
+//!                             # "tangent" for waypoints (their only heading)
 //! time_scale = 1.0            # k in [1, 100]: the reference is η_d(t/k); default 1
+//! origin = [43.295, 5.362, 0.0]  # the frame's origin: lat, lon (deg), alt (m); run then writes
+//!                             # the flown path as GeoJSON; default none
 //!
 //! [variation]                 # Table-3 parameter variation of the plant (not the controller)
 //! profile = "abs-sin"         # "none" | "constant" | "abs-sin" | "staircase" | "table3-staircase"
@@ -171,6 +178,7 @@ mod config;
 mod fixed_arrays;
 pub mod paper;
 mod parse;
+pub mod plan;
 pub mod real_vehicle;
 mod start;
 mod validate;

@@ -66,6 +66,7 @@ struct RawScenario {
 struct RawTrajectory {
     heading: Option<HeadingName>,
     time_scale: Option<f64>,
+    origin: Option<[f64; 3]>,
     #[serde(flatten)]
     path: TrajectoryKind,
 }
@@ -355,6 +356,7 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
             HeadingName::Tangent => HeadingMode::Tangent,
         };
     }
+    config.origin = raw.trajectory.origin;
     if let Some(k) = raw.trajectory.time_scale {
         config.time_scale = to_f32("trajectory.time_scale", k)?;
     }

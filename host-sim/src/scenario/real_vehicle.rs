@@ -39,6 +39,27 @@ pub const REAL_SCENARIOS: [(&str, &str); 6] = [
     ),
 ];
 
+/// The real vehicle's waypoint missions (docs/design.md §27), flown in the same table after
+/// [`REAL_SCENARIOS`]: (file name, its text).
+pub const WAYPOINT_SCENARIOS: [(&str, &str); 2] = [
+    (
+        "survey-200x100.toml",
+        include_str!("../../scenarios/real/survey-200x100.toml"),
+    ),
+    (
+        "harbour-wall.toml",
+        include_str!("../../scenarios/real/harbour-wall.toml"),
+    ),
+];
+
+/// The waypoint missions, validated ([`WAYPOINT_SCENARIOS`]).
+pub fn waypoint_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
+    WAYPOINT_SCENARIOS
+        .iter()
+        .map(|(_, text)| parse_scenario(text))
+        .collect()
+}
+
 /// The real missions, validated ([`REAL_SCENARIOS`]).
 pub fn real_scenarios() -> Result<Vec<Scenario>, ScenarioError> {
     REAL_SCENARIOS

@@ -92,6 +92,7 @@ pub(super) fn trajectory(mission: &Mission) -> Res<Trajectory> {
 /// steps per period). `config.controller` is valid (so `rate_hz ≥ 1`).
 pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     check_name(&config.name)?;
+    check_origin(config.origin)?;
     let rate = f64::from(config.controller.rate_hz);
     let period = 1.0 / rate;
 
@@ -332,6 +333,24 @@ fn each(key: &str, xs: &[f64], check: fn(&str, f64) -> Res<f64>) -> Res<()> {
         check(&format!("{key}[{i}]"), x)?;
     }
     Ok(())
+}
+
+/// `trajectory.origin`: a latitude in [−90, 90], a longitude in [−180, 180], a finite altitude.
+fn check_origin(origin: Option<[f64; 3]>) -> Res<()> {
+    match origin {
+        Some([lat, lon, alt]) if !(lat.abs() <= 90.0 && lon.abs() <= 180.0 && alt.is_finite()) => {
+            Err(invalid(
+                "trajectory.origin",
+                format!(
+                    "must be [latitude in [-90, 90], longitude in [-180, 180], a finite altitude], got [{}, {}, {}]",
+                    Readable(lat),
+                    Readable(lon),
+                    Readable(alt)
+                ),
+            ))
+        }
+        _ => Ok(()),
+    }
 }
 
 fn check_name(name: &str) -> Res<()> {

@@ -30,6 +30,7 @@ pub(super) fn horizontal(radius: f32, omega: f32, h: &Harmonics) -> Planar {
         y: radius * c,
         z: 0.0,
         z_dot: 0.0,
+        z_ddot: 0.0,
         d: [
             [radius * omega * c, -radius * omega * s],
             [-radius * omega * omega * s, -radius * omega * omega * c],

@@ -26,6 +26,7 @@ pub(super) fn planar(amplitude: f32, depth: f32, omega: f32, ph: &Phases) -> Pla
         y: amplitude * ch,
         z: depth,
         z_dot: 0.0,
+        z_ddot: 0.0,
         d: [
             [amplitude * omega * c1, -amplitude * half * sh],
             [

@@ -32,6 +32,7 @@ pub(super) fn planar(scale: f32, depth: f32, t: &Trajectory, ph: &Phases) -> Pla
         y: amp_y * c1,
         z: depth,
         z_dot: 0.0,
+        z_ddot: 0.0,
         d: [
             [scale * (t.rate + 2.5 * two * c2), -amp_y * omega * s1],
             [-2.5 * scale * two * two * s2, -amp_y * omega * omega * c1],

@@ -8,6 +8,8 @@ mod circle;
 mod figure_eight;
 mod helix;
 mod lawn_mower;
+pub(super) mod time_law;
+pub(super) mod waypoints;
 
 use crate::math;
 use crate::phase::{Frequency, LinearRate, MissionTime};
@@ -40,6 +42,13 @@ pub(super) fn check(path: &TrajectoryKind) -> Result<(), TrajectoryError> {
             depth,
             depth_rate,
         } => helix::check(radius, omega, depth, depth_rate),
+        TrajectoryKind::Waypoints {
+            points,
+            speed,
+            turn_radius,
+            speeds,
+            speed_change,
+        } => time_law::check(&points, speed, turn_radius, speeds, speed_change),
     }
 }
 
@@ -54,6 +63,7 @@ pub(super) fn rates(path: &TrajectoryKind) -> (f32, f32) {
         TrajectoryKind::Helix {
             omega, depth_rate, ..
         } => (omega, depth_rate),
+        TrajectoryKind::Waypoints { speed, .. } => (0.0, speed),
     }
 }
 
@@ -79,12 +89,15 @@ pub(super) fn heading_series(path: &TrajectoryKind) -> Option<Series> {
     match *path {
         TrajectoryKind::FigureEight { .. } => Some(Series::Triangle),
         TrajectoryKind::LawnMower { .. } => Some(Series::Trapezoid),
-        TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. } => None,
+        TrajectoryKind::Circle { .. }
+        | TrajectoryKind::Helix { .. }
+        | TrajectoryKind::Waypoints { .. } => None,
     }
 }
 
 /// Σ |amplitude|·frequency² of ẍ_d and of ÿ_d (`omega` = ω/k): the path's part of K_d
-/// (Assumption 1). The terms linear in t have no acceleration.
+/// (Assumption 1). The terms linear in t have no acceleration. The waypoint path's bound is
+/// its route's ([`waypoints::bounds`], in [`Trajectory`]'s build), not a sum of amplitudes.
 pub(super) fn accel(path: &TrajectoryKind, omega: f32) -> (f32, f32) {
     match *path {
         TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => {
@@ -92,10 +105,12 @@ pub(super) fn accel(path: &TrajectoryKind, omega: f32) -> (f32, f32) {
         }
         TrajectoryKind::FigureEight { amplitude, .. } => figure_eight::accel(amplitude, omega),
         TrajectoryKind::LawnMower { scale, .. } => lawn_mower::accel(scale, omega),
+        TrajectoryKind::Waypoints { .. } => (0.0, 0.0),
     }
 }
 
-/// The smallest horizontal speed √(ẋ_d² + ẏ_d²) over the path, in closed form (m/s).
+/// The smallest horizontal speed √(ẋ_d² + ẏ_d²) over the path, in closed form (m/s); the
+/// waypoint path's is its route's, sampled ([`waypoints::bounds`]).
 pub(super) fn min_speed(t: &Trajectory) -> f32 {
     let w = t.omega;
     match t.mission.path {
@@ -104,6 +119,7 @@ pub(super) fn min_speed(t: &Trajectory) -> f32 {
         }
         TrajectoryKind::FigureEight { amplitude, .. } => figure_eight::min_speed(amplitude, w),
         TrajectoryKind::LawnMower { scale, .. } => lawn_mower::min_speed(scale, t.rate, w),
+        TrajectoryKind::Waypoints { .. } => waypoints::bounds(&t.route).0 * t.rate,
     }
 }
 
@@ -124,7 +140,9 @@ pub(super) fn course_period_phases(path: &TrajectoryKind, a: u32) -> Option<Phas
             h: Harmonics::of(a),
             time,
         }),
-        TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. } => None,
+        TrajectoryKind::Circle { .. }
+        | TrajectoryKind::Helix { .. }
+        | TrajectoryKind::Waypoints { .. } => None,
     }
 }
 
@@ -141,13 +159,23 @@ pub(super) fn planar(t: &Trajectory, ph: &Phases) -> Planar {
             amplitude, depth, ..
         } => figure_eight::planar(amplitude, depth, t.omega, ph),
         TrajectoryKind::LawnMower { scale, depth, .. } => lawn_mower::planar(scale, depth, t, ph),
+        TrajectoryKind::Waypoints { .. } => match t.law.is_set() {
+            true => time_law::timed(&t.route, &t.law, &ph.time, &t.position_rate, t.rate),
+            false => waypoints::planar(&t.route, &ph.time, &t.position_rate, t.rate),
+        },
     }
 }
 
 /// The paper's ψ_d, ψ̇_d, ψ̈_d at phase θ (2⁻³² turns): ωt on the circle and the helix, the
-/// path's series on the others.
+/// path's series on the figure-eight and the lawn-mower. The waypoint path has no heading of
+/// its own in the paper: its "paper" heading is its course, as the tangent heading (Choice 154).
 #[inline]
-pub(super) fn paper_heading(t: &Trajectory, theta: u32, h: &Harmonics) -> (f32, f32, f32) {
+pub(super) fn paper_heading(
+    t: &Trajectory,
+    theta: u32,
+    h: &Harmonics,
+    p: &Planar,
+) -> (f32, f32, f32) {
     match t.mission.path {
         TrajectoryKind::Circle { .. } | TrajectoryKind::Helix { .. } => {
             (math::turns_to_radians(theta), t.omega, 0.0)
@@ -155,5 +183,6 @@ pub(super) fn paper_heading(t: &Trajectory, theta: u32, h: &Harmonics) -> (f32, 
         TrajectoryKind::FigureEight { .. } | TrajectoryKind::LawnMower { .. } => {
             t.heading_series(h)
         }
+        TrajectoryKind::Waypoints { .. } => crate::trajectory::phases::tangent(p),
     }
 }

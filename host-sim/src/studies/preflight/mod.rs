@@ -49,6 +49,7 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
+pub mod profile;
 mod sweep;
 
 use sweep::{Checker, Peaks};

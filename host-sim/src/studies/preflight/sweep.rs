@@ -274,6 +274,24 @@ impl<'a> Checker<'a> {
     /// Every sample of every case of `scope` at 1/k = `inv_k`; stops at the first violation
     /// unless `full` (which also collects the peaks), and at a stop request.
     pub(super) fn sweep(&self, scope: Scope, inv_k: f64, full: bool) -> Result<Sweep, CheckError> {
+        self.sweep_samples(scope, inv_k, full, 0..self.samples.len(), 1)
+    }
+
+    /// The samples (at k = 1: path time, s) the check takes, in order.
+    pub(super) fn sample_times(&self) -> impl Iterator<Item = f64> + '_ {
+        self.samples.iter().map(|s| s.s)
+    }
+
+    /// [`Checker::sweep`] of every `stride`-th sample of `range` only (the speed profile's
+    /// per-part search, docs/design.md §27).
+    pub(super) fn sweep_samples(
+        &self,
+        scope: Scope,
+        inv_k: f64,
+        full: bool,
+        range: std::ops::Range<usize>,
+        stride: usize,
+    ) -> Result<Sweep, CheckError> {
         let times = self.times(inv_k);
         let owned = match scope {
             Scope::AsWritten => self.profile_plants(&times).map_err(CheckError::Invalid)?,
@@ -284,7 +302,8 @@ impl<'a> Checker<'a> {
             first: None,
             peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
         };
-        for (j, smp) in self.samples.iter().enumerate() {
+        for j in range.step_by(stride.max(1)) {
+            let smp = &self.samples[j];
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
             let stiffness = self.pitch_stiffness(smp, inv_k);

@@ -1,0 +1,330 @@
+//! The speed profile of a waypoint mission (docs/design.md §27, Choices 156–158): the fastest
+//! speed per leg and turn at which the reference stays inside every thruster's margin envelope
+//! over the whole parameter box (and the configured current), joined by the core's speed
+//! changes, checked again as flown.
+//!
+//! 1. **Per part** (each leg and each turn, a segment of the route): the path is sampled once at
+//!    its constant `speed`; a speed v on a part is the time scale speed/v on that part's
+//!    samples, so the preflight's own sweep ([`Checker::sweep_samples`], scope
+//!    [`Scope::WholeBox`]) at 1/k = v/speed judges it. The largest feasible v is found by
+//!    geometric bisection to [`SPEED_TOLERANCE`] over every [`PROFILE_STRIDE`]-th sample; the
+//!    thruster of the first violation just above it is the part's limiting thruster.
+//! 2. **Room for the changes** (the core refuses a part too short for the changes at its two
+//!    ends): in the manner of TOPP's backward and forward passes, a part whose changes do not
+//!    fit is slowed towards its slower neighbour until they do, repeated until nothing changes.
+//!    Speeds are rounded down to [`SPEED_STEP`].
+//! 3. **Checked as flown:** the mission with the profile is sampled again (every sample, the
+//!    speed changes' tangential acceleration included) and swept over the whole box and as
+//!    written (its own payload profile at its own times, with the roll swings its payload
+//!    jumps leave: the verdict `check` and the real-vehicle table give); if any sample fails,
+//!    every speed is lowered by [`VERIFY_SHRINK`] and the whole is redone, at most
+//!    [`MAX_VERIFY_ROUNDS`] times.
+//!
+//! Compared with the uniform time scale: the fastest constant speed is the slowest part's
+//! (every part must hold it), so the survey at one speed takes length/min(v).
+
+use controller_core::{Mission, Trajectory, TrajectoryKind};
+use serde::{Deserialize, Serialize};
+
+use controller_core::trajectory::{Route, SpeedList, DEFAULT_SPEED_CHANGE, MAX_SPEED};
+
+use super::sweep::Checker;
+use super::{CheckError, Scope};
+use crate::scenario::{Scenario, SimConfig};
+
+/// Every this many samples of the path (0.5 s of path time at 20 Hz) in the per-part search.
+pub const PROFILE_STRIDE: usize = 10;
+/// The per-part bisection stops when the feasible and the infeasible speed differ by less than
+/// this fraction.
+pub const SPEED_TOLERANCE: f64 = 0.01;
+/// Proposed speeds are rounded down to a multiple of this (m/s).
+pub const SPEED_STEP: f64 = 0.01;
+/// Factor on every speed when the profile fails its check as flown.
+pub const VERIFY_SHRINK: f64 = 0.97;
+/// Rounds of [`VERIFY_SHRINK`] at most.
+pub const MAX_VERIFY_ROUNDS: usize = 8;
+/// The slowest speed the search considers (m/s): a part infeasible there is infeasible.
+const MIN_PROFILE_SPEED: f64 = 0.02;
+
+/// One part of the path as the profile flies it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PartTime {
+    /// `leg j` or `turn at j`.
+    pub name: String,
+    /// Its length along the path (m).
+    pub length: f64,
+    /// Its speed (m/s).
+    pub speed: f64,
+    /// The time spent on it (s), speed changes included.
+    pub time: f64,
+    /// The thruster that stops it going faster (the first violation just above its speed).
+    pub limiting: String,
+}
+
+/// The proposed profile and what it saves.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct SpeedProfile {
+    pub parts: Vec<PartTime>,
+    /// The speeds to pin (`speeds = […]`), m/s.
+    pub speeds: Vec<f64>,
+    /// The speed changes' largest |σ̈| (m/s²).
+    pub speed_change: f64,
+    /// The whole path with the profile (s).
+    pub total_time: f64,
+    /// The fastest constant speed over the whole path (m/s) and its time (s).
+    pub uniform_speed: f64,
+    pub uniform_time: f64,
+    /// The path's length (m) and its time at the file's own constant `speed` (s).
+    pub length: f64,
+    pub nominal_time: f64,
+    /// Rounds of [`VERIFY_SHRINK`] the check as flown needed.
+    pub shrink_rounds: usize,
+}
+
+/// The waypoint mission's parts: the route, its constant `speed`, and the speed change.
+struct Parts {
+    route: Route,
+    speed: f64,
+    accel: f64,
+}
+
+/// The speed profile of `scenario` at `margin`, if it is a waypoint mission (`None` otherwise).
+///
+/// # Errors
+/// [`CheckError::Invalid`] if the mission cannot be built at some step; [`CheckError::Interrupted`].
+pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>, CheckError> {
+    let cfg = scenario.config();
+    let TrajectoryKind::Waypoints {
+        speed,
+        speed_change,
+        ..
+    } = cfg.trajectory
+    else {
+        return Ok(None);
+    };
+    let constant = with_law(cfg, None, None, 1.0)?;
+    let parts = Parts {
+        route: *constant.trajectory().route(),
+        speed: f64::from(speed),
+        // The f32 as the decimal it was written as (0.05, not 0.0500000007).
+        accel: super::time_scale(speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
+    };
+    let checker = Checker::new(&constant, margin)?;
+    let (fastest, limiting) = per_part_speeds(&checker, &parts)?;
+    let uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
+    let mut speeds = fastest.clone();
+    for round in 0..=MAX_VERIFY_ROUNDS {
+        let fitted = fit_changes(&parts, &speeds);
+        let flown = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
+        let checker = Checker::new(&flown, margin)?;
+        let ok = checker.sweep(Scope::WholeBox, 1.0, false)?.first.is_none()
+            && checker.sweep(Scope::AsWritten, 1.0, false)?.first.is_none();
+        if ok || round == MAX_VERIFY_ROUNDS {
+            return Ok(Some(report(
+                &parts,
+                &flown,
+                fitted,
+                limiting,
+                uniform_speed,
+                round,
+            )));
+        }
+        speeds.iter_mut().for_each(|v| *v *= VERIFY_SHRINK);
+    }
+    unreachable!("the loop returns in its last round")
+}
+
+/// `cfg` with the time law `speeds` (per part; `None`: constant speed), time scale 1 and a
+/// duration that covers the whole path (and `extra` s beyond), validated.
+fn with_law(
+    cfg: &SimConfig,
+    speeds: Option<&[f64]>,
+    accel: Option<f64>,
+    extra: f64,
+) -> Result<Scenario, CheckError> {
+    let invalid = |e: String| CheckError::Invalid(e);
+    let mut c = cfg.clone();
+    let TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius,
+        ..
+    } = c.trajectory
+    else {
+        return Err(invalid("not a waypoint mission".into()));
+    };
+    let list = match speeds {
+        Some(s) => Some(
+            SpeedList::new(&s.iter().map(|&v| v as f32).collect::<Vec<_>>())
+                .map_err(|e| invalid(e.to_string()))?,
+        ),
+        None => None,
+    };
+    c.trajectory = TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius,
+        speeds: list,
+        speed_change: accel.map(|a| a as f32),
+    };
+    c.time_scale = 1.0;
+    let t = Trajectory::new(Mission {
+        path: c.trajectory,
+        heading: c.heading,
+        time_scale: 1.0,
+    })
+    .map_err(|e| invalid(format!("the profiled mission: {e}")))?;
+    c.duration = match t.time_law().is_set() {
+        true => f64::from(t.time_law().duration()),
+        false => f64::from(t.route().length()) / f64::from(speed),
+    } + extra;
+    Scenario::new(c).map_err(|e| invalid(e.to_string()))
+}
+
+/// The fastest feasible speed of every part (see the module docs, step 1), and the thruster
+/// that limits it.
+fn per_part_speeds(
+    checker: &Checker,
+    parts: &Parts,
+) -> Result<(Vec<f64>, Vec<String>), CheckError> {
+    let route = &parts.route;
+    let n_parts = route.segment_part(route.segment_count() - 1) + 1;
+    // The samples of each segment: σ = speed·s.
+    let times: Vec<f64> = checker.sample_times().collect();
+    let mut speeds = vec![f64::from(MAX_SPEED); n_parts];
+    let mut limiting = vec![String::from("none"); n_parts];
+    for i in 0..route.segment_count() {
+        let (s0, len) = (
+            f64::from(route.segment_start(i)),
+            f64::from(route.segment_length(i)),
+        );
+        let first = times.partition_point(|&s| s * parts.speed < s0);
+        let end = times.partition_point(|&s| s * parts.speed < s0 + len);
+        if first >= end {
+            continue;
+        }
+        let feasible = |v: f64| -> Result<Option<String>, CheckError> {
+            let sweep = checker.sweep_samples(
+                Scope::WholeBox,
+                v / parts.speed,
+                false,
+                first..end,
+                PROFILE_STRIDE,
+            )?;
+            Ok(sweep.first.map(|f| f.thruster))
+        };
+        let (mut lo, mut hi) = (MIN_PROFILE_SPEED, f64::from(MAX_SPEED));
+        let mut limit = String::from("none");
+        if let Some(t) = feasible(lo)? {
+            // Not even slowly: the part keeps the slowest speed; the check as flown says so.
+            speeds[route.segment_part(i)] = lo;
+            limiting[route.segment_part(i)] = t;
+            continue;
+        }
+        match feasible(hi)? {
+            None => lo = hi,
+            Some(t) => {
+                limit = t;
+                while hi / lo > 1.0 + SPEED_TOLERANCE {
+                    let mid = (lo * hi).sqrt();
+                    match feasible(mid)? {
+                        None => lo = mid,
+                        Some(t) => {
+                            hi = mid;
+                            limit = t;
+                        }
+                    }
+                }
+            }
+        }
+        let p = route.segment_part(i);
+        speeds[p] = speeds[p].min(lo);
+        limiting[p] = limit;
+    }
+    Ok((speeds, limiting))
+}
+
+/// The speeds rounded down to [`SPEED_STEP`], each part slowed until the core's speed changes
+/// fit in it (see the module docs, step 2). Terminates: speeds only fall, and a part no
+/// faster than both neighbours has no change in it.
+fn fit_changes(parts: &Parts, speeds: &[f64]) -> Vec<f64> {
+    let route = &parts.route;
+    let mut v: Vec<f64> = speeds
+        .iter()
+        .map(|&x| ((x / SPEED_STEP).floor() * SPEED_STEP).max(SPEED_STEP))
+        .collect();
+    let n = route.segment_count();
+    let peak = 15.0 / 8.0;
+    // The path a change from `a` down or up to `b` < `a` needs (with a 1 % allowance for the
+    // core's f32 arithmetic).
+    let room = |a: f64, b: f64| 1.01 * 0.5 * (a + b) * peak * (a - b) / parts.accel;
+    let need = |v: &[f64], i: usize| {
+        let vi = v[route.segment_part(i)];
+        let mut d = 0.0;
+        for j in [i.wrapping_sub(1), i + 1] {
+            if j < n && v[route.segment_part(j)] < vi {
+                d += room(vi, v[route.segment_part(j)]);
+            }
+        }
+        d
+    };
+    loop {
+        let mut changed = false;
+        for i in 0..n {
+            let p = route.segment_part(i);
+            while need(&v, i) > f64::from(route.segment_length(i)) && v[p] > SPEED_STEP {
+                v[p] = ((v[p] - SPEED_STEP) / SPEED_STEP).round() * SPEED_STEP;
+                changed = true;
+            }
+        }
+        if !changed {
+            return v;
+        }
+    }
+}
+
+/// The profile's report: each part's time from the flown law, the totals.
+fn report(
+    parts: &Parts,
+    flown: &Scenario,
+    speeds: Vec<f64>,
+    limiting: Vec<String>,
+    uniform_speed: f64,
+    shrink_rounds: usize,
+) -> SpeedProfile {
+    let route = &parts.route;
+    let law = flown.trajectory().time_law();
+    let n = route.segment_count();
+    let parts_out = (0..n)
+        .map(|i| {
+            let p = route.segment_part(i);
+            let start = f64::from(law.segment_time(i));
+            let end = match i + 1 < n {
+                true => f64::from(law.segment_time(i + 1)),
+                false => f64::from(law.duration()),
+            };
+            PartTime {
+                name: match p % 2 {
+                    0 => format!("leg {}", p / 2),
+                    _ => format!("turn at {}", p.div_ceil(2)),
+                },
+                length: f64::from(route.segment_length(i)),
+                speed: speeds[p],
+                time: end - start,
+                limiting: limiting[p].clone(),
+            }
+        })
+        .collect();
+    let length = f64::from(route.length());
+    SpeedProfile {
+        parts: parts_out,
+        speeds,
+        speed_change: parts.accel,
+        total_time: f64::from(law.duration()),
+        uniform_speed,
+        uniform_time: length / uniform_speed,
+        length,
+        nominal_time: length / parts.speed,
+        shrink_rounds,
+    }
+}

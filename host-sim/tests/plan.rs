@@ -1,0 +1,156 @@
+//! QGroundControl `.plan` import and export (docs/design.md §27): geodetic → NED against known
+//! lengths of a degree, the round trip, the errors, and the shipped example as a scenario.
+
+use host_sim::scenario::parse_scenario;
+use host_sim::scenario::plan::{self, Origin};
+use std::path::Path;
+use std::process::Command;
+
+#[test]
+fn geodetic_to_ned_matches_the_known_lengths_of_a_degree() {
+    // On the equator a degree of longitude is a·π/180 = 111 319.491 m (WGS-84 a).
+    let o = Origin {
+        lat: 0.0,
+        lon: 0.0,
+        alt: 0.0,
+    };
+    let p = o.to_ned(0.0, 0.01, -5.0);
+    assert!(
+        (p[1] - 1113.19491).abs() < 1e-4 && p[0].abs() < 1e-9,
+        "{p:?}"
+    );
+    assert_eq!(p[2], 5.0, "5 m below the origin is 5 m down");
+    // At 45° a degree of latitude is 111 131.75 m (the meridian arc from 44.5° to 45.5°);
+    // 0.01° across 45°.
+    let o = Origin {
+        lat: 44.995,
+        lon: 10.0,
+        alt: 0.0,
+    };
+    let p = o.to_ned(45.005, 10.0, 0.0);
+    assert!((p[0] - 1111.3175).abs() < 0.01, "{p:?}");
+}
+
+#[test]
+fn import_export_import_returns_the_same_points() {
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/plans/harbour-wall.plan"),
+    )
+    .unwrap();
+    let (origin, points) = plan::import(&text).unwrap();
+    assert_eq!(points.len(), 6);
+    // The example was written from these NED points (to 1e-9° ≈ 0.1 mm).
+    let want = [
+        [0.0, 0.0, 3.0],
+        [60.0, 20.0, 3.0],
+        [120.0, 40.0, 6.0],
+        [160.0, 90.0, 8.0],
+        [160.0, 150.0, 8.0],
+        [120.0, 190.0, 8.0],
+    ];
+    for (p, w) in points.iter().zip(want) {
+        for c in 0..3 {
+            assert!((p[c] - w[c]).abs() < 2e-4, "{p:?} vs {w:?}");
+        }
+    }
+    let (o2, again) = plan::import(&plan::export(&origin, &points)).unwrap();
+    assert_eq!(o2, origin);
+    for (a, b) in again.iter().zip(&points) {
+        for c in 0..3 {
+            assert!((a[c] - b[c]).abs() < 1e-6, "{a:?} vs {b:?}");
+        }
+    }
+    // The GeoJSON of the path: [lon, lat, alt] per point.
+    let g: serde_json::Value =
+        serde_json::from_str(&plan::geojson_line(&origin, "wall", &points)).unwrap();
+    let c = &g["geometry"]["coordinates"];
+    assert_eq!(c.as_array().unwrap().len(), 6);
+    assert_eq!(c[0][0].as_f64(), Some(origin.lon));
+    assert_eq!(c[0][2].as_f64(), Some(-3.0));
+}
+
+#[test]
+fn a_plan_with_other_items_is_refused_naming_the_item() {
+    let text = r#"{"fileType": "Plan", "mission": {"plannedHomePosition": [1, 2, 0], "items": [
+        {"type": "SimpleItem", "command": 16, "params": [0, 0, 0, null, 1.0, 2.0, -3]},
+        {"type": "SimpleItem", "command": 22, "params": [0, 0, 0, null, 1.0, 2.0, 10]}]}}"#;
+    let e = plan::import(text).unwrap_err();
+    assert!(e.contains("mission.items[1]") && e.contains("22"), "{e}");
+    let e = plan::import(r#"{"fileType": "Mission"}"#).unwrap_err();
+    assert!(e.contains("fileType"), "{e}");
+}
+
+#[test]
+fn the_shipped_plan_imports_as_a_valid_waypoint_scenario() {
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["import-plan", "--speed", "0.4"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/plans/harbour-wall.plan"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = parse_scenario(&String::from_utf8(out.stdout).unwrap()).expect("a valid scenario");
+    assert!(s.trajectory().route().length() > 300.0);
+    // A file that is not a plan: exit 2, naming the file.
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["import-plan"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/real/survey-200x100.toml"))
+        .output()
+        .unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    assert!(String::from_utf8_lossy(&out.stderr).contains("survey-200x100.toml"));
+}
+
+/// The imported plan flown (`run`, 40 s): the flown path is written as GeoJSON around the
+/// plan's home, starting on the first waypoint; a bad origin names `trajectory.origin`.
+#[test]
+fn a_run_with_an_origin_writes_the_flown_path_as_geojson() {
+    let dir = std::env::temp_dir().join(format!("host-sim-plan-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["import-plan", "--speed", "0.4", "--name", "wall"])
+        .arg(Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/plans/harbour-wall.plan"))
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    let scenario = dir.join("wall.toml");
+    std::fs::write(&scenario, format!("duration = 40.0\n{text}")).unwrap();
+    let run_dir = dir.join("out");
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["run", "--scenario"])
+        .arg(&scenario)
+        .arg("--out")
+        .arg(&run_dir)
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let g: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(run_dir.join("wall-flown.geojson")).unwrap())
+            .unwrap();
+    let c = g["geometry"]["coordinates"].as_array().unwrap();
+    assert!(c.len() > 10);
+    // The first waypoint is the plan's home, 3 m deep: [lon, lat, alt].
+    let first = &c[0];
+    assert!((first[0].as_f64().unwrap() - 5.362).abs() < 1e-6, "{first}");
+    assert!(
+        (first[1].as_f64().unwrap() - 43.295).abs() < 1e-6,
+        "{first}"
+    );
+    assert!((first[2].as_f64().unwrap() + 3.0).abs() < 0.01, "{first}");
+    let bad = text.replace("origin = [43.295", "origin = [143.295");
+    match parse_scenario(&bad) {
+        Err(host_sim::scenario::ScenarioError::Invalid { key, .. }) => {
+            assert_eq!(key, "trajectory.origin")
+        }
+        other => panic!("{other:?}"),
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
