@@ -10,8 +10,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
     self, CampaignArgs, CheckArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs, RunArgs,
-    Table1Args,
-    ValidateArgs,
+    Table1Args, ValidateArgs,
 };
 
 #[derive(Parser)]

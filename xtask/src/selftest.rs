@@ -58,6 +58,7 @@ pub fn run(ci: &mut Ci, built: &Built) {
         check_instruction_counts(ci, backend, &run.log);
         check_stage_budgets(ci, backend, &run.log);
         check_signing_budget(ci, backend, &run.log);
+        check_stack_budget(ci, backend, &run.log);
         compare_log(ci, backend, &run.log);
         if v.backend == Backend::DEFAULT {
             inject_failures(ci, elf);
@@ -101,6 +102,35 @@ fn check_signing_budget(ci: &mut Ci, backend: &str, log: &str) {
         }
         _ => ci.fail(format!(
             "self-test ({backend}): no `signing instructions per frame: sign=N verify=M` line in its log"
+        )),
+    }
+}
+
+/// The self-test's `stack high-water mark: N bytes`.
+fn stack_high_water(log: &str) -> Option<u32> {
+    log.lines()
+        .find_map(|l| l.split_once("stack high-water mark:"))
+        .and_then(|(_, rest)| rest.split_whitespace().next())
+        .and_then(|n| n.parse().ok())
+}
+
+/// The stack's high-water mark against [`budget::STACK_BUDGET_BYTES`].
+fn check_stack_budget(ci: &mut Ci, backend: &str, log: &str) {
+    match stack_high_water(log) {
+        Some(bytes) => {
+            println!(
+                "{backend}: stack high-water mark {bytes} B (budget {} B)",
+                budget::STACK_BUDGET_BYTES
+            );
+            if bytes > budget::STACK_BUDGET_BYTES {
+                ci.fail(format!(
+                    "self-test ({backend}): the stack reached {bytes} B, over its budget of {} B (firmware/src/budget.rs)",
+                    budget::STACK_BUDGET_BYTES
+                ));
+            }
+        }
+        None => ci.fail(format!(
+            "self-test ({backend}): no `stack high-water mark: N bytes` line in its log"
         )),
     }
 }
@@ -272,6 +302,21 @@ mod tests {
         assert_eq!(max_of(LOG, "stage law:"), Some(1004));
         assert_eq!(max_of(LOG, "stage trajectory:"), None);
         assert_eq!(max_of(LOG, "update instructions:"), Some(35200));
+    }
+
+    #[test]
+    fn the_stack_high_water_mark_is_read_from_its_line() {
+        let log = "INFO  stage law: max=1004 mean=996 instructions\n\
+                   INFO  stack high-water mark: 92612 bytes\n\
+                   INFO  self-test passed";
+        assert_eq!(stack_high_water(log), Some(92612));
+        const {
+            assert!(
+                92_612 > budget::STACK_BUDGET_BYTES,
+                "the 32-point capacity's stack is refused"
+            )
+        };
+        assert_eq!(stack_high_water(LOG), None);
     }
 
     #[test]

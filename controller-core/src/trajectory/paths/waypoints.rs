@@ -41,7 +41,15 @@ use crate::trajectory::error::TrajectoryError;
 use crate::trajectory::phases::Planar;
 
 /// Most waypoints in one mission (Choice 152).
+#[cfg(not(target_os = "none"))]
 pub const MAX_WAYPOINTS: usize = 32;
+/// Most waypoints in one mission on a bare-metal target (the board): 2 until the chunked
+/// mission upload exists (**Choice 160**). The link refuses a waypoint path in one frame
+/// (Choice 155), so the board never builds one; its capacity would only cost every
+/// `Trajectory` 8.6 kB of RAM and the stack that copies them (92.6 kB high-water mark in
+/// the self-test at 32 points, against 18.3 kB before the waypoint path existed).
+#[cfg(target_os = "none")]
+pub const MAX_WAYPOINTS: usize = 2;
 /// Segments of a path of [`MAX_WAYPOINTS`] points: its legs and the blends between them.
 pub const MAX_SEGMENTS: usize = 2 * MAX_WAYPOINTS - 3;
 /// Steps of the binary search: 2^SEARCH_STEPS ≥ [`MAX_SEGMENTS`].
