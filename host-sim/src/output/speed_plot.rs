@@ -36,15 +36,6 @@ pub fn plot_speed_profile(dir: &Path, scenario: &Scenario) -> Result<Option<Path
     let t = scenario.trajectory();
     let (route, law) = (t.route(), t.time_law());
     let k = f64::from(cfg.time_scale);
-    // The reference speed: σ̇ on the legs, σ̇·|p′| (≥ σ̇·cos(Δ/2)) in the turns (Choice 150).
-    let n = (cfg.duration * f64::from(SPEED_PLOT_RATE_HZ)).floor() as u64;
-    let reference: Vec<(f64, f64)> = (0..=n)
-        .map(|i| {
-            let d = t.sample(i, SPEED_PLOT_RATE_HZ);
-            let v = d.eta_dot.fixed_rows::<3>(0).norm();
-            (i as f64 / f64::from(SPEED_PLOT_RATE_HZ), f64::from(v))
-        })
-        .collect();
     // Each segment's start and end time (s, at the mission's time scale).
     let count = route.segment_count();
     let bounds = |i: usize| -> (f64, f64) {
@@ -89,7 +80,7 @@ pub fn plot_speed_profile(dir: &Path, scenario: &Scenario) -> Result<Option<Path
         "reference speed |η̇_d| (σ̇ on the legs)",
         C_WITH,
         Stroke::Solid,
-        reference,
+        reference_speed(scenario),
     ));
     panel.lines.push(Line::new(
         "each part's speed (speeds, else speed)",
@@ -110,4 +101,17 @@ pub fn plot_speed_profile(dir: &Path, scenario: &Scenario) -> Result<Option<Path
         panel_with_legend(path, &title, &panel)
     })?;
     Ok(Some(file))
+}
+
+/// The reference speed |η̇_d| at [`SPEED_PLOT_RATE_HZ`] over the run: σ̇ on the legs, σ̇·|p′|
+/// (≥ σ̇·cos(Δ/2)) in the turns (Choice 150).
+fn reference_speed(scenario: &Scenario) -> Vec<(f64, f64)> {
+    let n = (scenario.config().duration * f64::from(SPEED_PLOT_RATE_HZ)).floor() as u64;
+    (0..=n)
+        .map(|i| {
+            let d = scenario.trajectory().sample(i, SPEED_PLOT_RATE_HZ);
+            let v = d.eta_dot.fixed_rows::<3>(0).norm();
+            (i as f64 / f64::from(SPEED_PLOT_RATE_HZ), f64::from(v))
+        })
+        .collect()
 }
