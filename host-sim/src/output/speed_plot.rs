@@ -77,7 +77,7 @@ pub fn plot_speed_profile(dir: &Path, scenario: &Scenario) -> Result<Option<Path
     };
     let mut panel = Panel::new("", "t (s)", "speed (m/s)");
     panel.lines.push(Line::new(
-        "reference speed |η̇_d| (σ̇ on the legs)",
+        "reference speed |dη_d/dt| (dσ/dt on the legs)",
         C_WITH,
         Stroke::Solid,
         reference_speed(scenario),
