@@ -201,3 +201,29 @@ fn run_plots_the_speed_of_a_waypoint_mission_only() {
     assert_eq!(others, circle);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// A bad cap stops `check` with exit 2 and names the key and the leg (Choice 161).
+#[test]
+fn check_refuses_a_bad_cap_with_exit_2() {
+    let dir = std::env::temp_dir().join(format!("host-sim-cap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bad.toml");
+    std::fs::write(
+        &file,
+        "[trajectory]\nkind = \"waypoints\"\npoints = [[0, 0, 5], [20, 0, 5], [20, 10, 5]]\n\
+         speed = 0.5\nspeed_limits = [0.4, -1]\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["check", "--scenario"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("trajectory.speed_limits") && err.contains("leg 1"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
