@@ -844,3 +844,43 @@ fn a_pinned_speed_profile_parses_and_its_errors_name_speeds() {
     assert_eq!(key, "trajectory.speeds");
     assert!(msg.contains("part 0"), "{msg}");
 }
+
+/// `trajectory.speed_limits` (Choice 161): one cap per leg, each in (0, MAX_SPEED]; a wrong
+/// count, a bad value (naming its leg) or a closed-form kind is refused under the key.
+#[test]
+fn speed_limits_are_one_cap_per_leg_and_refused_by_key_and_leg() {
+    let points = "[[0, 0, 5], [60, 0, 5], [60, 30, 5]]";
+    let ok = parse_scenario(&waypoints_with(
+        points,
+        "speed = 0.5\nspeed_limits = [1.5, 0.75]\n",
+    ))
+    .expect("valid");
+    assert_eq!(ok.config().speed_limits, Some(vec![1.5, 0.75]));
+    let refused = |extra: &str, leg_text: &str| {
+        let e = parse_scenario(&waypoints_with(points, &format!("speed = 0.5\n{extra}")))
+            .expect_err(extra);
+        match &e {
+            ScenarioError::Invalid { key, message } => {
+                assert_eq!(key, "trajectory.speed_limits", "{e}");
+                assert!(message.contains(leg_text), "{extra}: {e}");
+            }
+            other => panic!("{extra}: {other}"),
+        }
+    };
+    refused("speed_limits = [1.0]", "(2 for 3 points), got 1");
+    refused("speed_limits = [1.0, 1.0, 1.0]", "got 3");
+    refused("speed_limits = [1.0, 0.0]", "leg 1");
+    refused("speed_limits = [-1.0, 1.0]", "leg 0");
+    refused("speed_limits = [1.0, 10.5]", "leg 1");
+    refused("speed_limits = [nan, 1.0]", "leg 0");
+    refused("speed_limits = [1.0, inf]", "leg 1");
+    // Not a waypoint mission: the key is not used.
+    let e = parse_scenario(
+        "name = \"c\"\n[trajectory]\nkind = \"circle\"\nradius = 10\nspeed_limits = [1.0]\n",
+    )
+    .expect_err("circle");
+    assert!(
+        matches!(&e, ScenarioError::Invalid { key, .. } if key == "trajectory.speed_limits"),
+        "{e}"
+    );
+}

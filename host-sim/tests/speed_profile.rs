@@ -73,3 +73,157 @@ fn the_profile_beats_the_uniform_scale_and_flies_within_the_bound() {
     assert!(bound::within_bound(&run), "{:?}", run.metrics);
     assert!(!run.missed(), "{}", run.outcome);
 }
+
+/// Two legs (40 m, 20 m) and one 90° turn, no payload: small enough for three proposals in a
+/// test.
+fn one_turn(caps: Option<Vec<f64>>) -> host_sim::scenario::Scenario {
+    short_survey()
+        .with(|c| {
+            c.trajectory = TrajectoryKind::Waypoints {
+                points: controller_core::WaypointList::new(&[
+                    [0.0, 0.0, 5.0],
+                    [40.0, 0.0, 5.0],
+                    [40.0, 20.0, 5.0],
+                ])
+                .unwrap(),
+                speed: 0.5,
+                turn_radius: None,
+                speeds: None,
+                speed_change: None,
+            };
+            c.duration = 150.0;
+            c.speed_limits = caps;
+            // No payload: the check as flown passes without the 3 % rounds (the cap exact).
+            c.variation = host_sim::plant::VariationProfile::None;
+        })
+        .unwrap()
+}
+
+/// Choice 161: a cap below a leg's free speed is the leg's speed (rounded down to the profile's
+/// 0.01 m/s) and named as its limit; a cap above the free speed changes nothing at all.
+#[test]
+fn a_leg_cap_bounds_its_leg_and_a_loose_cap_changes_nothing() {
+    let propose = |caps| {
+        profile::propose(&one_turn(caps), DEFAULT_MARGIN)
+            .unwrap()
+            .expect("a waypoint mission")
+    };
+    let free = propose(None);
+    assert_eq!(free.speeds.len(), 3, "{free:?}");
+    assert!(free.parts.iter().all(|p| p.limiting != profile::CAP));
+    // The free leg 0 is well above the cap below (2.11 m/s on the survey's legs, Choice 158).
+    assert!(free.speeds[0] > 1.2, "{free:?}");
+
+    // A cap of 0.987 m/s on leg 0 only: leg 0 at 0.98, the rest as free (their own searches).
+    let capped = propose(Some(vec![
+        0.987,
+        f64::from(controller_core::trajectory::MAX_SPEED),
+    ]));
+    assert_eq!(capped.shrink_rounds, 0, "{capped:?}");
+    assert_eq!(capped.speeds[0], 0.98, "{capped:?}");
+    assert_eq!(capped.parts[0].limiting, profile::CAP);
+    assert_ne!(capped.parts[2].limiting, profile::CAP);
+    assert!(capped.speeds[2] <= free.speeds[2]);
+    // Slower on leg 0, so the mission takes longer.
+    assert!(
+        capped.total_time > free.total_time,
+        "{capped:?} vs {free:?}"
+    );
+
+    // Caps above the free speeds (the largest speed allowed, which no leg holds): the same
+    // proposal, byte for byte.
+    let max = f64::from(controller_core::trajectory::MAX_SPEED);
+    let loose = propose(Some(vec![max, max]));
+    assert_eq!(
+        serde_json::to_string(&loose).unwrap(),
+        serde_json::to_string(&free).unwrap()
+    );
+}
+
+/// The files `host-sim run` leaves in `out` for `scenario` (a TOML text), with the run's name
+/// replaced by `NAME`.
+fn run_files(
+    scenario: &str,
+    name: &str,
+    out: &std::path::Path,
+) -> std::collections::BTreeSet<String> {
+    std::fs::create_dir_all(out).unwrap();
+    let file = out.with_extension("toml");
+    std::fs::write(&file, scenario).unwrap();
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["run", "--scenario"])
+        .arg(&file)
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    std::fs::read_dir(out)
+        .unwrap()
+        .map(|e| {
+            e.unwrap()
+                .file_name()
+                .to_string_lossy()
+                .replace(name, "NAME")
+        })
+        .collect()
+}
+
+/// Choice 162: `run` draws a waypoint mission's speed over time (a PNG, in the manifest) and
+/// nothing more; a closed-form mission gets no speed plot, and the other files are the same.
+#[test]
+fn run_plots_the_speed_of_a_waypoint_mission_only() {
+    let dir = std::env::temp_dir().join(format!("host-sim-speed-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    let waypoints = run_files(
+        "name = \"wp\"\nduration = 10.0\n[trajectory]\nkind = \"waypoints\"\n\
+         points = [[0, 0, 5], [20, 0, 5], [20, 10, 5]]\nspeed = 0.5\nspeed_limits = [0.4, 0.3]\n",
+        "wp",
+        &dir.join("wp"),
+    );
+    let png = std::fs::read(dir.join("wp/wp-speed.png")).expect("the speed plot");
+    assert_eq!(&png[..8], b"\x89PNG\r\n\x1a\n");
+    let manifest =
+        std::fs::read_to_string(dir.join("wp").join(host_sim::output::dir::MANIFEST)).unwrap();
+    assert!(manifest.lines().any(|l| l == "wp-speed.png"), "{manifest}");
+    let circle = run_files(
+        "name = \"ci\"\nduration = 10.0\n[trajectory]\nkind = \"circle\"\nradius = 10.0\n",
+        "ci",
+        &dir.join("ci"),
+    );
+    assert!(!circle.iter().any(|f| f.contains("speed")), "{circle:?}");
+    let mut others = waypoints.clone();
+    assert!(others.remove("NAME-speed.png"), "{waypoints:?}");
+    assert_eq!(others, circle);
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// A bad cap stops `check` with exit 2 and names the key and the leg (Choice 161).
+#[test]
+fn check_refuses_a_bad_cap_with_exit_2() {
+    let dir = std::env::temp_dir().join(format!("host-sim-cap-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("bad.toml");
+    std::fs::write(
+        &file,
+        "[trajectory]\nkind = \"waypoints\"\npoints = [[0, 0, 5], [20, 0, 5], [20, 10, 5]]\n\
+         speed = 0.5\nspeed_limits = [0.4, -1]\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["check", "--scenario"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(
+        err.contains("trajectory.speed_limits") && err.contains("leg 1"),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}

@@ -103,12 +103,13 @@ fn preflight_table(p: &Preflight) -> String {
     s
 }
 
-/// The speed profile's part of `check`'s text: time per part, the limiting thruster, the totals
+/// The speed profile's part of `check`'s text: time per part, the limiting thruster (or `cap`,
+/// `trajectory.speed_limits`), the totals
 /// against the uniform time scale, and the keys that pin it.
 fn profile_table(p: &SpeedProfile) -> String {
     let mut s = format!(
         "speed profile over the whole box (margin envelope, speed changes at {} m/s²):\n\
-         {:<12} {:>10} {:>12} {:>10}  limiting thruster\n",
+         {:<12} {:>10} {:>12} {:>10}  limited by (thruster or cap)\n",
         Readable(p.speed_change),
         "part",
         "length (m)",

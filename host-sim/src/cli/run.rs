@@ -11,7 +11,9 @@ use super::common::{
 };
 use super::Exit;
 use crate::interrupt;
+use crate::output::speed_plot::{plot_speed_profile, speed_plot_name};
 use crate::output::{self, sections, OutputDir, ReportRow};
+use crate::scenario::Scenario;
 use crate::sim::progress::Progress;
 
 /// `run`: one scenario from a TOML file (and its companion without Δu, for comparison).
@@ -69,6 +71,7 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
     progress.finish();
     let rows = [ReportRow::new(&with, without.as_ref())];
     let mut incomplete = incomplete.into_inner();
+    speed_plot(&dir, &scenario, &mut incomplete)?;
     let report = output::write_plots_and_report(
         &dir,
         &title,
@@ -95,4 +98,16 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .with_context(|| format!("cannot write {}", file.display()))?;
     }
     print_runs(stdout, args.json, &rows, &checks, &report, incomplete)
+}
+
+/// A waypoint mission's speed profile over time (docs/design.md §27, Choice 162), claimed in
+/// the manifest first; a plot that cannot be drawn is listed in `incomplete`.
+fn speed_plot(dir: &OutputDir, scenario: &Scenario, incomplete: &mut Vec<String>) -> Result<()> {
+    if let Some(name) = speed_plot_name(scenario) {
+        dir.claim(&name)?;
+        if let Err(e) = plot_speed_profile(dir.path(), scenario) {
+            incomplete.push(format!("speed plot of {}: {e:#}", scenario.config().name));
+        }
+    }
+    Ok(())
 }

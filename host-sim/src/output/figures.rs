@@ -61,7 +61,7 @@ fn time_range(with: &RunResult, without: Option<&RunResult>) -> Option<(f64, f64
     min_max(ts)
 }
 
-fn file_stem(name: &str) -> String {
+pub(super) fn file_stem(name: &str) -> String {
     let s: String = name
         .chars()
         .map(|c| {

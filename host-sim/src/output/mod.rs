@@ -22,6 +22,7 @@ pub mod figures;
 mod plot;
 pub mod report;
 pub mod sections;
+pub mod speed_plot;
 
 pub use self::csv::{partial_name, write_csv, CsvStream, CSV_COLUMNS};
 pub use self::dir::OutputDir;

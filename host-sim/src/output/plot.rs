@@ -474,3 +474,13 @@ pub(super) fn panel_grid(
         Ok(())
     })
 }
+
+/// A 1200×900 PNG at `path` of one `panel` under `title`, with its legend (no run subtitle: a
+/// plot of the mission, not of a run).
+pub(super) fn panel_with_legend(path: &Path, title: &str, panel: &Panel) -> Result<()> {
+    render(path, |root| {
+        let area = root.titled(title, (FONT, 24)).map_err(plot_err)?;
+        let area = legend_strip(&area, &[panel])?;
+        draw_panel(&area, panel)
+    })
+}

@@ -154,6 +154,11 @@ pub struct SimConfig {
     /// (`trajectory.origin`, e.g. a QGroundControl plan's home): `run` then writes the flown
     /// path as GeoJSON (docs/design.md §27). `None`: the frame is not placed on the earth.
     pub origin: Option<[f64; 3]>,
+    /// A waypoint mission's per-leg speed caps (m/s, one per leg: n − 1 for n points;
+    /// `trajectory.speed_limits`, **Choice 161**): a planning input of `check`'s speed profile
+    /// ([`crate::studies::preflight::profile`]), never flown (the pinned `speeds` are). `None`:
+    /// no caps.
+    pub speed_limits: Option<Vec<f64>>,
     /// Simulated time (s). Paper: 70.
     pub duration: f64,
     /// Plant RK4 step (s). Default 1 ms.
@@ -251,6 +256,7 @@ impl SimConfig {
             },
             time_scale: 1.0,
             origin: None,
+            speed_limits: None,
             duration: 70.0,
             plant_step: 0.001,
             controller: ControllerConfig::default(),

@@ -67,6 +67,7 @@ struct RawTrajectory {
     heading: Option<HeadingName>,
     time_scale: Option<f64>,
     origin: Option<[f64; 3]>,
+    speed_limits: Option<Vec<f64>>,
     #[serde(flatten)]
     path: TrajectoryKind,
 }
@@ -357,6 +358,7 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
         };
     }
     config.origin = raw.trajectory.origin;
+    config.speed_limits = raw.trajectory.speed_limits;
     if let Some(k) = raw.trajectory.time_scale {
         config.time_scale = to_f32("trajectory.time_scale", k)?;
     }

@@ -8,7 +8,8 @@ use controller_core::config::ConfigField;
 use controller_core::controller::{MAX_ANGULAR_RATE, MAX_LINEAR_SPEED, MAX_POSITION};
 use controller_core::model::{self, ParamVariation, VehicleParams, VARIED_PARAMETER_NAMES};
 use controller_core::readable::Readable;
-use controller_core::{Controller, Mission, Trajectory};
+use controller_core::trajectory::MAX_SPEED;
+use controller_core::{Controller, Mission, Trajectory, TrajectoryKind};
 use controller_core::{Fault, Status};
 
 use super::start::start_state;
@@ -93,6 +94,7 @@ pub(super) fn trajectory(mission: &Mission) -> Res<Trajectory> {
 pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     check_name(&config.name)?;
     check_origin(config.origin)?;
+    check_speed_limits(config)?;
     let rate = f64::from(config.controller.rate_hz);
     let period = 1.0 / rate;
 
@@ -350,6 +352,41 @@ fn check_origin(origin: Option<[f64; 3]>) -> Res<()> {
             ))
         }
         _ => Ok(()),
+    }
+}
+
+/// `trajectory.speed_limits` (**Choice 161**): a waypoint mission's, one per leg (n − 1 for n
+/// points), each finite in (0, [`MAX_SPEED`]] m/s; the error names the leg.
+fn check_speed_limits(config: &SimConfig) -> Res<()> {
+    const KEY: &str = "trajectory.speed_limits";
+    let Some(caps) = &config.speed_limits else {
+        return Ok(());
+    };
+    let TrajectoryKind::Waypoints { points, .. } = config.trajectory else {
+        return Err(invalid(KEY, "only used with kind = \"waypoints\""));
+    };
+    let legs = points.as_slice().len().saturating_sub(1);
+    if caps.len() != legs {
+        return Err(invalid(
+            KEY,
+            format!(
+                "needs one speed per leg ({legs} for {} points), got {}",
+                legs + 1,
+                caps.len()
+            ),
+        ));
+    }
+    let max = f64::from(MAX_SPEED);
+    match caps.iter().position(|&v| !(v > 0.0 && v <= max)) {
+        Some(leg) => Err(invalid(
+            KEY,
+            format!(
+                "leg {leg}: must be a speed in (0, {}] m/s, got {}",
+                Readable(max),
+                Readable(caps[leg])
+            ),
+        )),
+        None => Ok(()),
     }
 }
 

@@ -20,6 +20,11 @@
 //!    every speed is lowered by [`VERIFY_SHRINK`] and the whole is redone, at most
 //!    [`MAX_VERIFY_ROUNDS`] times.
 //!
+//! **Caps** (`trajectory.speed_limits`, **Choice 161**): a leg's cap is the first speed its
+//! search tries; if the sweep passes there the leg is proposed at the cap (limited by `cap`),
+//! else the search runs as without it (so a cap above the free speed changes nothing). The
+//! turns keep their own search; steps 2 and 3 only lower speeds, so no cap is exceeded.
+//!
 //! Compared with the uniform time scale: the fastest constant speed is the slowest part's
 //! (every part must hold it), so the survey at one speed takes length/min(v).
 
@@ -45,6 +50,8 @@ pub const VERIFY_SHRINK: f64 = 0.97;
 pub const MAX_VERIFY_ROUNDS: usize = 8;
 /// The slowest speed the search considers (m/s): a part infeasible there is infeasible.
 const MIN_PROFILE_SPEED: f64 = 0.02;
+/// What the report names as the limit of a leg its cap bound (`trajectory.speed_limits`).
+pub const CAP: &str = "cap";
 
 /// One part of the path as the profile flies it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -57,7 +64,8 @@ pub struct PartTime {
     pub speed: f64,
     /// The time spent on it (s), speed changes included.
     pub time: f64,
-    /// The thruster that stops it going faster (the first violation just above its speed).
+    /// The thruster that stops it going faster (the first violation just above its speed), or
+    /// [`CAP`] for a leg its cap bound.
     pub limiting: String,
 }
 
@@ -86,6 +94,8 @@ struct Parts {
     route: Route,
     speed: f64,
     accel: f64,
+    /// Per part: the leg's cap (`trajectory.speed_limits`), `None` for a turn or no cap.
+    caps: Vec<Option<f64>>,
 }
 
 /// The speed profile of `scenario` at `margin`, if it is a waypoint mission (`None` otherwise).
@@ -103,8 +113,18 @@ pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>,
         return Ok(None);
     };
     let constant = with_law(cfg, None, None, 1.0)?;
+    let route = *constant.trajectory().route();
+    let n_parts = route.segment_part(route.segment_count() - 1) + 1;
+    // Part 2j is leg j (the turns between).
+    let caps = (0..n_parts)
+        .map(|p| match (p % 2, &cfg.speed_limits) {
+            (0, Some(c)) => c.get(p / 2).copied(),
+            _ => None,
+        })
+        .collect();
     let parts = Parts {
-        route: *constant.trajectory().route(),
+        route,
+        caps,
         speed: f64::from(speed),
         // The f32 as the decimal it was written as (0.05, not 0.0500000007).
         accel: super::time_scale(speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
@@ -221,6 +241,15 @@ fn per_part_speeds(
             limiting[route.segment_part(i)] = t;
             continue;
         }
+        let p = route.segment_part(i);
+        if let Some(cap) = parts.caps[p] {
+            // The cap is the search's upper bound: feasible there, the leg flies at it.
+            if feasible(cap)?.is_none() {
+                speeds[p] = speeds[p].min(cap);
+                limiting[p] = String::from(CAP);
+                continue;
+            }
+        }
         match feasible(hi)? {
             None => lo = hi,
             Some(t) => {
@@ -237,7 +266,6 @@ fn per_part_speeds(
                 }
             }
         }
-        let p = route.segment_part(i);
         speeds[p] = speeds[p].min(lo);
         limiting[p] = limit;
     }
@@ -249,9 +277,12 @@ fn per_part_speeds(
 /// faster than both neighbours has no change in it.
 fn fit_changes(parts: &Parts, speeds: &[f64]) -> Vec<f64> {
     let route = &parts.route;
+    // Steps per m/s (100): n/100 is the double nearest the decimal n/100, so a cap written as
+    // 0.3 stays 0.3 (0.3/0.01 = 29.999… would floor to 29 steps; +1e-9 of a step keeps 30).
+    let per = (1.0 / SPEED_STEP).round();
     let mut v: Vec<f64> = speeds
         .iter()
-        .map(|&x| ((x / SPEED_STEP).floor() * SPEED_STEP).max(SPEED_STEP))
+        .map(|&x| ((x * per + 1e-9).floor() / per).max(SPEED_STEP))
         .collect();
     let n = route.segment_count();
     let peak = 15.0 / 8.0;
