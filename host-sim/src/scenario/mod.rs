@@ -189,7 +189,7 @@ mod start;
 mod validate;
 
 pub use config::{Bound, InitialAttitude, LinkFaults, SensorNoise, SimConfig, TickRange};
-pub use parse::{DEFAULT_NAME, DEFAULT_SEED};
+pub use parse::{reversed_mask, DEFAULT_NAME, DEFAULT_SEED};
 pub use start::start_state;
 pub use validate::{
     MAX_CONTROL_PERIODS, MAX_CURRENT_SPEED, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS,

@@ -571,7 +571,8 @@ fn build_controller(raw: &RawController) -> Res<ControllerConfig> {
         c.priority = axis_priority(order)?;
     }
     if let Some(names) = &raw.reversed_thrusters {
-        c.geometry = ThrusterGeometry::auv150(reversed_mask(names)?);
+        c.geometry =
+            ThrusterGeometry::auv150(reversed_mask("controller.reversed_thrusters", names)?);
     }
     Ok(c)
 }
@@ -580,8 +581,8 @@ fn build_controller(raw: &RawController) -> Res<ControllerConfig> {
 /// strong (positive-thrust) side against their reference axis (+x main, +z vertical, +y
 /// horizontal), each at most once: the AUV-150 layout with those mounting signs
 /// ([`ThrusterGeometry::auv150`], docs/design.md §9).
-fn reversed_mask(names: &[String]) -> Res<u8> {
-    let key = "controller.reversed_thrusters";
+/// `key` names the list in errors (`key[i]`); a campaign's `draw.mountings[k]` uses it too.
+pub fn reversed_mask(key: &str, names: &[String]) -> Res<u8> {
     let mut mask = 0u8;
     for (i, name) in names.iter().enumerate() {
         let t = THRUSTER_NAMES

@@ -39,7 +39,7 @@ use serde::{Deserialize, Serialize};
 
 use super::METRIC_NAMES;
 use crate::plant::{CurrentModel, VariationProfile};
-use crate::scenario::{Bound, Scenario, ScenarioError, MAX_CURRENT_SPEED};
+use crate::scenario::{reversed_mask, Bound, Scenario, ScenarioError, MAX_CURRENT_SPEED};
 
 /// Most runs of one campaign: 10⁹ (a run's index is recorded exactly, and a campaign of more is
 /// more likely a typo than a plan).
@@ -367,24 +367,9 @@ pub fn mounting_masks(lists: &[Vec<String>]) -> Result<Vec<u8>, CampaignError> {
         .iter()
         .enumerate()
         .map(|(k, names)| {
-            names.iter().enumerate().try_fold(0u8, |mask, (j, name)| {
-                let key = format!("draw.mountings[{k}][{j}]");
-                let t = THRUSTER_NAMES
-                    .iter()
-                    .position(|n| n == name)
-                    .ok_or_else(|| {
-                        invalid(
-                            &key,
-                            format!(
-                                "{name:?} is not a thruster: one of `{}`",
-                                THRUSTER_NAMES.join("`, `")
-                            ),
-                        )
-                    })?;
-                if mask & (1 << t) != 0 {
-                    return Err(invalid(&key, format!("{name:?} is named twice")));
-                }
-                Ok(mask | (1 << t))
+            reversed_mask(&format!("draw.mountings[{k}]"), names).map_err(|e| match e {
+                ScenarioError::Invalid { key, message } => invalid(&key, message),
+                other => invalid("draw.mountings", other.to_string()),
             })
         })
         .collect()
