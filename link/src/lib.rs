@@ -97,6 +97,7 @@ mod msg;
 mod refusal;
 pub mod seq;
 pub mod sign;
+pub mod upload;
 
 pub use frame::{
     decode_frame, decode_frame_signed, encode, encode_signed, FrameDecoder, LinkError, CRC_LEN,
@@ -108,3 +109,6 @@ pub use msg::{
     NOT_AUV150, PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;
+pub use upload::{
+    MissionUpload, UploadBuffer, UploadChunk, UploadHeader, UploadPart, UploadStatus,
+};
