@@ -22,7 +22,11 @@ fn largest() -> TrajectoryKind {
             let i = i as f32;
             [
                 37.5 * i,
-                if i as usize % 2 == 0 { 0.0 } else { 110.25 },
+                if (i as usize).is_multiple_of(2) {
+                    0.0
+                } else {
+                    110.25
+                },
                 5.0 + 0.125 * i,
             ]
         })
