@@ -28,11 +28,11 @@ use auv_link::seq::SeqCheck;
 use auv_link::sign::AuthError;
 use auv_link::{
     BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionPlan, Msg,
-    Refusal, StateFrame, Telemetry, DEFAULT_STALE_PERIODS,
+    Refusal, StateFrame, Telemetry, UploadBuffer, DEFAULT_STALE_PERIODS,
 };
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
 use controller_core::trajectory::TrajectoryError;
-use controller_core::{Controller, ControllerConfig, Mission, Status, Trajectory};
+use controller_core::{Controller, ControllerConfig, Status, Trajectory};
 
 use crate::limits;
 
@@ -162,6 +162,9 @@ pub struct Supervisor {
     board: BoardInfo,
     /// The mission and the board tick it started at.
     mission: Option<(Trajectory, u64)>,
+    /// The waypoint mission uploaded while disarmed (auv_link::upload): kept across disarming
+    /// and fail-safes, dropped by the next upload's `Begin`.
+    upload: UploadBuffer,
     clock: MissionClock,
     armed: bool,
     latched: Option<Latch>,
@@ -217,6 +220,7 @@ impl Supervisor {
             controller,
             board,
             mission: None,
+            upload: UploadBuffer::EMPTY,
             clock: MissionClock::START,
             armed: false,
             latched: None,
@@ -381,6 +385,10 @@ impl Supervisor {
                 Ok(())
             }
             Command::SetConfig(patch) => self.configure(patch),
+            // Refused while armed, like every setting: a mission is never changed under a
+            // running loop (Choice 164).
+            Command::Upload(_) if self.armed => Err(Refusal::WhileArmed),
+            Command::Upload(part) => self.upload.take(part),
         }
     }
 
@@ -410,9 +418,10 @@ impl Supervisor {
         if self.mission.is_some() {
             return Err(Refusal::MissionRunning);
         }
-        // The link's one conversion (auv_link::mission), validated by the core: path, heading
-        // and time scale.
-        let trajectory = Trajectory::new(Mission::from(*plan)).map_err(|e| mission_refusal(&e))?;
+        // The link's one conversion (auv_link::mission; an uploaded path from the upload
+        // buffer), validated by the core: path, heading and time scale.
+        let mission = plan.resolve(&self.upload)?;
+        let trajectory = Trajectory::new(mission).map_err(|e| mission_refusal(&e))?;
         self.mission = Some((trajectory, self.tick));
         self.clock = MissionClock::START;
         if self.lockstep {
@@ -606,6 +615,7 @@ impl Supervisor {
             thrust_unit: self.controller.config().thrust_unit.into(),
             reversed_thrusters: self.mounting,
             rx_ahead: self.rx_ahead,
+            upload: self.upload.status(),
         }
     }
 

@@ -57,7 +57,8 @@ fn deliver(sup: &mut Supervisor, dec: &mut FrameDecoder, seq: u16, msg: Msg) {
 fn the_board_builds_the_same_mission_from_the_link() {
     for (name, tr) in missions() {
         let spec = MissionSpec::try_from(tr.kind()).expect("one frame");
-        let on_board = Trajectory::new(TrajectoryKind::from(spec)).expect("valid mission");
+        let on_board = Trajectory::new(TrajectoryKind::try_from(spec).expect("a closed form"))
+            .expect("valid mission");
         assert_eq!(on_board, tr, "{name}");
         for k in [0u64, 777, 6999, 1 << 40] {
             assert_eq!(tr.sample(k, 100), on_board.sample(k, 100), "{name}");
