@@ -105,6 +105,28 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
             },
         );
     }
+    let uploads: Vec<_> = cases
+        .iter()
+        .filter_map(|c| c.pil.upload.as_ref().map(|u| (c, u)))
+        .collect();
+    if !uploads.is_empty() {
+        notes += "\n### Mission uploads (docs/design.md §27)\n\n";
+        for (c, u) in uploads {
+            notes += &format!(
+                "- {}: CRC {:#010x}, {} chunks in {} frames, {} bytes on the wire ({:.1} ms at \
+                 460 800 baud), verified after {} round(s), {} chunk(s) resent, {:.3} s\n",
+                c.run.name,
+                u.crc,
+                u.chunks,
+                u.frames,
+                u.bytes,
+                u.bytes as f64 * 10.0 / 460_800.0 * 1e3,
+                u.rounds,
+                u.resent,
+                u.seconds
+            );
+        }
+    }
     let realtime: Vec<_> = cases
         .iter()
         .filter_map(|c| c.pil.realtime.as_ref().map(|r| (c, r)))
