@@ -2,6 +2,7 @@
 //! core built for the host; the self-test checks the target against them and counts each
 //! stage on their inputs.
 
+use auv_link::{UploadBuffer, UploadChunk, UploadHeader, UploadPart};
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::{HeadingMode, Mission, Table1Case, Trajectory};
 
@@ -16,6 +17,8 @@ pub struct Golden {
     pub tangent: bool,
     /// A helix (radius, depth rate) flown instead of the case's path.
     pub helix: Option<(f32, f32)>,
+    /// The shipped survey flown instead (tangent heading), rebuilt from its upload.
+    pub waypoints: bool,
     pub eta: [f32; 6],
     pub nu: [f32; 6],
     pub voltage: [f32; THRUSTERS],
@@ -27,10 +30,13 @@ pub struct Golden {
 
 impl Golden {
     /// The mission this vector samples: its Table-1 case, with the tangent heading when
-    /// `tangent`, or the helix (as build.rs made it); `None` if the target refuses it.
+    /// `tangent`, or the helix, or the survey (as build.rs made it); `None` if the target
+    /// refuses it.
     pub fn trajectory(&self) -> Option<Trajectory> {
         let case = *Table1Case::ALL.get(self.case)?;
-        if let Some((radius, rate)) = self.helix {
+        if self.waypoints {
+            Trajectory::new(survey()?).ok()
+        } else if let Some((radius, rate)) = self.helix {
             Trajectory::helix(radius, rate).ok()
         } else if self.tangent {
             Trajectory::new(Mission {
@@ -42,4 +48,19 @@ impl Golden {
             Some(Trajectory::table1(case))
         }
     }
+}
+
+/// The shipped survey's mission, as the board gets it: its upload taken part by part into an
+/// upload buffer, verified against its CRC and resolved (`None` if any part is refused).
+pub fn survey() -> Option<Mission> {
+    let mut upload = UploadBuffer::EMPTY;
+    upload.take(&UploadPart::Begin(SURVEY_HEADER)).ok()?;
+    for c in &SURVEY_CHUNKS {
+        upload.take(&UploadPart::Chunk(*c)).ok()?;
+    }
+    Some(Mission {
+        path: upload.path(SURVEY_HEADER.crc).ok()?,
+        heading: HeadingMode::Tangent,
+        time_scale: 1.0,
+    })
 }

@@ -53,6 +53,9 @@ fn golden_vectors() -> (bool, u32, u32) {
     };
     let mut ok = true;
     let mut worst_ulps = 0u32;
+    // The survey's vectors must be bit for bit (the waypoint path's evaluation is the same
+    // f32 code on both sides, docs/design.md §27).
+    let (mut survey, mut survey_exact) = (0u32, 0u32);
     let (mut max_ticks, mut sum_ticks, mut timed) = (0u32, 0u64, 0u32);
     for (i, g) in GOLDEN.iter().enumerate() {
         let Some(tr) = g.trajectory() else {
@@ -84,6 +87,16 @@ fn golden_vectors() -> (bool, u32, u32) {
             worst_ulps = worst_ulps.max(ulps(o.tau[k], g.tau[k]));
         }
         worst_ulps = worst_ulps.max(ulps(o.delta, g.delta));
+        if g.waypoints {
+            survey += 1;
+            let exact = o.voltage.map(f32::to_bits) == g.voltage.map(f32::to_bits)
+                && o.tau.map(f32::to_bits) == g.tau.map(f32::to_bits)
+                && o.delta.to_bits() == g.delta.to_bits()
+                && o.w_norm.to_bits() == g.w_norm.to_bits()
+                && status == g.status;
+            survey_exact += u32::from(exact);
+            same &= exact;
+        }
         if !same {
             ok = false;
             error!(
@@ -98,6 +111,11 @@ fn golden_vectors() -> (bool, u32, u32) {
         GOLDEN.len(),
         worst_ulps
     );
+    info!(
+        "golden vectors on the shipped survey (waypoints, rebuilt from its upload): {} of {} bit for bit",
+        survey_exact, survey
+    );
+    ok &= survey > 0;
     let max = max_ticks * INSTRUCTIONS_PER_TICK;
     let mean = if timed > 0 {
         (sum_ticks / timed as u64) as u32 * INSTRUCTIONS_PER_TICK
