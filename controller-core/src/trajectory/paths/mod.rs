@@ -115,7 +115,7 @@ pub(super) fn heading_series(path: &TrajectoryKind) -> Option<Series> {
 
 /// Σ |amplitude|·frequency² of ẍ_d and of ÿ_d (`omega` = ω/k): the path's part of K_d
 /// (Assumption 1). The terms linear in t have no acceleration. The waypoint path's bound is
-/// its route's ([`waypoints::bounds`], in [`Trajectory`]'s build), not a sum of amplitudes.
+/// its route's ([`waypoints::bounds`], in [`Trajectory`]'s precompute), not a sum of amplitudes.
 pub(super) fn accel(path: &TrajectoryKind, omega: f32) -> (f32, f32) {
     match *path {
         TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => {
