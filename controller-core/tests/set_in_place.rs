@@ -6,7 +6,7 @@
 
 use controller_core::trajectory::{
     HeadingMode, Mission, SpeedList, Table1Case, Trajectory, TrajectoryError, TrajectoryKind,
-    WaypointList, MAX_PARTS, MAX_WAYPOINTS,
+    WaypointList, MAX_WAYPOINTS,
 };
 
 /// A 200 m × 100 m lawn-mower at 5 m depth, lines 20 m apart (12 points, ten 90° turns).
@@ -274,7 +274,6 @@ fn with_speeds(path: TrajectoryKind, list: SpeedList) -> TrajectoryKind {
 #[test]
 fn set_over_anything_equals_a_fresh_trajectory() {
     let missions = missions();
-    assert!(MAX_PARTS >= 2 * MAX_WAYPOINTS - 3);
     let fresh: Vec<Trajectory> = missions
         .iter()
         .map(|m| Trajectory::new(*m).unwrap_or_else(|e| panic!("{m:?}: {e}")))
