@@ -14,8 +14,8 @@ use std::fs;
 use std::path::PathBuf;
 
 use auv_link::sign::LinkKey;
-use controller_core::kinematics::{self, Attitude};
 use auv_link::MissionUpload;
+use controller_core::kinematics::{self, Attitude};
 use controller_core::{
     Controller, ControllerConfig, HeadingMode, Mission, Status, Table1Case, Trajectory,
     TrajectoryKind,
@@ -211,8 +211,10 @@ const SURVEY: &str = "host-sim/scenarios/real/survey-200x100.toml";
 /// The `[trajectory]` of the scenario file at `path`, a waypoint path, as the core's path: its
 /// `heading` key is the mission's, every other key the path's (`TrajectoryKind`'s serde form).
 fn survey_path(path: &std::path::Path) -> TrajectoryKind {
-    let text = fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
-    let file: toml::Table = toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let text =
+        fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    let file: toml::Table =
+        toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
     let mut trajectory = file
         .get("trajectory")
         .and_then(|t| t.as_table())
@@ -287,7 +289,11 @@ fn survey_golden(
     let chunks: Vec<String> = (0..up.chunks())
         .map(|i| {
             let c = up.chunk(i);
-            format!("    UploadChunk {{ index: {}, words: {} }},", c.index, arr(&c.words))
+            format!(
+                "    UploadChunk {{ index: {}, words: {} }},",
+                c.index,
+                arr(&c.words)
+            )
         })
         .collect();
     writeln!(

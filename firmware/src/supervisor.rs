@@ -160,8 +160,12 @@ struct Control {
 pub struct Supervisor {
     controller: Controller,
     board: BoardInfo,
-    /// The mission and the board tick it started at.
-    mission: Option<(Trajectory, u64)>,
+    /// The board tick the mission started at (`None`: no mission).
+    mission: Option<u64>,
+    /// The mission's trajectory, built in place by `StartMission` (`Trajectory::set`: a
+    /// waypoint path's route and time law are 8.6 kB, never copied on the stack) and flown
+    /// while `mission` is set.
+    trajectory: Trajectory,
     /// The waypoint mission uploaded while disarmed (auv_link::upload): kept across disarming
     /// and fail-safes, dropped by the next upload's `Begin`.
     upload: UploadBuffer,
@@ -220,6 +224,7 @@ impl Supervisor {
             controller,
             board,
             mission: None,
+            trajectory: Trajectory::EMPTY,
             upload: UploadBuffer::EMPTY,
             clock: MissionClock::START,
             armed: false,
@@ -420,9 +425,13 @@ impl Supervisor {
         }
         // The link's one conversion (auv_link::mission; an uploaded path from the upload
         // buffer), validated by the core: path, heading and time scale.
+        // No mission runs here, so the slot is free to build into (a refused mission leaves
+        // it unflown).
         let mission = plan.resolve(&self.upload)?;
-        let trajectory = Trajectory::new(mission).map_err(|e| mission_refusal(&e))?;
-        self.mission = Some((trajectory, self.tick));
+        self.trajectory
+            .set(&mission)
+            .map_err(|e| mission_refusal(&e))?;
+        self.mission = Some(self.tick);
         self.clock = MissionClock::START;
         if self.lockstep {
             // A state frame from before the mission is not on its clock.
@@ -528,7 +537,7 @@ impl Supervisor {
         let stale = self.periods_since_state > u32::from(self.stale_periods);
         // The mission's start tick only: the trajectory (8.6 kB with a waypoint path's route and
         // time law, docs/design.md §27) is borrowed in `fly`, not copied every period.
-        let mission = self.mission.as_ref().map(|&(_, start)| ((), start));
+        let mission = self.mission.map(|start| ((), start));
         match (self.armed, self.latched, mission, self.state) {
             (false, _, _, _) => (BoardStatus::Disarmed, off),
             (true, Some(l), _, _) => (BoardStatus::FailSafe(l.reason), off),
@@ -553,9 +562,7 @@ impl Supervisor {
 
     /// `update` on the latest state frame, timed; a fault latches the fail-safe.
     fn fly(&mut self, start: u64, s: &StateFrame, now: &dyn Fn() -> u32) -> (BoardStatus, Control) {
-        let Some((traj, _)) = &self.mission else {
-            return (BoardStatus::Armed, Control::default());
-        };
+        let traj = &self.trajectory;
         // Mission time: the board's own ticks since StartMission; in lock-step the state
         // frame's t_ticks, on the mission clock (so PIL does not depend on host speed).
         let mission_ticks = if self.lockstep {

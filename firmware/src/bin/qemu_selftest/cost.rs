@@ -95,10 +95,11 @@ pub fn stages(
     let mut update = Stat::default();
     // One row per Table-1 case, then the survey's.
     let mut per_case = [[0u32; STAGES + 1]; Table1Case::ALL.len() + 1];
+    let mut tr = Trajectory::EMPTY;
     for g in golden {
-        let Some(tr) = g.trajectory() else {
+        if !g.set(&mut tr) {
             continue;
-        };
+        }
         let c = if g.robust { with } else { without };
         let Some((counts, total)) = step_counts(counter, c, &tr, g) else {
             continue;
@@ -126,7 +127,11 @@ pub fn stages(
         Stage::ALL.map(|s| s.name())
     );
     let names = Table1Case::ALL.map(|c| c.name());
-    for (name, row) in names.iter().chain(["survey (waypoints)"].iter()).zip(per_case.iter()) {
+    for (name, row) in names
+        .iter()
+        .chain(["survey (waypoints)"].iter())
+        .zip(per_case.iter())
+    {
         info!(
             "  {=str}: {=[?]} = update {} instructions",
             name,

@@ -4,7 +4,7 @@
 
 use auv_link::{UploadBuffer, UploadChunk, UploadHeader, UploadPart};
 use controller_core::effectiveness::THRUSTERS;
-use controller_core::{HeadingMode, Mission, Table1Case, Trajectory};
+use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
 include!(concat!(env!("OUT_DIR"), "/golden.rs"));
 
@@ -30,23 +30,35 @@ pub struct Golden {
 
 impl Golden {
     /// The mission this vector samples: its Table-1 case, with the tangent heading when
-    /// `tangent`, or the helix, or the survey (as build.rs made it); `None` if the target
-    /// refuses it.
-    pub fn trajectory(&self) -> Option<Trajectory> {
+    /// `tangent`, or the helix, or the survey (as build.rs made it).
+    pub fn mission(&self) -> Option<Mission> {
         let case = *Table1Case::ALL.get(self.case)?;
         if self.waypoints {
-            Trajectory::new(survey()?).ok()
-        } else if let Some((radius, rate)) = self.helix {
-            Trajectory::helix(radius, rate).ok()
-        } else if self.tangent {
-            Trajectory::new(Mission {
-                heading: HeadingMode::Tangent,
-                ..Mission::paper(case.kind())
-            })
-            .ok()
-        } else {
-            Some(Trajectory::table1(case))
+            return survey();
         }
+        let path = match self.helix {
+            Some((radius, depth_rate)) => TrajectoryKind::Helix {
+                radius,
+                omega: Trajectory::PAPER_OMEGA,
+                depth: Trajectory::PAPER_DEPTH,
+                depth_rate,
+            },
+            None => case.kind(),
+        };
+        let heading = if self.tangent {
+            HeadingMode::Tangent
+        } else {
+            HeadingMode::Paper
+        };
+        Some(Mission {
+            heading,
+            ..Mission::paper(path)
+        })
+    }
+
+    /// Builds [`Golden::mission`] into `slot`, in place; false if the target refuses it.
+    pub fn set(&self, slot: &mut Trajectory) -> bool {
+        self.mission().is_some_and(|m| slot.set(&m).is_ok())
     }
 }
 

@@ -38,6 +38,8 @@ fn ulps(a: f32, b: f32) -> u32 {
     x.wrapping_sub(y).unsigned_abs()
 }
 
+/// Each vector's mission is built in one slot, in place (`Golden::set`).
+#[inline(never)]
 fn golden_vectors() -> (bool, u32, u32) {
     let with = Controller::new(ControllerConfig::default());
     let without = Controller::new(ControllerConfig {
@@ -57,12 +59,13 @@ fn golden_vectors() -> (bool, u32, u32) {
     // f32 code on both sides, docs/design.md §27).
     let (mut survey, mut survey_exact) = (0u32, 0u32);
     let (mut max_ticks, mut sum_ticks, mut timed) = (0u32, 0u64, 0u32);
+    let mut tr = Trajectory::EMPTY;
     for (i, g) in GOLDEN.iter().enumerate() {
-        let Some(tr) = g.trajectory() else {
+        if !g.set(&mut tr) {
             ok = false;
             error!("golden vector {}: the target refuses its mission", i);
             continue;
-        };
+        }
         let c = if g.robust { &with } else { &without };
         let t0 = SYST::get_current();
         let o = c.update(g.ticks, &g.eta, &g.nu, &tr);
@@ -150,8 +153,19 @@ fn frame(
     (buf, n)
 }
 
-fn circle_state(k: u64) -> StateFrame {
-    let d = Trajectory::table1(Table1Case::Circular10R).sample(k, 100);
+/// The paper's circle, built once into static memory (a trajectory is 8.6 kB: on the stack of
+/// `run` it would sit under every exercise). `None` on a second call.
+#[inline(never)]
+fn circle() -> Option<&'static Trajectory> {
+    let t: Option<&'static mut Trajectory> =
+        cortex_m::singleton!(: Trajectory = Trajectory::table1(Table1Case::Circular10R));
+    t.map(|t| &*t)
+}
+
+/// The state on the paper's circle (`circle`: its trajectory, built once by [`run`]: a
+/// trajectory is 8.6 kB, docs/design.md §27) at tick `k`.
+fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
+    let d = circle.sample(k, 100);
     let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
     StateFrame {
         t_ticks: k,
@@ -229,7 +243,8 @@ fn expect(
 /// and that what must latch stays reported.
 // Long: one scripted sequence of link events, each followed by the status it must give; its
 // log lines are the snapshot's, in this order, and the script reads best whole.
-fn fail_safe_exercise() -> bool {
+#[inline(never)]
+fn fail_safe_exercise(circle: &Trajectory) -> bool {
     let controller = match Controller::new(ControllerConfig::default()) {
         Ok(c) => c,
         Err(_) => return false,
@@ -250,7 +265,7 @@ fn fail_safe_exercise() -> bool {
         false,
     );
     for k in 0..3 {
-        host.send(sup, link, Msg::State(circle_state(k)), false);
+        host.send(sup, link, Msg::State(circle_state(circle, k)), false);
         expect(sup, &mut ok, "state frame", BoardStatus::Running, false);
     }
     expect(
@@ -273,14 +288,14 @@ fn fail_safe_exercise() -> bool {
     host.send(sup, link, Msg::Command(Command::Disarm), true);
     let counted = sup.rx_errors() == errors + 1;
     info!("corrupt frame counted and dropped: {}", counted);
-    host.send(sup, link, Msg::State(circle_state(6)), false);
+    host.send(sup, link, Msg::State(circle_state(circle, 6)), false);
     expect(sup, &mut ok, "link back, not re-armed", stale, false);
     host.send(sup, link, Msg::Command(Command::Arm), false);
     let t = expect(sup, &mut ok, "lone arm", stale, false);
     let lone_refused = t.last_refusal == Some(Refusal::Latched) && t.latched.is_some();
     info!("lone arm refused, reason still reported: {}", lone_refused);
     host.restart(sup, link);
-    let env = host.env(Msg::State(circle_state(7)));
+    let env = host.env(Msg::State(circle_state(circle, 7)));
     let (again, n) = frame(sup, link, &env, None, false);
     expect(
         sup,
@@ -293,7 +308,7 @@ fn fail_safe_exercise() -> bool {
     board::receive(sup, link, &again[..n]);
     let repeat_dropped = sup.rx_stale() == dropped_before + 1;
     info!("repeated state frame dropped: {}", repeat_dropped);
-    let mut bad = circle_state(8);
+    let mut bad = circle_state(circle, 8);
     bad.eta[2] = f32::NAN;
     host.send(sup, link, Msg::State(bad), false);
     let fault = BoardStatus::FailSafe(FailSafeReason::ControllerFault);
@@ -302,7 +317,7 @@ fn fail_safe_exercise() -> bool {
     let fault_kept = first.controller_fault != 0 && next.controller_fault == first.controller_fault;
     info!("fault code reported while latched: {}", fault_kept);
     host.restart(sup, link);
-    host.send(sup, link, Msg::State(circle_state(9)), false);
+    host.send(sup, link, Msg::State(circle_state(circle, 9)), false);
     expect(
         sup,
         &mut ok,
@@ -329,6 +344,7 @@ fn timed_frame(sup: &mut Supervisor, link: &mut LinkBuffers, host: &mut Host, ms
 /// telemetry, refused while armed and with an invalid mask; a `StartMission` with the tangent
 /// heading and a time scale flies, one with a time scale below 1 is refused with its reason.
 /// Logs the instructions each costs the board.
+#[inline(never)]
 fn real_chain_exercise() -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
@@ -399,6 +415,7 @@ fn real_chain_exercise() -> bool {
 /// A signed link: an unsigned frame, a replayed signed frame and one stamped at 2⁴⁸ − 1 are
 /// refused, a signed one is taken; the telemetry says signing is on, counts the stamp too far
 /// ahead, and is still signed.
+#[inline(never)]
 fn signed_link_exercise() -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
@@ -466,10 +483,11 @@ fn largest_telemetry() -> Envelope {
 /// Instructions to sign (encode) the largest telemetry frame and to receive (decode and
 /// verify) a state frame, signed and unsigned: what signing costs the board per frame, twice
 /// per period. Returns (sign, verify) of the signed link, or `None` if a frame failed.
-fn signing_cost() -> Option<(u32, u32)> {
+#[inline(never)]
+fn signing_cost(circle: &Trajectory) -> Option<(u32, u32)> {
     let key = LinkKey::new(SELFTEST_KEY);
     let telemetry = largest_telemetry();
-    let state = Envelope::new(7, Msg::State(circle_state(1234)));
+    let state = Envelope::new(7, Msg::State(circle_state(circle, 1234)));
     let mut counts = [[0u32; 2]; 2];
     let mut ok = true;
     for (i, signed) in [false, true].into_iter().enumerate() {
@@ -588,8 +606,12 @@ pub fn run(mut syst: SYST) -> bool {
     let (golden_ok, max, mean) = golden_vectors();
     info!("update instructions: max={} mean={}", max, mean);
     let budget_ok = crate::cost::run(max);
-    let link_ok = fail_safe_exercise() && signed_link_exercise() && real_chain_exercise();
-    let signing_ok = signing_cost().is_some();
+    let Some(circle) = circle() else {
+        error!("the circle's trajectory was built twice");
+        return false;
+    };
+    let link_ok = fail_safe_exercise(circle) && signed_link_exercise() && real_chain_exercise();
+    let signing_ok = signing_cost(circle).is_some();
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
     if wrong {
