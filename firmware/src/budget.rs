@@ -45,8 +45,11 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "kernels",
         update: 4_000,
-        // kinematics, trajectory, law, allocation, voltage maps
-        stages: [560, 520, 760, 1_000, 1_250],
+        // kinematics, trajectory, law, allocation, voltage maps. The trajectory stage's 720:
+        // a waypoint path's sample (two fixed binary searches, the time law's piece and the
+        // segment's sextic, docs/design.md §27) measured 642 on the survey's golden vectors,
+        // against 468 for the closed forms.
+        stages: [560, 720, 760, 1_000, 1_250],
     },
     // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
     StepBudget {
@@ -58,7 +61,8 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "micromath",
         update: 4_200,
-        stages: [500, 460, 780, 1_000, 1_250],
+        // The waypoint path's trajectory stage: 600 measured (docs/design.md §27).
+        stages: [500, 680, 780, 1_000, 1_250],
     },
 ];
 

@@ -157,12 +157,18 @@ impl Trajectory {
     /// An inert trajectory: the origin at the surface, held (η_d = 0, η̇_d = η̈_d = 0 at every
     /// t). Its mission (a circle of radius 0 and ω 0) is not one [`Trajectory::new`] accepts:
     /// it is what a trajectory holds before [`Trajectory::set`], and after a refused one.
+    /// Every bit of it is zero (its time scale too), so that a board initialises one with a
+    /// `memset` instead of copying 8.6 kB from flash.
     pub const EMPTY: Trajectory = Trajectory {
-        mission: Mission::paper(TrajectoryKind::Circle {
-            radius: 0.0,
-            omega: 0.0,
-            depth: 0.0,
-        }),
+        mission: Mission {
+            path: TrajectoryKind::Circle {
+                radius: 0.0,
+                omega: 0.0,
+                depth: 0.0,
+            },
+            heading: HeadingMode::Paper,
+            time_scale: 0.0,
+        },
         omega: 0.0,
         theta: Frequency::ZERO,
         half: Frequency::ZERO,
@@ -240,25 +246,10 @@ impl Trajectory {
         Ok(())
     }
 
-    /// Back to the behaviour of [`Trajectory::EMPTY`] (its scalars and no segments or pieces;
-    /// the arrays' other entries are left as they are).
+    /// Back to [`Trajectory::EMPTY`], every field.
     fn make_inert(&mut self) {
-        let e = &Self::EMPTY;
-        self.mission = Mission::paper(TrajectoryKind::Circle {
-            radius: 0.0,
-            omega: 0.0,
-            depth: 0.0,
-        });
-        self.omega = e.omega;
-        self.theta = e.theta;
-        self.half = e.half;
-        self.rate = e.rate;
-        self.position_rate = e.position_rate;
-        self.psi = e.psi;
-        self.accel_bound = e.accel_bound;
-        self.min_speed = e.min_speed;
-        self.route.clear();
-        self.law.clear();
+        // All zero bits (see `EMPTY`): a memset, not a copy of a constant from flash.
+        *self = Self::EMPTY;
     }
 
     /// Precomputes the constants of an already validated mission into `self`, whose route and
