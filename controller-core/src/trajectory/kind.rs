@@ -19,7 +19,7 @@ use crate::trajectory::{DEFAULT_SPEED_CHANGE, TURN_ACCEL};
 /// `[trajectory]` table of host-sim's scenario files. Values are not validated there: build the
 /// mission with [`Trajectory::new`].
 // The waypoint list is ~390 bytes beside the closed forms' 16: no heap on the board (no `Box`),
-// and a mission is copied at configuration only (`Trajectory::new`), never per sample.
+// and a mission is copied at configuration only (`Trajectory::set`), never per sample.
 #[allow(clippy::large_enum_variant)]
 // The tag in declaration order (Circle = 0), so that `Trajectory::EMPTY`, a circle of zeros, is
 // all zero bits (a board zeroes it instead of copying it from flash).
