@@ -83,9 +83,7 @@ fn the_board_flies_the_simulators_law_bit_for_bit_through_frames() {
             &mut sup,
             &mut dec,
             1,
-            Msg::Command(Command::StartMission(
-                tr.kind().into(),
-            )),
+            Msg::Command(Command::StartMission(tr.kind().into())),
         );
         for k in 0..50u64 {
             // A plant state near the reference, in f64 as the simulator holds it.
