@@ -5,7 +5,9 @@
 use auv_link::sign::{Direction, LinkKey, Signer, Verifier, MAX_TIMESTAMP};
 use auv_link::{encode, encode_signed, Command, ConfigPatch, Envelope, FrameDecoder, Msg};
 use auv_link::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
-use auv_link::{BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, MAX_FRAME};
+use auv_link::{
+    BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, UploadPart, MAX_FRAME,
+};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
 use cortex_m::peripheral::SYST;
@@ -17,7 +19,7 @@ use firmware::semihosting::CMDLINE_LEN;
 use firmware::supervisor::{BoardInfo, Mode, Supervisor};
 
 use crate::counter::{elapsed, start_counter};
-use crate::golden::GOLDEN;
+use crate::golden::{GOLDEN, SURVEY_CHUNKS, SURVEY_HEADER};
 use crate::stack;
 
 /// Target and host agree when the difference is within a few f32 roundings of the larger
@@ -412,6 +414,106 @@ fn real_chain_exercise() -> bool {
     kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
 }
 
+/// The shipped survey's upload through real frames (docs/design.md §27): refused while armed;
+/// disarmed, a `Begin` and its chunks with the second lost, the telemetry's acknowledgement
+/// naming it, the resend verifying the mission; then `StartMission` of it by its CRC flies.
+/// Logs the instructions each part and the start cost the board.
+#[inline(never)]
+fn upload_exercise() -> bool {
+    let Ok(controller) = Controller::new(ControllerConfig::default()) else {
+        return false;
+    };
+    let mut sup = Supervisor::new(controller, board_info(false));
+    let mut link = LinkBuffers::new();
+    let mut host = Host { seq: 0 };
+    let (sup, link) = (&mut sup, &mut link);
+    let now = || 0u32;
+    let begin = Msg::Command(Command::Upload(UploadPart::Begin(SURVEY_HEADER)));
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    host.send(sup, link, begin, false);
+    let armed_refused = sup.last_refusal() == Some(Refusal::WhileArmed);
+    host.send(sup, link, Msg::Command(Command::Disarm), false);
+    let begin_cost = timed_frame(sup, link, &mut host, begin);
+    let mut chunk_cost = 0;
+    for (i, c) in SURVEY_CHUNKS.iter().enumerate() {
+        if i != 1 {
+            let msg = Msg::Command(Command::Upload(UploadPart::Chunk(*c)));
+            chunk_cost = chunk_cost.max(timed_frame(sup, link, &mut host, msg));
+        }
+    }
+    let ack = sup.step(false, &now).telemetry.upload;
+    let one_missing = ack.crc == SURVEY_HEADER.crc && ack.missing().eq([1u8]) && !ack.verified;
+    let resend = Msg::Command(Command::Upload(UploadPart::Chunk(SURVEY_CHUNKS[1])));
+    let last_cost = timed_frame(sup, link, &mut host, resend);
+    let verified = sup.step(false, &now).telemetry.upload.verified;
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    let plan = MissionPlan {
+        path: MissionSpec::Waypoints {
+            crc: SURVEY_HEADER.crc,
+        },
+        heading: Heading::Tangent,
+        time_scale: 1.0,
+    };
+    let start = timed_frame(
+        sup,
+        link,
+        &mut host,
+        Msg::Command(Command::StartMission(plan)),
+    );
+    let flying = sup.mode() == Mode::Running && sup.refused_commands() == 1;
+    info!(
+        "survey upload: refused while armed {}, chunk 1 lost and named missing {}, verified after its resend {}, its mission running {}",
+        armed_refused, one_missing, verified, flying
+    );
+    info!(
+        "survey upload instructions (its Begin; a chunk, the largest; the last chunk with the CRC check; StartMission building the 12-point path in place): begin={} chunk={} last_chunk={} start_mission={}",
+        begin_cost, chunk_cost, last_cost, start
+    );
+    let largest = largest_set_cost();
+    armed_refused && one_missing && verified && flying && largest.is_some()
+}
+
+/// Instructions of `Trajectory::set` on the largest waypoint path the board takes: 32 points
+/// (a lawn-mower of 16 rows of 60 m, 20 m apart), a time law of 61 parts, tangent heading.
+#[inline(never)]
+fn largest_set_cost() -> Option<u32> {
+    let mut points = [[0.0f32; 3]; controller_core::trajectory::MAX_WAYPOINTS];
+    for (i, p) in points.iter_mut().enumerate() {
+        let row = (i / 2) as f32;
+        let east = (i % 2 == 0) == ((i / 2) % 2 == 0);
+        *p = [if east { 0.0 } else { 60.0 }, 20.0 * row, 5.0];
+    }
+    let mut speeds = [0.5f32; controller_core::trajectory::MAX_PARTS];
+    for (i, v) in speeds.iter_mut().enumerate() {
+        if i % 4 == 0 {
+            *v = 0.8;
+        }
+    }
+    let mission = controller_core::Mission {
+        path: controller_core::TrajectoryKind::Waypoints {
+            points: controller_core::trajectory::WaypointList::new(&points).ok()?,
+            speed: 0.5,
+            turn_radius: Some(3.0),
+            speeds: Some(controller_core::trajectory::SpeedList::new(&speeds).ok()?),
+            speed_change: None,
+        },
+        heading: controller_core::HeadingMode::Tangent,
+        time_scale: 1.0,
+    };
+    let Some(slot) = cortex_m::singleton!(: Trajectory = Trajectory::EMPTY) else {
+        return None;
+    };
+    let t0 = SYST::get_current();
+    let ok = slot.set(&mission).is_ok();
+    let t1 = SYST::get_current();
+    let n = elapsed(t0, t1) * INSTRUCTIONS_PER_TICK;
+    info!(
+        "Trajectory::set of the largest waypoint path (32 points, 61 parts): {} instructions, valid {}",
+        n, ok
+    );
+    ok.then_some(n)
+}
+
 /// A signed link: an unsigned frame, a replayed signed frame and one stamped at 2⁴⁸ − 1 are
 /// refused, a signed one is taken; the telemetry says signing is on, counts the stamp too far
 /// ahead, and is still signed.
@@ -610,7 +712,10 @@ pub fn run(mut syst: SYST) -> bool {
         error!("the circle's trajectory was built twice");
         return false;
     };
-    let link_ok = fail_safe_exercise(circle) && signed_link_exercise() && real_chain_exercise();
+    let link_ok = fail_safe_exercise(circle)
+        && signed_link_exercise()
+        && real_chain_exercise()
+        && upload_exercise();
     let signing_ok = signing_cost(circle).is_some();
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
