@@ -14,6 +14,7 @@ use super::common::{
 };
 use super::json::{print_json, Cases};
 use super::Exit;
+use crate::output::waypoint_plot::mission_plots;
 use crate::output::{self, sections, OutputDir, RealRow, ReportRow};
 use crate::scenario::real_vehicle;
 use crate::scenario::Scenario;
@@ -120,12 +121,19 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     );
     let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
-    let report = output::write_plots_and_report(
+    // The waypoint missions' path over the waypoints and speed over time (docs/design.md §27).
+    let mut extra = Vec::new();
+    for (scenario, run) in real_jobs.iter().zip(real_runs) {
+        let files = mission_plots(&dir, scenario, run, &mut incomplete)?;
+        extra.extend(files.into_iter().map(|f| (run.name.clone(), f)));
+    }
+    let report = output::write_plots_and_report_with(
         &dir,
         title,
         &rows,
         &sections,
         &real_plots,
+        &extra,
         &paper_table1::notes(),
         f64::from(DEFAULT_V_LIMIT),
         &mut incomplete,
