@@ -46,6 +46,11 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
         }
         Err(e) => return Err(anyhow!(e)),
     };
+    if !args.json {
+        // The verdict first: the profile's search takes a while.
+        writeln!(stdout, "{p}")?;
+        writeln!(stdout, "{}", preflight_table(&p))?;
+    }
     // A waypoint mission: the fastest speed profile (docs/design.md §27).
     let speed_profile = match profile::propose(&scenario, args.margin) {
         Ok(s) => s,
@@ -55,20 +60,16 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
         }
         Err(e) => return Err(anyhow!(e)),
     };
-    if args.json {
-        print_json(
+    match (args.json, speed_profile) {
+        (true, speed_profile) => print_json(
             stdout,
             &CheckJson {
                 preflight: &p,
                 speed_profile,
             },
-        )?;
-    } else {
-        writeln!(stdout, "{p}")?;
-        writeln!(stdout, "{}", preflight_table(&p))?;
-        if let Some(s) = speed_profile {
-            writeln!(stdout, "{}", profile_table(&s))?;
-        }
+        )?,
+        (false, Some(s)) => writeln!(stdout, "{}", profile_table(&s))?,
+        (false, None) => {}
     }
     Ok(if p.feasible() {
         Exit::Success
