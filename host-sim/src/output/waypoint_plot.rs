@@ -113,9 +113,10 @@ fn corner_zoom(scenario: &Scenario, points: &[[f64; 3]], run: &RunResult) -> Opt
         let t = (h / dn.abs().max(de.abs()).max(1e-12) * len).min(len);
         (w[1] + de / len * t, w[0] + dn / len * t)
     };
+    let miss = f64::from(route.miss(j));
     let mut p = Panel::new(
         "",
-        &format!("east y (m), zoom on waypoint {j}"),
+        &format!("east y (m): waypoint {j}, passed {miss:.2} m inside"),
         "north x (m)",
     );
     p.equal_aspect = true;
@@ -147,8 +148,7 @@ fn corner_zoom(scenario: &Scenario, points: &[[f64; 3]], run: &RunResult) -> Opt
         Stroke::Dots,
         vec![(w[1], w[0])],
     ));
-    let miss = f64::from(route.miss(j));
-    p.labels = vec![(w[1], w[0], format!("{j}: passed {miss:.2} m inside"))];
+    p.labels = vec![(w[1], w[0], j.to_string())];
     Some(p)
 }
 
