@@ -1,8 +1,9 @@
 //! The path over the waypoints of a waypoint mission (docs/design.md §27, **Choice 170**): a
 //! plan view as on a chart (east to the right, north up, equal scales) of the waypoints'
 //! polyline, the desired path η_d that cuts its corners on the blends (Choice 150) and the
-//! path flown, each waypoint marked and numbered as `check` names them (`turn at j`); below
-//! it, when the waypoints are not all at one depth, the depth profile along the path.
+//! path flown, each waypoint marked and numbered as `check` names them (`turn at j`); beside
+//! it a zoom on the corner the path passes farthest from, where the blend is plain; below them,
+//! when the waypoints are not all at one depth, the depth profile along the path.
 //! [`mission_plots`] writes it with the speed plot ([`super::speed_plot`]) for `run` and the
 //! main job.
 
