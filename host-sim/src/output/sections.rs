@@ -17,8 +17,9 @@ the course, the Table-3 payload trimmed to neutral buoyancy, Eqs 31–32 in kgf,
 actuator chain (the board's voltages, clamped at ±24 V, turned back into thrust by Eqs 31–32),
 each at the time scale the preflight check proposes; then missions planned as waypoints, on
 the speed profile the check proposes (docs/design.md §27): `survey-200x100`, a 200 m × 100 m
-lawn-mower at 5 m depth, and `harbour-wall`, a descending inspection imported from a
-QGroundControl plan. Below them, the
+lawn-mower at 5 m depth, `harbour-wall`, a descending inspection, and `pipeline`, a pipeline
+route descending from 4 m to 10 m, both imported from QGroundControl plans; each with its path
+over the waypoints and its speed over time among the plots. Below them, the
 paper's own six missions
 (its headings, untrimmed payload, time scale 1) through the same real chain: what the preflight
 calls infeasible, flown anyway.
