@@ -237,13 +237,12 @@ fn survey_golden(
     body: &mut String,
     n: &mut usize,
 ) -> String {
-    let kind = survey_path(path);
-    let up = MissionUpload::of(&kind).expect("a waypoint path");
     let mission = Mission {
-        path: kind,
+        path: survey_path(path),
         heading: HeadingMode::Tangent,
         time_scale: 1.0,
     };
+    let up = MissionUpload::of(&mission).expect("a waypoint path");
     let tr = Trajectory::new(mission).expect("the shipped survey is a valid mission");
     let (route, law) = (tr.route(), tr.time_law());
     for i in 0..route.segment_count().min(5) {
@@ -278,12 +277,14 @@ fn survey_golden(
     let h = up.header();
     let opt = |v: Option<f32>| v.map_or("None".to_string(), |x| format!("Some({})", f(x)));
     let mut s = format!(
-        "/// The shipped survey's upload ({SURVEY}).\npub const SURVEY_HEADER: UploadHeader = UploadHeader {{ points: {}, speeds: {:?}, speed: {}, turn_radius: {}, speed_change: {}, crc: {:#010x} }};\n",
+        "/// The shipped survey's upload ({SURVEY}).\npub const SURVEY_HEADER: UploadHeader = UploadHeader {{ points: {}, speeds: {:?}, speed: {}, turn_radius: {}, speed_change: {}, heading: Heading::{:?}, time_scale: {}, crc: {:#010x} }};\n",
         h.points,
         h.speeds,
         f(h.speed),
         opt(h.turn_radius),
         opt(h.speed_change),
+        h.heading,
+        f(h.time_scale),
         h.crc
     );
     let chunks: Vec<String> = (0..up.chunks())

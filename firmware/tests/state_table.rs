@@ -32,13 +32,15 @@ fn three_points() -> MissionUpload {
         [60.0, 60.0, 5.0],
     ])
     .expect("3 points");
-    MissionUpload::of(&controller_core::TrajectoryKind::Waypoints {
-        points,
-        speed: 0.5,
-        turn_radius: None,
-        speeds: None,
-        speed_change: None,
-    })
+    MissionUpload::of(&controller_core::Mission::paper(
+        controller_core::TrajectoryKind::Waypoints {
+            points,
+            speed: 0.5,
+            turn_radius: None,
+            speeds: None,
+            speed_change: None,
+        },
+    ))
     .expect("a waypoint path")
 }
 

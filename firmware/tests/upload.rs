@@ -55,7 +55,7 @@ fn start(crc: u32) -> Command {
 
 #[test]
 fn a_lost_chunk_is_acknowledged_resent_and_the_board_flies_the_cores_trajectory() {
-    let up = MissionUpload::of(&survey()).expect("a waypoint path");
+    let up = MissionUpload::of(&mission()).expect("a waypoint path");
     assert_eq!(up.chunks(), 2, "36 coordinates: two chunks of 32 words");
     let mut s = supervisor();
     let mut link = LinkBuffers::new();
@@ -153,7 +153,11 @@ fn an_uploaded_mission_the_core_refuses_is_an_invalid_mission() {
         speeds: None,
         speed_change: None,
     };
-    let up = MissionUpload::of(&bad).expect("a waypoint path");
+    let up = MissionUpload::of(&Mission {
+        heading: HeadingMode::Tangent,
+        ..Mission::paper(bad)
+    })
+    .expect("a waypoint path");
     let mut s = supervisor();
     let mut h = Host::new();
     h.command(&mut s, Command::Upload(UploadPart::Begin(up.header())));
@@ -164,4 +168,46 @@ fn an_uploaded_mission_the_core_refuses_is_an_invalid_mission() {
     let t = s.step(false, NOW).telemetry;
     assert_eq!(t.last_refusal, Some(Refusal::InvalidMission));
     assert_eq!(t.status, BoardStatus::Armed);
+}
+
+/// Choice 169: the board builds an uploaded mission when the upload is verified (disarmed), so
+/// that `StartMission` builds nothing; after a closed-form mission took the trajectory's slot
+/// it is rebuilt in the first period with no mission, before it is started again.
+#[test]
+fn an_upload_is_built_when_verified_and_started_without_building() {
+    let up = MissionUpload::of(&mission()).expect("a waypoint path");
+    let mut s = supervisor();
+    let mut h = Host::new();
+    h.command(&mut s, Command::Upload(UploadPart::Begin(up.header())));
+    h.command(&mut s, Command::Upload(UploadPart::Chunk(up.chunk(0))));
+    assert_eq!(s.trajectory_builds(), 0, "not verified yet");
+    h.command(&mut s, Command::Upload(UploadPart::Chunk(up.chunk(1))));
+    assert_eq!(s.trajectory_builds(), 1, "built when verified");
+    // Periods with no mission change nothing, and a repeated chunk builds nothing.
+    s.step(false, NOW);
+    h.command(&mut s, Command::Upload(UploadPart::Chunk(up.chunk(1))));
+    s.step(false, NOW);
+    assert_eq!(s.trajectory_builds(), 1);
+    h.command(&mut s, Command::Arm);
+    h.command(&mut s, start(up.crc()));
+    assert_eq!(s.mode(), firmware::supervisor::Mode::Running);
+    assert_eq!(s.trajectory_builds(), 1, "StartMission built nothing");
+    // The plan must be the upload's mission: another time scale is refused.
+    h.command(&mut s, Command::StopMission);
+    let slower = Command::StartMission(MissionPlan {
+        path: MissionSpec::Waypoints { crc: up.crc() },
+        heading: Heading::Tangent,
+        time_scale: 2.0,
+    });
+    h.command(&mut s, slower);
+    assert_eq!(s.last_refusal(), Some(Refusal::NoUpload));
+    // A closed form takes the slot; stopped, the next period rebuilds the upload.
+    h.command(&mut s, Command::StartMission(common::CIRCLE));
+    assert_eq!(s.trajectory_builds(), 2);
+    h.command(&mut s, Command::StopMission);
+    s.step(false, NOW);
+    assert_eq!(s.trajectory_builds(), 3, "rebuilt with no mission running");
+    h.command(&mut s, start(up.crc()));
+    assert_eq!(s.mode(), firmware::supervisor::Mode::Running);
+    assert_eq!(s.trajectory_builds(), 3);
 }

@@ -32,8 +32,10 @@ macro_rules! field_for_field {
             fn from(kind: TrajectoryKind) -> Self {
                 match kind {
                     $(TrajectoryKind::$variant { $($field),+ } => MissionSpec::$variant { $($field),+ },)+
+                    // A bare path is the paper's mission (k = 1); `MissionPlan::from(Mission)`
+                    // names the mission's own upload.
                     path @ TrajectoryKind::$big { .. } => MissionSpec::$big {
-                        crc: MissionUpload::of(&path).map_or(0, |u| u.crc()),
+                        crc: MissionUpload::of(&Mission::paper(path)).map_or(0, |u| u.crc()),
                     },
                 }
             }
@@ -77,25 +79,28 @@ impl core::fmt::Display for Uploaded {
     }
 }
 
-impl MissionSpec {
-    /// The path: a closed form field for field, an uploaded one from `upload` if it holds that
-    /// upload verified ([`UploadBuffer::path`], else [`Refusal::NoUpload`]).
-    pub fn resolve(self, upload: &UploadBuffer) -> Result<TrajectoryKind, Refusal> {
-        match TrajectoryKind::try_from(self) {
-            Ok(kind) => Ok(kind),
-            Err(Uploaded { crc }) => upload.path(crc),
-        }
-    }
-}
-
 impl MissionPlan {
-    /// The mission, its path resolved by [`MissionSpec::resolve`].
+    /// The mission: a closed-form path field for field; an uploaded one from `upload`, if it
+    /// holds that upload verified and the plan's heading and time scale are the upload's
+    /// ([`UploadBuffer::mission`]; else [`Refusal::NoUpload`]).
     pub fn resolve(&self, upload: &UploadBuffer) -> Result<Mission, Refusal> {
-        Ok(Mission {
-            path: self.path.resolve(upload)?,
-            heading: self.heading.into(),
-            time_scale: self.time_scale,
-        })
+        match TrajectoryKind::try_from(self.path) {
+            Ok(path) => Ok(Mission {
+                path,
+                heading: self.heading.into(),
+                time_scale: self.time_scale,
+            }),
+            Err(Uploaded { crc }) => {
+                let m = upload.mission(crc)?;
+                let same = Heading::from(m.heading) == self.heading
+                    && m.time_scale.to_bits() == self.time_scale.to_bits();
+                if same {
+                    Ok(m)
+                } else {
+                    Err(Refusal::NoUpload)
+                }
+            }
+        }
     }
 }
 
@@ -124,9 +129,14 @@ variant_for_variant!(Heading, HeadingMode, Paper, Tangent);
 variant_for_variant!(ThrustUnit, controller_core::ThrustUnit, Kgf, Newton);
 
 impl From<Mission> for MissionPlan {
+    /// A waypoint path is named by the CRC of this mission's upload (its heading and time
+    /// scale included).
     fn from(m: Mission) -> Self {
         MissionPlan {
-            path: m.path.into(),
+            path: match MissionUpload::of(&m) {
+                Some(u) => MissionSpec::Waypoints { crc: u.crc() },
+                None => m.path.into(),
+            },
             heading: m.heading.into(),
             time_scale: m.time_scale,
         }

@@ -56,7 +56,8 @@ pub enum Refusal {
     /// The last chunk of an upload completed a mission that does not match its CRC: every
     /// chunk is dropped, to be sent again.
     UploadCrc = 14,
-    /// `StartMission` of an uploaded path with no verified upload of that CRC.
+    /// `StartMission` of an uploaded path with no verified upload of that CRC, or with a
+    /// heading or time scale other than the upload's.
     NoUpload = 15,
 }
 

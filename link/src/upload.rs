@@ -14,24 +14,28 @@
 //! Every part of an upload is refused while armed (a mission is never changed under a running
 //! loop, Choice 164), and one with counts the board cannot hold is refused whole.
 //!
-//! **The mission.** `StartMission` then names the path as [`MissionSpec::Waypoints`] with the
-//! CRC: the board flies its upload only if it is verified and is that CRC
-//! ([`UploadBuffer::path`]); otherwise it refuses with [`Refusal::NoUpload`]. The upload
+//! **The mission.** The upload is the whole mission: the path, its heading and its time scale
+//! (the board builds its trajectory as soon as the upload is verified, while disarmed, so that
+//! `StartMission` costs no more than a closed form's; Choice 169). `StartMission` then names it
+//! as [`MissionSpec::Waypoints`] with the CRC, its heading and time scale the upload's: the
+//! board flies its upload only if it is verified and is that mission
+//! ([`UploadBuffer::mission`]); otherwise it refuses with [`Refusal::NoUpload`]. The upload
 //! survives disarming and a fail-safe, so a re-armed board restarts the same mission.
 //!
 //! **The CRC** (CRC-32/ISO-HDLC, [`mission_crc`]) covers the header's fields and every word,
 //! in this order: point count, speed count (0xFF: none), `speed`, `turn_radius` and
-//! `speed_change` (0xFF for none, else 0x01 and the value), each `f32` as its four
-//! little-endian bytes. It is the whole mission's check, beside each frame's CRC-16 (or MAC):
+//! `speed_change` (0xFF for none, else 0x01 and the value), the heading (0 paper, 1 tangent),
+//! the time scale, then the words, each `f32` as its four little-endian bytes. It is the whole mission's check, beside each frame's CRC-16 (or MAC):
 //! a mission assembled from chunks of two uploads, or a header from a third, does not match.
 //!
 //! [`MissionSpec::Waypoints`]: crate::MissionSpec::Waypoints
 //! [`Refusal::NoUpload`]: crate::Refusal::NoUpload
 
 use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOINTS};
-use controller_core::TrajectoryKind;
+use controller_core::{Mission, TrajectoryKind};
 use serde::{Deserialize, Serialize};
 
+use crate::msg::Heading;
 use crate::refusal::Refusal;
 
 /// Words (`f32`) per chunk: a chunk is 131 postcard bytes, under the largest telemetry frame,
@@ -62,13 +66,18 @@ pub struct UploadHeader {
     pub turn_radius: Option<f32>,
     /// The largest |σ̈| of a speed change (m/s²), or the default.
     pub speed_change: Option<f32>,
+    /// The mission's heading (Choice 169: the board builds the whole mission when the upload
+    /// is verified, so `StartMission` costs it nothing).
+    pub heading: Heading,
+    /// The mission's time scale k.
+    pub time_scale: f32,
     /// [`mission_crc`] of the header's other fields and every word.
     pub crc: u32,
 }
 
 impl UploadHeader {
     /// Worst-case postcard size (bytes).
-    pub const MAX_SIZE: usize = 1 + 2 + 4 + 5 + 5 + 5;
+    pub const MAX_SIZE: usize = 1 + 2 + 4 + 5 + 5 + 1 + 4 + 5;
 
     /// Words the chunks carry: 3 per point, then the speeds.
     pub fn words(&self) -> usize {
@@ -167,6 +176,8 @@ pub fn mission_crc(header: &UploadHeader, words: &[f32]) -> u32 {
             }
         }
     }
+    d.update(&[header.heading as u8]);
+    d.update(&header.time_scale.to_le_bytes());
     for w in words {
         d.update(&w.to_le_bytes());
     }
@@ -181,9 +192,14 @@ pub struct MissionUpload {
 }
 
 impl MissionUpload {
-    /// The upload of `path`, or `None` if it is not a waypoint path (a closed-form path fits
-    /// one `StartMission`).
-    pub fn of(path: &TrajectoryKind) -> Option<MissionUpload> {
+    /// The upload of `mission`, or `None` if its path is not a waypoint path (a closed-form
+    /// path fits one `StartMission`).
+    pub fn of(mission: &Mission) -> Option<MissionUpload> {
+        let Mission {
+            path,
+            heading,
+            time_scale,
+        } = mission;
         let TrajectoryKind::Waypoints {
             points,
             speed,
@@ -209,6 +225,8 @@ impl MissionUpload {
             speed: *speed,
             turn_radius: *turn_radius,
             speed_change: *speed_change,
+            heading: (*heading).into(),
+            time_scale: *time_scale,
             crc: 0,
         };
         header.crc = mission_crc(&header, &words[..header.words()]);
@@ -320,9 +338,9 @@ impl UploadBuffer {
         }
     }
 
-    /// The uploaded path, if the upload is verified and its CRC is `crc`; else
+    /// The uploaded mission, if the upload is verified and its CRC is `crc`; else
     /// [`Refusal::NoUpload`]. Not validated: build it with `controller_core::Trajectory`.
-    pub fn path(&self, crc: u32) -> Result<TrajectoryKind, Refusal> {
+    pub fn mission(&self, crc: u32) -> Result<Mission, Refusal> {
         let h = match self.header {
             Some(h) if self.verified && h.crc == crc => h,
             _ => return Err(Refusal::NoUpload),
@@ -340,13 +358,22 @@ impl UploadBuffer {
                     .map_err(|_| Refusal::NoUpload)?,
             ),
         };
-        Ok(TrajectoryKind::Waypoints {
-            points,
-            speed: h.speed,
-            turn_radius: h.turn_radius,
-            speeds,
-            speed_change: h.speed_change,
+        Ok(Mission {
+            path: TrajectoryKind::Waypoints {
+                points,
+                speed: h.speed,
+                turn_radius: h.turn_radius,
+                speeds,
+                speed_change: h.speed_change,
+            },
+            heading: h.heading.into(),
+            time_scale: h.time_scale,
         })
+    }
+
+    /// The CRC of the verified upload, if there is one.
+    pub fn verified(&self) -> Option<u32> {
+        self.header.filter(|_| self.verified).map(|h| h.crc)
     }
 }
 

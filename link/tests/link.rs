@@ -152,6 +152,8 @@ fn every_kind() -> Vec<Envelope> {
             speed: 1.5,
             turn_radius: None,
             speed_change: Some(0.05),
+            heading: Heading::Tangent,
+            time_scale: 2.0,
             crc: 0xCAFE_F00D,
         }))),
         Msg::Command(Command::Upload(UploadPart::Chunk(UploadChunk {
@@ -322,6 +324,8 @@ fn max_sizes_are_exact() {
         speed: f32::MAX,
         turn_radius: Some(f32::MAX),
         speed_change: Some(f32::MAX),
+        heading: Heading::Tangent,
+        time_scale: f32::MAX,
         crc: u32::MAX,
     };
     assert_eq!(postcard_len(&begin), UploadHeader::MAX_SIZE);
@@ -628,18 +632,24 @@ fn any_upload_part() -> BoxedStrategy<UploadPart> {
             any_f32(),
             proptest::option::of(any_f32()),
             proptest::option::of(any_f32()),
+            prop_oneof![Just(Heading::Paper), Just(Heading::Tangent)],
+            any_f32(),
             any::<u32>(),
         )
-            .prop_map(|(points, speeds, speed, turn_radius, speed_change, crc)| {
-                UploadPart::Begin(UploadHeader {
-                    points,
-                    speeds,
-                    speed,
-                    turn_radius,
-                    speed_change,
-                    crc,
-                })
-            }),
+            .prop_map(
+                |(points, speeds, speed, turn_radius, speed_change, heading, time_scale, crc)| {
+                    UploadPart::Begin(UploadHeader {
+                        points,
+                        speeds,
+                        speed,
+                        turn_radius,
+                        speed_change,
+                        heading,
+                        time_scale,
+                        crc,
+                    })
+                }
+            ),
         (any::<u8>(), prop::array::uniform32(any_f32()))
             .prop_map(|(index, words)| UploadPart::Chunk(UploadChunk { index, words })),
     ]

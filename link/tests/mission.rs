@@ -214,12 +214,18 @@ fn a_waypoint_path_crosses_as_its_uploads_crc_and_only_the_board_resolves_it() {
         speeds: None,
         speed_change: None,
     };
-    let upload = auv_link::MissionUpload::of(&kind).expect("a waypoint path");
+    let upload = auv_link::MissionUpload::of(&Mission::paper(kind)).expect("a waypoint path");
     assert_eq!(
         MissionSpec::from(kind),
         MissionSpec::Waypoints { crc: upload.crc() }
     );
     let plan = MissionPlan::from(Mission::paper(kind));
+    // Another heading or time scale is another mission: another CRC.
+    let tangent = Mission {
+        heading: HeadingMode::Tangent,
+        ..Mission::paper(kind)
+    };
+    assert_ne!(MissionPlan::from(tangent).path, plan.path);
     // Without the board's buffer, the wire path names an upload and nothing more.
     assert_eq!(
         Mission::try_from(plan),
@@ -236,4 +242,10 @@ fn a_waypoint_path_crosses_as_its_uploads_crc_and_only_the_board_resolves_it() {
             .expect("a chunk");
     }
     assert_eq!(plan.resolve(&board), Ok(Mission::paper(kind)));
+    // The upload's CRC with another time scale in the plan is not this upload.
+    let slower = MissionPlan {
+        time_scale: 2.0,
+        ..plan
+    };
+    assert_eq!(slower.resolve(&board), Err(auv_link::Refusal::NoUpload));
 }

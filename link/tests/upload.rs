@@ -10,7 +10,7 @@ use auv_link::{
     MAX_FRAME,
 };
 use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOINTS};
-use controller_core::TrajectoryKind;
+use controller_core::{HeadingMode, Mission, TrajectoryKind};
 use proptest::prelude::*;
 
 /// The largest mission: MAX_WAYPOINTS points, MAX_PARTS speeds, every optional field set,
@@ -41,6 +41,15 @@ fn largest() -> TrajectoryKind {
         turn_radius: Some(12.5),
         speeds: Some(SpeedList::new(&speeds).expect("MAX_PARTS speeds")),
         speed_change: Some(0.05),
+    }
+}
+
+/// `path` as a mission: the tangent heading at time scale 1.5 (so that both travel too).
+fn mission(path: TrajectoryKind) -> Mission {
+    Mission {
+        path,
+        heading: HeadingMode::Tangent,
+        time_scale: 1.5,
     }
 }
 
@@ -114,7 +123,7 @@ fn crc32_by_hand(bytes: &[u8]) -> u32 {
 #[test]
 fn the_largest_mission_crosses_chunk_by_chunk_bit_for_bit() {
     let kind = largest();
-    let up = MissionUpload::of(&kind).expect("a waypoint path");
+    let up = MissionUpload::of(&mission(kind)).expect("a waypoint path");
     assert_eq!(up.chunks() as usize, MAX_CHUNKS);
     assert_eq!(up.header().words(), MAX_WORDS);
     let mut board = UploadBuffer::EMPTY;
@@ -136,8 +145,9 @@ fn the_largest_mission_crosses_chunk_by_chunk_bit_for_bit() {
     assert!(status.verified, "{status:?}");
     assert_eq!(status.missing().count(), 0);
     assert_eq!(status.crc, up.crc());
-    let back = board.path(up.crc()).expect("the verified upload");
-    assert_eq!(bits(&back), bits(&kind));
+    let back = board.mission(up.crc()).expect("the verified upload");
+    assert_eq!(bits(&back.path), bits(&kind));
+    assert_eq!((back.heading, back.time_scale), (HeadingMode::Tangent, 1.5));
     // The whole largest upload on the wire, unsigned (the figure of docs/design.md §27): at
     // 460 800 baud, 10 bits a byte.
     let ms = wire_bytes as f64 * 10.0 / 460_800.0 * 1e3;
@@ -148,7 +158,7 @@ fn the_largest_mission_crosses_chunk_by_chunk_bit_for_bit() {
 #[test]
 fn the_crc_is_the_documented_layout() {
     for kind in [largest(), small()] {
-        let up = MissionUpload::of(&kind).expect("a waypoint path");
+        let up = MissionUpload::of(&mission(kind)).expect("a waypoint path");
         let h = up.header();
         let TrajectoryKind::Waypoints {
             points,
@@ -174,6 +184,8 @@ fn the_crc_is_the_documented_layout() {
                 }
             }
         }
+        bytes.push(1); // the tangent heading
+        bytes.extend(1.5f32.to_le_bytes());
         for p in points.as_slice().iter().flatten() {
             bytes.extend(p.to_le_bytes());
         }
@@ -187,7 +199,7 @@ fn the_crc_is_the_documented_layout() {
 
 #[test]
 fn a_chunk_of_another_upload_fails_the_crc_and_every_chunk_is_asked_again() {
-    let a = MissionUpload::of(&largest()).expect("waypoints");
+    let a = MissionUpload::of(&mission(largest())).expect("waypoints");
     // The same counts, one coordinate changed: every chunk but the first is the same.
     let TrajectoryKind::Waypoints {
         points,
@@ -201,13 +213,13 @@ fn a_chunk_of_another_upload_fails_the_crc_and_every_chunk_is_asked_again() {
     };
     let mut p = points.as_slice().to_vec();
     p[1][0] += 0.5;
-    let b = MissionUpload::of(&TrajectoryKind::Waypoints {
+    let b = MissionUpload::of(&mission(TrajectoryKind::Waypoints {
         points: WaypointList::new(&p).expect("points"),
         speed,
         turn_radius,
         speeds,
         speed_change,
-    })
+    }))
     .expect("waypoints");
     assert_ne!(a.crc(), b.crc());
     let mut board = UploadBuffer::EMPTY;
@@ -221,7 +233,7 @@ fn a_chunk_of_another_upload_fails_the_crc_and_every_chunk_is_asked_again() {
     let s = board.status();
     assert!(!s.verified);
     assert_eq!(s.missing().count(), a.chunks() as usize, "{s:?}");
-    assert_eq!(board.path(a.crc()), Err(Refusal::NoUpload));
+    assert_eq!(board.mission(a.crc()), Err(Refusal::NoUpload));
     // Sent again, right: verified.
     for i in 0..a.chunks() {
         board.take(&UploadPart::Chunk(a.chunk(i))).expect("a chunk");
@@ -231,12 +243,12 @@ fn a_chunk_of_another_upload_fails_the_crc_and_every_chunk_is_asked_again() {
     let mut bad = a.chunk(2);
     bad.words[7] = f32::from_bits(bad.words[7].to_bits() ^ 1);
     assert_eq!(board.take(&UploadPart::Chunk(bad)), Err(Refusal::UploadCrc));
-    assert_eq!(board.path(a.crc()), Err(Refusal::NoUpload));
+    assert_eq!(board.mission(a.crc()), Err(Refusal::NoUpload));
 }
 
 #[test]
 fn what_the_board_cannot_hold_is_refused_and_changes_nothing_it_should_not() {
-    let up = MissionUpload::of(&small()).expect("waypoints");
+    let up = MissionUpload::of(&mission(small())).expect("waypoints");
     let mut board = UploadBuffer::EMPTY;
     // A chunk before any Begin.
     assert_eq!(
@@ -282,12 +294,12 @@ fn what_the_board_cannot_hold_is_refused_and_changes_nothing_it_should_not() {
         Err(Refusal::InvalidUpload)
     );
     assert!(board.status().verified);
-    assert_eq!(board.path(up.crc()), Ok(small()));
+    assert_eq!(board.mission(up.crc()), Ok(mission(small())));
     // Another CRC is not this upload.
-    assert_eq!(board.path(up.crc() ^ 1), Err(Refusal::NoUpload));
+    assert_eq!(board.mission(up.crc() ^ 1), Err(Refusal::NoUpload));
     // A new Begin drops it.
     board.take(&UploadPart::Begin(up.header())).expect("fits");
-    assert_eq!(board.path(up.crc()), Err(Refusal::NoUpload));
+    assert_eq!(board.mission(up.crc()), Err(Refusal::NoUpload));
     // Chunk sizes: the chunk's words end the mission with zeros.
     assert!(up.chunk(0).words[3 * 3..].iter().all(|w| *w == 0.0));
     assert_eq!(CHUNK_WORDS, up.chunk(0).words.len());
@@ -305,7 +317,7 @@ proptest! {
         repeat in prop::collection::vec(0..MAX_CHUNKS as u8, 0..4),
     ) {
         let kind = largest();
-        let up = MissionUpload::of(&kind).expect("waypoints");
+        let up = MissionUpload::of(&mission(kind)).expect("waypoints");
         let mut board = UploadBuffer::EMPTY;
         board.take(&UploadPart::Begin(up.header())).expect("fits");
         for &i in order.iter().chain(repeat.iter()) {
@@ -322,7 +334,7 @@ proptest! {
             board.take(&UploadPart::Chunk(up.chunk(i))).expect("a chunk");
         }
         prop_assert!(board.status().verified);
-        let back = board.path(up.crc()).expect("verified");
-        prop_assert_eq!(bits(&back), bits(&kind));
+        let back = board.mission(up.crc()).expect("verified");
+        prop_assert_eq!(bits(&back.path), bits(&kind));
     }
 }

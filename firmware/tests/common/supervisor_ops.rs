@@ -503,13 +503,15 @@ fn three_points() -> MissionUpload {
         [60.0, 60.0, 5.0],
     ])
     .expect("3 points");
-    MissionUpload::of(&controller_core::TrajectoryKind::Waypoints {
-        points,
-        speed: 0.5,
-        turn_radius: None,
-        speeds: None,
-        speed_change: None,
-    })
+    MissionUpload::of(&controller_core::Mission::paper(
+        controller_core::TrajectoryKind::Waypoints {
+            points,
+            speed: 0.5,
+            turn_radius: None,
+            speeds: None,
+            speed_change: None,
+        },
+    ))
     .expect("a waypoint path")
 }
 
@@ -525,6 +527,12 @@ fn upload(input: &mut Bytes) -> UploadPart {
             speed: input.f32(),
             turn_radius: (input.u8() & 1 == 1).then(|| input.f32()),
             speed_change: (input.u8() & 1 == 1).then(|| input.f32()),
+            heading: if input.u8() & 1 == 1 {
+                Heading::Tangent
+            } else {
+                Heading::Paper
+            },
+            time_scale: input.f32(),
             crc: input.u32(),
         }),
         _ => {

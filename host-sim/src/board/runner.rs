@@ -192,7 +192,7 @@ impl BoardInTheLoop {
             "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
         })?;
         let mission = MissionPlan::from(scenario.trajectory().mission());
-        let upload = MissionUpload::of(&scenario.trajectory().kind());
+        let upload = MissionUpload::of(&scenario.trajectory().mission());
         let lose = faults.lose_upload_chunks.clone();
         let mut b = Self::new(wire, scenario, faults, pacing, reply_timeout, key, mission);
         let (arm_seq, refused_before) = b.configure(c, mounting, upload.as_ref(), &lose)?;

@@ -2,7 +2,7 @@
 //! core built for the host; the self-test checks the target against them and counts each
 //! stage on their inputs.
 
-use auv_link::{UploadBuffer, UploadChunk, UploadHeader, UploadPart};
+use auv_link::{Heading, UploadBuffer, UploadChunk, UploadHeader, UploadPart};
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
@@ -70,9 +70,5 @@ pub fn survey() -> Option<Mission> {
     for c in &SURVEY_CHUNKS {
         upload.take(&UploadPart::Chunk(*c)).ok()?;
     }
-    Some(Mission {
-        path: upload.path(SURVEY_HEADER.crc).ok()?,
-        heading: HeadingMode::Tangent,
-        time_scale: 1.0,
-    })
+    upload.mission(SURVEY_HEADER.crc).ok()
 }

@@ -466,7 +466,7 @@ fn upload_exercise() -> bool {
         armed_refused, one_missing, verified, flying
     );
     info!(
-        "survey upload instructions (its Begin; a chunk, the largest; the last chunk with the CRC check; StartMission building the 12-point path in place): begin={} chunk={} last_chunk={} start_mission={}",
+        "survey upload instructions (its Begin; a chunk, the largest; the last chunk: the CRC check and the 12-point mission built, disarmed; StartMission of the built mission): begin={} chunk={} last_chunk={} start_mission={}",
         begin_cost, chunk_cost, last_cost, start
     );
     let largest = largest_set_cost();
