@@ -10,8 +10,7 @@
 //! counted, and the latched reason is kept exactly when the next state is latched.
 
 use auv_link::{
-    Command, ConfigPatch, FailSafeReason, MissionPlan, MissionSpec, MissionUpload, Msg, Refusal,
-    UploadPart,
+    Command, ConfigPatch, FailSafeReason, MissionPlan, MissionSpec, Msg, Refusal, UploadPart,
 };
 use controller_core::effectiveness::THRUSTERS;
 use firmware::board::{self, LinkBuffers};
@@ -24,25 +23,12 @@ const README: &str = include_str!("../README.md");
 /// The line after which the table starts.
 const MARKER: &str = "<!-- state table: parsed by firmware/tests/state_table.rs -->";
 
-/// A three-point waypoint mission's upload (one chunk).
-fn three_points() -> MissionUpload {
-    let points = controller_core::trajectory::WaypointList::new(&[
-        [0.0, 10.0, 5.0],
-        [60.0, 10.0, 5.0],
-        [60.0, 60.0, 5.0],
-    ])
-    .expect("3 points");
-    MissionUpload::of(&controller_core::Mission::paper(
-        controller_core::TrajectoryKind::Waypoints {
-            points,
-            speed: 0.5,
-            turn_radius: None,
-            speeds: None,
-            speed_change: None,
-        },
-    ))
-    .expect("a waypoint path")
-}
+// The harness's valid upload (a three-point waypoint mission, one chunk), shared with the
+// supervisor fuzz target.
+#[path = "common/supervisor_ops.rs"]
+#[allow(dead_code)]
+mod supervisor_ops;
+use supervisor_ops::three_points;
 
 /// The events, as the table's first column names them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -496,7 +496,7 @@ fn command(input: &mut Bytes) -> Command {
 }
 
 /// The valid upload the harness sends most: a three-point waypoint mission (one chunk).
-fn three_points() -> MissionUpload {
+pub fn three_points() -> MissionUpload {
     let points = controller_core::trajectory::WaypointList::new(&[
         [0.0, 10.0, 5.0],
         [60.0, 10.0, 5.0],
