@@ -26,7 +26,6 @@ const MARKER: &str = "<!-- state table: parsed by firmware/tests/state_table.rs 
 // The harness's valid upload (a three-point waypoint mission, one chunk), shared with the
 // supervisor fuzz target.
 #[path = "common/supervisor_ops.rs"]
-#[allow(dead_code)]
 mod supervisor_ops;
 use supervisor_ops::three_points;
 
