@@ -14,9 +14,11 @@ use std::fs;
 use std::path::PathBuf;
 
 use auv_link::sign::LinkKey;
+use auv_link::MissionUpload;
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{
     Controller, ControllerConfig, HeadingMode, Mission, Status, Table1Case, Trajectory,
+    TrajectoryKind,
 };
 
 // The images' table, shared with the library (bin names, memory maps).
@@ -42,7 +44,9 @@ fn main() {
     println!("cargo:rerun-if-changed=build.rs");
     println!("cargo:rerun-if-changed=../controller-core/src");
 
-    fs::write(out.join("golden.rs"), golden()).expect("writing golden.rs");
+    let survey = root.join(SURVEY);
+    println!("cargo:rerun-if-changed={}", survey.display());
+    fs::write(out.join("golden.rs"), golden(&survey)).expect("writing golden.rs");
     fs::write(out.join("kernel_golden.rs"), kernel_golden()).expect("writing kernel_golden.rs");
 
     println!("cargo:rerun-if-env-changed={KEY_VAR}");
@@ -200,9 +204,113 @@ fn kernel_golden() -> String {
     s
 }
 
+/// The waypoint mission of the self-test's golden vectors (workspace-relative): the shipped
+/// survey, flown by the main job; the self-test rebuilds it on the target from its upload.
+const SURVEY: &str = "host-sim/scenarios/real/survey-200x100.toml";
+
+/// The `[trajectory]` of the scenario file at `path`, a waypoint path, as the core's path: its
+/// `heading` key is the mission's, every other key the path's (`TrajectoryKind`'s serde form).
+fn survey_path(path: &std::path::Path) -> TrajectoryKind {
+    let text =
+        fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    let file: toml::Table =
+        toml::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+    let mut trajectory = file
+        .get("trajectory")
+        .and_then(|t| t.as_table())
+        .cloned()
+        .unwrap_or_else(|| panic!("{}: no [trajectory]", path.display()));
+    trajectory.remove("heading");
+    trajectory
+        .try_into()
+        .unwrap_or_else(|e| panic!("{}: [trajectory]: {e}", path.display()))
+}
+
+/// The survey's upload as constants: its header and chunks (the self-test takes them as the
+/// board's supervisor would), and the golden vectors along it: two instants in each of its
+/// first segments (a leg speeding up, its cruise, the turns and the leg after), tangent
+/// heading, Δu on and off.
+fn survey_golden(
+    path: &std::path::Path,
+    with: &Controller,
+    without: &Controller,
+    body: &mut String,
+    n: &mut usize,
+) -> String {
+    let mission = Mission {
+        path: survey_path(path),
+        heading: HeadingMode::Tangent,
+        time_scale: 1.0,
+    };
+    let up = MissionUpload::of(&mission).expect("a waypoint path");
+    let tr = Trajectory::new(mission).expect("the shipped survey is a valid mission");
+    let (route, law) = (tr.route(), tr.time_law());
+    for i in 0..route.segment_count().min(5) {
+        let (t0, t1) = (law.segment_time(i), law.segment_time(i + 1));
+        for (k, f) in [0.2f32, 0.6].into_iter().enumerate() {
+            let ticks = ((t0 + f * (t1 - t0)) * 100.0) as u64;
+            let d = tr.sample(ticks, 100);
+            let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
+            let mut eta: [f32; 6] = d.eta.into();
+            let mut nu: [f32; 6] = nu.into();
+            let w = (2 * i + k) as f32;
+            eta[0] += 0.04 * (w * 0.9).sin();
+            eta[1] -= 0.03 * (w * 1.7).cos();
+            eta[2] += 0.02;
+            eta[5] += 0.02 * (w * 0.8).sin();
+            nu[0] -= 0.03;
+            let robust = k == 0 || i % 2 == 0;
+            let c = if robust { with } else { without };
+            let o = c.update(ticks, &eta, &nu, &tr);
+            let id = Id {
+                case: 0,
+                ticks,
+                robust,
+                tangent: true,
+                helix: None,
+                waypoints: true,
+            };
+            push(body, id, &eta, &nu, &o);
+            *n += 1;
+        }
+    }
+    let h = up.header();
+    let opt = |v: Option<f32>| v.map_or("None".to_string(), |x| format!("Some({})", f(x)));
+    let mut s = format!(
+        "/// The shipped survey's upload ({SURVEY}).\npub const SURVEY_HEADER: UploadHeader = UploadHeader {{ points: {}, speeds: {:?}, speed: {}, turn_radius: {}, speed_change: {}, heading: Heading::{:?}, time_scale: {}, crc: {:#010x} }};\n",
+        h.points,
+        h.speeds,
+        f(h.speed),
+        opt(h.turn_radius),
+        opt(h.speed_change),
+        h.heading,
+        f(h.time_scale),
+        h.crc
+    );
+    let chunks: Vec<String> = (0..up.chunks())
+        .map(|i| {
+            let c = up.chunk(i);
+            format!(
+                "    UploadChunk {{ index: {}, words: {} }},",
+                c.index,
+                arr(&c.words)
+            )
+        })
+        .collect();
+    writeln!(
+        s,
+        "pub const SURVEY_CHUNKS: [UploadChunk; {}] = [\n{}\n];",
+        up.chunks(),
+        chunks.join("\n")
+    )
+    .ok();
+    s
+}
+
 /// Deterministic inputs around each Table-1 mission (on and off the reference, with and
-/// without Δu, and two fault cases), and the host core's outputs for them.
-fn golden() -> String {
+/// without Δu, and two fault cases) and along the shipped survey, and the host core's outputs
+/// for them.
+fn golden(survey: &std::path::Path) -> String {
     let with = Controller::new(ControllerConfig::default()).expect("defaults");
     let without = Controller::new(ControllerConfig {
         robust: false,
@@ -238,6 +346,7 @@ fn golden() -> String {
                     robust,
                     tangent: false,
                     helix: None,
+                    waypoints: false,
                 };
                 push(&mut body, id, &eta, &nu, &o);
                 n += 1;
@@ -257,6 +366,7 @@ fn golden() -> String {
                     robust: true,
                     tangent: true,
                     helix: None,
+                    waypoints: false,
                 };
                 push(&mut body, id, &eta, &nu, &o);
                 n += 1;
@@ -275,6 +385,7 @@ fn golden() -> String {
                         robust,
                         tangent: false,
                         helix: Some(helix),
+                        waypoints: false,
                     };
                     push(&mut body, id, &eta, &nu, &o);
                     n += 1;
@@ -289,6 +400,7 @@ fn golden() -> String {
         robust: true,
         tangent: false,
         helix: None,
+        waypoints: false,
     };
     let tr = Trajectory::table1(Table1Case::Circular10R);
     let eta = [0.0, 10.0, 5.0, 0.0, 1.5, 0.0];
@@ -309,6 +421,7 @@ fn golden() -> String {
         &with.update(0, &eta, &nu, &tr),
     );
     n += 2;
+    s += &survey_golden(survey, &with, &without, &mut body, &mut n);
     writeln!(s, "pub const GOLDEN: [Golden; {n}] = [\n{body}];").ok();
     s
 }
@@ -335,6 +448,8 @@ struct Id {
     tangent: bool,
     /// A helix (radius, depth rate) flown instead of the case's path.
     helix: Option<(f32, f32)>,
+    /// The shipped survey (`SURVEY`) flown instead of the case's path.
+    waypoints: bool,
 }
 
 fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller_core::Output) {
@@ -344,6 +459,7 @@ fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller
         robust,
         tangent,
         helix,
+        waypoints,
     } = id;
     let helix = match helix {
         Some((r, rate)) => format!("Some(({}, {}))", f(r), f(rate)),
@@ -355,7 +471,7 @@ fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller
     };
     writeln!(
         body,
-        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, tangent: {tangent}, helix: {helix}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
+        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, tangent: {tangent}, helix: {helix}, waypoints: {waypoints}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
         arr(eta),
         arr(nu),
         arr(&o.voltage),

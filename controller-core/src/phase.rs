@@ -35,6 +35,12 @@ pub struct Frequency {
 }
 
 impl Frequency {
+    /// The zero frequency (no phase advance): [`Frequency::default`] as a constant.
+    pub const ZERO: Frequency = Frequency {
+        frac_q64: 0,
+        whole: 0,
+    };
+
     /// ω (rad/s, finite and ≥ 0; negative or non-finite values give the zero frequency) as a
     /// fixed-point turn rate. Configuration time only: this is f64 arithmetic.
     pub fn from_rad_per_s(omega: f64) -> Frequency {
@@ -203,6 +209,13 @@ pub struct LinearRate {
 }
 
 impl LinearRate {
+    /// The zero rate: [`LinearRate::default`] as a constant.
+    pub const ZERO: LinearRate = LinearRate {
+        hi: 0.0,
+        mid: 0.0,
+        lo: 0.0,
+    };
+
     /// `rate` (m/s, finite).
     pub fn new(rate: f64) -> LinearRate {
         let sum = rate as f32;

@@ -27,12 +27,12 @@
 use auv_link::seq::SeqCheck;
 use auv_link::sign::AuthError;
 use auv_link::{
-    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionPlan, Msg,
-    Refusal, StateFrame, Telemetry, DEFAULT_STALE_PERIODS,
+    BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, LinkError, MissionPlan,
+    MissionSpec, Msg, Refusal, StateFrame, Telemetry, UploadBuffer, DEFAULT_STALE_PERIODS,
 };
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
 use controller_core::trajectory::TrajectoryError;
-use controller_core::{Controller, ControllerConfig, Mission, Status, Trajectory};
+use controller_core::{Controller, ControllerConfig, Status, Trajectory};
 
 use crate::limits;
 
@@ -160,8 +160,20 @@ struct Control {
 pub struct Supervisor {
     controller: Controller,
     board: BoardInfo,
-    /// The mission and the board tick it started at.
-    mission: Option<(Trajectory, u64)>,
+    /// The board tick the mission started at (`None`: no mission).
+    mission: Option<u64>,
+    /// The mission's trajectory, built in place by `StartMission` (`Trajectory::set`: a
+    /// waypoint path's route and time law are 8.6 kB, never copied on the stack) and flown
+    /// while `mission` is set.
+    trajectory: Trajectory,
+    /// The waypoint mission uploaded while disarmed (auv_link::upload): kept across disarming
+    /// and fail-safes, dropped by the next upload's `Begin`.
+    upload: UploadBuffer,
+    /// The upload `trajectory` was last built from (its CRC) and how that went; `None` when it
+    /// holds anything else (Choice 169).
+    built: Option<(u32, Result<(), Refusal>)>,
+    /// Trajectories built since boot (for tests and the self-test).
+    builds: u32,
     clock: MissionClock,
     armed: bool,
     latched: Option<Latch>,
@@ -217,6 +229,10 @@ impl Supervisor {
             controller,
             board,
             mission: None,
+            trajectory: Trajectory::EMPTY,
+            upload: UploadBuffer::EMPTY,
+            built: None,
+            builds: 0,
             clock: MissionClock::START,
             armed: false,
             latched: None,
@@ -381,6 +397,15 @@ impl Supervisor {
                 Ok(())
             }
             Command::SetConfig(patch) => self.configure(patch),
+            // Refused while armed, like every setting: a mission is never changed under a
+            // running loop (Choice 164).
+            Command::Upload(_) if self.armed => Err(Refusal::WhileArmed),
+            Command::Upload(part) => {
+                self.upload.take(part)?;
+                // Verified: built now, disarmed, so that `StartMission` costs it nothing (a
+                // 32-point path is ~1 M instructions, more than a 200 Hz period).
+                self.build_upload()
+            }
         }
     }
 
@@ -410,16 +435,64 @@ impl Supervisor {
         if self.mission.is_some() {
             return Err(Refusal::MissionRunning);
         }
-        // The link's one conversion (auv_link::mission), validated by the core: path, heading
-        // and time scale.
-        let trajectory = Trajectory::new(Mission::from(*plan)).map_err(|e| mission_refusal(&e))?;
-        self.mission = Some((trajectory, self.tick));
+        // The link's one conversion (auv_link::mission; an uploaded path from the upload
+        // buffer), validated by the core: path, heading and time scale.
+        let mission = plan.resolve(&self.upload)?;
+        let uploaded = match plan.path {
+            MissionSpec::Waypoints { crc } => Some(crc),
+            _ => None,
+        };
+        match (uploaded, self.built) {
+            // Built when it was verified (or since): the slot holds exactly this mission (its
+            // CRC covers the heading and time scale, and `resolve` checked the plan's).
+            (Some(crc), Some((b, result))) if b == crc => result?,
+            // No mission runs here, so the slot is free to build into (a refused mission
+            // leaves it unflown).
+            _ => {
+                self.built = None;
+                self.builds = self.builds.wrapping_add(1);
+                self.trajectory
+                    .set(&mission)
+                    .map_err(|e| mission_refusal(&e))?;
+                self.built = uploaded.map(|crc| (crc, Ok(())));
+            }
+        }
+        self.mission = Some(self.tick);
         self.clock = MissionClock::START;
         if self.lockstep {
             // A state frame from before the mission is not on its clock.
             self.state = None;
         }
         Ok(())
+    }
+
+    /// Builds the verified upload into the trajectory slot unless it holds it already
+    /// (Choice 169); the core's refusal of it is kept, and returned now and by `StartMission`.
+    /// Called only while no mission runs: the build's cost (up to ~1 M instructions) lands in
+    /// a period whose overrun changes nothing.
+    fn build_upload(&mut self) -> Result<(), Refusal> {
+        let Some(crc) = self.upload.verified() else {
+            return Ok(());
+        };
+        if let Some((b, result)) = self.built {
+            if b == crc {
+                return result;
+            }
+        }
+        let result = match self.upload.mission(crc) {
+            Ok(m) => {
+                self.builds = self.builds.wrapping_add(1);
+                self.trajectory.set(&m).map_err(|e| mission_refusal(&e))
+            }
+            Err(r) => Err(r),
+        };
+        self.built = Some((crc, result));
+        result
+    }
+
+    /// Trajectories built since boot (`StartMission`s that built one, and verified uploads).
+    pub fn trajectory_builds(&self) -> u32 {
+        self.builds
     }
 
     /// Validates the whole patch against the board's limits and the core, then applies all of
@@ -498,6 +571,11 @@ impl Supervisor {
     /// free-running up-counting timer (any unit) to time `update`.
     pub fn step(&mut self, overrun: bool, now: &dyn Fn() -> u32) -> Step {
         self.state_fresh = false;
+        if self.mission.is_none() {
+            // A closed-form mission flown since the upload was built took its slot: rebuilt
+            // here, with no mission running, so that starting the upload again is free.
+            let _ = self.build_upload();
+        }
         if overrun {
             self.loop_overruns = self.loop_overruns.saturating_add(1);
         }
@@ -519,7 +597,7 @@ impl Supervisor {
         let stale = self.periods_since_state > u32::from(self.stale_periods);
         // The mission's start tick only: the trajectory (8.6 kB with a waypoint path's route and
         // time law, docs/design.md §27) is borrowed in `fly`, not copied every period.
-        let mission = self.mission.as_ref().map(|&(_, start)| ((), start));
+        let mission = self.mission.map(|start| ((), start));
         match (self.armed, self.latched, mission, self.state) {
             (false, _, _, _) => (BoardStatus::Disarmed, off),
             (true, Some(l), _, _) => (BoardStatus::FailSafe(l.reason), off),
@@ -544,9 +622,7 @@ impl Supervisor {
 
     /// `update` on the latest state frame, timed; a fault latches the fail-safe.
     fn fly(&mut self, start: u64, s: &StateFrame, now: &dyn Fn() -> u32) -> (BoardStatus, Control) {
-        let Some((traj, _)) = &self.mission else {
-            return (BoardStatus::Armed, Control::default());
-        };
+        let traj = &self.trajectory;
         // Mission time: the board's own ticks since StartMission; in lock-step the state
         // frame's t_ticks, on the mission clock (so PIL does not depend on host speed).
         let mission_ticks = if self.lockstep {
@@ -606,6 +682,7 @@ impl Supervisor {
             thrust_unit: self.controller.config().thrust_unit.into(),
             reversed_thrusters: self.mounting,
             rx_ahead: self.rx_ahead,
+            upload: self.upload.status(),
         }
     }
 

@@ -9,7 +9,9 @@
 //! (counted in `rx_errors`). Whatever a cell does not say must not happen: no refusal, nothing
 //! counted, and the latched reason is kept exactly when the next state is latched.
 
-use auv_link::{Command, ConfigPatch, FailSafeReason, MissionSpec, Msg, Refusal};
+use auv_link::{
+    Command, ConfigPatch, FailSafeReason, MissionPlan, MissionSpec, Msg, Refusal, UploadPart,
+};
 use controller_core::effectiveness::THRUSTERS;
 use firmware::board::{self, LinkBuffers};
 use firmware::supervisor::{Mode, Supervisor};
@@ -21,6 +23,12 @@ const README: &str = include_str!("../README.md");
 /// The line after which the table starts.
 const MARKER: &str = "<!-- state table: parsed by firmware/tests/state_table.rs -->";
 
+// The harness's valid upload (a three-point waypoint mission, one chunk), shared with the
+// supervisor fuzz target.
+#[path = "common/supervisor_ops.rs"]
+mod supervisor_ops;
+use supervisor_ops::three_points;
+
 /// The events, as the table's first column names them.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Event {
@@ -28,7 +36,10 @@ enum Event {
     Disarm,
     StartMission,
     StartMissionInvalid,
+    StartMissionNotUploaded,
     StopMission,
+    Upload,
+    UploadInvalid,
     SetConfig,
     SetConfigInvalid,
     StateInOrder,
@@ -41,12 +52,15 @@ enum Event {
 }
 
 impl Event {
-    const ALL: [Event; 14] = [
+    const ALL: [Event; 17] = [
         Event::Arm,
         Event::Disarm,
         Event::StartMission,
         Event::StartMissionInvalid,
+        Event::StartMissionNotUploaded,
         Event::StopMission,
+        Event::Upload,
+        Event::UploadInvalid,
         Event::SetConfig,
         Event::SetConfigInvalid,
         Event::StateInOrder,
@@ -64,7 +78,10 @@ impl Event {
             Event::Disarm => "Disarm",
             Event::StartMission => "StartMission",
             Event::StartMissionInvalid => "StartMission, invalid",
+            Event::StartMissionNotUploaded => "StartMission, not uploaded",
             Event::StopMission => "StopMission",
+            Event::Upload => "Upload",
+            Event::UploadInvalid => "Upload, invalid",
             Event::SetConfig => "SetConfig",
             Event::SetConfigInvalid => "SetConfig, invalid",
             Event::StateInOrder => "state frame, in order",
@@ -249,7 +266,19 @@ impl Rig {
             Event::StartMissionInvalid => {
                 self.command(Command::StartMission(invalid_mission.into()))
             }
+            Event::StartMissionNotUploaded => self.command(Command::StartMission(MissionPlan {
+                path: MissionSpec::Waypoints {
+                    crc: three_points().crc(),
+                },
+                ..CIRCLE
+            })),
             Event::StopMission => self.command(Command::StopMission),
+            Event::Upload => {
+                self.command(Command::Upload(UploadPart::Begin(three_points().header())))
+            }
+            Event::UploadInvalid => {
+                self.command(Command::Upload(UploadPart::Chunk(three_points().chunk(0))))
+            }
             Event::SetConfig => self.command(Command::SetConfig(ConfigPatch {
                 stale_periods: Some(3),
                 ..ConfigPatch::EMPTY

@@ -112,7 +112,7 @@ fn the_board_flies_the_chain_it_reports() {
             })
             .collect::<Vec<_>>()
     };
-    let tr = Trajectory::new(Mission::from(CIRCLE)).unwrap();
+    let tr = Trajectory::new(Mission::try_from(CIRCLE).expect("a closed form")).unwrap();
     for (patch, cfg) in [
         (Some(chain()), host_cfg),
         (None, ControllerConfig::default()),
@@ -274,7 +274,7 @@ fn start_mission_carries_heading_and_time_scale_and_the_board_flies_them() {
         h.command(&mut s, Command::StartMission(plan));
         assert_eq!((s.mode(), s.refused_commands()), (Mode::Running, 0));
         let tr = Trajectory::new(Mission {
-            path: CIRCLE.path.into(),
+            path: CIRCLE.path.try_into().expect("a closed form"),
             heading: heading.into(),
             time_scale,
         })
@@ -295,11 +295,14 @@ fn start_mission_carries_heading_and_time_scale_and_the_board_flies_them() {
     // What the board was given is the mission the host meant: on the circle x = R sin ωt,
     // y = R cos ωt the course is −ωt/k (the paper's heading is +ωt/k), at k = 2 and t = 5 s
     // −0.25 rad.
-    let on_board = Trajectory::new(Mission::from(MissionPlan {
-        heading: Heading::Tangent,
-        time_scale: 2.0,
-        ..CIRCLE
-    }))
+    let on_board = Trajectory::new(
+        Mission::try_from(MissionPlan {
+            heading: Heading::Tangent,
+            time_scale: 2.0,
+            ..CIRCLE
+        })
+        .expect("a closed form"),
+    )
     .unwrap();
     let psi = on_board.sample(500, 100).eta[5];
     assert!((psi + 0.25).abs() < 1e-5, "{psi}");

@@ -26,16 +26,18 @@ fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
     let v: serde_json::Value =
         serde_json::from_slice(&out.stdout).expect("stdout is one JSON object");
     let cases = v["cases"].as_array().unwrap();
-    // The twelve Table-1 runs, then the six real missions and the two waypoint missions, and
-    // the paper's six through the real chain (with Δu), each of the fourteen missions with its
+    // The twelve Table-1 runs, then the six real missions and the three waypoint missions, and
+    // the paper's six through the real chain (with Δu), each of the fifteen missions with its
     // preflight check.
-    assert_eq!(cases.len(), 26);
-    assert_eq!(v["preflight"].as_array().unwrap().len(), 14);
-    for c in &cases[12..20] {
+    assert_eq!(cases.len(), 27);
+    assert_eq!(v["preflight"].as_array().unwrap().len(), 15);
+    for c in &cases[12..21] {
         assert!(c["case"].as_str().unwrap().starts_with("real-"), "{c}");
     }
-    assert_eq!(cases[18]["case"], "real-survey-200x100");
-    assert_eq!(cases[19]["case"], "real-harbour-wall");
+    let waypoint_missions = ["real-survey-200x100", "real-harbour-wall", "real-pipeline"];
+    for (c, name) in cases[18..21].iter().zip(waypoint_missions) {
+        assert_eq!(c["case"], name);
+    }
     for name in [
         "circular-10R",
         "circular-20R",
@@ -63,6 +65,17 @@ fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
     let report = std::fs::read_to_string(out_dir.join("report.md")).unwrap();
     assert!(report.contains("circular-10R") && report.contains(".png"));
     assert!(out_dir.join("circular-10R-with.csv").exists());
+    // The waypoint missions' path over the waypoints and speed over time, written and linked
+    // (docs/design.md §27); a closed-form mission has neither.
+    for name in waypoint_missions {
+        for plot in ["waypoints", "speed"] {
+            let file = format!("{name}-{plot}.png");
+            assert!(out_dir.join(&file).is_file(), "{file}");
+            assert!(report.contains(&format!("]({file})")), "{file} not linked");
+        }
+    }
+    assert!(!out_dir.join("real-circular-10R-waypoints.png").exists());
+    assert!(!out_dir.join("real-circular-10R-speed.png").exists());
 }
 
 #[test]

@@ -154,3 +154,49 @@ fn a_run_with_an_origin_writes_the_flown_path_as_geojson() {
     }
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// The shipped pipeline mission (docs/design.md §27, Choice 174) is its plan, imported:
+/// `import-plan` on the shipped `.plan` gives exactly the shipped scenario's points and origin
+/// (so the two cannot drift apart), and those are the plan's geodetic points in the tangent
+/// plane to the 3 decimals the import prints.
+#[test]
+fn the_shipped_pipeline_is_its_plan_imported() {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios");
+    let out = Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["import-plan", "--speed", "0.5", "--name", "real-pipeline"])
+        .arg(dir.join("plans/pipeline.plan"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let imported = parse_scenario(&String::from_utf8(out.stdout).unwrap()).unwrap();
+    let shipped = host_sim::scenario::load_scenario(&dir.join("real/pipeline.toml")).unwrap();
+    let waypoints = |s: &host_sim::scenario::Scenario| match &s.config().trajectory {
+        controller_core::TrajectoryKind::Waypoints { points, speed, .. } => {
+            (points.as_slice().to_vec(), *speed)
+        }
+        other => panic!("not a waypoint mission: {other:?}"),
+    };
+    let (points, speed) = waypoints(&shipped);
+    assert_eq!((points.clone(), speed), waypoints(&imported));
+    assert_eq!(shipped.config().origin, imported.config().origin);
+    assert_eq!(shipped.config().name, imported.config().name);
+    // Against the plan read directly: the same points to the printed millimetre.
+    let text = std::fs::read_to_string(dir.join("plans/pipeline.plan")).unwrap();
+    let (origin, raw) = plan::import(&text).unwrap();
+    assert_eq!(
+        shipped.config().origin,
+        Some([origin.lat, origin.lon, origin.alt])
+    );
+    assert_eq!(raw.len(), points.len());
+    for (p, r) in points.iter().zip(&raw) {
+        for c in 0..3 {
+            assert!((f64::from(p[c]) - r[c]).abs() <= 5.1e-4, "{p:?} vs {r:?}");
+        }
+        // Within 400 m of the home: the flat earth is good to d²/R < 3 cm there (Choice 159).
+        assert!(r[0].hypot(r[1]) < 400.0, "{r:?}");
+    }
+}

@@ -173,8 +173,9 @@ fn run_files(
         .collect()
 }
 
-/// Choice 162: `run` draws a waypoint mission's speed over time (a PNG, in the manifest) and
-/// nothing more; a closed-form mission gets no speed plot, and the other files are the same.
+/// Choices 162 and 170: `run` draws a waypoint mission's speed over time and its path over the
+/// waypoints (PNGs, in the manifest) and nothing more; a closed-form mission gets neither, and
+/// the other files are the same.
 #[test]
 fn run_plots_the_speed_of_a_waypoint_mission_only() {
     let dir = std::env::temp_dir().join(format!("host-sim-speed-{}", std::process::id()));
@@ -198,6 +199,12 @@ fn run_plots_the_speed_of_a_waypoint_mission_only() {
     assert!(!circle.iter().any(|f| f.contains("speed")), "{circle:?}");
     let mut others = waypoints.clone();
     assert!(others.remove("NAME-speed.png"), "{waypoints:?}");
+    // And its path over the waypoints (Choice 170), in the manifest too.
+    assert!(others.remove("NAME-waypoints.png"), "{waypoints:?}");
+    assert!(
+        manifest.lines().any(|l| l == "wp-waypoints.png"),
+        "{manifest}"
+    );
     assert_eq!(others, circle);
     let _ = std::fs::remove_dir_all(&dir);
 }
@@ -225,5 +232,191 @@ fn check_refuses_a_bad_cap_with_exit_2() {
         err.contains("trajectory.speed_limits") && err.contains("leg 1"),
         "{err}"
     );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Two 150 m legs joined by a 20 m one between two 90° turns (6.7 m of straight between their
+/// blends), no payload, no caps.
+fn short_leg_between_turns() -> host_sim::scenario::Scenario {
+    one_turn(None)
+        .with(|c| {
+            if let TrajectoryKind::Waypoints { ref mut points, .. } = c.trajectory {
+                *points = controller_core::WaypointList::new(&[
+                    [0.0, 0.0, 5.0],
+                    [150.0, 0.0, 5.0],
+                    [150.0, 20.0, 5.0],
+                    [0.0, 20.0, 5.0],
+                ])
+                .unwrap();
+            }
+            c.duration = 700.0;
+        })
+        .unwrap()
+}
+
+/// Choice 171 (a regression: it read the thruster of its search, or `cap` with caps): a short
+/// leg between two turns, with no `speed_limits`, is slowed by the room for its speed changes
+/// and is labelled `changes`. Its speed is the fastest whose two changes, each
+/// (v + v_turn)/2 · (15/8)|v − v_turn|/A long (Choice 156's closed form), fit in it.
+#[test]
+fn a_short_leg_between_two_turns_is_limited_by_its_speed_changes() {
+    let s = short_leg_between_turns();
+    let p = profile::propose(&s, DEFAULT_MARGIN)
+        .unwrap()
+        .expect("a waypoint mission");
+    assert_eq!(p.speeds.len(), 5, "{p:?}");
+    assert_eq!(p.parts[2].limiting, profile::CHANGES, "{p:?}");
+    // The long legs reach their thruster's limit, and are labelled by it.
+    for leg in [0, 4] {
+        assert!(
+            controller_core::effectiveness::THRUSTER_NAMES
+                .contains(&p.parts[leg].limiting.as_str()),
+            "{p:?}"
+        );
+        assert!(p.speeds[leg] > 1.5 * p.speeds[2], "{p:?}");
+    }
+    let a = p.speed_change;
+    let change = |v: f64, w: f64| 0.5 * (v + w) * 15.0 / 8.0 * (v - w).abs() / a;
+    let need = |v: f64| change(v, p.speeds[1]) + change(v, p.speeds[3]);
+    let length = p.parts[2].length;
+    assert!(length < 7.0, "{p:?}");
+    assert!(
+        need(p.speeds[2]) <= length,
+        "{} > {length}",
+        need(p.speeds[2])
+    );
+    assert!(
+        need(p.speeds[2] + 0.02) > length,
+        "{} ≤ {length}",
+        need(p.speeds[2] + 0.02)
+    );
+}
+
+/// Choice 172: `check --json` on a waypoint mission prints the proposed profile (parts,
+/// speeds, times, limits, total and uniform time) under `speed_profile`, beside the check's
+/// own keys; a closed-form mission has no `speed_profile`.
+#[test]
+fn check_json_prints_the_speed_profile_of_a_waypoint_mission() {
+    let dir = std::env::temp_dir().join(format!("host-sim-check-json-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    // The real vehicle without payload, trimmed (untrimmed, the parameter box is statically
+    // infeasible on it).
+    let vehicle = "ideal_actuators = false\n[variation]\nprofile = \"none\"\ntrimmed = true\n\
+                   [controller]\n\
+                   thrust_unit = \"kgf\"\n\
+                   reversed_thrusters = [\"vert fore\", \"horz fore\", \"horz aft\"]\n";
+    let check = |name: &str, trajectory: &str| -> serde_json::Value {
+        let file = dir.join(format!("{name}.toml"));
+        std::fs::write(
+            &file,
+            format!("name = \"{name}\"\nduration = 100.0\n{vehicle}{trajectory}"),
+        )
+        .unwrap();
+        let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+            .args(["check", "--json", "--scenario"])
+            .arg(&file)
+            .output()
+            .unwrap();
+        assert!(
+            matches!(out.status.code(), Some(0 | 1)),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        serde_json::from_slice(&out.stdout).expect("stdout is one JSON object")
+    };
+    let v = check(
+        "wp",
+        "[trajectory]\nkind = \"waypoints\"\npoints = [[0, 0, 5], [40, 0, 5], [40, 20, 5]]\n\
+         speed = 0.5\n",
+    );
+    assert_eq!(v["name"], "wp");
+    assert!(v["verdict"].is_string() && v["thrusters"].is_array(), "{v}");
+    let p = &v["speed_profile"];
+    let parts = p["parts"].as_array().expect("the profile's parts");
+    let names: Vec<&str> = parts.iter().map(|x| x["name"].as_str().unwrap()).collect();
+    assert_eq!(names, ["leg 0", "turn at 1", "leg 1"]);
+    let speeds = p["speeds"].as_array().unwrap();
+    assert_eq!(speeds.len(), 3);
+    let mut sum = 0.0;
+    for (part, speed) in parts.iter().zip(speeds) {
+        assert_eq!(part["speed"], *speed);
+        assert!(part["limiting"].is_string() && part["length"].as_f64().unwrap() > 0.0);
+        sum += part["time"].as_f64().unwrap();
+    }
+    let total = p["total_time"].as_f64().unwrap();
+    assert!((sum - total).abs() < 1e-3 * total, "{sum} vs {total}");
+    // The turn is the slowest part, so one speed for the whole path takes longer.
+    assert!(p["uniform_time"].as_f64().unwrap() > total, "{p}");
+    // The uniform speed is the turn's before the profile's rounding down to 0.01 m/s.
+    let (uniform, turn) = (
+        p["uniform_speed"].as_f64().unwrap(),
+        speeds[1].as_f64().unwrap(),
+    );
+    assert!(uniform >= turn && uniform < turn + 0.01, "{p}");
+    let circle = check("ci", "[trajectory]\nkind = \"circle\"\nradius = 10.0\n");
+    assert!(circle["verdict"].is_string(), "{circle}");
+    assert!(circle.get("speed_profile").is_none(), "{circle}");
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The pixels of `colour` in a PNG.
+fn pixels_of(file: &std::path::Path, colour: [u8; 3]) -> usize {
+    let decoder = png::Decoder::new(std::fs::File::open(file).unwrap());
+    let mut reader = decoder.read_info().unwrap();
+    let mut buf = vec![0; reader.output_buffer_size()];
+    let info = reader.next_frame(&mut buf).unwrap();
+    assert_eq!(info.color_type, png::ColorType::Rgb, "{}", file.display());
+    buf[..info.buffer_size()]
+        .chunks_exact(3)
+        .filter(|p| *p == colour)
+        .count()
+}
+
+/// Choice 170: the path over the waypoints marks each waypoint (in the plan view, the zoom on
+/// a corner, and the depth profile when the depth changes, each a filled dot in the waypoints'
+/// own colour): a mission that changes depth shows its waypoints in one more panel than the
+/// same mission at one depth.
+#[test]
+fn the_waypoint_plot_marks_the_waypoints_and_adds_the_depth_when_it_changes() {
+    use host_sim::output::waypoint_plot::{plot_waypoint_path, C_WAYPOINT};
+    let dir = std::env::temp_dir().join(format!("host-sim-wp-plot-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let marks = |name: &str, depth: f32| -> usize {
+        let s = one_turn(None)
+            .with(|c| {
+                c.name = name.to_string();
+                c.duration = 20.0;
+                if let TrajectoryKind::Waypoints { ref mut points, .. } = c.trajectory {
+                    *points = controller_core::WaypointList::new(&[
+                        [0.0, 0.0, 5.0],
+                        [40.0, 0.0, 5.0],
+                        [40.0, 20.0, depth],
+                    ])
+                    .unwrap();
+                }
+            })
+            .unwrap();
+        let run = sim::run(&s);
+        let file = plot_waypoint_path(&dir, &s, &run).unwrap().expect("a plot");
+        assert_eq!(file, dir.join(format!("{name}-waypoints.png")));
+        let c = C_WAYPOINT;
+        pixels_of(&file, [c.0, c.1, c.2])
+    };
+    let flat = marks("flat", 5.0);
+    let descending = marks("descending", 8.0);
+    // Five dots at one depth (three waypoints, the zoom's one, the legend's): a dot of radius 3
+    // is at least 20 pixels.
+    assert!(flat >= 5 * 20, "{flat}");
+    // Three more in the depth profile.
+    assert!(descending >= flat + 3 * 20, "{descending} vs {flat}");
+    // A closed-form mission has no waypoint plot.
+    let circle = short_survey()
+        .with(|c| {
+            c.trajectory = controller_core::Table1Case::Circular10R.kind();
+            c.duration = 1.0;
+        })
+        .unwrap();
+    let run = sim::run(&circle);
+    assert_eq!(plot_waypoint_path(&dir, &circle, &run).unwrap(), None);
     let _ = std::fs::remove_dir_all(&dir);
 }

@@ -29,11 +29,11 @@
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 162 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 145 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//! - **Size:** at most [`MAX_FRAME`] = 174 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 157 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
 //!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
 //!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
-//!   board's link) the largest frame takes 3.5 ms, so a State frame in one direction and a
+//!   board's link) the largest frame takes 3.8 ms, so a State frame in one direction and a
 //!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
 //!   uses 35 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
 //!
@@ -97,6 +97,7 @@ mod msg;
 mod refusal;
 pub mod seq;
 pub mod sign;
+pub mod upload;
 
 pub use frame::{
     decode_frame, decode_frame_signed, encode, encode_signed, FrameDecoder, LinkError, CRC_LEN,
@@ -108,3 +109,6 @@ pub use msg::{
     NOT_AUV150, PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;
+pub use upload::{
+    MissionUpload, UploadBuffer, UploadChunk, UploadHeader, UploadPart, UploadStatus,
+};

@@ -12,33 +12,41 @@
 //! `MissionSpec` stays its own type because its layout *is* the wire format (variant order and
 //! field order fix the postcard bytes; see [`crate::msg`]), while `TrajectoryKind` may grow
 //! without a protocol change. A kind added to the core fails to compile here until the link
-//! carries it, or is listed as one that does not fit one frame: the waypoint path
-//! (docs/design.md §27) is up to 32 points, so core → wire is a `TryFrom` that refuses it
-//! ([`NotOneFrame`]) until the chunked mission upload carries it.
+//! carries it. The waypoint path (docs/design.md §27) is up to 32 points: it travels as a
+//! mission upload ([`crate::upload`]) and `StartMission` names it by the upload's CRC
+//! ([`MissionSpec::Waypoints`]), so core → wire computes that CRC, and wire → core needs the
+//! board's [`UploadBuffer`] ([`MissionPlan::resolve`]; without it, [`Uploaded`]).
 
 use controller_core::{HeadingMode, Mission, TrajectoryKind};
 
 use crate::msg::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
+use crate::refusal::Refusal;
+use crate::upload::{MissionUpload, UploadBuffer};
 
-/// Both `From` impls from one list of variants and fields, so the two directions cannot drift
+/// Both conversions from one list of variants and fields, so the two directions cannot drift
 /// apart. A variant or field missing from the list is a compile error (non-exhaustive match,
 /// or a pattern that does not mention a field).
 macro_rules! field_for_field {
-    ($($variant:ident { $($field:ident),+ $(,)? }),+ ; not one frame: $($big:ident),+ $(,)?) => {
-        impl TryFrom<TrajectoryKind> for MissionSpec {
-            type Error = NotOneFrame;
-            fn try_from(kind: TrajectoryKind) -> Result<Self, NotOneFrame> {
+    ($($variant:ident { $($field:ident),+ $(,)? }),+ ; uploaded: $big:ident) => {
+        impl From<TrajectoryKind> for MissionSpec {
+            fn from(kind: TrajectoryKind) -> Self {
                 match kind {
-                    $(TrajectoryKind::$variant { $($field),+ } => Ok(MissionSpec::$variant { $($field),+ }),)+
-                    $(TrajectoryKind::$big { .. } => Err(NotOneFrame),)+
+                    $(TrajectoryKind::$variant { $($field),+ } => MissionSpec::$variant { $($field),+ },)+
+                    // A bare path is the paper's mission (k = 1); `MissionPlan::from(Mission)`
+                    // names the mission's own upload.
+                    path @ TrajectoryKind::$big { .. } => MissionSpec::$big {
+                        crc: MissionUpload::of(&Mission::paper(path)).map_or(0, |u| u.crc()),
+                    },
                 }
             }
         }
 
-        impl From<MissionSpec> for TrajectoryKind {
-            fn from(spec: MissionSpec) -> Self {
+        impl TryFrom<MissionSpec> for TrajectoryKind {
+            type Error = Uploaded;
+            fn try_from(spec: MissionSpec) -> Result<Self, Uploaded> {
                 match spec {
-                    $(MissionSpec::$variant { $($field),+ } => TrajectoryKind::$variant { $($field),+ },)+
+                    $(MissionSpec::$variant { $($field),+ } => Ok(TrajectoryKind::$variant { $($field),+ }),)+
+                    MissionSpec::$big { crc } => Err(Uploaded { crc }),
                 }
             }
         }
@@ -50,17 +58,49 @@ field_for_field! {
     FigureEight { amplitude, omega, depth },
     LawnMower { scale, omega, depth },
     Helix { radius, omega, depth, depth_rate };
-    not one frame: Waypoints,
+    uploaded: Waypoints
 }
 
-/// A path that does not fit one `StartMission` frame (the waypoint path, docs/design.md §27):
-/// it is flown in SIL until the chunked mission upload carries it.
+/// A wire path that names a mission upload (the waypoint path, by its CRC): only the board
+/// that holds the upload can turn it into a path ([`MissionPlan::resolve`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct NotOneFrame;
+pub struct Uploaded {
+    /// The upload's CRC.
+    pub crc: u32,
+}
 
-impl core::fmt::Display for NotOneFrame {
+impl core::fmt::Display for Uploaded {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        f.write_str("a waypoint mission does not fit one StartMission frame (no mission upload yet: fly it in SIL)")
+        write!(
+            f,
+            "the path is the mission upload of CRC {:#010x}, which only its board holds",
+            self.crc
+        )
+    }
+}
+
+impl MissionPlan {
+    /// The mission: a closed-form path field for field; an uploaded one from `upload`, if it
+    /// holds that upload verified and the plan's heading and time scale are the upload's
+    /// ([`UploadBuffer::mission`]; else [`Refusal::NoUpload`]).
+    pub fn resolve(&self, upload: &UploadBuffer) -> Result<Mission, Refusal> {
+        match TrajectoryKind::try_from(self.path) {
+            Ok(path) => Ok(Mission {
+                path,
+                heading: self.heading.into(),
+                time_scale: self.time_scale,
+            }),
+            Err(Uploaded { crc }) => {
+                let m = upload.mission(crc)?;
+                let same = Heading::from(m.heading) == self.heading
+                    && m.time_scale.to_bits() == self.time_scale.to_bits();
+                if same {
+                    Ok(m)
+                } else {
+                    Err(Refusal::NoUpload)
+                }
+            }
+        }
     }
 }
 
@@ -88,10 +128,27 @@ macro_rules! variant_for_variant {
 variant_for_variant!(Heading, HeadingMode, Paper, Tangent);
 variant_for_variant!(ThrustUnit, controller_core::ThrustUnit, Kgf, Newton);
 
-impl TryFrom<Mission> for MissionPlan {
-    type Error = NotOneFrame;
-    fn try_from(m: Mission) -> Result<Self, NotOneFrame> {
-        Ok(MissionPlan {
+impl From<Mission> for MissionPlan {
+    /// A waypoint path is named by the CRC of this mission's upload (its heading and time
+    /// scale included).
+    fn from(m: Mission) -> Self {
+        MissionPlan {
+            path: match MissionUpload::of(&m) {
+                Some(u) => MissionSpec::Waypoints { crc: u.crc() },
+                None => m.path.into(),
+            },
+            heading: m.heading.into(),
+            time_scale: m.time_scale,
+        }
+    }
+}
+
+impl TryFrom<MissionPlan> for Mission {
+    type Error = Uploaded;
+    /// A mission on a closed-form path ([`Uploaded`] for an uploaded one: see
+    /// [`MissionPlan::resolve`]).
+    fn try_from(m: MissionPlan) -> Result<Self, Uploaded> {
+        Ok(Mission {
             path: m.path.try_into()?,
             heading: m.heading.into(),
             time_scale: m.time_scale,
@@ -99,21 +156,10 @@ impl TryFrom<Mission> for MissionPlan {
     }
 }
 
-impl From<MissionPlan> for Mission {
-    fn from(m: MissionPlan) -> Self {
-        Mission {
-            path: m.path.into(),
-            heading: m.heading.into(),
-            time_scale: m.time_scale,
-        }
-    }
-}
-
-impl TryFrom<TrajectoryKind> for MissionPlan {
-    type Error = NotOneFrame;
+impl From<TrajectoryKind> for MissionPlan {
     /// The paper's mission on this path ([`Mission::paper`]).
-    fn try_from(kind: TrajectoryKind) -> Result<Self, NotOneFrame> {
-        Mission::paper(kind).try_into()
+    fn from(kind: TrajectoryKind) -> Self {
+        Mission::paper(kind).into()
     }
 }
 

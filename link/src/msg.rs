@@ -9,6 +9,7 @@ use controller_core::effectiveness::THRUSTERS;
 use serde::{Deserialize, Serialize};
 
 use crate::refusal::Refusal;
+use crate::upload::{UploadPart, UploadStatus};
 
 /// The protocol version this crate speaks; sent as the first byte of every frame.
 ///
@@ -22,7 +23,11 @@ use crate::refusal::Refusal;
 ///
 /// 4: `Telemetry` counts the authentic frames refused for a timestamp too far ahead
 /// ([`Telemetry::rx_ahead`], [`crate::sign::AuthError::Ahead`]).
-pub const PROTOCOL_VERSION: u8 = 4;
+///
+/// 5: the chunked mission upload ([`crate::upload`]): `Command::Upload`, the waypoint path
+/// named by its CRC (`MissionSpec::Waypoints`), the upload's acknowledgement in every
+/// `Telemetry` ([`Telemetry::upload`]), and the upload's refusals.
+pub const PROTOCOL_VERSION: u8 = 5;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -129,11 +134,18 @@ pub enum Command {
     StopMission,
     /// Change the fields that are `Some`; the others keep their values.
     SetConfig(ConfigPatch),
+    // Protocol 5.
+    /// A part of a waypoint mission's upload ([`crate::upload`]); refused while armed.
+    Upload(UploadPart),
 }
 
 impl Command {
     /// Worst-case postcard size of a `Command` (bytes).
-    pub const MAX_SIZE: usize = TAG + max(MissionPlan::MAX_SIZE, ConfigPatch::MAX_SIZE);
+    pub const MAX_SIZE: usize = TAG
+        + max(
+            MissionPlan::MAX_SIZE,
+            max(ConfigPatch::MAX_SIZE, UploadPart::MAX_SIZE),
+        );
 }
 
 /// A mission as the board flies it: the wire form of `controller_core::Mission` — the path
@@ -230,6 +242,13 @@ pub enum MissionSpec {
         depth: f32,
         /// ż_d (m/s, positive = descending).
         depth_rate: f32,
+    },
+    // Protocol 5.
+    /// The waypoint path the board holds from a mission upload ([`crate::upload`]) whose
+    /// whole-mission CRC is `crc`: refused unless that upload is verified.
+    Waypoints {
+        /// [`crate::upload::mission_crc`] of the upload.
+        crc: u32,
     },
 }
 
@@ -390,6 +409,9 @@ pub struct Telemetry {
     /// allows over the last accepted stamp; also counted in `rx_auth_errors` and `rx_errors`).
     /// A navigation computer whose clock jumped sees it rise, and the board fail safe.
     pub rx_ahead: u32,
+    // Protocol 5: appended fields.
+    /// What the board holds of a mission upload: the acknowledgement the sender resends by.
+    pub upload: UploadStatus,
 }
 
 impl Telemetry {
@@ -423,6 +445,12 @@ impl Telemetry {
         thrust_unit: ThrustUnit::Newton,
         reversed_thrusters: u8::MAX,
         rx_ahead: u32::MAX,
+        upload: UploadStatus {
+            crc: u32::MAX,
+            chunks: u8::MAX,
+            received: u32::MAX,
+            verified: true,
+        },
     };
 }
 
@@ -448,7 +476,8 @@ impl Telemetry {
         + BOOL
         + ThrustUnit::MAX_SIZE
         + U8
-        + U32;
+        + U32
+        + UploadStatus::MAX_SIZE;
 
     /// The controller fault this report carries (`None`: no fault, or a code this crate does
     /// not know).

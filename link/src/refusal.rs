@@ -48,6 +48,17 @@ pub enum Refusal {
     /// `SetConfig` whose axis priority the core refuses (a weight of an actuated axis that is
     /// not finite and > 0).
     InvalidPriority = 12,
+    // Protocol 5.
+    /// `Upload` whose `Begin` has counts the board cannot hold (fewer than 2 or more than
+    /// `MAX_WAYPOINTS` points, more than `MAX_PARTS` speeds), or a chunk with no upload begun
+    /// or an index past its last.
+    InvalidUpload = 13,
+    /// The last chunk of an upload completed a mission that does not match its CRC: every
+    /// chunk is dropped, to be sent again.
+    UploadCrc = 14,
+    /// `StartMission` of an uploaded path with no verified upload of that CRC, or with a
+    /// heading or time scale other than the upload's.
+    NoUpload = 15,
 }
 
 impl Refusal {
@@ -88,6 +99,9 @@ refusal_names! {
     TangentTooSlow => "too slow for tangent heading",
     InvalidMounting => "invalid thruster mounting",
     InvalidPriority => "invalid axis priority",
+    InvalidUpload => "invalid upload",
+    UploadCrc => "upload CRC mismatch",
+    NoUpload => "no such upload",
 }
 
 impl Refusal {

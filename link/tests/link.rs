@@ -4,7 +4,8 @@ use auv_link::sign::{AuthError, SIGNATURE_LEN};
 use auv_link::{
     decode_frame, encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope,
     FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, Refusal,
-    StateFrame, Telemetry, ThrustUnit, CRC_LEN, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
+    StateFrame, Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, UploadStatus,
+    CRC_LEN, MAX_BODY, MAX_FRAME, PROTOCOL_VERSION,
 };
 use proptest::prelude::*;
 
@@ -83,6 +84,12 @@ fn telemetry(status: BoardStatus) -> Telemetry {
         thrust_unit: ThrustUnit::Kgf,
         reversed_thrusters: 0b1_1110,
         rx_ahead: 5,
+        upload: UploadStatus {
+            crc: 0xDEAD_BEEF,
+            chunks: 5,
+            received: 0b1_0110,
+            verified: false,
+        },
     }
 }
 
@@ -134,6 +141,25 @@ fn every_kind() -> Vec<Envelope> {
             time_scale: 1.0,
         })),
         Msg::Command(Command::SetConfig(ConfigPatch::EMPTY)),
+        Msg::Command(Command::StartMission(MissionPlan {
+            path: MissionSpec::Waypoints { crc: 0x1234_5678 },
+            heading: Heading::Tangent,
+            time_scale: 1.0,
+        })),
+        Msg::Command(Command::Upload(UploadPart::Begin(UploadHeader {
+            points: 3,
+            speeds: Some(5),
+            speed: 1.5,
+            turn_radius: None,
+            speed_change: Some(0.05),
+            heading: Heading::Tangent,
+            time_scale: 2.0,
+            crc: 0xCAFE_F00D,
+        }))),
+        Msg::Command(Command::Upload(UploadPart::Chunk(UploadChunk {
+            index: 2,
+            words: [-3.25; auv_link::upload::CHUNK_WORDS],
+        }))),
         Msg::Command(Command::SetConfig(ConfigPatch {
             rate_hz: Some(100),
             robust: Some(false),
@@ -292,10 +318,27 @@ fn max_sizes_are_exact() {
         }),
     };
     assert_eq!(postcard_len(&p), ConfigPatch::MAX_SIZE);
+    let begin = UploadHeader {
+        points: u8::MAX,
+        speeds: Some(u8::MAX),
+        speed: f32::MAX,
+        turn_radius: Some(f32::MAX),
+        speed_change: Some(f32::MAX),
+        heading: Heading::Tangent,
+        time_scale: f32::MAX,
+        crc: u32::MAX,
+    };
+    assert_eq!(postcard_len(&begin), UploadHeader::MAX_SIZE);
+    let chunk = UploadChunk {
+        index: u8::MAX,
+        words: [f32::MAX; auv_link::upload::CHUNK_WORDS],
+    };
+    assert_eq!(postcard_len(&chunk), UploadChunk::MAX_SIZE);
+    assert_eq!(postcard_len(&t.upload), auv_link::UploadStatus::MAX_SIZE);
     assert_eq!(
-        postcard_len(&Command::SetConfig(p)),
+        postcard_len(&Command::Upload(UploadPart::Chunk(chunk))),
         Command::MAX_SIZE,
-        "SetConfig is the largest command"
+        "an upload chunk is the largest command"
     );
     assert_eq!(postcard_len(&Msg::Telemetry(t)), Msg::MAX_SIZE);
     assert_eq!(postcard_len(&largest()), Envelope::MAX_SIZE);
@@ -311,12 +354,14 @@ fn largest_message_fits_max_frame_exactly() {
     // + 2 (protocol 2) + 2 (unit) + 2 (mask) + 31 (priority: 6 ranks, 6 weights) bytes; a
     // StartMission is its tag, the path (17), the heading (1) and the time scale (4).
     assert_eq!(ConfigPatch::MAX_SIZE, 57);
-    assert_eq!(Command::MAX_SIZE, 58);
     assert_eq!(MissionPlan::MAX_SIZE + 1, 23);
-    // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes).
-    assert_eq!(Envelope::MAX_SIZE, 145);
-    assert_eq!(MAX_BODY, 160);
-    assert_eq!(MAX_FRAME, 162);
+    // Protocol 5's upload chunk: the command's tag, the part's tag, the index, 32 words.
+    assert_eq!(Command::MAX_SIZE, 1 + 1 + 1 + 32 * 4);
+    // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes); protocol 5's
+    // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes).
+    assert_eq!(Envelope::MAX_SIZE, 145 + 12);
+    assert_eq!(MAX_BODY, 160 + 12);
+    assert_eq!(MAX_FRAME, 162 + 12);
     // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
     // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
@@ -373,7 +418,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 1, 2, 3, 5, 0x7F, 0xFF] {
+    for version in [0u8, 1, 2, 3, 4, 6, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -390,30 +435,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[5, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[6, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 5 })]
+        vec![Err(LinkError::Version { got: 6 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 4, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    assert_eq!(PROTOCOL_VERSION, 4);
-    let wire = frame_from_body(&[4, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 5, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 5);
+    let wire = frame_from_body(&[5, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
     // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
     // short: Deserialize.
     for body in [
-        &[4, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[&[4, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
-        &[&[4, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
-        &[4, 0x00, 0x03][..],
-        &[4, 0x00, 0x01, 0x05][..],
-        &[4, 0x00, 0x00, 0x01][..],
-        &[4][..],
+        &[5, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[5, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[5, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[5, 0x00, 0x03][..],
+        &[5, 0x00, 0x01, 0x06][..],
+        &[5, 0x00, 0x00, 0x01][..],
+        &[5][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -422,7 +467,7 @@ fn hand_made_frames_match_the_documented_format() {
         );
     }
     // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
-    let signed = [&[4, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    let signed = [&[5, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
     assert_eq!(
         decode_stream(&frame_from_body(&signed)),
         vec![Err(LinkError::Auth(AuthError::SigningOff))]
@@ -563,6 +608,50 @@ fn any_mission() -> BoxedStrategy<MissionSpec> {
                 depth_rate,
             }
         }),
+        any::<u32>().prop_map(|crc| MissionSpec::Waypoints { crc }),
+    ]
+    .boxed()
+}
+
+fn any_upload_status() -> BoxedStrategy<UploadStatus> {
+    (any::<u32>(), any::<u8>(), any::<u32>(), any::<bool>())
+        .prop_map(|(crc, chunks, received, verified)| UploadStatus {
+            crc,
+            chunks,
+            received,
+            verified,
+        })
+        .boxed()
+}
+
+fn any_upload_part() -> BoxedStrategy<UploadPart> {
+    prop_oneof![
+        (
+            any::<u8>(),
+            any::<Option<u8>>(),
+            any_f32(),
+            proptest::option::of(any_f32()),
+            proptest::option::of(any_f32()),
+            prop_oneof![Just(Heading::Paper), Just(Heading::Tangent)],
+            any_f32(),
+            any::<u32>(),
+        )
+            .prop_map(
+                |(points, speeds, speed, turn_radius, speed_change, heading, time_scale, crc)| {
+                    UploadPart::Begin(UploadHeader {
+                        points,
+                        speeds,
+                        speed,
+                        turn_radius,
+                        speed_change,
+                        heading,
+                        time_scale,
+                        crc,
+                    })
+                }
+            ),
+        (any::<u8>(), prop::array::uniform32(any_f32()))
+            .prop_map(|(index, words)| UploadPart::Chunk(UploadChunk { index, words })),
     ]
     .boxed()
 }
@@ -628,6 +717,7 @@ fn any_command() -> BoxedStrategy<Command> {
         Just(Command::StopMission),
         any_plan().prop_map(Command::StartMission),
         any_patch().prop_map(Command::SetConfig),
+        any_upload_part().prop_map(Command::Upload),
     ]
     .boxed()
 }
@@ -664,6 +754,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any_unit(),
             any::<u8>(),
             any::<u32>(),
+            any_upload_status(),
         ),
     )
         .prop_map(
@@ -689,6 +780,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     thrust_unit,
                     reversed_thrusters,
                     rx_ahead,
+                    upload,
                 ),
             )| Telemetry {
                 tick,
@@ -716,6 +808,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 thrust_unit,
                 reversed_thrusters,
                 rx_ahead,
+                upload,
             },
         )
         .boxed()

@@ -16,7 +16,7 @@ fn kind_index(k: &TrajectoryKind) -> usize {
         TrajectoryKind::FigureEight { .. } => 1,
         TrajectoryKind::LawnMower { .. } => 2,
         TrajectoryKind::Helix { .. } => 3,
-        // Does not fit one frame: refused by the conversion (tested below).
+        // Crosses as a mission upload named by its CRC (tests/upload.rs).
         TrajectoryKind::Waypoints { .. } => KINDS,
     }
 }
@@ -114,9 +114,7 @@ fn every_kind_round_trips_through_a_frame() {
             };
             let env = Envelope::new(
                 seq as u16,
-                Msg::Command(Command::StartMission(
-                    MissionPlan::try_from(mission).expect("one frame"),
-                )),
+                Msg::Command(Command::StartMission(MissionPlan::from(mission))),
             );
             let mut wire = [0u8; MAX_FRAME];
             let n = encode(&env, &mut wire).expect("a mission fits a frame");
@@ -124,7 +122,7 @@ fn every_kind_round_trips_through_a_frame() {
             let Msg::Command(Command::StartMission(plan)) = back.msg else {
                 panic!("decoded {back:?}");
             };
-            let again = Mission::from(plan);
+            let again = Mission::try_from(plan).expect("a closed-form path");
             assert!(
                 same_bits(&again.path, &kind),
                 "{kind:?} came back as {again:?}"
@@ -138,7 +136,7 @@ fn every_kind_round_trips_through_a_frame() {
     assert_eq!(seen, [true; KINDS], "some kind never crossed the link");
     // A bare path is the paper's mission.
     assert_eq!(
-        Mission::from(MissionPlan::try_from(Table1Case::Circular10R.kind()).expect("one frame")),
+        Mission::try_from(MissionPlan::from(Table1Case::Circular10R.kind())).expect("closed form"),
         Mission::paper(Table1Case::Circular10R.kind())
     );
     for u in controller_core::ThrustUnit::ALL {
@@ -165,13 +163,12 @@ fn wire_bytes_are_the_documented_layout() {
             want.extend(x.to_le_bytes());
         }
         let mut buf = [0u8; MissionSpec::MAX_SIZE];
-        let got = postcard::to_slice(&MissionSpec::try_from(kind).expect("one frame"), &mut buf)
-            .expect("fits MAX_SIZE");
+        let got = postcard::to_slice(&MissionSpec::from(kind), &mut buf).expect("fits MAX_SIZE");
         assert_eq!(got, &want[..], "{kind:?}");
         // A plan: the path's bytes, the heading's variant index (paper 0, tangent 1), then the
         // time scale as an f32 little-endian.
         let plan = MissionPlan {
-            path: kind.try_into().expect("one frame"),
+            path: kind.into(),
             heading: Heading::Tangent,
             time_scale: 2.5,
         };
@@ -193,9 +190,9 @@ fn the_receiver_validates_what_it_converts() {
         depth: 5.0,
         depth_rate: 0.2,
     };
-    let spec = MissionSpec::try_from(helix).expect("one frame");
+    let spec = MissionSpec::from(helix);
     assert_eq!(
-        Trajectory::new(TrajectoryKind::from(spec)),
+        Trajectory::new(TrajectoryKind::try_from(spec).expect("closed form")),
         Trajectory::new(helix)
     );
     let bad = MissionSpec::Circle {
@@ -203,12 +200,11 @@ fn the_receiver_validates_what_it_converts() {
         omega: 0.1,
         depth: 5.0,
     };
-    assert!(Trajectory::new(TrajectoryKind::from(bad)).is_err());
+    assert!(Trajectory::new(TrajectoryKind::try_from(bad).expect("closed form")).is_err());
 }
 
 #[test]
-fn a_waypoint_mission_is_refused_by_the_one_frame_conversion() {
-    // 32 points do not fit a frame: the conversion says so instead of truncating.
+fn a_waypoint_path_crosses_as_its_uploads_crc_and_only_the_board_resolves_it() {
     let points = controller_core::WaypointList::new(&[[0.0, 0.0, 5.0], [50.0, 0.0, 5.0]])
         .expect("two points");
     let kind = TrajectoryKind::Waypoints {
@@ -218,12 +214,38 @@ fn a_waypoint_mission_is_refused_by_the_one_frame_conversion() {
         speeds: None,
         speed_change: None,
     };
+    let upload = auv_link::MissionUpload::of(&Mission::paper(kind)).expect("a waypoint path");
     assert_eq!(
-        MissionSpec::try_from(kind),
-        Err(auv_link::mission::NotOneFrame)
+        MissionSpec::from(kind),
+        MissionSpec::Waypoints { crc: upload.crc() }
     );
+    let plan = MissionPlan::from(Mission::paper(kind));
+    // Another heading or time scale is another mission: another CRC.
+    let tangent = Mission {
+        heading: HeadingMode::Tangent,
+        ..Mission::paper(kind)
+    };
+    assert_ne!(MissionPlan::from(tangent).path, plan.path);
+    // Without the board's buffer, the wire path names an upload and nothing more.
     assert_eq!(
-        MissionPlan::try_from(Mission::paper(kind)),
-        Err(auv_link::mission::NotOneFrame)
+        Mission::try_from(plan),
+        Err(auv_link::mission::Uploaded { crc: upload.crc() })
     );
+    let mut board = auv_link::UploadBuffer::EMPTY;
+    assert_eq!(plan.resolve(&board), Err(auv_link::Refusal::NoUpload));
+    board
+        .take(&auv_link::UploadPart::Begin(upload.header()))
+        .expect("fits");
+    for i in 0..upload.chunks() {
+        board
+            .take(&auv_link::UploadPart::Chunk(upload.chunk(i)))
+            .expect("a chunk");
+    }
+    assert_eq!(plan.resolve(&board), Ok(Mission::paper(kind)));
+    // The upload's CRC with another time scale in the plan is not this upload.
+    let slower = MissionPlan {
+        time_scale: 2.0,
+        ..plan
+    };
+    assert_eq!(slower.resolve(&board), Err(auv_link::Refusal::NoUpload));
 }

@@ -79,6 +79,7 @@ fn telemetry_fault_code_is_the_cores() {
         thrust_unit: ThrustUnit::Kgf,
         reversed_thrusters: 0,
         rx_ahead: 0,
+        upload: auv_link::UploadStatus::NONE,
     };
     assert_eq!(t.fault(), None);
     for f in Fault::ALL {

@@ -313,7 +313,7 @@ mod tests {
         const {
             assert!(
                 92_612 > budget::STACK_BUDGET_BYTES,
-                "the 32-point capacity's stack is refused"
+                "the 32-point capacity's stack, trajectories by value, is refused"
             )
         };
         assert_eq!(stack_high_water(LOG), None);

@@ -19,8 +19,11 @@ use crate::trajectory::{DEFAULT_SPEED_CHANGE, TURN_ACCEL};
 /// `[trajectory]` table of host-sim's scenario files. Values are not validated there: build the
 /// mission with [`Trajectory::new`].
 // The waypoint list is ~390 bytes beside the closed forms' 16: no heap on the board (no `Box`),
-// and a mission is copied at configuration only (`Trajectory::new`), never per sample.
+// and a mission is copied at configuration only (`Trajectory::set`), never per sample.
 #[allow(clippy::large_enum_variant)]
+// The tag in declaration order (Circle = 0), so that `Trajectory::EMPTY`, a circle of zeros, is
+// all zero bits (a board zeroes it instead of copying it from flash).
+#[repr(u8)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 #[cfg_attr(feature = "serde", derive(serde::Serialize, serde::Deserialize))]
 #[cfg_attr(

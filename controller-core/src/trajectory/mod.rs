@@ -154,8 +154,37 @@ impl Trajectory {
     /// would need state in a stateless `update`). The shipped paths never stop.
     pub const MIN_TANGENT_SPEED: f32 = 0.02;
 
+    /// An inert trajectory: the origin at the surface, held (η_d = 0, η̇_d = η̈_d = 0 at every
+    /// t). Its mission (a circle of radius 0 and ω 0) is not one [`Trajectory::new`] accepts:
+    /// it is what a trajectory holds before [`Trajectory::set`], and after a refused one.
+    /// Every bit of it is zero (its time scale too), so that a board initialises one with a
+    /// `memset` instead of copying 8.6 kB from flash.
+    pub const EMPTY: Trajectory = Trajectory {
+        mission: Mission {
+            path: TrajectoryKind::Circle {
+                radius: 0.0,
+                omega: 0.0,
+                depth: 0.0,
+            },
+            heading: HeadingMode::Paper,
+            time_scale: 0.0,
+        },
+        omega: 0.0,
+        theta: Frequency::ZERO,
+        half: Frequency::ZERO,
+        rate: 0.0,
+        position_rate: LinearRate::ZERO,
+        psi: [[0.0; 3]; ODD_TERMS],
+        accel_bound: 0.0,
+        min_speed: 0.0,
+        route: Route::EMPTY,
+        law: TimeLaw::EMPTY,
+    };
+
     /// Validates `mission` and precomputes the series coefficients, K_d and the minimum speed.
-    /// A [`TrajectoryKind`] is the paper's mission ([`Mission::paper`]).
+    /// A [`TrajectoryKind`] is the paper's mission ([`Mission::paper`]). A host convenience:
+    /// `EMPTY` and then [`Trajectory::set`], returned by value (on the board, where a
+    /// `Trajectory` of 32 waypoints is 8.6 kB, call `set` on one that stays in place).
     ///
     /// Checks, in field order: every parameter finite; radius/amplitude in (0, [`MAX_SIZE`]],
     /// lawn-mower scale in (0, [`MAX_SIZE`]/15]; omega in (0, [`MAX_OMEGA`]];
@@ -170,8 +199,27 @@ impl Trajectory {
     /// [`MAX_TIME_SCALE`]: Self::MAX_TIME_SCALE
     /// [`MIN_TANGENT_SPEED`]: Self::MIN_TANGENT_SPEED
     pub fn new(mission: impl Into<Mission>) -> Result<Self, TrajectoryError> {
-        let mission = mission.into();
-        paths::check(&mission.path)?;
+        let mut t = Self::EMPTY;
+        t.set(&mission.into())?;
+        Ok(t)
+    }
+
+    /// [`Trajectory::new`] in place (Choice 180): validates `mission` and precomputes it into
+    /// `self`, with no `Trajectory`, [`Route`] or [`TimeLaw`] on the stack (a waypoint path's
+    /// route and time law are checked as they are built, once). The result is exactly
+    /// [`Trajectory::new`]'s whatever `self` held before, and so is the error. After an error
+    /// `self` samples as [`Trajectory::EMPTY`] (the origin held; never panics, finite).
+    pub fn set(&mut self, mission: &Mission) -> Result<(), TrajectoryError> {
+        let result = self.try_set(mission);
+        if result.is_err() {
+            self.make_inert();
+        }
+        result
+    }
+
+    /// [`Trajectory::set`] before its clean-up on an error.
+    fn try_set(&mut self, mission: &Mission) -> Result<(), TrajectoryError> {
+        paths::build_into(&mission.path, &mut self.route, &mut self.law)?;
         let k = mission.time_scale;
         if !k.is_finite() {
             return Err(TrajectoryError::NonFinite {
@@ -186,79 +234,76 @@ impl Trajectory {
                 max: Self::MAX_TIME_SCALE,
             });
         }
-        let t = Self::build(mission);
+        self.precompute(mission);
         if mission.heading == HeadingMode::Tangent
-            && (t.min_speed.is_nan() || t.min_speed < Self::MIN_TANGENT_SPEED)
+            && (self.min_speed.is_nan() || self.min_speed < Self::MIN_TANGENT_SPEED)
         {
             return Err(TrajectoryError::TooSlowForTangent {
-                min_speed: t.min_speed,
+                min_speed: self.min_speed,
                 threshold: Self::MIN_TANGENT_SPEED,
             });
         }
-        Ok(t)
+        Ok(())
     }
 
-    /// Precomputes the constants of an already validated mission.
-    fn build(mission: Mission) -> Self {
+    /// Back to [`Trajectory::EMPTY`], every field.
+    fn make_inert(&mut self) {
+        // All zero bits (see `EMPTY`): a memset, not a copy of a constant from flash.
+        *self = Self::EMPTY;
+    }
+
+    /// Precomputes the constants of an already validated mission into `self`, whose route and
+    /// time law are already built (empty for the closed forms).
+    fn precompute(&mut self, mission: &Mission) {
         let k = mission.time_scale as f64;
         let (omega, rate) = paths::rates(&mission.path);
         // η_d(t/k): every frequency and every linear rate over k (exact for k = 1).
         let omega_f64 = omega as f64 / k;
         let rate_f64 = rate as f64 / k;
         let omega = omega_f64 as f32;
-        let position_rate = paths::position_rate(&mission.path, rate_f64);
-        let half = paths::half_frequency(&mission.path, omega_f64);
-        let psi = match paths::heading_series(&mission.path) {
+        self.mission = *mission;
+        self.omega = omega;
+        self.theta = Frequency::from_rad_per_s(omega_f64);
+        self.half = paths::half_frequency(&mission.path, omega_f64);
+        self.rate = rate_f64 as f32;
+        self.position_rate = paths::position_rate(&mission.path, rate_f64);
+        self.psi = match paths::heading_series(&mission.path) {
             Some(series) => series_coefficients(series, omega),
             None => [[0.0; 3]; ODD_TERMS],
         };
-        let (route, law) = paths::time_law::route_and_law(&mission.path);
-        let mut t = Self {
-            route,
-            law,
-            mission,
-            omega,
-            theta: Frequency::from_rad_per_s(omega_f64),
-            half,
-            rate: rate_f64 as f32,
-            position_rate,
-            psi,
-            accel_bound: 0.0,
-            min_speed: 0.0,
-        };
-        t.min_speed = paths::min_speed(&t);
+        self.accel_bound = 0.0;
         // Assumption 1 (Eq 19): per component Σ |amplitude|·frequency² over its harmonics
         // (|sin|, |cos| ≤ 1), then the Euclidean norm over the components. Linear-in-t terms
         // (lawn-mower 0.25 s t, helix z) and the circle's ψ = ωt have no acceleration.
         if let TrajectoryKind::Waypoints { .. } = mission.path {
-            if t.law.is_set() {
+            if self.law.is_set() {
                 // The time law's σ̇ is over k: its derivatives are evaluated per unit time.
-                t.rate = (1.0 / k) as f32;
-                t.position_rate = LinearRate::new(1.0 / k);
+                self.rate = (1.0 / k) as f32;
+                self.position_rate = LinearRate::new(1.0 / k);
             }
             let (min_speed, accel) = paths::time_law::speed_and_accel_bound(
-                &t.route,
-                &t.law,
-                t.rate,
+                &self.route,
+                &self.law,
+                self.rate,
                 heading::TANGENT_BOUND_MARGIN,
             );
-            t.min_speed = min_speed;
-            t.accel_bound = sqrt_upper(accel);
-            return t;
+            self.min_speed = min_speed;
+            self.accel_bound = sqrt_upper(accel);
+            return;
         }
+        self.min_speed = paths::min_speed(self);
         let heading_bound = match mission.heading {
             HeadingMode::Paper => {
                 let mut series_bound = 0.0f32;
-                for c in &psi {
+                for c in &self.psi {
                     series_bound += libm::fabsf(c[2]);
                 }
                 series_bound
             }
-            HeadingMode::Tangent => t.tangent_accel_bound(),
+            HeadingMode::Tangent => self.tangent_accel_bound(),
         };
         let (x, y) = paths::accel(&mission.path, omega);
-        t.accel_bound = sqrt_upper(x * x + y * y + heading_bound * heading_bound);
-        t
+        self.accel_bound = sqrt_upper(x * x + y * y + heading_bound * heading_bound);
     }
 
     /// Circle of radius `radius` with the paper's ω = 0.1 rad/s and depth 5 m.
@@ -290,7 +335,9 @@ impl Trajectory {
 
     /// One of the paper's Table-1 missions (always valid, so no `Result`).
     pub fn table1(case: Table1Case) -> Self {
-        Self::build(Mission::paper(case.kind()))
+        let mut t = Self::EMPTY;
+        t.precompute(&Mission::paper(case.kind()));
+        t
     }
 
     /// The mission's path: its shape and parameters.

@@ -63,8 +63,8 @@ use auv_link::sign::{
 };
 use auv_link::{
     decode_frame, decode_frame_signed, encode, encode_signed, BoardStatus, Command, ConfigPatch,
-    Envelope, FailSafeReason, Heading, MissionPlan, MissionSpec, Msg, StateFrame, Telemetry,
-    ThrustUnit, DEFAULT_STALE_PERIODS, MAX_FRAME,
+    Envelope, FailSafeReason, Heading, MissionPlan, MissionSpec, MissionUpload, Msg, StateFrame,
+    Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, DEFAULT_STALE_PERIODS, MAX_FRAME,
 };
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Table1Case, Trajectory};
@@ -82,12 +82,14 @@ pub const OP_PERIODS: u8 = 7;
 /// Number of ops (`op byte % OPS`).
 pub const OPS: u8 = 8;
 
-/// Command kinds (the byte after `OP_COMMAND`, `% 5`).
+/// Command kinds (the byte after `OP_COMMAND`, `% 6`).
 pub const CMD_ARM: u8 = 0;
 pub const CMD_DISARM: u8 = 1;
 pub const CMD_START: u8 = 2;
 pub const CMD_STOP: u8 = 3;
 pub const CMD_CONFIG: u8 = 4;
+/// A part of a mission upload: of a valid three-point mission, or from fuzz bytes.
+pub const CMD_UPLOAD: u8 = 5;
 
 /// How a frame is signed (the signing byte, `% 5`).
 pub const SIGN_AS_EXPECTED: u8 = 0;
@@ -409,6 +411,12 @@ fn mission(input: &mut Bytes) -> MissionPlan {
 
 fn path(input: &mut Bytes) -> MissionSpec {
     let kind = input.u8();
+    if kind & 0x90 == 0x10 {
+        // The uploaded mission, by its CRC (the board flies it only if it holds it verified).
+        return MissionSpec::Waypoints {
+            crc: three_points().crc(),
+        };
+    }
     if kind & 0x80 == 0 {
         return MissionSpec::Circle {
             radius: 10.0,
@@ -477,12 +485,64 @@ fn patch(input: &mut Bytes) -> ConfigPatch {
 }
 
 fn command(input: &mut Bytes) -> Command {
-    match input.u8() % 5 {
+    match input.u8() % 6 {
         CMD_ARM => Command::Arm,
         CMD_DISARM => Command::Disarm,
         CMD_START => Command::StartMission(mission(input)),
         CMD_STOP => Command::StopMission,
+        CMD_UPLOAD => Command::Upload(upload(input)),
         _ => Command::SetConfig(patch(input)),
+    }
+}
+
+/// The valid upload the harness sends most: a three-point waypoint mission (one chunk).
+pub fn three_points() -> MissionUpload {
+    let points = controller_core::trajectory::WaypointList::new(&[
+        [0.0, 10.0, 5.0],
+        [60.0, 10.0, 5.0],
+        [60.0, 60.0, 5.0],
+    ])
+    .expect("3 points");
+    MissionUpload::of(&controller_core::Mission::paper(
+        controller_core::TrajectoryKind::Waypoints {
+            points,
+            speed: 0.5,
+            turn_radius: None,
+            speeds: None,
+            speed_change: None,
+        },
+    ))
+    .expect("a waypoint path")
+}
+
+/// An upload part: the valid mission's `Begin` or chunk, or a header or chunk of fuzz bytes.
+fn upload(input: &mut Bytes) -> UploadPart {
+    let up = three_points();
+    match input.u8() % 4 {
+        0 => UploadPart::Begin(up.header()),
+        1 => UploadPart::Chunk(up.chunk(input.u8() % 2)),
+        2 => UploadPart::Begin(UploadHeader {
+            points: input.u8(),
+            speeds: (input.u8() & 1 == 1).then(|| input.u8()),
+            speed: input.f32(),
+            turn_radius: (input.u8() & 1 == 1).then(|| input.f32()),
+            speed_change: (input.u8() & 1 == 1).then(|| input.f32()),
+            heading: if input.u8() & 1 == 1 {
+                Heading::Tangent
+            } else {
+                Heading::Paper
+            },
+            time_scale: input.f32(),
+            crc: input.u32(),
+        }),
+        _ => {
+            let index = input.u8();
+            let mut words = [0.0; auv_link::upload::CHUNK_WORDS];
+            for w in words.iter_mut().take(4) {
+                *w = input.f32();
+            }
+            UploadPart::Chunk(UploadChunk { index, words })
+        }
     }
 }
 
@@ -779,6 +839,9 @@ impl Harness {
                         m.periods_since_state = None;
                     }
                 }
+            }
+            Command::Upload(_) => {
+                assert!(refused || !m.armed, "an upload part accepted armed");
             }
             Command::SetConfig(p) => {
                 if !refused {

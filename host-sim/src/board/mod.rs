@@ -15,13 +15,15 @@
 //! | [`image`] | which firmware ELF may fly (its image marker), and where the build leaves it |
 //! | [`frames`] | the navigation computer's side of the wire: state frames, signing time |
 //! | [`stats`], [`comparison`] | a run's link and board figures; the board run against SIL |
+//! | [`upload`] | a waypoint mission's chunked upload before `Arm`, resent until verified |
 //!
 //! Set-up: the runner waits for the board's first telemetry and numbers its own frames from the
 //! board's `last_rx_seq` on (a restarted runner is heard again: `auv_link::seq`), then sends
 //! `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods, thrust unit,
 //! thruster mounting, axis priority }` from the scenario's validated controller and `Arm`,
 //! and waits for the board to report itself armed with that thrust unit and mounting (a
-//! refused command is reported with the board's reason); then `StartMission` with the
+//! refused command is reported with the board's reason; a waypoint mission is uploaded
+//! between the `SetConfig` and the `Arm`, [`upload`]); then `StartMission` with the
 //! scenario's validated mission (path, heading, time scale) and the first state frame. Every
 //! telemetry frame must name the thrust unit the plant reads the voltages in, or the run
 //! stops (docs/design.md §9). In lock-step the board runs
@@ -64,8 +66,10 @@ pub mod runner;
 mod send;
 pub mod stats;
 pub mod transport;
+pub mod upload;
 
 pub use comparison::{BoardComparison, Mode, PIL_SIL_TOLERANCE};
 pub use pacing::{Pacing, RealTimeStats};
 pub use runner::BoardInTheLoop;
 pub use stats::{BoardStats, FailSafeEvent, FailSafeEventKind};
+pub use upload::UploadStats;

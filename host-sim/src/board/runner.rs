@@ -11,8 +11,8 @@ use std::time::{Duration, Instant};
 use auv_link::seq::SeqCheck;
 use auv_link::sign::{Direction, LinkKey, Signer, Verifier};
 use auv_link::{
-    BoardStatus, Command as LinkCommand, ConfigPatch, FrameDecoder, MissionPlan, Msg, StateFrame,
-    Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
+    BoardStatus, Command as LinkCommand, ConfigPatch, FrameDecoder, MissionPlan, MissionUpload,
+    Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
 };
 use controller_core::ControllerConfig;
 
@@ -191,10 +191,11 @@ impl BoardInTheLoop {
         let mounting = c.geometry.auv150_reversed().ok_or_else(|| {
             "the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly".to_string()
         })?;
-        let mission =
-            MissionPlan::try_from(scenario.trajectory().mission()).map_err(|e| e.to_string())?;
+        let mission = MissionPlan::from(scenario.trajectory().mission());
+        let upload = MissionUpload::of(&scenario.trajectory().mission());
+        let lose = faults.lose_upload_chunks.clone();
         let mut b = Self::new(wire, scenario, faults, pacing, reply_timeout, key, mission);
-        let (arm_seq, refused_before) = b.configure(c, mounting)?;
+        let (arm_seq, refused_before) = b.configure(c, mounting, upload.as_ref(), &lose)?;
         b.wait_armed(arm_seq, refused_before, mounting)?;
         if b.rt.is_some() {
             b.find_phase()?;
@@ -258,7 +259,13 @@ impl BoardInTheLoop {
     ///
     /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
     /// from a run before, and refuses a configuration while armed).
-    fn configure(&mut self, c: &ControllerConfig, mounting: u8) -> Result<(u16, u32), String> {
+    fn configure(
+        &mut self,
+        c: &ControllerConfig,
+        mounting: u8,
+        upload: Option<&MissionUpload>,
+        lose: &[u8],
+    ) -> Result<(u16, u32), String> {
         // Continue the board's numbering: a board that already heard a runner (this one
         // restarted) drops frames numbered at or before its last (auv_link::seq).
         let first = self.next_telemetry()?;
@@ -280,9 +287,24 @@ impl BoardInTheLoop {
             reversed_thrusters: Some(mounting),
             priority: Some(c.priority.into()),
         })))?;
+        // A waypoint mission travels as an upload, taken only while disarmed (upload.rs),
+        // once the board has taken the configuration (its refusals are the set-up's, those
+        // of a lossy upload the upload's own).
+        let mut refused = first.refused_commands;
+        if let Some(up) = upload {
+            let config_seq = self.seq.wrapping_sub(1);
+            let t = self.acknowledged(config_seq)?;
+            if t.refused_commands > refused {
+                return Err(format!(
+                    "the board refused the set-up: {}",
+                    t.last_refusal.map_or("(no reason)", |r| r.as_str())
+                ));
+            }
+            refused = self.upload(up, lose)?;
+        }
         let arm_seq = self.seq;
         self.send(Msg::Command(LinkCommand::Arm))?;
-        Ok((arm_seq, first.refused_commands))
+        Ok((arm_seq, refused))
     }
 
     /// Waits until the board reports itself armed with the scenario's mounting and unit.

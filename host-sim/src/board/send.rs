@@ -18,7 +18,7 @@ impl BoardInTheLoop {
         self.write(&buf[..n])
     }
 
-    fn encode(&mut self, msg: Msg, buf: &mut [u8; MAX_FRAME]) -> Result<usize, String> {
+    pub(super) fn encode(&mut self, msg: Msg, buf: &mut [u8; MAX_FRAME]) -> Result<usize, String> {
         let env = Envelope {
             version: PROTOCOL_VERSION,
             seq: self.seq,
@@ -35,7 +35,7 @@ impl BoardInTheLoop {
         .map_err(|e| format!("encoding: {e}"))
     }
 
-    fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
+    pub(super) fn write(&mut self, bytes: &[u8]) -> Result<(), String> {
         self.stream
             .write_frame(bytes)
             .map_err(|e| self.lost(&e, "write"))

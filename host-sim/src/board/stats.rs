@@ -43,6 +43,9 @@ pub struct BoardStats {
     pub board_loop_overruns: u32,
     pub rearms: u32,
     pub failsafe_events: Vec<FailSafeEvent>,
+    /// The waypoint mission's upload, if it had one.
+    #[serde(default)]
+    pub upload: Option<super::upload::UploadStats>,
     /// The link was signed (both ends).
     #[serde(default)]
     pub signed: bool,

@@ -51,6 +51,10 @@ pub struct LoopArgs {
     /// Send nothing at all during these ticks.
     #[arg(long, value_parser = TickRange::parse)]
     pub silent: Vec<TickRange>,
+    /// Lose this chunk of a waypoint mission's upload on its first sending (the runner resends
+    /// it when the board's acknowledgement shows it missing); repeatable.
+    #[arg(long)]
+    pub lose_upload_chunk: Vec<u8>,
     /// Run beyond the step cap (see `run --help`).
     #[arg(long)]
     pub allow_long_run: bool,
@@ -84,6 +88,8 @@ pub(super) fn loop_scenarios(args: &LoopArgs) -> Result<Vec<Scenario>> {
             f.corrupt.extend(args.corrupt.iter().copied());
             f.delay.extend(args.delay.iter().copied());
             f.silent.extend(args.silent.iter().copied());
+            f.lose_upload_chunks
+                .extend(args.lose_upload_chunk.iter().copied());
             if !args.delay.is_empty() {
                 f.delay_ticks = args.delay_ticks;
             }

@@ -6,6 +6,7 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Result};
 use clap::Args;
 use controller_core::readable::Readable;
+use serde::Serialize;
 
 use super::common::load;
 use super::json::print_json;
@@ -18,7 +19,8 @@ use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 pub struct CheckArgs {
     #[arg(long)]
     pub scenario: PathBuf,
-    /// Print one JSON object (the check's [`Preflight`]) instead of the text.
+    /// Print one JSON object (the check's [`Preflight`], and a waypoint mission's proposed
+    /// speed profile under `speed_profile`) instead of the text.
     #[arg(long)]
     pub json: bool,
     /// Fraction of each thruster's envelope the reference may use, in (0, 1]; the rest is left
@@ -44,27 +46,47 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
         }
         Err(e) => return Err(anyhow!(e)),
     };
-    if args.json {
-        print_json(stdout, &p)?;
-    } else {
+    if !args.json {
+        // The verdict first: the profile's search takes a while.
         writeln!(stdout, "{p}")?;
         writeln!(stdout, "{}", preflight_table(&p))?;
-        // A waypoint mission: the fastest speed profile (docs/design.md §27).
-        match profile::propose(&scenario, args.margin) {
-            Ok(Some(s)) => writeln!(stdout, "{}", profile_table(&s))?,
-            Ok(None) => {}
-            Err(CheckError::Interrupted) => {
-                eprintln!("host-sim: check: interrupted before the speed profile");
-                return Ok(Exit::Interrupted);
-            }
-            Err(e) => return Err(anyhow!(e)),
+    }
+    // A waypoint mission: the fastest speed profile (docs/design.md §27).
+    let speed_profile = match profile::propose(&scenario, args.margin) {
+        Ok(s) => s,
+        Err(CheckError::Interrupted) => {
+            eprintln!("host-sim: check: interrupted before the speed profile");
+            return Ok(Exit::Interrupted);
         }
+        Err(e) => return Err(anyhow!(e)),
+    };
+    match (args.json, speed_profile) {
+        (true, speed_profile) => print_json(
+            stdout,
+            &CheckJson {
+                preflight: &p,
+                speed_profile,
+            },
+        )?,
+        (false, Some(s)) => writeln!(stdout, "{}", profile_table(&s))?,
+        (false, None) => {}
     }
     Ok(if p.feasible() {
         Exit::Success
     } else {
         Exit::Infeasible
     })
+}
+
+/// What `check --json` prints: the check's [`Preflight`] (its keys at the top level) and, for a
+/// waypoint mission, the proposed [`SpeedProfile`] under `speed_profile` (docs/design.md §27,
+/// Choice 172).
+#[derive(Serialize)]
+struct CheckJson<'a> {
+    #[serde(flatten)]
+    preflight: &'a Preflight,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    speed_profile: Option<SpeedProfile>,
 }
 
 /// The per-thruster part of `check`'s text.
@@ -104,12 +126,12 @@ fn preflight_table(p: &Preflight) -> String {
 }
 
 /// The speed profile's part of `check`'s text: time per part, the limiting thruster (or `cap`,
-/// `trajectory.speed_limits`), the totals
+/// `trajectory.speed_limits`, or `changes`: too short for the speed changes), the totals
 /// against the uniform time scale, and the keys that pin it.
 fn profile_table(p: &SpeedProfile) -> String {
     let mut s = format!(
         "speed profile over the whole box (margin envelope, speed changes at {} m/s²):\n\
-         {:<12} {:>10} {:>12} {:>10}  limited by (thruster or cap)\n",
+         {:<12} {:>10} {:>12} {:>10}  limited by (thruster, cap or changes)\n",
         Readable(p.speed_change),
         "part",
         "length (m)",

@@ -11,9 +11,8 @@ use super::common::{
 };
 use super::Exit;
 use crate::interrupt;
-use crate::output::speed_plot::{plot_speed_profile, speed_plot_name};
+use crate::output::waypoint_plot::mission_plots;
 use crate::output::{self, sections, OutputDir, ReportRow};
-use crate::scenario::Scenario;
 use crate::sim::progress::Progress;
 
 /// `run`: one scenario from a TOML file (and its companion without Δu, for comparison).
@@ -71,13 +70,18 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
     progress.finish();
     let rows = [ReportRow::new(&with, without.as_ref())];
     let mut incomplete = incomplete.into_inner();
-    speed_plot(&dir, &scenario, &mut incomplete)?;
-    let report = output::write_plots_and_report(
+    // A waypoint mission's path over its waypoints and speed over time (docs/design.md §27).
+    let extra: Vec<(String, PathBuf)> = mission_plots(&dir, &scenario, &with, &mut incomplete)?
+        .into_iter()
+        .map(|f| (with.name.clone(), f))
+        .collect();
+    let report = output::write_plots_and_report_with(
         &dir,
         &title,
         &rows,
         &sections::preflight(&checks, std::iter::once(&with).chain(&without)),
         &[],
+        &extra,
         "",
         f64::from(cfg.controller.voltage_limit),
         &mut incomplete,
@@ -98,16 +102,4 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .with_context(|| format!("cannot write {}", file.display()))?;
     }
     print_runs(stdout, args.json, &rows, &checks, &report, incomplete)
-}
-
-/// A waypoint mission's speed profile over time (docs/design.md §27, Choice 162), claimed in
-/// the manifest first; a plot that cannot be drawn is listed in `incomplete`.
-fn speed_plot(dir: &OutputDir, scenario: &Scenario, incomplete: &mut Vec<String>) -> Result<()> {
-    if let Some(name) = speed_plot_name(scenario) {
-        dir.claim(&name)?;
-        if let Err(e) = plot_speed_profile(dir.path(), scenario) {
-            incomplete.push(format!("speed plot of {}: {e:#}", scenario.config().name));
-        }
-    }
-    Ok(())
 }

@@ -14,6 +14,7 @@ use super::common::{
 };
 use super::json::{print_json, Cases};
 use super::Exit;
+use crate::output::waypoint_plot::mission_plots;
 use crate::output::{self, sections, OutputDir, RealRow, ReportRow};
 use crate::scenario::real_vehicle;
 use crate::scenario::Scenario;
@@ -118,16 +119,13 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         real_runs.iter().chain(chain_runs),
         contract.as_ref().map(|(_, v)| v),
     );
-    let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
     let mut incomplete = incomplete.into_inner();
-    let report = output::write_plots_and_report(
+    let report = write_report(
         &dir,
         title,
         &rows,
         &sections,
-        &real_plots,
-        &paper_table1::notes(),
-        f64::from(DEFAULT_V_LIMIT),
+        (&real_jobs, real_runs),
         &mut incomplete,
     )?;
     report_incomplete(&incomplete);
@@ -158,6 +156,36 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         )?;
     }
     Ok(exit)
+}
+
+/// The plots of every run (the paper's rows, then the real missions without a companion), the
+/// waypoint missions' path over the waypoints and speed over time after their own
+/// (docs/design.md §27, Choice 173), and `report.md`; returns its path.
+fn write_report(
+    dir: &OutputDir,
+    title: &str,
+    rows: &[ReportRow],
+    sections: &str,
+    (real_jobs, real_runs): (&[Scenario], &[RunResult]),
+    incomplete: &mut Vec<String>,
+) -> Result<PathBuf> {
+    let real_plots: Vec<ReportRow> = real_runs.iter().map(|r| ReportRow::new(r, None)).collect();
+    let mut extra = Vec::new();
+    for (scenario, run) in real_jobs.iter().zip(real_runs) {
+        let files = mission_plots(dir, scenario, run, incomplete)?;
+        extra.extend(files.into_iter().map(|f| (run.name.clone(), f)));
+    }
+    output::write_plots_and_report_with(
+        dir,
+        title,
+        rows,
+        sections,
+        &real_plots,
+        &extra,
+        &paper_table1::notes(),
+        f64::from(DEFAULT_V_LIMIT),
+        incomplete,
+    )
 }
 
 /// The report's sections after the paper's table: the real vehicle's table, the preflight

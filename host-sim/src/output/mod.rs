@@ -23,6 +23,7 @@ mod plot;
 pub mod report;
 pub mod sections;
 pub mod speed_plot;
+pub mod waypoint_plot;
 
 pub use self::csv::{partial_name, write_csv, CsvStream, CSV_COLUMNS};
 pub use self::dir::OutputDir;
@@ -54,6 +55,34 @@ pub fn write_plots_and_report(
     voltage_limit: f64,
     incomplete: &mut Vec<String>,
 ) -> Result<PathBuf> {
+    write_plots_and_report_with(
+        dir,
+        title,
+        rows,
+        sections,
+        extra_plots,
+        &[],
+        notes,
+        voltage_limit,
+        incomplete,
+    )
+}
+
+/// [`write_plots_and_report`] with plots already written for some runs (`mission_plots`: the
+/// run's name and the file, e.g. a waypoint mission's path and speed plots,
+/// [`waypoint_plot::mission_plots`]), each linked in the report after its run's five plots.
+#[allow(clippy::too_many_arguments)]
+pub fn write_plots_and_report_with(
+    dir: &OutputDir,
+    title: &str,
+    rows: &[ReportRow],
+    sections: &str,
+    extra_plots: &[ReportRow],
+    mission_plots: &[(String, PathBuf)],
+    notes: &str,
+    voltage_limit: f64,
+    incomplete: &mut Vec<String>,
+) -> Result<PathBuf> {
     let mut plots = Vec::new();
     for row in rows.iter().chain(extra_plots) {
         let written = plot_names(&row.with.name)
@@ -64,6 +93,12 @@ pub fn write_plots_and_report(
             Ok(files) => plots.extend(files),
             Err(e) => incomplete.push(format!("plots of {}: {e:#}", row.with.name)),
         }
+        plots.extend(
+            mission_plots
+                .iter()
+                .filter(|(run, _)| *run == row.with.name)
+                .map(|(_, file)| file.clone()),
+        );
     }
     let path = dir.claim("report.md")?;
     let text = report_markdown(dir.path(), title, rows, sections, &plots, notes, incomplete);

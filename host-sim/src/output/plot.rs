@@ -87,6 +87,8 @@ pub(super) struct Panel {
     pub x_range: Option<(f64, f64)>,
     /// Same metres per pixel on both axes.
     pub equal_aspect: bool,
+    /// Text written beside points of the data (a waypoint's number): (x, y, text).
+    pub labels: Vec<(f64, f64, String)>,
 }
 
 impl Panel {
@@ -98,6 +100,7 @@ impl Panel {
             lines: Vec::new(),
             x_range: None,
             equal_aspect: false,
+            labels: Vec::new(),
         }
     }
 }
@@ -233,6 +236,19 @@ fn draw_panel(area: &DrawingArea<BitMapBackend, Shift>, panel: &Panel) -> Result
     for line in &panel.lines {
         draw_line(&mut chart, line)?;
     }
+    let font = TextStyle::from((FONT, 17).into_font()).color(&C_DESIRED);
+    chart
+        .draw_series(
+            panel
+                .labels
+                .iter()
+                .filter(|(x, y, _)| usable(*x) && usable(*y))
+                .map(|(x, y, text)| {
+                    // Up and right of the point, clear of a marker drawn on it.
+                    EmptyElement::at((*x, *y)) + Text::new(text.clone(), (7, -20), font.clone())
+                }),
+        )
+        .map_err(plot_err)?;
     Ok(())
 }
 
@@ -482,5 +498,57 @@ pub(super) fn panel_with_legend(path: &Path, title: &str, panel: &Panel) -> Resu
         let area = root.titled(title, (FONT, 24)).map_err(plot_err)?;
         let area = legend_strip(&area, &[panel])?;
         draw_panel(&area, panel)
+    })
+}
+
+/// One row of [`rows_with_legend`]: its share of the height, and its panels left to right,
+/// each with its share of the width.
+pub(super) struct Row<'p> {
+    pub share: f64,
+    pub cells: Vec<(f64, &'p Panel)>,
+}
+
+/// Splits `area` into parts of `shares` (their sum is the whole), along x (`across`) or y.
+fn split_shares<'b>(
+    area: &DrawingArea<BitMapBackend<'b>, Shift>,
+    shares: &[f64],
+    across: bool,
+) -> Vec<DrawingArea<BitMapBackend<'b>, Shift>> {
+    let (w, h) = area.dim_in_pixel();
+    let size = f64::from(if across { w } else { h });
+    let total: f64 = shares.iter().sum();
+    let mut at = 0.0;
+    let cuts: Vec<i32> = shares
+        .iter()
+        .take(shares.len().saturating_sub(1))
+        .map(|s| {
+            at += s / total;
+            (size * at).round() as i32
+        })
+        .collect();
+    match across {
+        true => area.split_by_breakpoints(&cuts, &[] as &[i32]),
+        false => area.split_by_breakpoints(&[] as &[i32], &cuts),
+    }
+}
+
+/// A 1200×900 PNG at `path` of panels in `rows` (top to bottom, each split left to right)
+/// under `title`, with one legend for all of them (no run subtitle: a plot of a mission).
+pub(super) fn rows_with_legend(path: &Path, title: &str, rows: &[Row]) -> Result<()> {
+    render(path, |root| {
+        let area = root.titled(title, (FONT, 24)).map_err(plot_err)?;
+        let refs: Vec<&Panel> = rows
+            .iter()
+            .flat_map(|r| r.cells.iter().map(|c| c.1))
+            .collect();
+        let area = legend_strip(&area, &refs)?;
+        let heights: Vec<f64> = rows.iter().map(|r| r.share).collect();
+        for (row, strip) in rows.iter().zip(split_shares(&area, &heights, false)) {
+            let widths: Vec<f64> = row.cells.iter().map(|c| c.0).collect();
+            for ((_, panel), cell) in row.cells.iter().zip(split_shares(&strip, &widths, true)) {
+                draw_panel(&cell, panel)?;
+            }
+        }
+        Ok(())
     })
 }

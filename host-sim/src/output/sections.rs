@@ -17,8 +17,9 @@ the course, the Table-3 payload trimmed to neutral buoyancy, Eqs 31–32 in kgf,
 actuator chain (the board's voltages, clamped at ±24 V, turned back into thrust by Eqs 31–32),
 each at the time scale the preflight check proposes; then missions planned as waypoints, on
 the speed profile the check proposes (docs/design.md §27): `survey-200x100`, a 200 m × 100 m
-lawn-mower at 5 m depth, and `harbour-wall`, a descending inspection imported from a
-QGroundControl plan. Below them, the
+lawn-mower at 5 m depth, `harbour-wall`, a descending inspection, and `pipeline`, a pipeline
+route descending from 4 m to 10 m, both imported from QGroundControl plans; each with its path
+over the waypoints and its speed over time among the plots. Below them, the
 paper's own six missions
 (its headings, untrimmed payload, time scale 1) through the same real chain: what the preflight
 calls infeasible, flown anyway.
@@ -104,6 +105,28 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
                 None => "—".to_string(),
             },
         );
+    }
+    let uploads: Vec<_> = cases
+        .iter()
+        .filter_map(|c| c.pil.upload.as_ref().map(|u| (c, u)))
+        .collect();
+    if !uploads.is_empty() {
+        notes += "\n### Mission uploads (docs/design.md §27)\n\n";
+        for (c, u) in uploads {
+            notes += &format!(
+                "- {}: CRC {:#010x}, {} chunks in {} frames, {} bytes on the wire ({:.1} ms at \
+                 460 800 baud), verified after {} round(s), {} chunk(s) resent, {:.3} s\n",
+                c.run.name,
+                u.crc,
+                u.chunks,
+                u.frames,
+                u.bytes,
+                u.bytes as f64 * 10.0 / 460_800.0 * 1e3,
+                u.rounds,
+                u.resent,
+                u.seconds
+            );
+        }
     }
     let realtime: Vec<_> = cases
         .iter()

@@ -103,6 +103,9 @@ pub struct LinkFaults {
     pub delay_ticks: u64,
     /// Nothing is sent at all (no state, no commands).
     pub silent: Vec<TickRange>,
+    /// Chunks of a waypoint mission's upload whose first sending is lost (the runner must
+    /// resend them on the board's acknowledgement; no fail-safe follows).
+    pub lose_upload_chunks: Vec<u8>,
 }
 
 impl Default for LinkFaults {
@@ -114,6 +117,7 @@ impl Default for LinkFaults {
             delay: Vec::new(),
             delay_ticks: Self::DEFAULT_DELAY_TICKS,
             silent: Vec::new(),
+            lose_upload_chunks: Vec::new(),
         }
     }
 }

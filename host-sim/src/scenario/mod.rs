@@ -135,6 +135,7 @@
 //! delay = ["200..210"]        # the state from delay_ticks earlier is sent instead
 //! delay_ticks = 5             # default 5
 //! silent = ["300..310"]       # nothing sent at all
+//! lose_upload_chunks = [1]    # a waypoint mission's upload chunks lost on their first sending
 //! ```
 //!
 //! **Arrays** have exactly the length shown (`k1` six numbers, `q` two, `velocity` three…):

@@ -110,6 +110,7 @@ struct RawLinkFaults {
     delay: Option<Vec<String>>,
     delay_ticks: Option<u64>,
     silent: Option<Vec<String>>,
+    lose_upload_chunks: Option<Vec<u8>>,
 }
 
 #[derive(Clone, Copy, Deserialize)]
@@ -436,6 +437,7 @@ fn build_link_faults(raw: &RawLinkFaults) -> Res<LinkFaults> {
         delay: ranges("delay", &raw.delay)?,
         delay_ticks: raw.delay_ticks.unwrap_or(LinkFaults::DEFAULT_DELAY_TICKS),
         silent: ranges("silent", &raw.silent)?,
+        lose_upload_chunks: raw.lose_upload_chunks.clone().unwrap_or_default(),
     })
 }
 

@@ -41,7 +41,7 @@ pub const REAL_SCENARIOS: [(&str, &str); 6] = [
 
 /// The real vehicle's waypoint missions (docs/design.md §27), flown in the same table after
 /// [`REAL_SCENARIOS`]: (file name, its text).
-pub const WAYPOINT_SCENARIOS: [(&str, &str); 2] = [
+pub const WAYPOINT_SCENARIOS: [(&str, &str); 3] = [
     (
         "survey-200x100.toml",
         include_str!("../../scenarios/real/survey-200x100.toml"),
@@ -49,6 +49,10 @@ pub const WAYPOINT_SCENARIOS: [(&str, &str); 2] = [
     (
         "harbour-wall.toml",
         include_str!("../../scenarios/real/harbour-wall.toml"),
+    ),
+    (
+        "pipeline.toml",
+        include_str!("../../scenarios/real/pipeline.toml"),
     ),
 ];
 

@@ -256,8 +256,10 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         thrust_unit,
         reversed_thrusters,
         rx_ahead,
+        upload,
     } = a;
-    *thrust_unit == b.thrust_unit
+    *upload == b.upload
+        && *thrust_unit == b.thrust_unit
         && *rx_ahead == b.rx_ahead
         && *reversed_thrusters == b.reversed_thrusters
         && *tick == b.tick

@@ -1,6 +1,8 @@
 //! Processor in the loop: the QEMU flying image flies the simulated vehicle through
-//! `host-sim pil`. Five checks: a short lawn-mower mission must equal SIL bit for bit, on an
-//! unsigned and on a signed link (the public CI test key, [`CI_TEST_KEY`]); a short real-chain
+//! `host-sim pil`. Six checks: a short lawn-mower mission must equal SIL bit for bit, on an
+//! unsigned and on a signed link (the public CI test key, [`CI_TEST_KEY`]); a waypoint mission
+//! uploaded over a link that loses one chunk ([`WAYPOINTS`]) must equal SIL bit for bit with
+//! the chunk resent once; a short real-chain
 //! mission (kgf, tangent heading, time scale > 1, the real actuator chain, the real vehicle's
 //! mounting: [`REAL_CHAIN`]) must equal SIL bit for bit with the board reporting the
 //! scenario's thrust unit and mounting; a link-fault case must enter and leave fail-safe
@@ -29,6 +31,14 @@ pub const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
 const REAL_CHAIN: &str = "host-sim/scenarios/real/figure-eight-30x30.toml";
 /// Seconds of the real-chain mission: 300 periods, a few seconds of QEMU.
 const REAL_CHAIN_SECONDS: &str = "3";
+
+/// The waypoint mission PIL flies (workspace-relative, docs/design.md §27): uploaded in two
+/// chunks, the second lost on its first sending ([`WAYPOINTS_LOST_CHUNK`]), so the board's
+/// acknowledgement and the runner's resend are on the path; flown for its whole scenario
+/// duration (a leg, a speed change, a turn and the next leg).
+const WAYPOINTS: &str = "host-sim/scenarios/waypoints-short.toml";
+/// The chunk of [`WAYPOINTS`]'s upload lost on its first sending.
+const WAYPOINTS_LOST_CHUNK: &str = "1";
 
 /// The link-fault case's silent ticks [from, to) and delayed ticks (see [`link_faults`]).
 const SILENT: (u64, u64) = (300, 310);
@@ -138,10 +148,17 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
     let signed = [&short[..3], &["5", "--link-key-file", &key]].concat();
     let real = ["--scenario", REAL_CHAIN, "--duration", REAL_CHAIN_SECONDS];
     let real_chain = real_chain_scenario(ci);
+    let waypoints = [
+        "--scenario",
+        WAYPOINTS,
+        "--lose-upload-chunk",
+        WAYPOINTS_LOST_CHUNK,
+    ];
     for (name, args, want_signed) in [
         ("short", &short[..], false),
         ("short-signed", &signed[..], true),
         ("real-chain", &real[..], false),
+        ("waypoints", &waypoints[..], false),
     ] {
         let want_chain = if name == "real-chain" {
             match &real_chain {
@@ -170,6 +187,30 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
             chain_taken(ci, name, unit, *mounting, &c);
         }
         clean_link(ci, name, want_signed, &c);
+        if name == "waypoints" {
+            upload_resent(ci, name, &c);
+        }
+    }
+}
+
+/// The waypoint mission went up as an upload: its lost chunk was acknowledged as missing and
+/// resent once, in a second round, and nothing else was resent.
+fn upload_resent(ci: &mut Ci, name: &str, c: &BoardComparison) {
+    let Some(u) = &c.pil.upload else {
+        ci.fail(format!(
+            "PIL {name}: the waypoint mission was flown without an upload"
+        ));
+        return;
+    };
+    println!(
+        "{name}: upload CRC {:#010x}, {} chunks, {} frames, {} bytes, {} rounds, {} resent, {:.3} s",
+        u.crc, u.chunks, u.frames, u.bytes, u.rounds, u.resent, u.seconds
+    );
+    if u.chunks < 2 || u.rounds != 2 || u.resent != 1 {
+        ci.fail(format!(
+            "PIL {name}: upload of {} chunks took {} rounds and resent {} chunks; with chunk {WAYPOINTS_LOST_CHUNK} lost once it must take 2 rounds and resend 1",
+            u.chunks, u.rounds, u.resent
+        ));
     }
 }
 

@@ -16,11 +16,17 @@ use crate::phase::{Frequency, LinearRate, MissionTime};
 use crate::trajectory::error::TrajectoryError;
 use crate::trajectory::phases::{Harmonics, Phases, Planar};
 use crate::trajectory::series::Series;
-use crate::trajectory::{Trajectory, TrajectoryKind};
+use crate::trajectory::{Route, TimeLaw, Trajectory, TrajectoryKind};
 
-/// The path's parameters, checked in field order; the error names the field.
-pub(super) fn check(path: &TrajectoryKind) -> Result<(), TrajectoryError> {
-    match *path {
+/// The path's parameters, checked in field order (the error names the field), and the waypoint
+/// path's route and time law built into `route` and `law` in place as they are checked
+/// (Choice 180); for the other kinds both are left empty.
+pub(super) fn build_into(
+    path: &TrajectoryKind,
+    route: &mut Route,
+    law: &mut TimeLaw,
+) -> Result<(), TrajectoryError> {
+    let checked = match *path {
         TrajectoryKind::Circle {
             radius,
             omega,
@@ -43,13 +49,25 @@ pub(super) fn check(path: &TrajectoryKind) -> Result<(), TrajectoryError> {
             depth_rate,
         } => helix::check(radius, omega, depth, depth_rate),
         TrajectoryKind::Waypoints {
-            points,
+            ref points,
             speed,
             turn_radius,
-            speeds,
+            ref speeds,
             speed_change,
-        } => time_law::check(&points, speed, turn_radius, speeds, speed_change),
-    }
+        } => {
+            let path = time_law::Waypoints {
+                points,
+                speed,
+                turn_radius,
+                speeds: speeds.as_ref(),
+                speed_change,
+            };
+            return time_law::build_into(&path, route, law);
+        }
+    };
+    route.clear();
+    law.clear();
+    checked
 }
 
 /// The base frequency ω (rad/s) and the rate of the terms linear in t, before the time scale:
@@ -97,7 +115,7 @@ pub(super) fn heading_series(path: &TrajectoryKind) -> Option<Series> {
 
 /// Σ |amplitude|·frequency² of ẍ_d and of ÿ_d (`omega` = ω/k): the path's part of K_d
 /// (Assumption 1). The terms linear in t have no acceleration. The waypoint path's bound is
-/// its route's ([`waypoints::bounds`], in [`Trajectory`]'s build), not a sum of amplitudes.
+/// its route's ([`waypoints::bounds`], in [`Trajectory`]'s precompute), not a sum of amplitudes.
 pub(super) fn accel(path: &TrajectoryKind, omega: f32) -> (f32, f32) {
     match *path {
         TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => {

@@ -24,7 +24,7 @@ use super::waypoints::{
 use crate::phase::{LinearRate, MissionTime};
 use crate::trajectory::error::{positive, TrajectoryError};
 use crate::trajectory::phases::Planar;
-use crate::trajectory::{Trajectory, TrajectoryKind};
+use crate::trajectory::Trajectory;
 
 /// Parts of a path of [`MAX_WAYPOINTS`] points: its legs and its turns, alternating.
 pub const MAX_PARTS: usize = 2 * MAX_WAYPOINTS - 3;
@@ -114,10 +114,18 @@ impl TimeLaw {
     };
 
     /// The time law of `route` at `speeds` (one per part) with speed changes at `accel`
-    /// (m/s²). Refused, under `speeds`: a count other than the route's parts, a speed outside
-    /// (0, [`MAX_SPEED`]], a part too short for its speed changes; under `speed_change`: an
-    /// `accel` outside (0, [`MAX_SPEED_CHANGE`]].
-    pub fn new(route: &Route, speeds: &SpeedList, accel: f32) -> Result<TimeLaw, TrajectoryError> {
+    /// (m/s²), built into `self` in place (Choice 180: no `TimeLaw` on the stack; every piece
+    /// past the new law's is reset, so the result is the same whatever `self` held; after an
+    /// error `self` has no pieces). Refused, under `speeds`: a count other than the route's
+    /// parts, a speed outside (0, [`MAX_SPEED`]], a part too short for its speed changes; under
+    /// `speed_change`: an `accel` outside (0, [`MAX_SPEED_CHANGE`]].
+    pub fn build_into(
+        &mut self,
+        route: &Route,
+        speeds: &SpeedList,
+        accel: f32,
+    ) -> Result<(), TrajectoryError> {
+        self.clear();
         positive("speed_change", accel, MAX_SPEED_CHANGE)?;
         let n = route.segment_count();
         let parts = if n == 0 {
@@ -135,7 +143,6 @@ impl TimeLaw {
             positive("speeds", v, MAX_SPEED)?;
         }
         let v = |i: usize| speeds.as_slice()[route.segment_part(i)];
-        let mut law = TimeLaw::EMPTY;
         let mut t = 0.0f32;
         for i in 0..n {
             let vi = v(i);
@@ -151,6 +158,7 @@ impl TimeLaw {
                 down.map_or(0.0, |o| change(o).1),
             );
             if d_up + d_down > len {
+                self.clear();
                 return Err(TrajectoryError::SpeedChangeTooLong {
                     part: route.segment_part(i),
                     needs: d_up + d_down,
@@ -160,22 +168,29 @@ impl TimeLaw {
             let mut local = 0.0f32;
             if let Some(o) = up {
                 let (dur, dist) = change(o);
-                law.push(t, i, local, o, vi - o, 1.0 / dur);
+                self.push(t, i, local, o, vi - o, 1.0 / dur);
                 t += dur;
                 local += dist;
             }
             let cruise = len - d_up - d_down;
-            law.push(t, i, local, vi, 0.0, 0.0);
+            self.push(t, i, local, vi, 0.0, 0.0);
             t += cruise / vi;
             local += cruise;
             if let Some(o) = down {
                 let (dur, _) = change(o);
-                law.push(t, i, local, vi, o - vi, 1.0 / dur);
+                self.push(t, i, local, vi, o - vi, 1.0 / dur);
                 t += dur;
             }
         }
-        law.duration = t;
-        Ok(law)
+        self.duration = t;
+        Ok(())
+    }
+
+    /// Back to [`TimeLaw::EMPTY`], in place.
+    pub(crate) fn clear(&mut self) {
+        self.count = 0;
+        self.pieces.fill(NO_PIECE);
+        self.duration = 0.0;
     }
 
     fn push(&mut self, t0: f32, segment: usize, local0: f32, v0: f32, dv: f32, inv_dur: f32) {
@@ -296,47 +311,41 @@ impl TimeLaw {
     }
 }
 
-/// speed in (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then
-/// the points ([`Route::new`]), then the time law if there is one ([`TimeLaw::new`]).
-pub(super) fn check(
-    points: &WaypointList,
-    speed: f32,
-    radius: Option<f32>,
-    speeds: Option<SpeedList>,
-    speed_change: Option<f32>,
+/// Checks a waypoint path's parameters and builds its route and time law in place
+/// (Choice 180: validation is the build, nothing is built twice or on the stack): speed in
+/// (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then the
+/// points ([`Route::build_into`]), then the time law if there is one ([`TimeLaw::build_into`];
+/// else [`TimeLaw::EMPTY`], with `speed_change` still checked if given). After an error the
+/// route and the law are unspecified but safe to sample.
+pub(super) fn build_into(
+    path: &Waypoints,
+    route: &mut Route,
+    law: &mut TimeLaw,
 ) -> Result<(), TrajectoryError> {
-    positive("speed", speed, MAX_SPEED)?;
-    if let Some(r) = radius {
+    positive("speed", path.speed, MAX_SPEED)?;
+    if let Some(r) = path.turn_radius {
         positive("turn_radius", r, Trajectory::MAX_SIZE)?;
     }
-    let route = Route::new(points, turn_radius(speed, radius))?;
-    if let Some(s) = speeds {
-        TimeLaw::new(&route, &s, speed_change.unwrap_or(DEFAULT_SPEED_CHANGE))?;
-    } else if let Some(a) = speed_change {
-        positive("speed_change", a, MAX_SPEED_CHANGE)?;
+    route.build_into(path.points, turn_radius(path.speed, path.turn_radius))?;
+    match path.speeds {
+        Some(s) => law.build_into(route, s, path.speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
+        None => {
+            law.clear();
+            match path.speed_change {
+                Some(a) => positive("speed_change", a, MAX_SPEED_CHANGE),
+                None => Ok(()),
+            }
+        }
     }
-    Ok(())
 }
 
-/// The route and the time law of a validated waypoint path (empty for the other kinds).
-pub(crate) fn route_and_law(path: &TrajectoryKind) -> (Route, TimeLaw) {
-    let TrajectoryKind::Waypoints {
-        points,
-        speed,
-        turn_radius: radius,
-        speeds,
-        speed_change,
-    } = *path
-    else {
-        return (Route::EMPTY, TimeLaw::EMPTY);
-    };
-    let route = Route::new(&points, turn_radius(speed, radius)).unwrap_or(Route::EMPTY);
-    let law = match speeds {
-        Some(s) => TimeLaw::new(&route, &s, speed_change.unwrap_or(DEFAULT_SPEED_CHANGE))
-            .unwrap_or(TimeLaw::EMPTY),
-        None => TimeLaw::EMPTY,
-    };
-    (route, law)
+/// The fields of a [`TrajectoryKind::Waypoints`], borrowed (no copy of its lists).
+pub(super) struct Waypoints<'a> {
+    pub(super) points: &'a WaypointList,
+    pub(super) speed: f32,
+    pub(super) turn_radius: Option<f32>,
+    pub(super) speeds: Option<&'a SpeedList>,
+    pub(super) speed_change: Option<f32>,
 }
 
 /// The smallest horizontal speed and the square of K_d (Assumption 1) of the path flown at

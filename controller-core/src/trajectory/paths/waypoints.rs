@@ -40,16 +40,10 @@ use crate::phase::{LinearRate, MissionTime};
 use crate::trajectory::error::TrajectoryError;
 use crate::trajectory::phases::Planar;
 
-/// Most waypoints in one mission (Choice 152).
-#[cfg(not(target_os = "none"))]
+/// Most waypoints in one mission (Choice 152), on every target: the board builds a
+/// trajectory in place ([`crate::Trajectory::set`], Choice 180), so the capacity costs it the
+/// `Trajectory`'s static size but no stack copies of it.
 pub const MAX_WAYPOINTS: usize = 32;
-/// Most waypoints in one mission on a bare-metal target (the board): 2 until the chunked
-/// mission upload exists (**Choice 160**). The link refuses a waypoint path in one frame
-/// (Choice 155), so the board never builds one; its capacity would only cost every
-/// `Trajectory` 8.6 kB of RAM and the stack that copies them (92.6 kB high-water mark in
-/// the self-test at 32 points, against 18.3 kB before the waypoint path existed).
-#[cfg(target_os = "none")]
-pub const MAX_WAYPOINTS: usize = 2;
 /// Segments of a path of [`MAX_WAYPOINTS`] points: its legs and the blends between them.
 pub const MAX_SEGMENTS: usize = 2 * MAX_WAYPOINTS - 3;
 /// Steps of the binary search: 2^SEARCH_STEPS ≥ [`MAX_SEGMENTS`].
@@ -116,7 +110,7 @@ pub fn turn_radius(speed: f32, configured: Option<f32>) -> f32 {
 }
 
 /// One segment: p(σ) = p0 + dir·(σ − s0) + e·q(u), u = (σ − s0)/len (e = 0 on a leg).
-#[derive(Clone, Copy, Debug, PartialEq, Default)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Segment {
     s0: f32,
     len: f32,
@@ -128,6 +122,17 @@ pub(crate) struct Segment {
     dir: [f32; 3],
     e: [f32; 3],
 }
+
+/// An unused segment (all zeros).
+const NO_SEGMENT: Segment = Segment {
+    s0: 0.0,
+    len: 0.0,
+    inv_len: 0.0,
+    part: 0,
+    p0: [0.0; 3],
+    dir: [0.0; 3],
+    e: [0.0; 3],
+};
 
 /// The precomputed path: its segments in order of σ, the total length, and the end point and
 /// direction the path continues along.
@@ -169,6 +174,28 @@ fn length(v: [f32; 3]) -> f32 {
     math::exact_sqrt(dot(v, v))
 }
 
+/// Every coordinate finite and within ±[`MAX_COORDINATE`] (parameter `points`).
+fn check_points(pts: &[[f32; 3]]) -> Result<(), TrajectoryError> {
+    for p in pts {
+        for &c in p {
+            if !c.is_finite() {
+                return Err(TrajectoryError::NonFinite {
+                    parameter: "points",
+                });
+            }
+            if c.abs() > MAX_COORDINATE {
+                return Err(TrajectoryError::OutOfRange {
+                    parameter: "points",
+                    value: c,
+                    min: -MAX_COORDINATE,
+                    max: MAX_COORDINATE,
+                });
+            }
+        }
+    }
+    Ok(())
+}
+
 /// The cut distance at a corner whose unit directions are `u_in`, `u_out` (Choice 151), and
 /// the turn angle (rad). sin(Δ/2) = |u_out − u_in|/2, cos(Δ/2) = |u_in + u_out|/2.
 pub(crate) fn corner(u_in: [f32; 3], u_out: [f32; 3], turn_radius: f32) -> (f32, f32) {
@@ -182,15 +209,7 @@ impl Route {
     /// No segments (the route of a path that is not a waypoint path).
     pub const EMPTY: Route = Route {
         count: 0,
-        segments: [Segment {
-            s0: 0.0,
-            len: 0.0,
-            part: 0,
-            inv_len: 0.0,
-            p0: [0.0; 3],
-            dir: [0.0; 3],
-            e: [0.0; 3],
-        }; MAX_SEGMENTS],
+        segments: [NO_SEGMENT; MAX_SEGMENTS],
         length: 0.0,
         end: [0.0; 3],
         end_dir: [0.0; 3],
@@ -200,30 +219,22 @@ impl Route {
 
     /// Checks the points (Choice 152; the error's parameter is `points`) and builds the legs
     /// and blends for corners of radius `turn_radius` (m, positive and finite: checked by the
-    /// caller). Fixed work: at most [`MAX_SEGMENTS`] segments.
-    pub fn new(list: &WaypointList, turn_radius: f32) -> Result<Route, TrajectoryError> {
+    /// caller) into `self`, in place (Choice 180: no `Route` on the stack). Every entry past
+    /// the new path's is reset, so the result is the same whatever `self` held; after an error
+    /// `self` has no segments (it samples as [`Route::EMPTY`]). Fixed work: at most
+    /// [`MAX_SEGMENTS`] segments.
+    pub fn build_into(
+        &mut self,
+        list: &WaypointList,
+        turn_radius: f32,
+    ) -> Result<(), TrajectoryError> {
+        self.clear();
         let pts = list.as_slice();
         let n = pts.len();
         if n < 2 {
             return Err(TrajectoryError::WaypointCount { count: n });
         }
-        for p in pts {
-            for &c in p {
-                if !c.is_finite() {
-                    return Err(TrajectoryError::NonFinite {
-                        parameter: "points",
-                    });
-                }
-                if c.abs() > MAX_COORDINATE {
-                    return Err(TrajectoryError::OutOfRange {
-                        parameter: "points",
-                        value: c,
-                        min: -MAX_COORDINATE,
-                        max: MAX_COORDINATE,
-                    });
-                }
-            }
-        }
+        check_points(pts)?;
         // Legs: unit directions and lengths.
         let mut dirs = [[0.0f32; 3]; MAX_WAYPOINTS];
         let mut lens = [0.0f32; MAX_WAYPOINTS];
@@ -243,7 +254,6 @@ impl Route {
             dirs[i] = scale(d, 1.0 / len);
             lens[i] = len;
         }
-        let mut route = Route::EMPTY;
         let cos_max = libm::cosf(MAX_TURN_DEGREES.to_radians());
         for j in 1..n - 1 {
             if dot(dirs[j - 1], dirs[j]) < cos_max {
@@ -254,17 +264,28 @@ impl Route {
                 });
             }
             let (cut, turn) = corner(dirs[j - 1], dirs[j], turn_radius);
-            route.cuts[j] = cut;
-            route.turns[j] = turn;
+            self.cuts[j] = cut;
+            self.turns[j] = turn;
         }
         for (i, &has) in lens.iter().enumerate().take(n - 1) {
-            let needs = route.cuts[i] + route.cuts[i + 1];
+            let needs = self.cuts[i] + self.cuts[i + 1];
             if needs > has {
                 return Err(TrajectoryError::LegTooShort { leg: i, needs, has });
             }
         }
-        route.assemble(pts, &dirs, &lens);
-        Ok(route)
+        self.assemble(pts, &dirs, &lens);
+        Ok(())
+    }
+
+    /// Back to [`Route::EMPTY`], in place.
+    pub(crate) fn clear(&mut self) {
+        self.count = 0;
+        self.segments.fill(NO_SEGMENT);
+        self.length = 0.0;
+        self.end = [0.0; 3];
+        self.end_dir = [0.0; 3];
+        self.cuts.fill(0.0);
+        self.turns.fill(0.0);
     }
 
     /// The segments in order: leg 0, blend 1, leg 1, … (a leg's straight remainder shorter

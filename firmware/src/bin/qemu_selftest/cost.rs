@@ -93,18 +93,24 @@ pub fn stages(
 ) -> ([u32; STAGES], u32) {
     let mut stage = [Stat::default(); STAGES];
     let mut update = Stat::default();
-    let mut per_case = [[0u32; STAGES + 1]; Table1Case::ALL.len()];
+    // One row per Table-1 case, then the survey's.
+    let mut per_case = [[0u32; STAGES + 1]; Table1Case::ALL.len() + 1];
+    let mut tr = Trajectory::EMPTY;
     for g in golden {
-        let Some(tr) = g.trajectory() else {
+        if !g.set(&mut tr) {
             continue;
-        };
+        }
         let c = if g.robust { with } else { without };
         let Some((counts, total)) = step_counts(counter, c, &tr, g) else {
             continue;
         };
-        // The per-mission rows are the Table-1 paths (either heading); the helix counts in
-        // the per-stage maxima below only.
-        let row = g.helix.is_none().then_some(g.case);
+        // The per-mission rows are the Table-1 paths (either heading) and the survey; the
+        // helix counts in the per-stage maxima below only.
+        let row = if g.waypoints {
+            Some(Table1Case::ALL.len())
+        } else {
+            g.helix.is_none().then_some(g.case)
+        };
         for (i, &n) in counts.iter().enumerate() {
             stage[i].add(n);
             if let Some(r) = row {
@@ -120,10 +126,15 @@ pub fn stages(
         "step cost per call (instructions, the largest over each mission's golden vectors), stages {=[?]}:",
         Stage::ALL.map(|s| s.name())
     );
-    for (case, row) in Table1Case::ALL.iter().zip(per_case.iter()) {
+    let names = Table1Case::ALL.map(|c| c.name());
+    for (name, row) in names
+        .iter()
+        .chain(["survey (waypoints)"].iter())
+        .zip(per_case.iter())
+    {
         info!(
             "  {=str}: {=[?]} = update {} instructions",
-            case.name(),
+            name,
             row[..STAGES],
             row[STAGES]
         );

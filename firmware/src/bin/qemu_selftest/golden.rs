@@ -2,8 +2,9 @@
 //! core built for the host; the self-test checks the target against them and counts each
 //! stage on their inputs.
 
+use auv_link::{Heading, UploadBuffer, UploadChunk, UploadHeader, UploadPart};
 use controller_core::effectiveness::THRUSTERS;
-use controller_core::{HeadingMode, Mission, Table1Case, Trajectory};
+use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
 include!(concat!(env!("OUT_DIR"), "/golden.rs"));
 
@@ -16,6 +17,8 @@ pub struct Golden {
     pub tangent: bool,
     /// A helix (radius, depth rate) flown instead of the case's path.
     pub helix: Option<(f32, f32)>,
+    /// The shipped survey flown instead (tangent heading), rebuilt from its upload.
+    pub waypoints: bool,
     pub eta: [f32; 6],
     pub nu: [f32; 6],
     pub voltage: [f32; THRUSTERS],
@@ -27,19 +30,45 @@ pub struct Golden {
 
 impl Golden {
     /// The mission this vector samples: its Table-1 case, with the tangent heading when
-    /// `tangent`, or the helix (as build.rs made it); `None` if the target refuses it.
-    pub fn trajectory(&self) -> Option<Trajectory> {
+    /// `tangent`, or the helix, or the survey (as build.rs made it).
+    pub fn mission(&self) -> Option<Mission> {
         let case = *Table1Case::ALL.get(self.case)?;
-        if let Some((radius, rate)) = self.helix {
-            Trajectory::helix(radius, rate).ok()
-        } else if self.tangent {
-            Trajectory::new(Mission {
-                heading: HeadingMode::Tangent,
-                ..Mission::paper(case.kind())
-            })
-            .ok()
-        } else {
-            Some(Trajectory::table1(case))
+        if self.waypoints {
+            return survey();
         }
+        let path = match self.helix {
+            Some((radius, depth_rate)) => TrajectoryKind::Helix {
+                radius,
+                omega: Trajectory::PAPER_OMEGA,
+                depth: Trajectory::PAPER_DEPTH,
+                depth_rate,
+            },
+            None => case.kind(),
+        };
+        let heading = if self.tangent {
+            HeadingMode::Tangent
+        } else {
+            HeadingMode::Paper
+        };
+        Some(Mission {
+            heading,
+            ..Mission::paper(path)
+        })
     }
+
+    /// Builds [`Golden::mission`] into `slot`, in place; false if the target refuses it.
+    pub fn set(&self, slot: &mut Trajectory) -> bool {
+        self.mission().is_some_and(|m| slot.set(&m).is_ok())
+    }
+}
+
+/// The shipped survey's mission, as the board gets it: its upload taken part by part into an
+/// upload buffer, verified against its CRC and resolved (`None` if any part is refused).
+pub fn survey() -> Option<Mission> {
+    let mut upload = UploadBuffer::EMPTY;
+    upload.take(&UploadPart::Begin(SURVEY_HEADER)).ok()?;
+    for c in &SURVEY_CHUNKS {
+        upload.take(&UploadPart::Chunk(*c)).ok()?;
+    }
+    upload.mission(SURVEY_HEADER.crc).ok()
 }

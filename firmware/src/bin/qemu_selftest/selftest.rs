@@ -5,7 +5,9 @@
 use auv_link::sign::{Direction, LinkKey, Signer, Verifier, MAX_TIMESTAMP};
 use auv_link::{encode, encode_signed, Command, ConfigPatch, Envelope, FrameDecoder, Msg};
 use auv_link::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
-use auv_link::{BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, MAX_FRAME};
+use auv_link::{
+    BoardStatus, FailSafeReason, Refusal, StateFrame, Telemetry, UploadPart, MAX_FRAME,
+};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Status, Table1Case, Trajectory};
 use cortex_m::peripheral::SYST;
@@ -17,7 +19,7 @@ use firmware::semihosting::CMDLINE_LEN;
 use firmware::supervisor::{BoardInfo, Mode, Supervisor};
 
 use crate::counter::{elapsed, start_counter};
-use crate::golden::GOLDEN;
+use crate::golden::{GOLDEN, SURVEY_CHUNKS, SURVEY_HEADER};
 use crate::stack;
 
 /// Target and host agree when the difference is within a few f32 roundings of the larger
@@ -38,6 +40,8 @@ fn ulps(a: f32, b: f32) -> u32 {
     x.wrapping_sub(y).unsigned_abs()
 }
 
+/// Each vector's mission is built in one slot, in place (`Golden::set`).
+#[inline(never)]
 fn golden_vectors() -> (bool, u32, u32) {
     let with = Controller::new(ControllerConfig::default());
     let without = Controller::new(ControllerConfig {
@@ -53,13 +57,17 @@ fn golden_vectors() -> (bool, u32, u32) {
     };
     let mut ok = true;
     let mut worst_ulps = 0u32;
+    // The survey's vectors must be bit for bit (the waypoint path's evaluation is the same
+    // f32 code on both sides, docs/design.md §27).
+    let (mut survey, mut survey_exact) = (0u32, 0u32);
     let (mut max_ticks, mut sum_ticks, mut timed) = (0u32, 0u64, 0u32);
+    let mut tr = Trajectory::EMPTY;
     for (i, g) in GOLDEN.iter().enumerate() {
-        let Some(tr) = g.trajectory() else {
+        if !g.set(&mut tr) {
             ok = false;
             error!("golden vector {}: the target refuses its mission", i);
             continue;
-        };
+        }
         let c = if g.robust { &with } else { &without };
         let t0 = SYST::get_current();
         let o = c.update(g.ticks, &g.eta, &g.nu, &tr);
@@ -84,6 +92,16 @@ fn golden_vectors() -> (bool, u32, u32) {
             worst_ulps = worst_ulps.max(ulps(o.tau[k], g.tau[k]));
         }
         worst_ulps = worst_ulps.max(ulps(o.delta, g.delta));
+        if g.waypoints {
+            survey += 1;
+            let exact = o.voltage.map(f32::to_bits) == g.voltage.map(f32::to_bits)
+                && o.tau.map(f32::to_bits) == g.tau.map(f32::to_bits)
+                && o.delta.to_bits() == g.delta.to_bits()
+                && o.w_norm.to_bits() == g.w_norm.to_bits()
+                && status == g.status;
+            survey_exact += u32::from(exact);
+            same &= exact;
+        }
         if !same {
             ok = false;
             error!(
@@ -98,6 +116,11 @@ fn golden_vectors() -> (bool, u32, u32) {
         GOLDEN.len(),
         worst_ulps
     );
+    info!(
+        "golden vectors on the shipped survey (waypoints, rebuilt from its upload): {} of {} bit for bit",
+        survey_exact, survey
+    );
+    ok &= survey > 0;
     let max = max_ticks * INSTRUCTIONS_PER_TICK;
     let mean = if timed > 0 {
         (sum_ticks / timed as u64) as u32 * INSTRUCTIONS_PER_TICK
@@ -132,8 +155,19 @@ fn frame(
     (buf, n)
 }
 
-fn circle_state(k: u64) -> StateFrame {
-    let d = Trajectory::table1(Table1Case::Circular10R).sample(k, 100);
+/// The paper's circle, built once into static memory (a trajectory is 8.6 kB: on the stack of
+/// `run` it would sit under every exercise). `None` on a second call.
+#[inline(never)]
+fn circle() -> Option<&'static Trajectory> {
+    let t: Option<&'static mut Trajectory> =
+        cortex_m::singleton!(: Trajectory = Trajectory::table1(Table1Case::Circular10R));
+    t.map(|t| &*t)
+}
+
+/// The state on the paper's circle (`circle`: its trajectory, built once by [`run`]: a
+/// trajectory is 8.6 kB, docs/design.md §27) at tick `k`.
+fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
+    let d = circle.sample(k, 100);
     let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
     StateFrame {
         t_ticks: k,
@@ -211,7 +245,8 @@ fn expect(
 /// and that what must latch stays reported.
 // Long: one scripted sequence of link events, each followed by the status it must give; its
 // log lines are the snapshot's, in this order, and the script reads best whole.
-fn fail_safe_exercise() -> bool {
+#[inline(never)]
+fn fail_safe_exercise(circle: &Trajectory) -> bool {
     let controller = match Controller::new(ControllerConfig::default()) {
         Ok(c) => c,
         Err(_) => return false,
@@ -232,7 +267,7 @@ fn fail_safe_exercise() -> bool {
         false,
     );
     for k in 0..3 {
-        host.send(sup, link, Msg::State(circle_state(k)), false);
+        host.send(sup, link, Msg::State(circle_state(circle, k)), false);
         expect(sup, &mut ok, "state frame", BoardStatus::Running, false);
     }
     expect(
@@ -255,14 +290,14 @@ fn fail_safe_exercise() -> bool {
     host.send(sup, link, Msg::Command(Command::Disarm), true);
     let counted = sup.rx_errors() == errors + 1;
     info!("corrupt frame counted and dropped: {}", counted);
-    host.send(sup, link, Msg::State(circle_state(6)), false);
+    host.send(sup, link, Msg::State(circle_state(circle, 6)), false);
     expect(sup, &mut ok, "link back, not re-armed", stale, false);
     host.send(sup, link, Msg::Command(Command::Arm), false);
     let t = expect(sup, &mut ok, "lone arm", stale, false);
     let lone_refused = t.last_refusal == Some(Refusal::Latched) && t.latched.is_some();
     info!("lone arm refused, reason still reported: {}", lone_refused);
     host.restart(sup, link);
-    let env = host.env(Msg::State(circle_state(7)));
+    let env = host.env(Msg::State(circle_state(circle, 7)));
     let (again, n) = frame(sup, link, &env, None, false);
     expect(
         sup,
@@ -275,7 +310,7 @@ fn fail_safe_exercise() -> bool {
     board::receive(sup, link, &again[..n]);
     let repeat_dropped = sup.rx_stale() == dropped_before + 1;
     info!("repeated state frame dropped: {}", repeat_dropped);
-    let mut bad = circle_state(8);
+    let mut bad = circle_state(circle, 8);
     bad.eta[2] = f32::NAN;
     host.send(sup, link, Msg::State(bad), false);
     let fault = BoardStatus::FailSafe(FailSafeReason::ControllerFault);
@@ -284,7 +319,7 @@ fn fail_safe_exercise() -> bool {
     let fault_kept = first.controller_fault != 0 && next.controller_fault == first.controller_fault;
     info!("fault code reported while latched: {}", fault_kept);
     host.restart(sup, link);
-    host.send(sup, link, Msg::State(circle_state(9)), false);
+    host.send(sup, link, Msg::State(circle_state(circle, 9)), false);
     expect(
         sup,
         &mut ok,
@@ -311,6 +346,7 @@ fn timed_frame(sup: &mut Supervisor, link: &mut LinkBuffers, host: &mut Host, ms
 /// telemetry, refused while armed and with an invalid mask; a `StartMission` with the tangent
 /// heading and a time scale flies, one with a time scale below 1 is refused with its reason.
 /// Logs the instructions each costs the board.
+#[inline(never)]
 fn real_chain_exercise() -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
@@ -378,9 +414,110 @@ fn real_chain_exercise() -> bool {
     kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
 }
 
+/// The shipped survey's upload through real frames (docs/design.md §27): refused while armed;
+/// disarmed, a `Begin` and its chunks with the second lost, the telemetry's acknowledgement
+/// naming it, the resend verifying the mission; then `StartMission` of it by its CRC flies.
+/// Logs the instructions each part and the start cost the board.
+#[inline(never)]
+fn upload_exercise() -> bool {
+    let Ok(controller) = Controller::new(ControllerConfig::default()) else {
+        return false;
+    };
+    let mut sup = Supervisor::new(controller, board_info(false));
+    let mut link = LinkBuffers::new();
+    let mut host = Host { seq: 0 };
+    let (sup, link) = (&mut sup, &mut link);
+    let now = || 0u32;
+    let begin = Msg::Command(Command::Upload(UploadPart::Begin(SURVEY_HEADER)));
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    host.send(sup, link, begin, false);
+    let armed_refused = sup.last_refusal() == Some(Refusal::WhileArmed);
+    host.send(sup, link, Msg::Command(Command::Disarm), false);
+    let begin_cost = timed_frame(sup, link, &mut host, begin);
+    let mut chunk_cost = 0;
+    for (i, c) in SURVEY_CHUNKS.iter().enumerate() {
+        if i != 1 {
+            let msg = Msg::Command(Command::Upload(UploadPart::Chunk(*c)));
+            chunk_cost = chunk_cost.max(timed_frame(sup, link, &mut host, msg));
+        }
+    }
+    let ack = sup.step(false, &now).telemetry.upload;
+    let one_missing = ack.crc == SURVEY_HEADER.crc && ack.missing().eq([1u8]) && !ack.verified;
+    let resend = Msg::Command(Command::Upload(UploadPart::Chunk(SURVEY_CHUNKS[1])));
+    let last_cost = timed_frame(sup, link, &mut host, resend);
+    let verified = sup.step(false, &now).telemetry.upload.verified;
+    host.send(sup, link, Msg::Command(Command::Arm), false);
+    let plan = MissionPlan {
+        path: MissionSpec::Waypoints {
+            crc: SURVEY_HEADER.crc,
+        },
+        heading: Heading::Tangent,
+        time_scale: 1.0,
+    };
+    let start = timed_frame(
+        sup,
+        link,
+        &mut host,
+        Msg::Command(Command::StartMission(plan)),
+    );
+    let flying = sup.mode() == Mode::Running && sup.refused_commands() == 1;
+    info!(
+        "survey upload: refused while armed {}, chunk 1 lost and named missing {}, verified after its resend {}, its mission running {}",
+        armed_refused, one_missing, verified, flying
+    );
+    info!(
+        "survey upload instructions (its Begin; a chunk, the largest; the last chunk: the CRC check and the 12-point mission built, disarmed; StartMission of the built mission): begin={} chunk={} last_chunk={} start_mission={}",
+        begin_cost, chunk_cost, last_cost, start
+    );
+    let largest = largest_set_cost();
+    armed_refused && one_missing && verified && flying && largest.is_some()
+}
+
+/// Instructions of `Trajectory::set` on the largest waypoint path the board takes: 32 points
+/// (a lawn-mower of 16 rows of 60 m, 20 m apart), a time law of 61 parts, tangent heading.
+#[inline(never)]
+fn largest_set_cost() -> Option<u32> {
+    let mut points = [[0.0f32; 3]; controller_core::trajectory::MAX_WAYPOINTS];
+    for (i, p) in points.iter_mut().enumerate() {
+        let row = (i / 2) as f32;
+        let east = (i % 2 == 0) == ((i / 2) % 2 == 0);
+        *p = [if east { 0.0 } else { 60.0 }, 20.0 * row, 5.0];
+    }
+    let mut speeds = [0.5f32; controller_core::trajectory::MAX_PARTS];
+    for (i, v) in speeds.iter_mut().enumerate() {
+        if i % 4 == 0 {
+            *v = 0.8;
+        }
+    }
+    let mission = controller_core::Mission {
+        path: controller_core::TrajectoryKind::Waypoints {
+            points: controller_core::trajectory::WaypointList::new(&points).ok()?,
+            speed: 0.5,
+            turn_radius: Some(3.0),
+            speeds: Some(controller_core::trajectory::SpeedList::new(&speeds).ok()?),
+            speed_change: None,
+        },
+        heading: controller_core::HeadingMode::Tangent,
+        time_scale: 1.0,
+    };
+    let Some(slot) = cortex_m::singleton!(: Trajectory = Trajectory::EMPTY) else {
+        return None;
+    };
+    let t0 = SYST::get_current();
+    let ok = slot.set(&mission).is_ok();
+    let t1 = SYST::get_current();
+    let n = elapsed(t0, t1) * INSTRUCTIONS_PER_TICK;
+    info!(
+        "Trajectory::set of the largest waypoint path (32 points, 61 parts): {} instructions, valid {}",
+        n, ok
+    );
+    ok.then_some(n)
+}
+
 /// A signed link: an unsigned frame, a replayed signed frame and one stamped at 2⁴⁸ − 1 are
 /// refused, a signed one is taken; the telemetry says signing is on, counts the stamp too far
 /// ahead, and is still signed.
+#[inline(never)]
 fn signed_link_exercise() -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
@@ -448,10 +585,11 @@ fn largest_telemetry() -> Envelope {
 /// Instructions to sign (encode) the largest telemetry frame and to receive (decode and
 /// verify) a state frame, signed and unsigned: what signing costs the board per frame, twice
 /// per period. Returns (sign, verify) of the signed link, or `None` if a frame failed.
-fn signing_cost() -> Option<(u32, u32)> {
+#[inline(never)]
+fn signing_cost(circle: &Trajectory) -> Option<(u32, u32)> {
     let key = LinkKey::new(SELFTEST_KEY);
     let telemetry = largest_telemetry();
-    let state = Envelope::new(7, Msg::State(circle_state(1234)));
+    let state = Envelope::new(7, Msg::State(circle_state(circle, 1234)));
     let mut counts = [[0u32; 2]; 2];
     let mut ok = true;
     for (i, signed) in [false, true].into_iter().enumerate() {
@@ -570,8 +708,15 @@ pub fn run(mut syst: SYST) -> bool {
     let (golden_ok, max, mean) = golden_vectors();
     info!("update instructions: max={} mean={}", max, mean);
     let budget_ok = crate::cost::run(max);
-    let link_ok = fail_safe_exercise() && signed_link_exercise() && real_chain_exercise();
-    let signing_ok = signing_cost().is_some();
+    let Some(circle) = circle() else {
+        error!("the circle's trajectory was built twice");
+        return false;
+    };
+    let link_ok = fail_safe_exercise(circle)
+        && signed_link_exercise()
+        && real_chain_exercise()
+        && upload_exercise();
+    let signing_ok = signing_cost(circle).is_some();
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
     if wrong {

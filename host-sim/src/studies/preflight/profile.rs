@@ -25,6 +25,12 @@
 //! else the search runs as without it (so a cap above the free speed changes nothing). The
 //! turns keep their own search; steps 2 and 3 only lower speeds, so no cap is exceeded.
 //!
+//! **The limit reported** per part is what bounded its search in step 1 (a thruster, or
+//! [`CAP`]) unless step 2 slowed it below that speed: then [`CHANGES`] (**Choice 171**), since
+//! neither a thruster nor the cap keeps it there but its length, too short for the speed
+//! changes to and from its own speed at `speed_change`. Step 3's rounds lower every speed
+//! alike and keep the labels.
+//!
 //! Compared with the uniform time scale: the fastest constant speed is the slowest part's
 //! (every part must hold it), so the survey at one speed takes length/min(v).
 
@@ -52,6 +58,10 @@ pub const MAX_VERIFY_ROUNDS: usize = 8;
 const MIN_PROFILE_SPEED: f64 = 0.02;
 /// What the report names as the limit of a leg its cap bound (`trajectory.speed_limits`).
 pub const CAP: &str = "cap";
+/// What the report names as the limit of a part that step 2 slowed below its own speed (and
+/// below its cap): too short to reach it and come back with the speed changes at
+/// `speed_change` (**Choice 171**).
+pub const CHANGES: &str = "changes";
 
 /// One part of the path as the profile flies it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -64,8 +74,9 @@ pub struct PartTime {
     pub speed: f64,
     /// The time spent on it (s), speed changes included.
     pub time: f64,
-    /// The thruster that stops it going faster (the first violation just above its speed), or
-    /// [`CAP`] for a leg its cap bound.
+    /// The thruster that stops it going faster (the first violation just above its speed),
+    /// [`CAP`] for a leg its cap bound, or [`CHANGES`] for a part too short for the speed
+    /// changes to and from a faster speed.
     pub limiting: String,
 }
 
@@ -134,12 +145,22 @@ pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>,
     let uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
     let mut speeds = fastest.clone();
     for round in 0..=MAX_VERIFY_ROUNDS {
-        let fitted = fit_changes(&parts, &speeds);
+        let rounded = round_down(&speeds);
+        let fitted = fit_changes(&parts, &rounded);
         let flown = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
         let checker = Checker::new(&flown, margin)?;
         let ok = checker.sweep(Scope::WholeBox, 1.0, false)?.first.is_none()
             && checker.sweep(Scope::AsWritten, 1.0, false)?.first.is_none();
         if ok || round == MAX_VERIFY_ROUNDS {
+            // A part step 2 slowed is limited by the changes, not by what bounded its search.
+            let limiting = limiting
+                .iter()
+                .zip(fitted.iter().zip(&rounded))
+                .map(|(l, (f, r))| match f < r {
+                    true => String::from(CHANGES),
+                    false => l.clone(),
+                })
+                .collect();
             return Ok(Some(report(
                 &parts,
                 &flown,
@@ -272,18 +293,23 @@ fn per_part_speeds(
     Ok((speeds, limiting))
 }
 
-/// The speeds rounded down to [`SPEED_STEP`], each part slowed until the core's speed changes
-/// fit in it (see the module docs, step 2). Terminates: speeds only fall, and a part no
-/// faster than both neighbours has no change in it.
-fn fit_changes(parts: &Parts, speeds: &[f64]) -> Vec<f64> {
-    let route = &parts.route;
+/// The speeds rounded down to [`SPEED_STEP`] (at least one step).
+fn round_down(speeds: &[f64]) -> Vec<f64> {
     // Steps per m/s (100): n/100 is the double nearest the decimal n/100, so a cap written as
     // 0.3 stays 0.3 (0.3/0.01 = 29.999… would floor to 29 steps; +1e-9 of a step keeps 30).
     let per = (1.0 / SPEED_STEP).round();
-    let mut v: Vec<f64> = speeds
+    speeds
         .iter()
         .map(|&x| ((x * per + 1e-9).floor() / per).max(SPEED_STEP))
-        .collect();
+        .collect()
+}
+
+/// The speeds (already on [`SPEED_STEP`], [`round_down`]), each part slowed until the core's
+/// speed changes fit in it (see the module docs, step 2). Terminates: speeds only fall, and a
+/// part no faster than both neighbours has no change in it.
+fn fit_changes(parts: &Parts, speeds: &[f64]) -> Vec<f64> {
+    let route = &parts.route;
+    let mut v = speeds.to_vec();
     let n = route.segment_count();
     let peak = 15.0 / 8.0;
     // The path a change from `a` down or up to `b` < `a` needs (with a 1 % allowance for the
