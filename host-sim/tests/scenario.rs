@@ -884,3 +884,34 @@ fn speed_limits_are_one_cap_per_leg_and_refused_by_key_and_leg() {
         "{e}"
     );
 }
+
+/// `link_faults.lose_upload_chunks` (Choice 166): chunks of a waypoint mission's upload; a
+/// closed-form mission (nothing uploaded) or a chunk past the upload's last is refused under
+/// the key.
+#[test]
+fn lost_upload_chunks_are_a_waypoint_missions_and_within_its_upload() {
+    let points = "[[0, 0, 5], [60, 0, 5], [60, 30, 5]]";
+    let with = |faults: &str| {
+        parse_scenario(&format!(
+            "{}[link_faults]\n{faults}\n",
+            waypoints_with(points, "speed = 0.5\n")
+        ))
+    };
+    let ok = with("lose_upload_chunks = [0]").expect("valid");
+    assert_eq!(ok.config().link_faults.lose_upload_chunks, vec![0]);
+    // Three points are 9 words: one chunk, so chunk 1 does not exist.
+    let e = with("lose_upload_chunks = [1]").expect_err("chunk 1");
+    assert!(
+        matches!(&e, ScenarioError::Invalid { key, message }
+            if key == "link_faults.lose_upload_chunks" && message.contains("1 chunks")),
+        "{e}"
+    );
+    let e = parse_scenario(
+        "name = \"c\"\n[trajectory]\nkind = \"circle\"\nradius = 10\n[link_faults]\nlose_upload_chunks = [0]\n",
+    )
+    .expect_err("circle");
+    assert!(
+        matches!(&e, ScenarioError::Invalid { key, .. } if key == "link_faults.lose_upload_chunks"),
+        "{e}"
+    );
+}

@@ -95,6 +95,7 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     check_name(&config.name)?;
     check_origin(config.origin)?;
     check_speed_limits(config)?;
+    check_lost_chunks(config)?;
     let rate = f64::from(config.controller.rate_hz);
     let period = 1.0 / rate;
 
@@ -384,6 +385,38 @@ fn check_speed_limits(config: &SimConfig) -> Res<()> {
                 "leg {leg}: must be a speed in (0, {}] m/s, got {}",
                 Readable(max),
                 Readable(caps[leg])
+            ),
+        )),
+        None => Ok(()),
+    }
+}
+
+/// `link_faults.lose_upload_chunks` (**Choice 166**): only a waypoint mission is uploaded, and
+/// each index must be one of its upload's chunks.
+fn check_lost_chunks(config: &SimConfig) -> Res<()> {
+    const KEY: &str = "link_faults.lose_upload_chunks";
+    let lost = &config.link_faults.lose_upload_chunks;
+    if lost.is_empty() {
+        return Ok(());
+    }
+    let mission = controller_core::Mission {
+        path: config.trajectory,
+        heading: config.heading,
+        time_scale: config.time_scale,
+    };
+    let Some(up) = auv_link::MissionUpload::of(&mission) else {
+        return Err(invalid(
+            KEY,
+            "only a waypoint mission is uploaded (kind = \"waypoints\")",
+        ));
+    };
+    match lost.iter().find(|&&i| i >= up.chunks()) {
+        Some(i) => Err(invalid(
+            KEY,
+            format!(
+                "chunk {i}: the upload has {} chunks (0 to {})",
+                up.chunks(),
+                up.chunks() - 1
             ),
         )),
         None => Ok(()),

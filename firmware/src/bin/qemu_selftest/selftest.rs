@@ -500,9 +500,7 @@ fn largest_set_cost() -> Option<u32> {
         heading: controller_core::HeadingMode::Tangent,
         time_scale: 1.0,
     };
-    let Some(slot) = cortex_m::singleton!(: Trajectory = Trajectory::EMPTY) else {
-        return None;
-    };
+    let slot = cortex_m::singleton!(: Trajectory = Trajectory::EMPTY)?;
     let t0 = SYST::get_current();
     let ok = slot.set(&mission).is_ok();
     let t1 = SYST::get_current();
