@@ -92,6 +92,7 @@
 #![warn(missing_docs)]
 
 mod frame;
+mod heading;
 pub mod mission;
 mod msg;
 mod refusal;
@@ -103,10 +104,11 @@ pub use frame::{
     decode_frame, decode_frame_signed, encode, encode_signed, FrameDecoder, LinkError, CRC_LEN,
     MAX_BODY, MAX_FRAME,
 };
+pub use heading::Heading;
 pub use msg::{
-    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, Heading,
-    MissionPlan, MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
-    NOT_AUV150, PROTOCOL_VERSION,
+    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionPlan,
+    MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS, NOT_AUV150,
+    PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;
 pub use upload::{

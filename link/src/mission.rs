@@ -19,7 +19,8 @@
 
 use controller_core::{HeadingMode, Mission, TrajectoryKind};
 
-use crate::msg::{AxisPriority, Heading, MissionPlan, MissionSpec, ThrustUnit};
+use crate::heading::Heading;
+use crate::msg::{AxisPriority, MissionPlan, MissionSpec, ThrustUnit};
 use crate::refusal::Refusal;
 use crate::upload::{MissionUpload, UploadBuffer};
 

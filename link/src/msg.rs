@@ -8,6 +8,7 @@
 use controller_core::effectiveness::THRUSTERS;
 use serde::{Deserialize, Serialize};
 
+use crate::heading::Heading;
 use crate::refusal::Refusal;
 use crate::upload::{UploadPart, UploadStatus};
 
@@ -166,21 +167,6 @@ pub struct MissionPlan {
 impl MissionPlan {
     /// Worst-case postcard size of a `MissionPlan` (bytes).
     pub const MAX_SIZE: usize = MissionSpec::MAX_SIZE + Heading::MAX_SIZE + F32;
-}
-
-/// The wire form of `controller_core::HeadingMode` (variant order is the wire format).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[cfg_attr(feature = "defmt", derive(defmt::Format))]
-pub enum Heading {
-    /// The paper's heading of the path.
-    Paper,
-    /// The path's course, atan2(ẏ_d, ẋ_d).
-    Tangent,
-}
-
-impl Heading {
-    /// Worst-case postcard size of a `Heading` (bytes).
-    pub const MAX_SIZE: usize = TAG;
 }
 
 /// The wire form of `controller_core::ThrustUnit`, the unit Eqs 31–32 are read in (variant

@@ -35,7 +35,7 @@ use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOI
 use controller_core::{Mission, TrajectoryKind};
 use serde::{Deserialize, Serialize};
 
-use crate::msg::Heading;
+use crate::heading::Heading;
 use crate::refusal::Refusal;
 
 /// Words (`f32`) per chunk: a chunk is 131 postcard bytes, under the largest telemetry frame,

@@ -40,6 +40,32 @@ fn ulps(a: f32, b: f32) -> u32 {
     x.wrapping_sub(y).unsigned_abs()
 }
 
+/// The target's output against one golden vector's: within [`close`] (voltages, τ, δ, ‖w‖ and
+/// the status), bit for bit, and the largest difference in ulp.
+fn compare(
+    o: &controller_core::Output,
+    status: u8,
+    g: &crate::golden::Golden,
+) -> (bool, bool, u32) {
+    let mut same = status == g.status && close(o.delta, g.delta) && close(o.w_norm, g.w_norm);
+    let mut worst = ulps(o.delta, g.delta);
+    for (a, b) in o
+        .voltage
+        .iter()
+        .zip(&g.voltage)
+        .chain(o.tau.iter().zip(&g.tau))
+    {
+        same &= close(*a, *b);
+        worst = worst.max(ulps(*a, *b));
+    }
+    let exact = o.voltage.map(f32::to_bits) == g.voltage.map(f32::to_bits)
+        && o.tau.map(f32::to_bits) == g.tau.map(f32::to_bits)
+        && o.delta.to_bits() == g.delta.to_bits()
+        && o.w_norm.to_bits() == g.w_norm.to_bits()
+        && status == g.status;
+    (same, exact, worst)
+}
+
 /// Each vector's mission is built in one slot, in place (`Golden::set`).
 #[inline(never)]
 fn golden_vectors() -> (bool, u32, u32) {
@@ -82,23 +108,10 @@ fn golden_vectors() -> (bool, u32, u32) {
             sum_ticks += dt as u64;
             timed += 1;
         }
-        let mut same = status == g.status && close(o.delta, g.delta) && close(o.w_norm, g.w_norm);
-        for k in 0..5 {
-            same &= close(o.voltage[k], g.voltage[k]);
-            worst_ulps = worst_ulps.max(ulps(o.voltage[k], g.voltage[k]));
-        }
-        for k in 0..6 {
-            same &= close(o.tau[k], g.tau[k]);
-            worst_ulps = worst_ulps.max(ulps(o.tau[k], g.tau[k]));
-        }
-        worst_ulps = worst_ulps.max(ulps(o.delta, g.delta));
+        let (mut same, exact, diff) = compare(&o, status, g);
+        worst_ulps = worst_ulps.max(diff);
         if g.waypoints {
             survey += 1;
-            let exact = o.voltage.map(f32::to_bits) == g.voltage.map(f32::to_bits)
-                && o.tau.map(f32::to_bits) == g.tau.map(f32::to_bits)
-                && o.delta.to_bits() == g.delta.to_bits()
-                && o.w_norm.to_bits() == g.w_norm.to_bits()
-                && status == g.status;
             survey_exact += u32::from(exact);
             same &= exact;
         }
