@@ -420,3 +420,54 @@ fn the_waypoint_plot_marks_the_waypoints_and_adds_the_depth_when_it_changes() {
     assert_eq!(plot_waypoint_path(&dir, &circle, &run).unwrap(), None);
     let _ = std::fs::remove_dir_all(&dir);
 }
+
+/// Choice 175 (a regression: `check` exited 2 with "the profiled mission: tangent heading needs
+/// a horizontal speed of at least 0.02 m/s"): a waypoint mission whose box cannot be held even
+/// at rest (the real vehicle with its payload untrimmed) has no speed profile. `propose` names
+/// the part and the thruster, and `check` prints the verdict, says so, and exits 1
+/// (infeasible), not 2.
+#[test]
+fn a_mission_the_box_cannot_hold_at_rest_has_no_profile_and_check_says_infeasible() {
+    // The shipped survey's vehicle (Table-3 payload) on one_turn's path, untrimmed.
+    let path = one_turn(None).config().trajectory;
+    let untrimmed = short_survey()
+        .with(|c| {
+            c.trajectory = path;
+            c.duration = 150.0;
+            c.trimmed = false;
+        })
+        .unwrap();
+    match profile::propose(&untrimmed, DEFAULT_MARGIN) {
+        Err(host_sim::studies::preflight::CheckError::NoProfile { part, thruster }) => {
+            assert_eq!(part, "leg 0");
+            assert!(!thruster.is_empty());
+        }
+        other => panic!("expected no profile, got {other:?}"),
+    }
+    let dir = std::env::temp_dir().join(format!("host-sim-noprofile-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("untrimmed.toml");
+    std::fs::write(
+        &file,
+        "name = \"untrimmed\"\nduration = 150\nideal_actuators = false\n\
+         [trajectory]\nkind = \"waypoints\"\npoints = [[0, 0, 5], [40, 0, 5], [40, 20, 5]]\n\
+         speed = 0.5\n[variation]\nprofile = \"table3-staircase\"\ntrimmed = false\n\
+         [controller]\nthrust_unit = \"kgf\"\n",
+    )
+    .unwrap();
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .args(["check", "--scenario"])
+        .arg(&file)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{text}\n{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(text.contains("INFEASIBLE"), "{text}");
+    assert!(text.contains("no speed profile: leg 0"), "{text}");
+    std::fs::remove_dir_all(&dir).ok();
+}

@@ -52,8 +52,11 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
         writeln!(stdout, "{}", preflight_table(&p))?;
     }
     // A waypoint mission: the fastest speed profile (docs/design.md §27).
-    let speed_profile = match profile::propose(&scenario, args.margin) {
-        Ok(s) => s,
+    // None at all (Choice 175): said, and the verdict above stands (infeasible: a part that
+    // cannot be flown even slowly over the box cannot be flown as written either).
+    let (speed_profile, no_speed_profile) = match profile::propose(&scenario, args.margin) {
+        Ok(s) => (s, None),
+        Err(e @ CheckError::NoProfile { .. }) => (None, Some(e.to_string())),
         Err(CheckError::Interrupted) => {
             eprintln!("host-sim: check: interrupted before the speed profile");
             return Ok(Exit::Interrupted);
@@ -66,10 +69,15 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
             &CheckJson {
                 preflight: &p,
                 speed_profile,
+                no_speed_profile,
             },
         )?,
         (false, Some(s)) => writeln!(stdout, "{}", profile_table(&s))?,
-        (false, None) => {}
+        (false, None) => {
+            if let Some(why) = no_speed_profile {
+                writeln!(stdout, "{why}")?;
+            }
+        }
     }
     Ok(if p.feasible() {
         Exit::Success
@@ -87,6 +95,9 @@ struct CheckJson<'a> {
     preflight: &'a Preflight,
     #[serde(skip_serializing_if = "Option::is_none")]
     speed_profile: Option<SpeedProfile>,
+    /// Why a waypoint mission has no profile (Choice 175).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    no_speed_profile: Option<String>,
 }
 
 /// The per-thruster part of `check`'s text.

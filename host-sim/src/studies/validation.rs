@@ -275,7 +275,7 @@ pub fn validate_one(
     let p = match preflight::check_as_written(base, margin) {
         Ok(p) => p,
         Err(CheckError::Interrupted) => return Ok(None),
-        Err(CheckError::Invalid(e)) => return Err(e),
+        Err(e) => return Err(e.to_string()),
     };
     let mounting = base
         .config()

@@ -80,6 +80,15 @@ pub enum CheckError {
     /// mission is 1.7·10⁶ samples of the path at each of the 2⁹ corners, minutes of work, so
     /// the check polls the request at every sample (**Choice 120**).
     Interrupted,
+    /// A waypoint mission with no speed profile: `part` cannot be flown over the whole box
+    /// even at the slowest speed the search tries, `thruster` beyond its envelope there (the
+    /// box cannot be held at rest: docs/design.md §27, **Choice 175**).
+    NoProfile {
+        /// `leg j` or `turn at j`.
+        part: String,
+        /// The thruster out of its envelope.
+        thruster: String,
+    },
 }
 
 impl fmt::Display for CheckError {
@@ -87,6 +96,11 @@ impl fmt::Display for CheckError {
         match self {
             CheckError::Invalid(e) => f.write_str(e),
             CheckError::Interrupted => f.write_str("interrupted before the check was done"),
+            CheckError::NoProfile { part, thruster } => write!(
+                f,
+                "no speed profile: {part} cannot be flown over the whole box even at {} m/s ({thruster} beyond its envelope)",
+                profile::MIN_PROFILE_SPEED
+            ),
         }
     }
 }

@@ -55,7 +55,7 @@ pub const VERIFY_SHRINK: f64 = 0.97;
 /// Rounds of [`VERIFY_SHRINK`] at most.
 pub const MAX_VERIFY_ROUNDS: usize = 8;
 /// The slowest speed the search considers (m/s): a part infeasible there is infeasible.
-const MIN_PROFILE_SPEED: f64 = 0.02;
+pub const MIN_PROFILE_SPEED: f64 = 0.02;
 /// What the report names as the limit of a leg its cap bound (`trajectory.speed_limits`).
 pub const CAP: &str = "cap";
 /// What the report names as the limit of a part that step 2 slowed below its own speed (and
@@ -112,7 +112,9 @@ struct Parts {
 /// The speed profile of `scenario` at `margin`, if it is a waypoint mission (`None` otherwise).
 ///
 /// # Errors
-/// [`CheckError::Invalid`] if the mission cannot be built at some step; [`CheckError::Interrupted`].
+/// [`CheckError::Invalid`] if the mission cannot be built at some step;
+/// [`CheckError::NoProfile`] if a part cannot be flown over the whole box even at the slowest
+/// speed; [`CheckError::Interrupted`].
 pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>, CheckError> {
     let cfg = scenario.config();
     let TrajectoryKind::Waypoints {
@@ -256,11 +258,13 @@ fn per_part_speeds(
         };
         let (mut lo, mut hi) = (MIN_PROFILE_SPEED, f64::from(MAX_SPEED));
         let mut limit = String::from("none");
-        if let Some(t) = feasible(lo)? {
-            // Not even slowly: the part keeps the slowest speed; the check as flown says so.
-            speeds[route.segment_part(i)] = lo;
-            limiting[route.segment_part(i)] = t;
-            continue;
+        if let Some(thruster) = feasible(lo)? {
+            // Not even slowly: no profile flies (Choice 175), and a path this slow could not
+            // even be built for the tangent heading.
+            return Err(CheckError::NoProfile {
+                part: part_name(route.segment_part(i)),
+                thruster,
+            });
         }
         let p = route.segment_part(i);
         if let Some(cap) = parts.caps[p] {
@@ -291,6 +295,14 @@ fn per_part_speeds(
         limiting[p] = limit;
     }
     Ok((speeds, limiting))
+}
+
+/// Part `p`'s name: part 2j is `leg j`, part 2j − 1 the `turn at j`.
+fn part_name(p: usize) -> String {
+    match p % 2 {
+        0 => format!("leg {}", p / 2),
+        _ => format!("turn at {}", p.div_ceil(2)),
+    }
 }
 
 /// The speeds rounded down to [`SPEED_STEP`] (at least one step).
@@ -361,10 +373,7 @@ fn report(
                 false => f64::from(law.duration()),
             };
             PartTime {
-                name: match p % 2 {
-                    0 => format!("leg {}", p / 2),
-                    _ => format!("turn at {}", p.div_ceil(2)),
-                },
+                name: part_name(p),
                 length: f64::from(route.segment_length(i)),
                 speed: speeds[p],
                 time: end - start,
