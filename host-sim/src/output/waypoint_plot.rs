@@ -121,34 +121,12 @@ fn corner_zoom(scenario: &Scenario, points: &[[f64; 3]], run: &RunResult) -> Opt
         "north x (m)",
     );
     p.equal_aspect = true;
-    p.lines.push(Line::new(
-        "waypoints' polyline",
-        C_LIMIT,
-        Stroke::Dashed,
-        vec![
-            towards(&points[j - 1]),
-            (w[1], w[0]),
-            towards(&points[j + 1]),
-        ],
-    ));
-    p.lines.push(Line::new(
-        format!("flown, {}", run.du_label()),
-        C_WITH,
-        Stroke::Solid,
-        run.samples.iter().map(|s| en(&s.eta)).collect(),
-    ));
-    p.lines.push(Line::new(
-        "desired η_d (blends cut the corners)",
-        C_DESIRED,
-        Stroke::Dashed,
-        run.samples.iter().map(|s| en(&s.eta_d)).collect(),
-    ));
-    p.lines.push(Line::new(
-        WAYPOINT_LABEL,
-        C_WAYPOINT,
-        Stroke::Dots,
-        vec![(w[1], w[0])],
-    ));
+    let polyline = vec![
+        towards(&points[j - 1]),
+        (w[1], w[0]),
+        towards(&points[j + 1]),
+    ];
+    plan_lines(&mut p, polyline, run, &en, vec![(w[1], w[0])]);
     p.labels = vec![(w[1], w[0], j.to_string())];
     Some(p)
 }
@@ -158,11 +136,31 @@ fn plan_view(points: &[[f64; 3]], run: &RunResult) -> Panel {
     let mut p = Panel::new("", "east y (m)", "north x (m)");
     p.equal_aspect = true;
     let en = |v: &[f64]| (v[1], v[0]);
+    let marks: Vec<_> = points.iter().map(|w| en(w)).collect();
+    plan_lines(&mut p, marks.clone(), run, &en, marks);
+    p.labels = points
+        .iter()
+        .enumerate()
+        .map(|(j, w)| (w[1], w[0], j.to_string()))
+        .collect();
+    p
+}
+
+/// The four lines of a plan panel, in drawing order: the waypoints' polyline, the flown path,
+/// the desired path over it (which it tracks to centimetres), the waypoints; `en` maps a pose
+/// to (east, north).
+fn plan_lines(
+    p: &mut Panel,
+    polyline: Vec<(f64, f64)>,
+    run: &RunResult,
+    en: &dyn Fn(&[f64]) -> (f64, f64),
+    waypoints: Vec<(f64, f64)>,
+) {
     p.lines.push(Line::new(
         "waypoints' polyline",
         C_LIMIT,
         Stroke::Dashed,
-        points.iter().map(|w| en(w)).collect(),
+        polyline,
     ));
     p.lines.push(Line::new(
         format!("flown, {}", run.du_label()),
@@ -170,7 +168,6 @@ fn plan_view(points: &[[f64; 3]], run: &RunResult) -> Panel {
         Stroke::Solid,
         run.samples.iter().map(|s| en(&s.eta)).collect(),
     ));
-    // Over the flown path, which tracks it to centimetres.
     p.lines.push(Line::new(
         "desired η_d (blends cut the corners)",
         C_DESIRED,
@@ -181,14 +178,8 @@ fn plan_view(points: &[[f64; 3]], run: &RunResult) -> Panel {
         WAYPOINT_LABEL,
         C_WAYPOINT,
         Stroke::Dots,
-        points.iter().map(|w| en(w)).collect(),
+        waypoints,
     ));
-    p.labels = points
-        .iter()
-        .enumerate()
-        .map(|(j, w)| (w[1], w[0], j.to_string()))
-        .collect();
-    p
 }
 
 /// The depth profile: −z (m, up) against the distance along the desired path, the flown depth
