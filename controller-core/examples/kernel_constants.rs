@@ -364,9 +364,17 @@ fn main() {
         std::f64::consts::PI
     );
     assert!((pi.to_f64() - std::f64::consts::PI).abs() < 1e-15);
+    cody_waite_items(&pio2);
+    reduction_items(&pi, &pio2);
+    atan2_base_items(&pi, &pio2);
+    sin_cos_polynomials();
+    atan_polynomials();
+    cbrt_items();
+}
 
-    // Cody–Waite: π/2 = C1 + C2 + C3 + C4, C1..C3 with 14 significant bits (k·Cᵢ exact for
-    // k < 2^10), C4 the rest rounded to 24 bits.
+/// Cody–Waite: π/2 = C1 + C2 + C3 + C4, C1..C3 with 14 significant bits (k·Cᵢ exact for
+/// k < 2^10), C4 the rest rounded to 24 bits.
+fn cody_waite_items(pio2: &Fixed) {
     println!("\n// Cody–Waite splits of π/2");
     let mut rest = Signed(false, pio2.clone());
     for (i, bits) in [(1, 14), (2, 14), (3, 14), (4, 24)] {
@@ -379,9 +387,12 @@ fn main() {
         rest = rest.sub(&exact);
     }
     println!("// remainder after the four parts ≈ {:e}", rest.1.to_f64());
+}
 
-    // 2/π bits 1..=224 (seven words).
-    let two_over_pi = quotient(&Fixed::int(2), &pi);
+/// The Payne–Hanek table (2/π bits 1..=224, seven words), π/4 in 0.64 fixed point and π/2 in
+/// Q1.31, each rounded.
+fn reduction_items(pi: &Fixed, pio2: &Fixed) {
+    let two_over_pi = quotient(&Fixed::int(2), pi);
     println!("\n/// 2/π, bits 1…224 after the binary point, most significant first.");
     print!("const TWO_OVER_PI: [u32; 7] = [");
     for w in 0..7 {
@@ -415,8 +426,10 @@ fn main() {
         q += 1;
     }
     println!("/// π/2 · 2^31, rounded.\nconst PIO2_Q31: u32 = {q:#010x};");
+}
 
-    // atan2 base angles: atan(1/2), π/4, π/2 ∓ those, π − those, and π/2, π, as hi + lo.
+/// atan2 base angles: atan(1/2), π/4, π/2 ∓ those, π − those, and π/2, π, as hi + lo.
+fn atan2_base_items(pi: &Fixed, pio2: &Fixed) {
     println!("\n// atan2 base angles (hi, lo)");
     let atan_half = atan_inv(2);
     let pio4 = Signed(false, pio2.half());
@@ -444,8 +457,11 @@ fn main() {
             lo.to_bits()
         );
     }
+}
 
-    // Minimax polynomials. The reduced argument of sin/cos is within π/4 up to a few ulps.
+/// Minimax polynomials of sin and cos. The reduced argument of sin/cos is within π/4 up to a
+/// few ulps.
+fn sin_cos_polynomials() {
     let rmax: f64 = std::f64::consts::FRAC_PI_4 * (1.0 + 1e-6);
     let zmax = rmax * rmax;
     println!("\n// sin r = r + r³ S(r²), relative error, |r| ≤ {rmax}");
@@ -488,8 +504,10 @@ fn main() {
         );
         coef_items(&format!("C{n}_"), &c);
     }
+}
 
-    // atan u = u − u³ A(u²) on |u| ≤ 7/16 (the widest of the atan2 kernel's intervals).
+/// atan u = u − u³ A(u²) on |u| ≤ 7/16 (the widest of the atan2 kernel's intervals).
+fn atan_polynomials() {
     let umax: f64 = 7.0 / 16.0 * (1.0 + 1e-6);
     println!("\n// atan u = u − u³ A(u²), relative error, |u| ≤ {umax}");
     // h(z) = (u − atan u)/u³ = Σ (−1)^k z^k / (2k + 3)
@@ -514,8 +532,10 @@ fn main() {
         );
         coef_items(&format!("A{n}_"), &c);
     }
+}
 
-    // Cube root's first guess on [1, 2], relative error.
+/// The cube root's first guess on [1, 2] (relative error), and ∛2, ∛4.
+fn cbrt_items() {
     println!("\n// ∛m ≈ G(m) on [1, 2], relative error");
     for n in [2, 3] {
         let (c, e) = remez(&|m: f64| m.cbrt(), &|m: f64| 1.0 / m.cbrt(), 1.0, 2.0, n);
