@@ -57,6 +57,16 @@ pub struct LineComment {
 pub struct Lexed {
     pub tokens: Vec<Token>,
     pub comments: Vec<LineComment>,
+    /// The source text of each string literal token (quotes and prefix included, escapes not
+    /// processed), by token index: `#[path = "…"]` names a module's file with one.
+    pub strings: std::collections::BTreeMap<usize, String>,
+}
+
+impl Lexed {
+    /// The contents of the plain string literal at token `i` (`"src/x.rs"` gives `src/x.rs`).
+    pub fn string(&self, i: usize) -> Option<&str> {
+        self.strings.get(&i)?.strip_prefix('"')?.strip_suffix('"')
+    }
 }
 
 const PUNCT: &str = "{}()[]<>;,.:#!?&|*+-/=%^@~$";
@@ -90,6 +100,8 @@ pub fn lex(src: &str) -> Lexed {
         } else if c == '/' && next == Some('*') {
             i = block_comment_end(&chars, i, &mut line);
         } else if let Some(end) = string_end(&chars, i, &mut line) {
+            out.strings
+                .insert(out.tokens.len(), chars[i..end].iter().collect());
             out.tokens.push(token(Kind::Literal, start_line));
             i = end;
         } else if c == '\'' {
@@ -304,6 +316,19 @@ mod tests {
                 text: "// d".into()
             }]
         );
+    }
+
+    #[test]
+    fn string_literals_keep_their_text() {
+        let l = lex("#[path = \"a/b.rs\"] mod m; const R: &str = r#\"x\"#;");
+        let at = |w: &str| l.tokens.iter().position(|t| t.is_word(w)).unwrap();
+        assert_eq!(l.string(at("path") + 2), Some("a/b.rs"));
+        assert_eq!(
+            l.string(at("str") + 2),
+            None,
+            "a raw string is not a plain one"
+        );
+        assert_eq!(l.strings.len(), 2);
     }
 
     #[test]

@@ -1,21 +1,35 @@
 //! The workspace's source rules, read from the files themselves (`cargo test -p xtask` checks
-//! them, `xtask/tests/source_rules.rs`; docs/design.md §22):
+//! them, `xtask/tests/source_rules.rs`; docs/design.md §24, Choices 86, 210 and 211). They
+//! read every crate of the repository ([`crates`]): each target (library, binaries, examples,
+//! benchmarks, build script) of every package. Test code is left out: `#[cfg(test)]` and
+//! `#[test]` items, integration tests (`tests/`) and fuzz targets (`fuzz/`, which include the
+//! tests' shared helpers); every `.rs` file must belong to some crate ([`unseen_rust_files`]).
 //!
 //! - **Long functions** ([`long_functions`]): a function outside test code longer than
 //!   [`LONG_FN_LINES`] lines says why, in a line comment starting with [`LONG_MARKER`] among
 //!   the comments and attributes directly above it (a straight-line state table, a closed form
 //!   that reads best whole).
-//! - **Import circles** ([`modules::import_circles`]): no two modules of a crate import each
-//!   other; the module graph itself is [`modules::Crate::graph`], for further rules.
+//! - **Import circles** ([`cycles::import_circles`]): no set of modules of a crate reach each
+//!   other through their imports. A module depends on the module that defines what it names,
+//!   through re-exports ([`modules`]), and on the folders it reaches into, not on its own
+//!   ancestors ([`cycles::rule_graph`]); every strongly connected component of two or more
+//!   modules is a circle, reported with the line behind each step.
 //!
 //! The files are read as tokens ([`lex`]), not parsed: braces, comments, strings and character
 //! literals are told apart, which is all the rules need, and no parser crate is built for it.
 
+pub mod cycles;
 pub mod items;
 pub mod lex;
 pub mod modules;
+pub mod names;
+pub mod targets;
 
+use std::collections::BTreeSet;
 use std::path::{Path, PathBuf};
+
+use cycles::Circle;
+use modules::Crate;
 
 /// The longest a function may be (lines from its `fn` keyword to its closing brace) without a
 /// reason written beside it.
@@ -25,41 +39,19 @@ pub const LONG_FN_LINES: usize = 80;
 /// (among its doc comment and attributes).
 pub const LONG_MARKER: &str = "// Long:";
 
-/// The workspace's members: (package name, directory), from the root `Cargo.toml`.
-pub fn members(root: &Path) -> Result<Vec<(String, PathBuf)>, String> {
-    let read = |p: &Path| -> Result<toml::Table, String> {
-        let text = std::fs::read_to_string(p).map_err(|e| format!("{}: {e}", p.display()))?;
-        text.parse().map_err(|e| format!("{}: {e}", p.display()))
-    };
-    let manifest = read(&root.join("Cargo.toml"))?;
-    let members = manifest
-        .get("workspace")
-        .and_then(|w| w.get("members"))
-        .and_then(|m| m.as_array())
-        .ok_or("Cargo.toml: no [workspace] members")?;
-    let mut out = Vec::new();
-    for m in members {
-        let dir = root.join(m.as_str().ok_or("a workspace member is not a string")?);
-        let package = read(&dir.join("Cargo.toml"))?;
-        let name = package
-            .get("package")
-            .and_then(|p| p.get("name"))
-            .and_then(|n| n.as_str())
-            .ok_or_else(|| format!("{}: no package name", dir.display()))?;
-        out.push((name.to_string(), dir));
-    }
-    Ok(out)
-}
-
-/// Every `.rs` file under `dir`, sorted.
+/// Every `.rs` file under `dir`, sorted; directories named `target` or starting with a dot
+/// are not searched.
 pub fn rust_files(dir: &Path) -> Vec<PathBuf> {
     let mut out = Vec::new();
     let mut stack = vec![dir.to_path_buf()];
     while let Some(d) = stack.pop() {
         for e in std::fs::read_dir(&d).into_iter().flatten().flatten() {
             let p = e.path();
+            let name = e.file_name().to_string_lossy().into_owned();
             if p.is_dir() {
-                stack.push(p);
+                if name != "target" && !name.starts_with('.') {
+                    stack.push(p);
+                }
             } else if p.extension().is_some_and(|x| x == "rs") {
                 out.push(p);
             }
@@ -69,25 +61,77 @@ pub fn rust_files(dir: &Path) -> Vec<PathBuf> {
     out
 }
 
-/// Every crate (lib and binary targets) of every workspace member, with its module graph.
-pub fn crates(root: &Path) -> Result<Vec<modules::Crate>, String> {
-    Ok(members(root)?
+/// Every crate of every package under `root` (each target, test code included), with its
+/// module graph.
+pub fn all_crates(root: &Path) -> Result<Vec<Crate>, String> {
+    Ok(targets::packages(root)?
         .iter()
-        .flat_map(|(name, dir)| modules::crates_of(name, dir))
+        .flat_map(|(name, dir, manifest)| targets::targets(name, dir, manifest))
+        .map(|t| modules::crate_of(t.crate_name(), t.kind, &t.root))
         .collect())
 }
 
-/// Every function longer than [`LONG_FN_LINES`] in the `src/` trees of the workspace's members,
-/// with its file relative to `root`.
-pub fn workspace_long_functions(root: &Path) -> Result<Vec<(PathBuf, LongFn)>, String> {
-    let mut out = Vec::new();
-    for (_, dir) in members(root)? {
-        for file in rust_files(&dir.join("src")) {
-            let text =
-                std::fs::read_to_string(&file).map_err(|e| format!("{}: {e}", file.display()))?;
-            let rel = file.strip_prefix(root).unwrap_or(&file).to_path_buf();
-            out.extend(long_functions(&text).into_iter().map(|f| (rel.clone(), f)));
+/// The crates the rules check: [`all_crates`] but integration tests and fuzz targets.
+pub fn crates(root: &Path) -> Result<Vec<Crate>, String> {
+    let mut all = all_crates(root)?;
+    all.retain(|c| !c.kind.is_test_code());
+    Ok(all)
+}
+
+/// Every import circle of the crates under `root`, its files relative to `root`.
+pub fn circles(root: &Path) -> Result<Vec<Circle>, String> {
+    let mut out: Vec<Circle> = crates(root)?
+        .iter()
+        .flat_map(cycles::import_circles)
+        .collect();
+    for step in out
+        .iter_mut()
+        .flat_map(|c| c.walk.iter_mut().chain(c.other_edges.iter_mut()))
+    {
+        if let Ok(rel) = step.site.file.strip_prefix(root) {
+            step.site.file = rel.to_path_buf();
         }
+    }
+    Ok(out)
+}
+
+/// A circle tolerated while it is being broken: (crate, its modules, sorted).
+pub type KnownCircle<'a> = (&'a str, &'a [&'a str]);
+
+/// True if `circle` is exactly the known one.
+pub fn is_known(circle: &Circle, known: &KnownCircle) -> bool {
+    circle.krate == known.0
+        && circle
+            .modules
+            .iter()
+            .map(String::as_str)
+            .eq(known.1.iter().copied())
+}
+
+/// `.rs` files under `root` that no crate reads (as a module of any target, test modules and
+/// integration tests included): a file the rules would never see.
+pub fn unseen_rust_files(root: &Path) -> Result<Vec<PathBuf>, String> {
+    let seen: BTreeSet<PathBuf> = all_crates(root)?.iter().flat_map(Crate::files).collect();
+    Ok(rust_files(root)
+        .into_iter()
+        .filter(|f| !seen.contains(f))
+        .map(|f| f.strip_prefix(root).unwrap_or(&f).to_path_buf())
+        .collect())
+}
+
+/// Every function longer than [`LONG_FN_LINES`] in the files of the crates the rules check
+/// (each file once, test-only module files left out), with its file relative to `root`.
+pub fn workspace_long_functions(root: &Path) -> Result<Vec<(PathBuf, LongFn)>, String> {
+    let files: BTreeSet<PathBuf> = crates(root)?
+        .iter()
+        .flat_map(|c| c.modules.values().map(|m| m.file.clone()))
+        .collect();
+    let mut out = Vec::new();
+    for file in files {
+        let text =
+            std::fs::read_to_string(&file).map_err(|e| format!("{}: {e}", file.display()))?;
+        let rel = file.strip_prefix(root).unwrap_or(&file).to_path_buf();
+        out.extend(long_functions(&text).into_iter().map(|f| (rel.clone(), f)));
     }
     Ok(out)
 }

@@ -1,33 +1,58 @@
-//! The module graph of each crate of the workspace: which modules a module's code names
-//! (`use crate::a::…`, `use super::…`, `crate::a::f()` in code, a child module by name), and
-//! the import circles between pairs of modules.
+//! The module graph of each crate: which modules a module's code depends on, each edge with
+//! the line that makes it.
 //!
-//! A crate is one target: a package's `src/lib.rs`, `src/main.rs`, `src/bin/NAME.rs` or
-//! `src/bin/NAME/main.rs`; its modules are found from the root through `mod NAME;`
-//! declarations (and inline `mod NAME { … }`), as the compiler finds them. Test code
-//! (`#[cfg(test)]`, `#[test]`) is left out. A path is resolved to the longest module prefix of
-//! it: `crate::scenario::Scenario` names the module `scenario`.
+//! A crate is one target ([`super::targets`]); its modules are found from the root through
+//! `mod NAME;` declarations (with their `#[path = "…"]`) and inline `mod NAME { … }`, as the
+//! compiler finds them. Test code (`#[cfg(test)]`, `#[test]`) is left out; the files of
+//! test-only modules are kept apart ([`Crate::test_files`]).
+//!
+//! An edge goes from a module to the module that **defines** what it names: a path is
+//! resolved to its longest module prefix, then the item named there is looked up in that
+//! module's namespace, following its `use` declarations (a `pub use` re-export, or a private
+//! `use` that its children reach through `super::`) and glob imports to the module that
+//! defines the item. So `use super::Limits` in `trajectory::error`, where `trajectory`
+//! re-exports `Limits` from `trajectory::paths::waypoints`, is an edge to
+//! `trajectory::paths::waypoints`, not to the parent. A `use` is an edge only if the module's
+//! own code uses the name it binds (or it privately imports a trait, for its methods): a
+//! re-export that only passes a name on is not a dependency of the module that writes it.
+//! Items of other crates are not edges.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
-use super::items::{in_spans, item_end, matching_brace, test_spans};
-use super::lex::{lex, Token};
+use super::items::{in_spans, matching_brace, test_spans};
+use super::lex::{lex, Lexed, Token};
+use super::names::{join, names_in_file, ItemKind, Names};
+use super::targets::Kind;
 
-/// A module: its file and the modules its code names (module paths within the crate, `""`
-/// for the crate root; never the module itself).
+/// Where an edge comes from: the file and line of the `use` or path, and its text.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Site {
+    pub file: PathBuf,
+    pub line: usize,
+    /// `use super::Limits (re-exported by trajectory)`, `crate::sim::fly`.
+    pub text: String,
+}
+
+/// A module: its file and the modules its code depends on (module paths within the crate,
+/// `""` for the crate root; never the module itself), each with the first line that does.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Module {
     pub file: PathBuf,
     pub imports: BTreeSet<String>,
+    pub sites: BTreeMap<String, Site>,
 }
 
 /// The modules of one crate, by path (`"scenario::check"`; `""` is the root).
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Crate {
-    /// The package and, for a binary, its target: `host-sim`, `host-sim bin host-sim`.
+    /// The package and, for any other target than its library, the target:
+    /// `host-sim`, `host-sim bin host-sim`, `firmware build` ([`super::targets::Target`]).
     pub name: String,
+    pub kind: Kind,
     pub modules: BTreeMap<String, Module>,
+    /// The files of modules declared only under test code (`#[cfg(test)] mod tests;`).
+    pub test_files: BTreeSet<PathBuf>,
 }
 
 impl Crate {
@@ -38,108 +63,130 @@ impl Crate {
             .map(|(m, info)| (m.as_str(), &info.imports))
             .collect()
     }
-}
 
-/// Every crate (lib and binary targets) of the package in `package_dir`.
-pub fn crates_of(package: &str, package_dir: &Path) -> Vec<Crate> {
-    let src = package_dir.join("src");
-    let mut roots: Vec<(String, PathBuf)> = Vec::new();
-    if src.join("lib.rs").is_file() {
-        roots.push((package.to_string(), src.join("lib.rs")));
+    /// Every file of the crate, test-only module files included.
+    pub fn files(&self) -> BTreeSet<PathBuf> {
+        let mut out: BTreeSet<PathBuf> = self.modules.values().map(|m| m.file.clone()).collect();
+        out.extend(self.test_files.iter().cloned());
+        out
     }
-    if src.join("main.rs").is_file() {
-        roots.push((format!("{package} bin {package}"), src.join("main.rs")));
-    }
-    let mut bins: Vec<PathBuf> = std::fs::read_dir(src.join("bin"))
-        .into_iter()
-        .flatten()
-        .flatten()
-        .map(|e| e.path())
-        .collect();
-    bins.sort();
-    for p in bins {
-        let stem = p.file_stem().map(|s| s.to_string_lossy().into_owned());
-        let stem = stem.unwrap_or_default();
-        if p.extension().is_some_and(|x| x == "rs") {
-            roots.push((format!("{package} bin {stem}"), p));
-        } else if p.join("main.rs").is_file() {
-            roots.push((format!("{package} bin {stem}"), p.join("main.rs")));
-        }
-    }
-    roots
-        .into_iter()
-        .map(|(name, root)| crate_of(name, &root))
-        .collect()
 }
 
 /// One crate from its root file.
-fn crate_of(name: String, root: &Path) -> Crate {
+pub fn crate_of(name: String, kind: Kind, root: &Path) -> Crate {
+    let (tree, test_files, lexed) = module_tree(root);
+    let mut names: BTreeMap<String, Names> = BTreeMap::new();
+    for (module, lexed) in &lexed {
+        names.extend(names_in_file(&lexed.tokens, module));
+    }
+    let known: BTreeSet<String> = tree.keys().cloned().collect();
+    let resolver = Resolver {
+        known: &known,
+        names: &names,
+    };
+    let mut modules: BTreeMap<String, Module> = tree
+        .iter()
+        .map(|(m, f)| {
+            let module = Module {
+                file: f.clone(),
+                ..Module::default()
+            };
+            (m.clone(), module)
+        })
+        .collect();
+    for (module, own) in &names {
+        let Some(m) = modules.get_mut(module) else {
+            continue;
+        };
+        for (to, line, text) in resolver.edges(module, own) {
+            if to != *module && m.imports.insert(to.clone()) {
+                let file = m.file.clone();
+                m.sites.insert(to, Site { file, line, text });
+            }
+        }
+    }
+    Crate {
+        name,
+        kind,
+        modules,
+        test_files,
+    }
+}
+
+/// A crate's modules and their files, the files of its test-only modules, and each
+/// module file's tokens (by the module the file holds).
+type Tree = (
+    BTreeMap<String, PathBuf>,
+    BTreeSet<PathBuf>,
+    BTreeMap<String, Lexed>,
+);
+
+/// The module tree from the root file: every module and its file, as the compiler finds it.
+fn module_tree(root: &Path) -> Tree {
     let dir = root.parent().unwrap_or(Path::new(".")).to_path_buf();
-    // First the module tree (names and files), then each module's imports, which need the
-    // whole tree to find the longest module prefix of a path.
-    let mut files: Vec<(String, PathBuf, PathBuf)> = vec![(String::new(), root.to_path_buf(), dir)];
+    // (module, file, its children's directory, declared under test code).
+    let mut files: Vec<(String, PathBuf, PathBuf, bool)> =
+        vec![(String::new(), root.to_path_buf(), dir, false)];
     let mut lexed = BTreeMap::new();
     let mut tree: BTreeMap<String, PathBuf> = BTreeMap::new();
-    while let Some((module, file, child_dir)) = files.pop() {
+    let mut test_files = BTreeSet::new();
+    while let Some((module, file, child_dir, test)) = files.pop() {
         let Ok(text) = std::fs::read_to_string(&file) else {
             continue;
         };
-        let tokens = lex(&text).tokens;
-        tree.insert(module.clone(), file.clone());
-        for (m, d, decl) in module_declarations(&tokens, &module, &child_dir) {
-            match decl {
-                Decl::Inline => {
-                    tree.insert(m, file.clone());
+        let l = lex(&text);
+        let file_dir = file.parent().unwrap_or(Path::new(".")).to_path_buf();
+        for decl in module_declarations(&l, &module, &child_dir) {
+            let test = test || decl.test;
+            match decl.file {
+                None if test => {}
+                None => {
+                    tree.insert(decl.module, file.clone());
                 }
-                Decl::File => {
-                    let own = d.join(last(&m));
-                    let flat = d.join(format!("{}.rs", last(&m)));
+                Some(DeclFile::Path(p)) => {
+                    let own = file_dir.clone();
+                    files.push((decl.module, normalize(&file_dir.join(p)), own, test));
+                }
+                Some(DeclFile::Default(d)) => {
+                    let name = last(&decl.module).to_string();
+                    let own = d.join(&name);
+                    let flat = d.join(format!("{name}.rs"));
                     let nested = own.join("mod.rs");
                     if flat.is_file() {
-                        files.push((m, flat, own));
+                        files.push((decl.module, flat, own, test));
                     } else if nested.is_file() {
-                        files.push((m, nested, own));
+                        files.push((decl.module, nested, own, test));
                     }
                 }
             }
         }
-        lexed.insert(module, tokens);
-    }
-    let known: BTreeSet<String> = tree.keys().cloned().collect();
-    let mut modules: BTreeMap<String, Module> = tree
-        .iter()
-        .map(|(m, f)| {
-            (
-                m.clone(),
-                Module {
-                    file: f.clone(),
-                    imports: BTreeSet::new(),
-                },
-            )
-        })
-        .collect();
-    for (module, tokens) in &lexed {
-        for (from, to) in imports(tokens, module, &known) {
-            if from != to {
-                if let Some(m) = modules.get_mut(&from) {
-                    m.imports.insert(to);
-                }
-            }
+        if test {
+            test_files.insert(file);
+        } else {
+            tree.insert(module.clone(), file);
+            lexed.insert(module, l);
         }
     }
-    Crate { name, modules }
+    (tree, test_files, lexed)
+}
+
+/// `a/b/../c` as `a/c` (a `#[path]` that climbs out of its folder), without touching the disk.
+fn normalize(path: &Path) -> PathBuf {
+    let mut out = PathBuf::new();
+    for c in path.components() {
+        match c {
+            std::path::Component::ParentDir if out.file_name().is_some() => {
+                out.pop();
+            }
+            std::path::Component::CurDir => {}
+            c => out.push(c),
+        }
+    }
+    out
 }
 
 fn last(module: &str) -> &str {
     module.rsplit("::").next().unwrap_or(module)
-}
-
-fn join(parent: &str, child: &str) -> String {
-    if parent.is_empty() {
-        child.to_string()
-    } else {
-        format!("{parent}::{child}")
-    }
 }
 
 fn parent(module: &str) -> String {
@@ -148,16 +195,25 @@ fn parent(module: &str) -> String {
         .map_or(String::new(), |(p, _)| p.to_string())
 }
 
-enum Decl {
-    /// `mod name;`: a file.
-    File,
-    /// `mod name { … }`: in this file.
-    Inline,
+/// Where a declared module's file is.
+enum DeclFile {
+    /// `#[path = "…"] mod name;`: this path, relative to the declaring file's directory.
+    Path(String),
+    /// `mod name;`: `name.rs` or `name/mod.rs` in this directory.
+    Default(PathBuf),
 }
 
-/// The `mod` declarations of a file outside test code, with the directory where each
-/// declared module's own children live.
-fn module_declarations(tokens: &[Token], module: &str, dir: &Path) -> Vec<(String, PathBuf, Decl)> {
+/// A `mod` declaration: the module, its file (`None` for an inline `mod name { … }`), and
+/// whether it is under test code.
+struct Decl {
+    module: String,
+    file: Option<DeclFile>,
+    test: bool,
+}
+
+/// The `mod` declarations of a file, with where each declared module's file is.
+fn module_declarations(lexed: &Lexed, module: &str, dir: &Path) -> Vec<Decl> {
+    let tokens = &lexed.tokens;
     let tests = test_spans(tokens);
     let mut out = Vec::new();
     // Inline modules open a scope: (module path, its children's directory, closing brace).
@@ -167,7 +223,7 @@ fn module_declarations(tokens: &[Token], module: &str, dir: &Path) -> Vec<(Strin
         while scopes.len() > 1 && scopes.last().is_some_and(|s| i > s.2) {
             scopes.pop();
         }
-        if !t.is_word("mod") || in_spans(&tests, i) {
+        if !t.is_word("mod") {
             continue;
         }
         let Some(name) = tokens.get(i + 1).and_then(Token::word) else {
@@ -175,11 +231,26 @@ fn module_declarations(tokens: &[Token], module: &str, dir: &Path) -> Vec<(Strin
         };
         let (current, current_dir, _) = scopes.last().cloned().unwrap_or_default();
         let m = join(&current, name);
+        let test = in_spans(&tests, i);
         match tokens.get(i + 2) {
-            Some(t) if t.is_punct(";") => out.push((m, current_dir, Decl::File)),
+            Some(t) if t.is_punct(";") => {
+                let file = match path_attribute(lexed, i) {
+                    Some(p) => DeclFile::Path(p),
+                    None => DeclFile::Default(current_dir),
+                };
+                out.push(Decl {
+                    module: m,
+                    file: Some(file),
+                    test,
+                });
+            }
             Some(t) if t.is_punct("{") => {
                 let close = matching_brace(tokens, i + 2);
-                out.push((m.clone(), current_dir.clone(), Decl::Inline));
+                out.push(Decl {
+                    module: m.clone(),
+                    file: None,
+                    test,
+                });
                 scopes.push((m, current_dir.join(name), close));
             }
             _ => {}
@@ -188,287 +259,318 @@ fn module_declarations(tokens: &[Token], module: &str, dir: &Path) -> Vec<(Strin
     out
 }
 
-/// (module, module it names) for every path in a file's code outside test code.
-fn imports(tokens: &[Token], module: &str, known: &BTreeSet<String>) -> Vec<(String, String)> {
-    let tests = test_spans(tokens);
-    let mut out = Vec::new();
-    let mut scopes: Vec<(String, usize)> = vec![(module.to_string(), usize::MAX)];
-    let mut i = 0;
-    while i < tokens.len() {
-        while scopes.len() > 1 && scopes.last().is_some_and(|s| i > s.1) {
-            scopes.pop();
+/// The `#[path = "…"]` among the attributes and qualifiers before the `mod` at `i`.
+fn path_attribute(lexed: &Lexed, i: usize) -> Option<String> {
+    let tokens = &lexed.tokens;
+    let mut k = i;
+    // Back over `pub`, `pub(crate)` and attributes: stop at the previous item's end.
+    while k > 0 {
+        k -= 1;
+        let t = &tokens[k];
+        if t.is_punct(";") || t.is_punct("}") || t.is_punct("{") {
+            return None;
         }
-        let current = scopes.last().map(|s| s.0.clone()).unwrap_or_default();
-        if in_spans(&tests, i) {
-            i += 1;
-            continue;
+        if t.is_word("path")
+            && tokens.get(k + 1).is_some_and(|t| t.is_punct("="))
+            && k > 0
+            && tokens[k - 1].is_punct("[")
+        {
+            return lexed.string(k + 2).map(str::to_string);
         }
-        let t = &tokens[i];
-        if t.is_word("mod") && tokens.get(i + 2).is_some_and(|t| t.is_punct("{")) {
-            if let Some(name) = tokens[i + 1].word() {
-                scopes.push((join(&current, name), matching_brace(tokens, i + 2)));
-            }
-            i += 3;
-            continue;
-        }
-        if t.is_word("use") {
-            let end = item_end(tokens, i);
-            let mut paths = Vec::new();
-            use_tree(&tokens[i + 1..end], &mut Vec::new(), &mut paths);
-            for p in paths {
-                if let Some(to) = resolve(&p, &current, known) {
-                    out.push((current.clone(), to));
-                }
-            }
-            i = end;
-            continue;
-        }
-        // A path in code: `crate::…`, `super::…`, `self::…`, or `child::…` at its start.
-        let starts_path = tokens.get(i + 1).is_some_and(|n| n.is_punct("::"))
-            && !(i > 0 && (tokens[i - 1].is_punct("::") || tokens[i - 1].is_punct("$")));
-        if let (true, Some(first)) = (starts_path, t.word()) {
-            let mut path = vec![first.to_string()];
-            let mut j = i + 1;
-            while tokens.get(j).is_some_and(|t| t.is_punct("::")) {
-                match tokens.get(j + 1).and_then(Token::word) {
-                    Some(w) => path.push(w.to_string()),
-                    None => break,
-                }
-                j += 2;
-            }
-            if let Some(to) = resolve(&path, &current, known) {
-                out.push((current.clone(), to));
-            }
-            i = j;
-            continue;
-        }
-        i += 1;
     }
-    out
+    None
 }
 
-/// The paths a `use` tree names (its tokens after `use`, up to the `;`), each as segments
-/// from its start: `crate::a::{b, c::{self, d}}` gives `crate::a::b`, `crate::a::c`,
-/// `crate::a::c::d`.
-fn use_tree(tokens: &[Token], prefix: &mut Vec<String>, out: &mut Vec<Vec<String>>) -> usize {
-    let depth = prefix.len();
-    let mut i = 0;
-    while i < tokens.len() {
-        let t = &tokens[i];
-        if t.is_punct("::") {
-            i += 1;
-        } else if t.is_punct("{") {
-            // A group: each element is a tree with this prefix.
-            i += 1;
-            while i < tokens.len() && !tokens[i].is_punct("}") {
-                if tokens[i].is_punct(",") {
-                    i += 1;
+/// What a path or a name resolves to.
+#[derive(Clone, Debug, PartialEq, Eq)]
+enum Found {
+    /// An item (or module) of this module of the crate.
+    Module(String),
+    /// Something of another crate (`std`, `nalgebra`), perhaps re-exported by the crate.
+    External,
+    /// Nothing the scan can see (a local item, a macro-made one).
+    Unknown,
+}
+
+/// How deep re-exports are followed before giving up (a crate does not chain this many).
+const MAX_HOPS: usize = 16;
+
+/// Resolves paths against a crate's modules and their names.
+struct Resolver<'a> {
+    known: &'a BTreeSet<String>,
+    names: &'a BTreeMap<String, Names>,
+}
+
+impl Resolver<'_> {
+    /// The edges of module `module` with names `own`: (to, line, text).
+    fn edges(&self, module: &str, own: &Names) -> Vec<(String, usize, String)> {
+        let mut out = Vec::new();
+        for u in &own.uses {
+            let Some(binds) = &u.binds else {
+                // A glob: an edge to the module that defines each name its code uses.
+                let Found::Module(from) = self.resolve(&u.segments, module, 0) else {
                     continue;
+                };
+                for w in &own.words {
+                    if let Found::Module(to) = self.lookup(&from, w, 0) {
+                        let via = (to != from).then_some(from.as_str());
+                        out.push((to.clone(), u.line, with_via(u.text(), via)));
+                    }
                 }
-                // An element that is not a tree (nothing Rust accepts) is skipped.
-                i += use_tree(&tokens[i..], prefix, out).max(1);
+                continue;
+            };
+            let (found, via) = self.resolve_via(&u.segments, module);
+            let Found::Module(to) = found else { continue };
+            let trait_import = !u.public
+                && u.segments
+                    .last()
+                    .is_some_and(|n| self.kind_in(&to, n) == Some(ItemKind::Trait));
+            if own.words.contains(binds) || binds == "_" || trait_import {
+                out.push((to, u.line, with_via(u.text(), via.as_deref())));
             }
-            i += 1;
-            break;
-        } else if t.is_punct("*") {
-            out.push(prefix.clone());
-            i += 1;
-            break;
-        } else if let Some(w) = t.word() {
-            if w == "self" && !prefix.is_empty() {
-                // `a::{self, …}`: the module `a` itself.
+        }
+        for p in &own.paths {
+            let (found, via) = self.resolve_via(&p.segments, module);
+            if let Found::Module(to) = found {
+                let text = with_via(p.segments.join("::"), via.as_deref());
+                out.push((to, p.line, text));
+            }
+        }
+        out
+    }
+
+    fn kind_in(&self, module: &str, name: &str) -> Option<ItemKind> {
+        self.names.get(module)?.defines.get(name).copied()
+    }
+
+    /// Resolves `path` in `current`, and the module whose namespace passed it on if that is
+    /// not the one that defines it (`trajectory` for `super::Limits`).
+    fn resolve_via(&self, path: &[String], current: &str) -> (Found, Option<String>) {
+        let found = self.resolve(path, current, 0);
+        let prefix = self.module_prefix(path, current);
+        let via = match (&found, prefix) {
+            (Found::Module(to), Some((m, _))) if *to != m => Some(m),
+            _ => None,
+        };
+        (found, via)
+    }
+
+    /// What `path`, written in module `current`, names.
+    fn resolve(&self, path: &[String], current: &str, hops: usize) -> Found {
+        if hops > MAX_HOPS {
+            return Found::Unknown;
+        }
+        if let Some(bound) = self.bound_by_use(path, current) {
+            // The path starts with a name a `use` of this module binds: follow that `use`.
+            let mut full = bound.segments.clone();
+            full.extend(path[1..].iter().cloned());
+            return self.resolve(&full, current, hops + 1);
+        }
+        let Some((module, rest)) = self.module_prefix(path, current) else {
+            return Found::External;
+        };
+        match rest.first() {
+            None => Found::Module(module),
+            Some(name) => match self.lookup(&module, name, hops + 1) {
+                Found::Unknown => Found::Module(module),
+                found => found,
+            },
+        }
+    }
+
+    /// The longest prefix of `path` (written in `current`) that is a module of the crate,
+    /// and the segments after it; `None` for a path that does not start at a module of the
+    /// crate (`std::fmt`, a local type).
+    fn module_prefix<'p>(
+        &self,
+        path: &'p [String],
+        current: &str,
+    ) -> Option<(String, &'p [String])> {
+        let (mut base, rest) = match path.first()?.as_str() {
+            "crate" => (String::new(), &path[1..]),
+            "self" => (current.to_string(), &path[1..]),
+            "super" => {
+                let mut base = current.to_string();
+                let mut n = 0;
+                while path.get(n).is_some_and(|s| s == "super") {
+                    base = parent(&base);
+                    n += 1;
+                }
+                (base, &path[n..])
+            }
+            // A child module by name (2018 paths: `use check::invalid;` in `scenario`).
+            first if self.known.contains(&join(current, first)) => (current.to_string(), path),
+            _ => return None,
+        };
+        let mut found = base.clone();
+        let mut used = 0;
+        for (k, seg) in rest.iter().enumerate() {
+            base = join(&base, seg);
+            if self.known.contains(&base) {
+                found = base.clone();
+                used = k + 1;
             } else {
-                prefix.push(w.to_string());
+                break;
             }
-            i += 1;
-            if tokens.get(i).is_some_and(|t| t.is_punct("::")) {
-                continue;
-            }
-            if tokens.get(i).is_some_and(|t| t.is_word("as")) {
-                i += 2;
-            }
-            out.push(prefix.clone());
-            break;
-        } else {
-            // `,`, `}` or `;`: the end of this tree.
-            break;
         }
+        Some((found, &rest[used..]))
     }
-    prefix.truncate(depth);
-    i
-}
 
-/// The module a path names: its longest prefix that is a module of the crate, `None` for a
-/// path outside the crate (another crate, `std`). `current` is the module the path is in.
-fn resolve(path: &[String], current: &str, known: &BTreeSet<String>) -> Option<String> {
-    let (mut base, rest) = match path.first()?.as_str() {
-        "crate" => (String::new(), &path[1..]),
-        "self" => (current.to_string(), &path[1..]),
-        "super" => {
-            let mut base = current.to_string();
-            let mut n = 0;
-            while path.get(n).is_some_and(|s| s == "super") {
-                base = parent(&base);
-                n += 1;
-            }
-            (base, &path[n..])
+    /// The top-level `use` of `current` that binds the first segment of `path`, if the path
+    /// does not start at a module already (`paths::circle::f` after `use super::paths;`).
+    fn bound_by_use(&self, path: &[String], current: &str) -> Option<&super::names::UsePath> {
+        let first = path.first()?;
+        if ["crate", "self", "super"].contains(&first.as_str())
+            || self.known.contains(&join(current, first))
+        {
+            return None;
         }
-        // A child module by name (2018 paths: `use check::invalid;` in `scenario`).
-        first if known.contains(&join(current, first)) => (current.to_string(), path),
-        _ => return None,
-    };
-    let mut found = base.clone();
-    for seg in rest {
-        base = join(&base, seg);
-        if known.contains(&base) {
-            found = base.clone();
-        } else {
-            break;
-        }
+        self.names
+            .get(current)?
+            .uses
+            .iter()
+            .find(|u| u.top_level && u.binds.as_ref() == Some(first) && u.segments[0] != *first)
     }
-    Some(found)
-}
 
-/// True if `a` is an ancestor of `b` (`scenario` of `scenario::check`); the root (`""`) is
-/// everything's ancestor.
-pub fn is_ancestor(a: &str, b: &str) -> bool {
-    a != b && (a.is_empty() || b.starts_with(&format!("{a}::")))
-}
-
-/// True if module `x`'s own code depends on module `y`: it names `y`, a module inside `y`
-/// (`y::z`), or a module that contains `y` (`scenario` for `scenario::check`: a parent
-/// re-exports and uses its children) other than one that contains `x` too (a module's own
-/// parent, whose items its siblings also use, or the root).
-fn depends(x: &str, xm: &Module, y: &str) -> bool {
-    xm.imports
-        .iter()
-        .any(|m| m == y || is_ancestor(y, m) || (is_ancestor(m, y) && !is_ancestor(m, x)))
-}
-
-/// The pairs of modules of `krate` that import each other, each pair once, sorted. A module
-/// depends on another when its own code names that module, a module inside it, or a module
-/// that contains it other than one that contains the first module too (its parent's items are
-/// its siblings' as well). A module and its own ancestor or descendant are never a pair: a
-/// parent declares and re-exports its children, and children use their parent's items.
-pub fn import_circles(krate: &Crate) -> Vec<(String, String)> {
-    let mut out = Vec::new();
-    for (a, ma) in &krate.modules {
-        for (b, mb) in krate.modules.range::<String, _>((
-            std::ops::Bound::Excluded(a.clone()),
-            std::ops::Bound::Unbounded,
-        )) {
-            if is_ancestor(a, b) || is_ancestor(b, a) {
-                continue;
-            }
-            if depends(a, ma, b) && depends(b, mb, a) {
-                out.push((a.clone(), b.clone()));
+    /// The module that defines `name` as seen from module `module`'s namespace: its own item,
+    /// a child module, or where a `use` or glob of it takes the name from.
+    fn lookup(&self, module: &str, name: &str, hops: usize) -> Found {
+        if hops > MAX_HOPS {
+            return Found::Unknown;
+        }
+        let child = join(module, name);
+        if self.known.contains(&child) {
+            return Found::Module(child);
+        }
+        let Some(names) = self.names.get(module) else {
+            return Found::Unknown;
+        };
+        if names.defines.contains_key(name) {
+            return Found::Module(module.to_string());
+        }
+        let top = names.uses.iter().filter(|u| u.top_level);
+        if let Some(u) = top.clone().find(|u| u.binds.as_deref() == Some(name)) {
+            return self.resolve(&u.segments, module, hops + 1);
+        }
+        for glob in top.filter(|u| u.binds.is_none()) {
+            if let Found::Module(from) = self.resolve(&glob.segments, module, hops + 1) {
+                if let found @ Found::Module(_) = self.lookup(&from, name, hops + 1) {
+                    return found;
+                }
             }
         }
+        Found::Unknown
     }
-    out
+}
+
+fn with_via(text: String, via: Option<&str>) -> String {
+    match via {
+        Some(m) => format!("{text} (through {})", display(m)),
+        None => text,
+    }
+}
+
+/// A module's name as the rules print it: the root is `crate`.
+pub fn display(module: &str) -> &str {
+    if module.is_empty() {
+        "crate"
+    } else {
+        module
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn paths(src: &str) -> Vec<String> {
-        let toks = lex(src).tokens;
-        let mut out = Vec::new();
-        use_tree(&toks[1..], &mut Vec::new(), &mut out);
-        out.into_iter().map(|p| p.join("::")).collect()
-    }
-
-    #[test]
-    fn use_trees_flatten_to_their_paths() {
-        assert_eq!(
-            paths("use crate::a::{b, c::{self, d as e}, f::*};"),
-            [
-                "crate::a::b",
-                "crate::a::c",
-                "crate::a::c::d",
-                "crate::a::f"
-            ]
-        );
-        assert_eq!(paths("use super::super::x;"), ["super::super::x"]);
-        assert_eq!(paths("use std::fmt;"), ["std::fmt"]);
-    }
-
-    fn known(ms: &[&str]) -> BTreeSet<String> {
-        ms.iter().map(|s| s.to_string()).collect()
-    }
-
-    #[test]
-    fn paths_resolve_to_their_longest_module_prefix() {
-        let k = known(&["", "a", "a::b", "c"]);
-        let r = |p: &str, cur: &str| {
-            let segs: Vec<String> = p.split("::").map(str::to_string).collect();
-            resolve(&segs, cur, &k)
-        };
-        assert_eq!(r("crate::a::b::Item", "c").as_deref(), Some("a::b"));
-        assert_eq!(r("crate::a::Item", "c").as_deref(), Some("a"));
-        assert_eq!(r("crate::Item", "c").as_deref(), Some(""));
-        assert_eq!(r("super::c::f", "a::b").as_deref(), Some("a"));
-        assert_eq!(r("super::super::c::f", "a::b").as_deref(), Some("c"));
-        assert_eq!(r("self::b::f", "a").as_deref(), Some("a::b"));
-        assert_eq!(r("b::f", "a").as_deref(), Some("a::b"));
-        assert_eq!(r("nalgebra::Vector6", "a"), None);
-    }
-
-    #[test]
-    fn code_paths_and_use_lines_become_imports_but_not_comments_or_tests() {
-        let k = known(&["", "a", "a::b", "c", "d"]);
-        let src = "\
-use super::c::X; // crate::d::Y
-fn f() { crate::d::g(); b::h(); let s = \"crate::x\"; }
-pub(crate) fn g() {}
-#[cfg(test)]
-mod tests { use crate::x::Z; }
-";
-        let got: BTreeSet<String> = imports(&lex(src).tokens, "a", &k)
-            .into_iter()
-            .map(|(_, to)| to)
-            .collect();
-        assert_eq!(got, known(&["a::b", "c", "d"]));
-    }
-
-    fn krate(edges: &[(&str, &[&str])]) -> Crate {
-        Crate {
-            name: "t".into(),
-            modules: edges
-                .iter()
-                .map(|(m, to)| {
-                    (
-                        m.to_string(),
-                        Module {
-                            file: PathBuf::new(),
-                            imports: known(to),
-                        },
-                    )
-                })
-                .collect(),
+    /// A crate from its files (`("lib.rs", "mod a; …")`), written under a directory of its
+    /// own (`name`, one per test).
+    fn krate(name: &str, files: &[(&str, &str)]) -> Crate {
+        let dir = std::env::temp_dir().join(format!("xtask-modules-{}-{name}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        for (f, text) in files {
+            let p = dir.join(f);
+            std::fs::create_dir_all(p.parent().unwrap()).unwrap();
+            std::fs::write(p, text).unwrap();
         }
+        let c = crate_of("t".into(), Kind::Lib, &dir.join("lib.rs"));
+        let _ = std::fs::remove_dir_all(&dir);
+        c
+    }
+
+    fn edges(c: &Crate) -> Vec<String> {
+        c.modules
+            .iter()
+            .flat_map(|(m, info)| {
+                info.imports
+                    .iter()
+                    .map(move |to| format!("{} -> {}", display(m), display(to)))
+            })
+            .collect()
     }
 
     #[test]
-    fn circles_are_pairs_that_import_each_other_or_each_others_parents() {
-        let c = krate(&[
-            ("", &["a", "b", "s"]),
-            ("a", &["b", ""]),
-            ("b", &["a"]),
-            // A parent and its child using each other is not a circle.
-            ("s", &["s::p", "s::q"]),
-            ("s::p", &["s", "s::q", "paper"]),
-            ("s::q", &["s"]),
-            // `paper` imports `s`, which holds `s::p`, which imports `paper`.
-            ("paper", &["s"]),
-            ("sil", &["s::q"]),
-            // Siblings that use their parent's items are not a circle.
-            ("s::r", &["s"]),
+    fn names_resolve_through_re_exports_to_the_module_that_defines_them() {
+        let c = krate("re-exports", &[
+            ("lib.rs", "mod t; mod u; mod v; mod w; pub use t::Limits; fn root() {}"),
+            ("v.rs", "pub trait Tr { fn m(&self); }"),
+            // A re-export its own code does not use: no edge.
+            ("w.rs", "pub use crate::t::Limits;"),
+            (
+                "t/mod.rs",
+                "mod limits; mod error; mod deep; pub use limits::Limits; use error::Error as E;\n\
+                 pub fn f(e: E) {}",
+            ),
+            ("t/limits.rs", "pub struct Limits;"),
+            (
+                "t/error.rs",
+                "use super::Limits;\npub struct Error(Limits);",
+            ),
+            ("t/deep.rs", "use super::*; fn g(_: Limits) {}"),
+            // A path through the root's re-export, and a trait imported for its methods.
+            (
+                "u.rs",
+                "pub use crate::t::Limits as L2; use crate::v::Tr;\n\
+                 fn h() { let _ = crate::Limits; 1.m(); crate::root(); }",
+            ),
         ]);
         assert_eq!(
-            import_circles(&c),
-            [("a", "b"), ("paper", "s::p")].map(|(x, y)| (x.to_string(), y.to_string()))
+            edges(&c),
+            [
+                "t -> t::error",
+                "t::deep -> t::limits",
+                "t::error -> t::limits",
+                "u -> crate",
+                "u -> t::limits",
+                "u -> v",
+            ]
         );
+        let site = &c.modules["t::error"].sites["t::limits"];
+        assert_eq!(
+            (site.line, site.text.as_str()),
+            (1, "use super::Limits (through t)")
+        );
+    }
+
+    #[test]
+    fn path_attributes_inline_modules_and_test_modules() {
+        let c = krate("path", &[
+            (
+                "lib.rs",
+                "#[path = \"other/x.rs\"]\npub mod x;\nmod i { pub fn f() { crate::x::g(); } }\n\
+                 #[cfg(test)]\nmod tests;",
+            ),
+            ("other/x.rs", "pub fn g() {}"),
+            ("tests.rs", "fn t() {}"),
+        ]);
+        assert_eq!(
+            c.modules.keys().collect::<Vec<_>>(),
+            ["", "i", "x"],
+            "{c:?}"
+        );
+        assert!(c.modules["x"].file.ends_with("other/x.rs"));
+        assert_eq!(edges(&c), ["i -> x"]);
+        assert_eq!(c.test_files.len(), 1);
+        assert!(c.test_files.iter().all(|f| f.ends_with("tests.rs")));
     }
 }
