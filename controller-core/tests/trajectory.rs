@@ -9,6 +9,7 @@
 //! an absolute error of ≈ 1e-3 (up to 2e-3 documented). The numbers measured with each backend
 //! are given at each tolerance.
 
+use controller_core::trajectory::{Circle, FigureEight, Helix, LawnMower};
 use controller_core::trajectory::{
     Desired, Table1Case, Trajectory, TrajectoryError, TrajectoryKind,
 };
@@ -36,20 +37,20 @@ fn all_trajectories() -> Vec<(String, Trajectory)> {
     v.push(("helix".into(), Trajectory::helix(10.0, 0.2).unwrap()));
     v.push((
         "figure-eight-fast".into(),
-        Trajectory::new(TrajectoryKind::FigureEight {
+        Trajectory::new(TrajectoryKind::FigureEight(FigureEight {
             amplitude: 7.0,
             omega: 0.3,
             depth: 12.0,
-        })
+        }))
         .unwrap(),
     ));
     v.push((
         "lawn-mower-slow-descending".into(),
-        Trajectory::new(TrajectoryKind::LawnMower {
+        Trajectory::new(TrajectoryKind::LawnMower(LawnMower {
             scale: 0.5,
             omega: 0.02,
             depth: 40.0,
-        })
+        }))
         .unwrap(),
     ));
     v
@@ -76,10 +77,10 @@ const FD_RATE: u32 = 1_000_000;
 /// Hence a libm tolerance of 1e-3 of each component's peak derivative (≈ 2× the sum).
 fn fd_half_step(kind: TrajectoryKind) -> u64 {
     let omega = match kind {
-        TrajectoryKind::Circle { omega, .. }
-        | TrajectoryKind::Helix { omega, .. }
-        | TrajectoryKind::FigureEight { omega, .. }
-        | TrajectoryKind::LawnMower { omega, .. } => omega as f64,
+        TrajectoryKind::Circle(Circle { omega, .. })
+        | TrajectoryKind::Helix(Helix { omega, .. })
+        | TrajectoryKind::FigureEight(FigureEight { omega, .. })
+        | TrajectoryKind::LawnMower(LawnMower { omega, .. }) => omega as f64,
         TrajectoryKind::Waypoints { .. } => {
             unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
         }
@@ -258,10 +259,10 @@ fn figure_eight_and_lawn_mower_paper_values() {
             }
             // z = depth with zero rate, except for the helix (tested below).
             let depth = match traj.kind() {
-                TrajectoryKind::Circle { depth, .. }
-                | TrajectoryKind::FigureEight { depth, .. }
-                | TrajectoryKind::LawnMower { depth, .. } => Some(depth),
-                TrajectoryKind::Helix { .. } => None,
+                TrajectoryKind::Circle(Circle { depth, .. })
+                | TrajectoryKind::FigureEight(FigureEight { depth, .. })
+                | TrajectoryKind::LawnMower(LawnMower { depth, .. }) => Some(depth),
+                TrajectoryKind::Helix(_) => None,
                 TrajectoryKind::Waypoints { .. } => {
                     unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
                 }
@@ -577,14 +578,14 @@ fn accel_bound_bounds_and_is_useful() {
 /// (0.1f32 = 0.100000001490…; the 1.5e-9 difference would be 5e-4 rad after 100 h).
 fn reference(kind: TrajectoryKind, t: f64) -> (f64, f64, f64) {
     match kind {
-        TrajectoryKind::Circle { radius, omega, .. }
-        | TrajectoryKind::Helix { radius, omega, .. } => {
+        TrajectoryKind::Circle(Circle { radius, omega, .. })
+        | TrajectoryKind::Helix(Helix { radius, omega, .. }) => {
             let (r, w) = (radius as f64, omega as f64);
             (r * (w * t).sin(), r * (w * t).cos(), wrap(w * t))
         }
-        TrajectoryKind::FigureEight {
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude, omega, ..
-        } => {
+        }) => {
             let (a, w) = (amplitude as f64, omega as f64);
             let psi: f64 = (1..=9)
                 .step_by(2)
@@ -602,7 +603,7 @@ fn reference(kind: TrajectoryKind, t: f64) -> (f64, f64, f64) {
                 / PI;
             (a * (w * t).sin(), a * (0.5 * w * t).cos(), wrap(psi))
         }
-        TrajectoryKind::LawnMower { scale, omega, .. } => {
+        TrajectoryKind::LawnMower(LawnMower { scale, omega, .. }) => {
             let (s, w) = (scale as f64, omega as f64);
             let psi: f64 = (1..=9)
                 .map(|n| {
@@ -634,9 +635,10 @@ fn reference_tol(kind: TrajectoryKind) -> (f64, f64) {
         return (1e-4, 1e-4);
     }
     let amp = match kind {
-        TrajectoryKind::Circle { radius, .. } | TrajectoryKind::Helix { radius, .. } => radius,
-        TrajectoryKind::FigureEight { amplitude, .. } => amplitude,
-        TrajectoryKind::LawnMower { scale, .. } => 15.0 * scale,
+        TrajectoryKind::Circle(Circle { radius, .. })
+        | TrajectoryKind::Helix(Helix { radius, .. }) => radius,
+        TrajectoryKind::FigureEight(FigureEight { amplitude, .. }) => amplitude,
+        TrajectoryKind::LawnMower(LawnMower { scale, .. }) => 15.0 * scale,
         TrajectoryKind::Waypoints { .. } => {
             unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
         }
@@ -728,36 +730,38 @@ fn any_kind() -> impl Strategy<Value = TrajectoryKind> {
     let rate = -Trajectory::MAX_DEPTH_RATE..=Trajectory::MAX_DEPTH_RATE;
     prop_oneof![
         (size.clone(), omega.clone(), depth.clone()).prop_map(|(radius, omega, depth)| {
-            TrajectoryKind::Circle {
+            TrajectoryKind::Circle(Circle {
                 radius,
                 omega,
                 depth,
-            }
+            })
         }),
         (size.clone(), omega.clone(), depth.clone()).prop_map(|(amplitude, omega, depth)| {
-            TrajectoryKind::FigureEight {
+            TrajectoryKind::FigureEight(FigureEight {
                 amplitude,
                 omega,
                 depth,
-            }
+            })
         }),
         (
             1e-3f32..=Trajectory::MAX_SIZE / 15.0,
             omega.clone(),
             depth.clone()
         )
-            .prop_map(|(scale, omega, depth)| TrajectoryKind::LawnMower {
-                scale,
-                omega,
-                depth,
-            }),
+            .prop_map(
+                |(scale, omega, depth)| TrajectoryKind::LawnMower(LawnMower {
+                    scale,
+                    omega,
+                    depth,
+                })
+            ),
         (size, omega, depth, rate).prop_map(|(radius, omega, depth, depth_rate)| {
-            TrajectoryKind::Helix {
+            TrajectoryKind::Helix(Helix {
                 radius,
                 omega,
                 depth,
                 depth_rate,
-            }
+            })
         }),
     ]
 }
@@ -788,33 +792,33 @@ proptest! {
 fn extreme_ticks_and_parameters_stay_finite() {
     let m = Trajectory::MAX_SIZE;
     let kinds = [
-        TrajectoryKind::Circle {
+        TrajectoryKind::Circle(Circle {
             radius: m,
             omega: Trajectory::MAX_OMEGA,
             depth: -Trajectory::MAX_DEPTH,
-        },
-        TrajectoryKind::FigureEight {
+        }),
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude: m,
             omega: Trajectory::MAX_OMEGA,
             depth: Trajectory::MAX_DEPTH,
-        },
-        TrajectoryKind::LawnMower {
+        }),
+        TrajectoryKind::LawnMower(LawnMower {
             scale: m / 15.0,
             omega: Trajectory::MAX_OMEGA,
             depth: 0.0,
-        },
-        TrajectoryKind::Helix {
+        }),
+        TrajectoryKind::Helix(Helix {
             radius: m,
             omega: Trajectory::MAX_OMEGA,
             depth: Trajectory::MAX_DEPTH,
             depth_rate: Trajectory::MAX_DEPTH_RATE,
-        },
-        TrajectoryKind::Helix {
+        }),
+        TrajectoryKind::Helix(Helix {
             radius: 1e-3,
             omega: f32::MIN_POSITIVE,
             depth: 0.0,
             depth_rate: -Trajectory::MAX_DEPTH_RATE,
-        },
+        }),
     ];
     for kind in kinds {
         let traj = Trajectory::new(kind).unwrap();
@@ -889,11 +893,11 @@ fn constructor_errors_name_the_parameter() {
         Err(OutOfRange { parameter: "radius", max, .. }) if max == Trajectory::MAX_SIZE
     ));
     let circle = |omega, depth| {
-        Trajectory::new(TrajectoryKind::Circle {
+        Trajectory::new(TrajectoryKind::Circle(Circle {
             radius: 10.0,
             omega,
             depth,
-        })
+        }))
     };
     assert_eq!(
         circle(0.0, 5.0),
@@ -928,11 +932,11 @@ fn constructor_errors_name_the_parameter() {
             ..
         })
     ));
-    let lawn = Trajectory::new(TrajectoryKind::LawnMower {
+    let lawn = Trajectory::new(TrajectoryKind::LawnMower(LawnMower {
         scale: 1.0,
         omega: 0.0,
         depth: 5.0,
-    });
+    }));
     assert_eq!(
         lawn,
         Err(NotPositive {

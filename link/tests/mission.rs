@@ -6,16 +6,17 @@ use auv_link::{
     decode_frame, encode, AxisPriority, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg,
     ThrustUnit, MAX_FRAME,
 };
+use controller_core::trajectory::{Circle, FigureEight, Helix, LawnMower};
 use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
 /// Which kind a mission is. Exhaustive on purpose: a kind added to the core does not compile
 /// here until this test (and so the round trip) covers it.
 fn kind_index(k: &TrajectoryKind) -> usize {
     match k {
-        TrajectoryKind::Circle { .. } => 0,
-        TrajectoryKind::FigureEight { .. } => 1,
-        TrajectoryKind::LawnMower { .. } => 2,
-        TrajectoryKind::Helix { .. } => 3,
+        TrajectoryKind::Circle(_) => 0,
+        TrajectoryKind::FigureEight(_) => 1,
+        TrajectoryKind::LawnMower(_) => 2,
+        TrajectoryKind::Helix(_) => 3,
         // Crosses as a mission upload named by its CRC (tests/upload.rs).
         TrajectoryKind::Waypoints { .. } => KINDS,
     }
@@ -29,33 +30,33 @@ const KINDS: usize = 4;
 fn missions() -> Vec<TrajectoryKind> {
     let mut m: Vec<TrajectoryKind> = Table1Case::ALL.iter().map(|c| c.kind()).collect();
     m.extend([
-        TrajectoryKind::Helix {
+        TrajectoryKind::Helix(Helix {
             radius: 10.0,
             omega: 0.1,
             depth: 5.0,
             depth_rate: 0.2,
-        },
-        TrajectoryKind::Helix {
+        }),
+        TrajectoryKind::Helix(Helix {
             radius: 3.5,
             omega: 0.25,
             depth: 40.0,
             depth_rate: -0.05,
-        },
-        TrajectoryKind::Circle {
+        }),
+        TrajectoryKind::Circle(Circle {
             radius: 1e-3,
             omega: f32::from_bits(1),
             depth: -2.0,
-        },
-        TrajectoryKind::FigureEight {
+        }),
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude: f32::from_bits(0x7FC0_1234),
             omega: 0.1,
             depth: 0.0,
-        },
-        TrajectoryKind::LawnMower {
+        }),
+        TrajectoryKind::LawnMower(LawnMower {
             scale: 2.5,
             omega: 0.02,
             depth: 12.0,
-        },
+        }),
     ]);
     m
 }
@@ -68,27 +69,27 @@ fn same_bits(a: &TrajectoryKind, b: &TrajectoryKind) -> bool {
 /// The fields in declaration order, padded with 0.0 to four.
 fn fields(k: &TrajectoryKind) -> [f32; 4] {
     match *k {
-        TrajectoryKind::Circle {
+        TrajectoryKind::Circle(Circle {
             radius,
             omega,
             depth,
-        } => [radius, omega, depth, 0.0],
-        TrajectoryKind::FigureEight {
+        }) => [radius, omega, depth, 0.0],
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude,
             omega,
             depth,
-        } => [amplitude, omega, depth, 0.0],
-        TrajectoryKind::LawnMower {
+        }) => [amplitude, omega, depth, 0.0],
+        TrajectoryKind::LawnMower(LawnMower {
             scale,
             omega,
             depth,
-        } => [scale, omega, depth, 0.0],
-        TrajectoryKind::Helix {
+        }) => [scale, omega, depth, 0.0],
+        TrajectoryKind::Helix(Helix {
             radius,
             omega,
             depth,
             depth_rate,
-        } => [radius, omega, depth, depth_rate],
+        }) => [radius, omega, depth, depth_rate],
         TrajectoryKind::Waypoints { .. } => unreachable!("not a one-frame kind"),
     }
 }
@@ -184,12 +185,12 @@ fn wire_bytes_are_the_documented_layout() {
 fn the_receiver_validates_what_it_converts() {
     // A valid helix builds the same trajectory on both sides of the conversion; a negative
     // radius converts (the link carries it) and is refused by Trajectory::new.
-    let helix = TrajectoryKind::Helix {
+    let helix = TrajectoryKind::Helix(Helix {
         radius: 10.0,
         omega: 0.1,
         depth: 5.0,
         depth_rate: 0.2,
-    };
+    });
     let spec = MissionSpec::from(helix);
     assert_eq!(
         Trajectory::new(TrajectoryKind::try_from(spec).expect("closed form")),
