@@ -110,7 +110,7 @@ fn golden_vectors() -> (bool, u32, u32) {
         }
         let (mut same, exact, diff) = compare(&o, status, g);
         worst_ulps = worst_ulps.max(diff);
-        if g.waypoints {
+        if g.is_survey() {
             survey += 1;
             survey_exact += u32::from(exact);
             same &= exact;
