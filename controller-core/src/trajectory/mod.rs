@@ -400,7 +400,7 @@ impl Trajectory {
             h: Harmonics::of(theta),
             time,
         };
-        let p = self.mission.path.planar(self, &ph);
+        let p = paths::planar(self, &ph);
         let mut eta = Vector6::<f32>::zeros();
         let mut eta_dot = Vector6::<f32>::zeros();
         let mut eta_ddot = Vector6::<f32>::zeros();
@@ -415,7 +415,7 @@ impl Trajectory {
         eta_ddot[2] = p.z_ddot;
         let (psi, rate, accel) = match self.mission.heading {
             HeadingMode::Tangent => tangent(&p),
-            HeadingMode::Paper => self.mission.path.paper_heading(self, theta, &ph.h, &p),
+            HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h, &p),
         };
         eta[5] = psi;
         eta_dot[5] = rate;

@@ -168,6 +168,27 @@ impl TrajectoryKind {
     }
 }
 
+/// The path at a sample of `t` ([`PathKind::planar`] of its kind): the tick path's dispatch,
+/// one `match` on the kind `t` holds, each arm inlined.
+#[inline]
+pub(super) fn planar(
+    t: &crate::Trajectory,
+    ph: &crate::trajectory::phases::Phases,
+) -> crate::trajectory::phases::Planar {
+    dispatch!(&t.mission.path, k => k.planar(t, ph))
+}
+
+/// The paper's heading at a sample of `t` ([`PathKind::paper_heading`] of its kind).
+#[inline]
+pub(super) fn paper_heading(
+    t: &crate::Trajectory,
+    theta: u32,
+    h: &crate::trajectory::phases::Harmonics,
+    p: &crate::trajectory::phases::Planar,
+) -> (f32, f32, f32) {
+    dispatch!(&t.mission.path, k => k.paper_heading(t, theta, h, p))
+}
+
 impl PathKind for TrajectoryKind {
     fn parameters(&mut self, visit: &mut dyn FnMut(&crate::trajectory::Parameter, &mut f32)) {
         TrajectoryKind::parameters(self, visit)

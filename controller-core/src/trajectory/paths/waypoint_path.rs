@@ -74,8 +74,9 @@ impl PathKind for WaypointPath<'_> {
         waypoints::bounds(&t.route).0 * t.rate
     }
 
-    /// Along the route, at constant speed or by the time law.
-    #[inline]
+    /// Along the route, at constant speed or by the time law. Inlined into the dispatch, so
+    /// that the borrowed fields it does not read are never formed on the tick path.
+    #[inline(always)]
     fn planar(&self, t: &Trajectory, ph: &Phases) -> Planar {
         match t.law.is_set() {
             true => time_law::timed(&t.route, &t.law, &ph.time, &t.position_rate, t.rate),
@@ -85,7 +86,7 @@ impl PathKind for WaypointPath<'_> {
 
     /// The waypoint path has no heading of its own in the paper: its "paper" heading is its
     /// course, as the tangent heading (Choice 154).
-    #[inline]
+    #[inline(always)]
     fn paper_heading(
         &self,
         _t: &Trajectory,
