@@ -6,6 +6,7 @@ use auv_link::{
     decode_frame, encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope,
     FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame,
     Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, CRC_LEN, MAX_BODY, MAX_FRAME,
+    PROTOCOL_VERSION,
 };
 use controller_core::TrajectoryKind;
 
@@ -241,4 +242,22 @@ fn every_path_kind_has_its_wire_variant_in_order() {
         TrajectoryKind::EXAMPLES.len()
     ));
     assert_eq!(TrajectoryKind::NAMES.len(), TrajectoryKind::EXAMPLES.len());
+}
+
+#[test]
+fn a_new_wire_variant_comes_with_a_new_protocol_version() {
+    // What each protocol version's wire carries of the closed sets: (version, path kinds,
+    // commands). A board refuses a tag past its own variants, so a variant added to
+    // `MissionSpec` or `Command` is a new protocol: this fails until PROTOCOL_VERSION is
+    // bumped and its row added here.
+    const CARRIED: [(u8, usize, usize); 1] = [(5, 5, 6)];
+    let now = (
+        PROTOCOL_VERSION,
+        TrajectoryKind::EXAMPLES.len(),
+        Command::EXAMPLES.len(),
+    );
+    assert!(
+        CARRIED.contains(&now),
+        "the wire carries {now:?} (version, path kinds, commands): bump PROTOCOL_VERSION and add it"
+    );
 }
