@@ -189,15 +189,8 @@ fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
     }
 }
 
-const MISSION: MissionPlan = MissionPlan {
-    path: MissionSpec::Circle {
-        radius: 10.0,
-        omega: 0.1,
-        depth: 5.0,
-    },
-    heading: Heading::Paper,
-    time_scale: 1.0,
-};
+/// The paper's 10 m circle, as the paper flies it.
+const MISSION: MissionPlan = MissionPlan::EXAMPLE;
 
 fn board_info(signing: bool) -> BoardInfo {
     BoardInfo {
