@@ -75,7 +75,8 @@ pub use limits::{
 pub use mission::Mission;
 pub use paths::time_law::{SpeedList, TimeLaw};
 pub use paths::waypoints::{turn_radius, PathPoint, Route, WaypointList};
-pub use paths::{Circle, FigureEight, Helix, LawnMower, TrajectoryKind};
+// Every kind's parameter struct (declared by the list in `paths/mod.rs`) and `TrajectoryKind`.
+pub use paths::*;
 pub use table1::Table1Case;
 
 use nalgebra::Vector6;
