@@ -11,10 +11,10 @@
 use std::env;
 use std::fmt::Write as _;
 use std::fs;
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use auv_link::sign::LinkKey;
-use auv_link::MissionUpload;
+use auv_link::{MissionPlan, MissionUpload};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{
     Controller, ControllerConfig, HeadingMode, Mission, Status, Table1Case, Trajectory,
@@ -23,6 +23,11 @@ use controller_core::{
 
 // The images' table, shared with the library (bin names, memory maps).
 use firmware_images::image;
+
+// The golden vector's one definition, shared with the self-test that reads them.
+#[path = "src/bin/qemu_selftest/vector.rs"]
+mod vector;
+use vector::Golden;
 
 // The STM32 image's link key from the environment (host-tested in tests/provision.rs).
 #[path = "src/provision.rs"]
@@ -42,6 +47,7 @@ fn main() {
         println!("cargo:rerun-if-changed={}", src.display());
     }
     println!("cargo:rerun-if-changed=build.rs");
+    println!("cargo:rerun-if-changed=src/bin/qemu_selftest/vector.rs");
     println!("cargo:rerun-if-changed=../controller-core/src");
 
     let survey = root.join(SURVEY);
@@ -73,20 +79,91 @@ fn main() {
     fs::write(out.join("link_key.rs"), code).expect("writing link_key.rs");
 }
 
+/// xorshift64: the kernels' deterministic inputs.
+struct XorShift(u64);
+
+impl XorShift {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        self.0
+    }
+
+    /// An f32 of either sign with an exponent in [−40, 40] and a random mantissa.
+    fn wide(&mut self) -> f32 {
+        let r = self.next();
+        let e = (r % 81) as i32 - 40;
+        let m = ((r >> 8) as u32) & 0x007f_ffff;
+        f32::from_bits(((((r >> 40) & 1) as u32) << 31) | (((e + 127) as u32) << 23) | m)
+    }
+}
+
+/// `pub const KERNEL_<name>: [(u32, …); n] = [rows];`
+fn kernel_table(s: &mut String, name: &str, tuple: &str, rows: &[String]) {
+    writeln!(
+        s,
+        "pub const KERNEL_{name}: [{tuple}; {}] = [{}];",
+        rows.len(),
+        rows.join(", ")
+    )
+    .ok();
+}
+
+fn bits(x: f32) -> String {
+    format!("{:#010x}", x.to_bits())
+}
+
 /// Inputs of every range of the math kernels (`controller_core::math::kernels`) and the host's
 /// results, as bit patterns: the self-test checks that the target gives the same bits.
 fn kernel_golden() -> String {
     use controller_core::math::kernels;
-    // xorshift64: deterministic inputs.
-    let mut state = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        state ^= state << 13;
-        state ^= state >> 7;
-        state ^= state << 17;
-        state
-    };
+    let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
     let mut s = String::new();
-    // sin_cos: no reduction, Cody–Waite, Payne–Hanek, and the special values.
+    let rows: Vec<String> = sin_cos_inputs(&mut rng)
+        .into_iter()
+        .map(|x| {
+            let (sn, cs) = kernels::sin_cos(x);
+            format!("({}, {}, {})", bits(x), bits(sn), bits(cs))
+        })
+        .collect();
+    kernel_table(&mut s, "SIN_COS", "(u32, u32, u32)", &rows);
+    let rows: Vec<String> = (0..64)
+        .map(|_| rng.next() as u32)
+        .chain([0, 1 << 30, 1 << 31, 3 << 30, u32::MAX])
+        .map(|p| {
+            let (sn, cs) = kernels::sin_cos_turns(p);
+            format!("({p:#010x}, {}, {})", bits(sn), bits(cs))
+        })
+        .collect();
+    kernel_table(&mut s, "SIN_COS_TURNS", "(u32, u32, u32)", &rows);
+    let rows: Vec<String> = (0..64)
+        .map(|_| (rng.wide(), rng.wide()))
+        .chain([
+            (0.0, -0.0),
+            (-0.0, 0.0),
+            (f32::INFINITY, -f32::INFINITY),
+            (1.0, 0.0),
+        ])
+        .map(|(y, x)| format!("({}, {}, {})", bits(y), bits(x), bits(kernels::atan2(y, x))))
+        .collect();
+    kernel_table(&mut s, "ATAN2", "(u32, u32, u32)", &rows);
+    for (name, f) in [
+        ("CBRT", kernels::cbrt as fn(f32) -> f32),
+        ("SQRT", kernels::sqrt),
+    ] {
+        let rows: Vec<String> = (0..64)
+            .map(|_| rng.wide().abs())
+            .chain([0.0, -0.0, 1e-45, f32::MAX, 27.0, -8.0, f32::INFINITY])
+            .map(|x| format!("({}, {})", bits(x), bits(f(x))))
+            .collect();
+        kernel_table(&mut s, name, "(u32, u32)", &rows);
+    }
+    s
+}
+
+/// sin_cos's inputs: no reduction, Cody–Waite, Payne–Hanek, and the special values.
+fn sin_cos_inputs(rng: &mut XorShift) -> Vec<f32> {
     let mut xs: Vec<f32> = Vec::new();
     for (lo, hi) in [
         (0.0f32, 0.78f32),
@@ -96,14 +173,14 @@ fn kernel_golden() -> String {
     ] {
         for _ in 0..24 {
             // Uniform on [0, π/4], log-uniform on the others.
-            let u = (next() >> 11) as f64 / (1u64 << 53) as f64;
+            let u = (rng.next() >> 11) as f64 / (1u64 << 53) as f64;
             let (lo, hi) = (lo as f64, hi as f64);
             let x = if lo == 0.0 {
                 u * hi
             } else {
                 lo * (hi / lo).powf(u)
             } as f32;
-            xs.push(if next() & 1 == 1 { -x } else { x });
+            xs.push(if rng.next() & 1 == 1 { -x } else { x });
         }
     }
     xs.extend([
@@ -115,93 +192,7 @@ fn kernel_golden() -> String {
         f32::INFINITY,
         f32::NAN,
     ]);
-    let rows: Vec<String> = xs
-        .iter()
-        .map(|&x| {
-            let (sn, cs) = kernels::sin_cos(x);
-            format!(
-                "({:#010x}, {:#010x}, {:#010x})",
-                x.to_bits(),
-                sn.to_bits(),
-                cs.to_bits()
-            )
-        })
-        .collect();
-    writeln!(
-        s,
-        "pub const KERNEL_SIN_COS: [(u32, u32, u32); {}] = [{}];",
-        rows.len(),
-        rows.join(", ")
-    )
-    .ok();
-    let rows: Vec<String> = (0..64)
-        .map(|_| next() as u32)
-        .chain([0, 1 << 30, 1 << 31, 3 << 30, u32::MAX])
-        .map(|p| {
-            let (sn, cs) = kernels::sin_cos_turns(p);
-            format!(
-                "({p:#010x}, {:#010x}, {:#010x})",
-                sn.to_bits(),
-                cs.to_bits()
-            )
-        })
-        .collect();
-    writeln!(
-        s,
-        "pub const KERNEL_SIN_COS_TURNS: [(u32, u32, u32); {}] = [{}];",
-        rows.len(),
-        rows.join(", ")
-    )
-    .ok();
-    let wide = |next: &mut dyn FnMut() -> u64| {
-        let r = next();
-        let e = (r % 81) as i32 - 40;
-        let m = ((r >> 8) as u32) & 0x007f_ffff;
-        f32::from_bits(((((r >> 40) & 1) as u32) << 31) | (((e + 127) as u32) << 23) | m)
-    };
-    let rows: Vec<String> = (0..64)
-        .map(|_| (wide(&mut next), wide(&mut next)))
-        .chain([
-            (0.0, -0.0),
-            (-0.0, 0.0),
-            (f32::INFINITY, -f32::INFINITY),
-            (1.0, 0.0),
-        ])
-        .map(|(y, x)| {
-            let a = kernels::atan2(y, x);
-            format!(
-                "({:#010x}, {:#010x}, {:#010x})",
-                y.to_bits(),
-                x.to_bits(),
-                a.to_bits()
-            )
-        })
-        .collect();
-    writeln!(
-        s,
-        "pub const KERNEL_ATAN2: [(u32, u32, u32); {}] = [{}];",
-        rows.len(),
-        rows.join(", ")
-    )
-    .ok();
-    for (name, f) in [
-        ("CBRT", kernels::cbrt as fn(f32) -> f32),
-        ("SQRT", kernels::sqrt),
-    ] {
-        let rows: Vec<String> = (0..64)
-            .map(|_| wide(&mut next).abs())
-            .chain([0.0, -0.0, 1e-45, f32::MAX, 27.0, -8.0, f32::INFINITY])
-            .map(|x| format!("({:#010x}, {:#010x})", x.to_bits(), f(x).to_bits()))
-            .collect();
-        writeln!(
-            s,
-            "pub const KERNEL_{name}: [(u32, u32); {}] = [{}];",
-            rows.len(),
-            rows.join(", ")
-        )
-        .ok();
-    }
-    s
+    xs
 }
 
 /// The waypoint mission of the self-test's golden vectors (workspace-relative): the shipped
@@ -210,7 +201,7 @@ const SURVEY: &str = "host-sim/scenarios/real/survey-200x100.toml";
 
 /// The `[trajectory]` of the scenario file at `path`, a waypoint path, as the core's path: its
 /// `heading` key is the mission's, every other key the path's (`TrajectoryKind`'s serde form).
-fn survey_path(path: &std::path::Path) -> TrajectoryKind {
+fn survey_path(path: &Path) -> TrajectoryKind {
     let text =
         fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     let file: toml::Table =
@@ -226,23 +217,18 @@ fn survey_path(path: &std::path::Path) -> TrajectoryKind {
         .unwrap_or_else(|e| panic!("{}: [trajectory]: {e}", path.display()))
 }
 
-/// The survey's upload as constants: its header and chunks (the self-test takes them as the
-/// board's supervisor would), and the golden vectors along it: two instants in each of its
-/// first segments (a leg speeding up, its cruise, the turns and the leg after), tangent
-/// heading, Δu on and off.
-fn survey_golden(
-    path: &std::path::Path,
-    with: &Controller,
-    without: &Controller,
-    body: &mut String,
-    n: &mut usize,
-) -> String {
+/// The survey's upload as constants (`SURVEY_HEADER`, `SURVEY_CHUNKS`: the self-test takes
+/// them as the board's supervisor would), and the golden vectors along it: two instants in
+/// each of its first segments (a leg speeding up, its cruise, the turns and the leg after),
+/// tangent heading, Δu on and off, keyed by the plan that names the upload.
+fn survey_golden(path: &Path, c: &Controllers, vectors: &mut Vec<Golden>) -> String {
     let mission = Mission {
         path: survey_path(path),
         heading: HeadingMode::Tangent,
         time_scale: 1.0,
     };
     let up = MissionUpload::of(&mission).expect("a waypoint path");
+    let plan = MissionPlan::from(mission);
     let tr = Trajectory::new(mission).expect("the shipped survey is a valid mission");
     let (route, law) = (tr.route(), tr.time_law());
     for i in 0..route.segment_count().min(5) {
@@ -260,224 +246,170 @@ fn survey_golden(
             eta[5] += 0.02 * (w * 0.8).sin();
             nu[0] -= 0.03;
             let robust = k == 0 || i % 2 == 0;
-            let c = if robust { with } else { without };
-            let o = c.update(ticks, &eta, &nu, &tr);
-            let id = Id {
-                case: 0,
-                ticks,
-                robust,
-                tangent: true,
-                helix: None,
-                waypoints: true,
-            };
-            push(body, id, &eta, &nu, &o);
-            *n += 1;
+            vectors.push(c.vector(plan, ticks, robust, eta, nu, &tr));
         }
     }
-    let h = up.header();
-    let opt = |v: Option<f32>| v.map_or("None".to_string(), |x| format!("Some({})", f(x)));
-    let mut s = format!(
-        "/// The shipped survey's upload ({SURVEY}).\npub const SURVEY_HEADER: UploadHeader = UploadHeader {{ points: {}, speeds: {:?}, speed: {}, turn_radius: {}, speed_change: {}, heading: Heading::{:?}, time_scale: {}, crc: {:#010x} }};\n",
-        h.points,
-        h.speeds,
-        f(h.speed),
-        opt(h.turn_radius),
-        opt(h.speed_change),
-        h.heading,
-        f(h.time_scale),
-        h.crc
-    );
     let chunks: Vec<String> = (0..up.chunks())
-        .map(|i| {
-            let c = up.chunk(i);
-            format!(
-                "    UploadChunk {{ index: {}, words: {} }},",
-                c.index,
-                arr(&c.words)
-            )
-        })
+        .map(|i| format!("    {:?},", up.chunk(i)))
         .collect();
-    writeln!(
-        s,
-        "pub const SURVEY_CHUNKS: [UploadChunk; {}] = [\n{}\n];",
+    format!(
+        "/// The shipped survey's upload ({SURVEY}).\npub const SURVEY_HEADER: UploadHeader = {:?};\npub const SURVEY_CHUNKS: [UploadChunk; {}] = [\n{}\n];\n",
+        up.header(),
         up.chunks(),
         chunks.join("\n")
     )
-    .ok();
-    s
 }
 
-/// Deterministic inputs around each Table-1 mission (on and off the reference, with and
-/// without Δu, and two fault cases) and along the shipped survey, and the host core's outputs
-/// for them.
-fn golden(survey: &std::path::Path) -> String {
-    let with = Controller::new(ControllerConfig::default()).expect("defaults");
-    let without = Controller::new(ControllerConfig {
-        robust: false,
-        ..ControllerConfig::default()
-    })
-    .expect("defaults without Δu");
-    let mut s = String::new();
-    let mut n = 0usize;
-    let mut body = String::new();
+/// The controllers the vectors run, Δu on and off, and one vector from each.
+struct Controllers {
+    with: Controller,
+    without: Controller,
+}
+
+impl Controllers {
+    fn new() -> Self {
+        let with = Controller::new(ControllerConfig::default()).expect("defaults");
+        let without = Controller::new(ControllerConfig {
+            robust: false,
+            ..ControllerConfig::default()
+        })
+        .expect("defaults without Δu");
+        Controllers { with, without }
+    }
+
+    /// The host core's output for these inputs on `tr`, the mission `plan` names.
+    fn vector(
+        &self,
+        plan: MissionPlan,
+        ticks: u64,
+        robust: bool,
+        eta: [f32; 6],
+        nu: [f32; 6],
+        tr: &Trajectory,
+    ) -> Golden {
+        let c = if robust { &self.with } else { &self.without };
+        let o = c.update(ticks, &eta, &nu, tr);
+        Golden {
+            plan,
+            ticks,
+            robust,
+            eta,
+            nu,
+            voltage: o.voltage,
+            tau: o.tau,
+            delta: o.delta,
+            w_norm: o.w_norm,
+            status: match o.status {
+                Status::Ok => 0,
+                Status::Fault(_) => 1,
+            },
+        }
+    }
+}
+
+/// The instants of each Table-1 mission's vectors (100 Hz ticks).
+const TICKS: [u64; 4] = [0, 1234, 4567, 6999];
+
+/// The inputs of Table-1 case `ci` at its instant `k`: the reference, off by a few
+/// centimetres and degrees, differently per vector.
+fn inputs(ci: usize, k: usize) -> ([f32; 6], [f32; 6]) {
+    let tr = Trajectory::table1(Table1Case::ALL[ci]);
+    let d = tr.sample(TICKS[k], 100);
+    let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
+    let mut eta: [f32; 6] = d.eta.into();
+    let mut nu: [f32; 6] = nu.into();
+    let w = (ci * 4 + k) as f32;
+    eta[0] += 0.03 * (w * 0.7).sin();
+    eta[1] -= 0.02 * (w * 1.3).cos();
+    eta[2] += 0.01 * w / 24.0;
+    eta[3] += 0.2 * (w * 0.5).sin();
+    eta[4] += 0.05 * (w * 0.9).cos();
+    eta[5] += 0.03 * (w * 1.1).sin();
+    nu[0] += 0.05 * (w * 0.3).cos();
+    nu[4] += 0.01 * (w * 0.4).sin();
+    (eta, nu)
+}
+
+/// Each Table-1 mission at its four instants, Δu on and off, and with the tangent heading
+/// (ψ_d = the path's course: one atan2 and its derivatives) at the middle two, Δu on.
+fn table1_golden(c: &Controllers, vectors: &mut Vec<Golden>) {
     for (ci, case) in Table1Case::ALL.iter().enumerate() {
-        let tr = Trajectory::table1(*case);
-        for (k, ticks) in [0u64, 1234, 4567, 6999].iter().enumerate() {
-            let d = tr.sample(*ticks, 100);
-            let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
-            let mut eta: [f32; 6] = d.eta.into();
-            let mut nu: [f32; 6] = nu.into();
-            // Off the reference by a few centimetres and degrees, different per vector.
-            let w = (ci * 4 + k) as f32;
-            eta[0] += 0.03 * (w * 0.7).sin();
-            eta[1] -= 0.02 * (w * 1.3).cos();
-            eta[2] += 0.01 * w / 24.0;
-            eta[3] += 0.2 * (w * 0.5).sin();
-            eta[4] += 0.05 * (w * 0.9).cos();
-            eta[5] += 0.03 * (w * 1.1).sin();
-            nu[0] += 0.05 * (w * 0.3).cos();
-            nu[4] += 0.01 * (w * 0.4).sin();
+        let paper = Mission::paper(case.kind());
+        let tangent = Mission {
+            heading: HeadingMode::Tangent,
+            ..paper
+        };
+        let tr = Trajectory::new(paper).expect("a Table-1 mission");
+        let tr_tangent = Trajectory::new(tangent)
+            .expect("every Table-1 path is fast enough for the tangent heading");
+        for (k, &ticks) in TICKS.iter().enumerate() {
+            let (eta, nu) = inputs(ci, k);
             for robust in [true, false] {
-                let c = if robust { &with } else { &without };
-                let o = c.update(*ticks, &eta, &nu, &tr);
-                let id = Id {
-                    case: ci,
-                    ticks: *ticks,
-                    robust,
-                    tangent: false,
-                    helix: None,
-                    waypoints: false,
-                };
-                push(&mut body, id, &eta, &nu, &o);
-                n += 1;
+                vectors.push(c.vector(paper.into(), ticks, robust, eta, nu, &tr));
             }
-            // The tangent heading (ψ_d = the path's course: one atan2 and its derivatives)
-            // on the same inputs, at two of the four instants, Δu on.
             if k == 1 || k == 2 {
-                let tangent = Trajectory::new(Mission {
-                    heading: HeadingMode::Tangent,
-                    ..Mission::paper(case.kind())
-                })
-                .expect("every Table-1 path is fast enough for the tangent heading");
-                let o = with.update(*ticks, &eta, &nu, &tangent);
-                let id = Id {
-                    case: ci,
-                    ticks: *ticks,
-                    robust: true,
-                    tangent: true,
-                    helix: None,
-                    waypoints: false,
-                };
-                push(&mut body, id, &eta, &nu, &o);
-                n += 1;
-            }
-            // The helix (the fourth path kind: the circle's radius, a descent rate, so z_d
-            // grows with t) at the circle's inputs, Δu on and off.
-            if ci == 0 && (k == 1 || k == 3) {
-                let helix = (10.0, 0.05);
-                let tr = Trajectory::helix(helix.0, helix.1).expect("a valid helix");
-                for robust in [true, false] {
-                    let c = if robust { &with } else { &without };
-                    let o = c.update(*ticks, &eta, &nu, &tr);
-                    let id = Id {
-                        case: ci,
-                        ticks: *ticks,
-                        robust,
-                        tangent: false,
-                        helix: Some(helix),
-                        waypoints: false,
-                    };
-                    push(&mut body, id, &eta, &nu, &o);
-                    n += 1;
-                }
+                vectors.push(c.vector(tangent.into(), ticks, true, eta, nu, &tr_tangent));
             }
         }
     }
-    // Faults: pitch beyond the limit, and a NaN.
-    let fault = || Id {
-        case: 0,
-        ticks: 0,
-        robust: true,
-        tangent: false,
-        helix: None,
-        waypoints: false,
-    };
-    let tr = Trajectory::table1(Table1Case::Circular10R);
-    let eta = [0.0, 10.0, 5.0, 0.0, 1.5, 0.0];
-    let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 0.1];
-    push(
-        &mut body,
-        fault(),
-        &eta,
-        &nu,
-        &with.update(0, &eta, &nu, &tr),
-    );
-    let eta = [0.0, 10.0, f32::NAN, 0.0, 0.0, 0.0];
-    push(
-        &mut body,
-        fault(),
-        &eta,
-        &nu,
-        &with.update(0, &eta, &nu, &tr),
-    );
-    n += 2;
-    s += &survey_golden(survey, &with, &without, &mut body, &mut n);
-    writeln!(s, "pub const GOLDEN: [Golden; {n}] = [\n{body}];").ok();
-    s
 }
 
-fn f(x: f32) -> String {
-    if x.is_nan() {
-        "f32::NAN".into()
-    } else {
-        format!("f32::from_bits({:#010x})", x.to_bits())
+/// Every closed-form kind of `TrajectoryKind::EXAMPLES` that no Table-1 mission flies (the
+/// helix today) at the first Table-1 mission's inputs of its instants 1 and 3, Δu on and off:
+/// a new kind has golden vectors without a line here.
+fn example_golden(c: &Controllers, vectors: &mut Vec<Golden>) {
+    let in_table1 =
+        |k: &TrajectoryKind| Table1Case::ALL.iter().any(|c| c.kind().name() == k.name());
+    for kind in TrajectoryKind::EXAMPLES {
+        if in_table1(&kind) || MissionUpload::of(&Mission::paper(kind)).is_some() {
+            continue;
+        }
+        let tr = Trajectory::new(kind).expect("every example is a valid mission");
+        for k in [1, 3] {
+            let (eta, nu) = inputs(0, k);
+            for robust in [true, false] {
+                vectors.push(c.vector(kind.into(), TICKS[k], robust, eta, nu, &tr));
+            }
+        }
     }
 }
 
-fn arr(a: &[f32]) -> String {
-    let items: Vec<String> = a.iter().map(|x| f(*x)).collect();
-    format!("[{}]", items.join(", "))
+/// Two faults on the first Table-1 mission: pitch beyond the limit, and a NaN.
+fn fault_golden(c: &Controllers, vectors: &mut Vec<Golden>) {
+    let paper = Mission::paper(Table1Case::ALL[0].kind());
+    let tr = Trajectory::new(paper).expect("a Table-1 mission");
+    let nu = [1.0, 0.0, 0.0, 0.0, 0.0, 0.1];
+    for eta in [
+        [0.0, 10.0, 5.0, 0.0, 1.5, 0.0],
+        [0.0, 10.0, f32::NAN, 0.0, 0.0, 0.0],
+    ] {
+        vectors.push(c.vector(paper.into(), 0, true, eta, nu, &tr));
+    }
 }
 
-/// Which vector: its Table-1 case, tick, Δu on or off, and whether the mission flies the
-/// tangent heading (the self-test's `Golden` fields of the same names).
-struct Id {
-    case: usize,
-    ticks: u64,
-    robust: bool,
-    tangent: bool,
-    /// A helix (radius, depth rate) flown instead of the case's path.
-    helix: Option<(f32, f32)>,
-    /// The shipped survey (`SURVEY`) flown instead of the case's path.
-    waypoints: bool,
+/// Deterministic inputs around each Table-1 mission (on and off the reference, with and
+/// without Δu, and two fault cases), on each other closed-form kind's example and along the
+/// shipped survey, and the host core's outputs for them: `GOLDEN`, and the survey's upload.
+fn golden(survey: &Path) -> String {
+    let c = Controllers::new();
+    let mut vectors = Vec::new();
+    table1_golden(&c, &mut vectors);
+    example_golden(&c, &mut vectors);
+    fault_golden(&c, &mut vectors);
+    let mut s = survey_golden(survey, &c, &mut vectors);
+    writeln!(s, "pub const GOLDEN: [Golden; {}] = [", vectors.len()).ok();
+    for g in &vectors {
+        writeln!(s, "    {},", rust(g)).ok();
+    }
+    s += "];\n";
+    s
 }
 
-fn push(body: &mut String, id: Id, eta: &[f32; 6], nu: &[f32; 6], o: &controller_core::Output) {
-    let Id {
-        case,
-        ticks,
-        robust,
-        tangent,
-        helix,
-        waypoints,
-    } = id;
-    let helix = match helix {
-        Some((r, rate)) => format!("Some(({}, {}))", f(r), f(rate)),
-        None => "None".to_string(),
-    };
-    let status = match o.status {
-        Status::Ok => 0,
-        Status::Fault(_) => 1,
-    };
-    writeln!(
-        body,
-        "    Golden {{ case: {case}, ticks: {ticks}, robust: {robust}, tangent: {tangent}, helix: {helix}, waypoints: {waypoints}, eta: {}, nu: {}, voltage: {}, tau: {}, delta: {}, w_norm: {}, status: {status} }},",
-        arr(eta),
-        arr(nu),
-        arr(&o.voltage),
-        arr(&o.tau),
-        f(o.delta),
-        f(o.w_norm)
-    )
-    .ok();
+/// `g` as a Rust expression: its `Debug` form, whose every finite `f32` is the shortest
+/// literal that parses back to its bits, and a non-finite one its constant (a NaN input is
+/// `f32::NAN`).
+fn rust(g: &Golden) -> String {
+    format!("{g:?}")
+        .replace("NaN", "f32::NAN")
+        .replace("inf", "f32::INFINITY")
 }

@@ -7,6 +7,7 @@
 //! unscaled mission sampled at t/k, and the closed-form minimum speeds checked against a
 //! dense sampling.
 
+use controller_core::trajectory::{Circle, FigureEight, Helix, LawnMower};
 use controller_core::trajectory::{
     HeadingMode, Mission, Trajectory, TrajectoryError, TrajectoryKind,
 };
@@ -27,44 +28,44 @@ fn paths() -> Vec<(&'static str, TrajectoryKind)> {
     vec![
         (
             "circle-10",
-            TrajectoryKind::Circle {
+            TrajectoryKind::Circle(Circle {
                 radius: 10.0,
                 omega: 0.1,
                 depth: 5.0,
-            },
+            }),
         ),
         (
             "figure-eight-20",
-            TrajectoryKind::FigureEight {
+            TrajectoryKind::FigureEight(FigureEight {
                 amplitude: 20.0,
                 omega: 0.1,
                 depth: 5.0,
-            },
+            }),
         ),
         (
             "lawn-mower-1",
-            TrajectoryKind::LawnMower {
+            TrajectoryKind::LawnMower(LawnMower {
                 scale: 1.0,
                 omega: 0.05,
                 depth: 5.0,
-            },
+            }),
         ),
         (
             "lawn-mower-fast",
-            TrajectoryKind::LawnMower {
+            TrajectoryKind::LawnMower(LawnMower {
                 scale: 0.5,
                 omega: 0.12,
                 depth: 5.0,
-            },
+            }),
         ),
         (
             "helix",
-            TrajectoryKind::Helix {
+            TrajectoryKind::Helix(Helix {
                 radius: 15.0,
                 omega: 0.1,
                 depth: 5.0,
                 depth_rate: 0.1,
-            },
+            }),
         ),
     ]
 }
@@ -92,21 +93,21 @@ fn missions() -> Vec<(String, Mission)> {
 /// path, written here from the paper's formulas in f64: [[x, ẋ, ẍ, x⃛], [y, …]], z, ż.
 fn path_f64(kind: TrajectoryKind, t: f64) -> ([[f64; 4]; 2], f64, f64) {
     match kind {
-        TrajectoryKind::Circle {
+        TrajectoryKind::Circle(Circle {
             radius,
             omega,
             depth,
-        }
-        | TrajectoryKind::Helix {
+        })
+        | TrajectoryKind::Helix(Helix {
             radius,
             omega,
             depth,
             ..
-        } => {
+        }) => {
             let (r, w) = (radius as f64, omega as f64);
             let (s, c) = (w * t).sin_cos();
             let rate = match kind {
-                TrajectoryKind::Helix { depth_rate, .. } => depth_rate as f64,
+                TrajectoryKind::Helix(Helix { depth_rate, .. }) => depth_rate as f64,
                 _ => 0.0,
             };
             (
@@ -118,11 +119,11 @@ fn path_f64(kind: TrajectoryKind, t: f64) -> ([[f64; 4]; 2], f64, f64) {
                 rate,
             )
         }
-        TrajectoryKind::FigureEight {
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude,
             omega,
             depth,
-        } => {
+        }) => {
             let (a, w) = (amplitude as f64, omega as f64);
             let h = 0.5 * w;
             let (s, c) = (w * t).sin_cos();
@@ -136,11 +137,11 @@ fn path_f64(kind: TrajectoryKind, t: f64) -> ([[f64; 4]; 2], f64, f64) {
                 0.0,
             )
         }
-        TrajectoryKind::LawnMower {
+        TrajectoryKind::LawnMower(LawnMower {
             scale,
             omega,
             depth,
-        } => {
+        }) => {
             let (sc, w) = (scale as f64, omega as f64);
             let w2 = 2.0 * w;
             let (s2, c2) = (w2 * t).sin_cos();
@@ -179,10 +180,10 @@ fn course_f64(kind: TrajectoryKind, t: f64) -> (f64, f64, f64) {
 
 fn base_omega(kind: TrajectoryKind) -> f64 {
     match kind {
-        TrajectoryKind::Circle { omega, .. }
-        | TrajectoryKind::Helix { omega, .. }
-        | TrajectoryKind::FigureEight { omega, .. }
-        | TrajectoryKind::LawnMower { omega, .. } => omega as f64,
+        TrajectoryKind::Circle(Circle { omega, .. })
+        | TrajectoryKind::Helix(Helix { omega, .. })
+        | TrajectoryKind::FigureEight(FigureEight { omega, .. })
+        | TrajectoryKind::LawnMower(LawnMower { omega, .. }) => omega as f64,
         TrajectoryKind::Waypoints { .. } => {
             unreachable!("the closed-form kinds only (waypoints: tests/waypoints.rs)")
         }
@@ -192,7 +193,7 @@ fn base_omega(kind: TrajectoryKind) -> f64 {
 /// One period of the path (s, unscaled): the figure-eight's y has half the frequency.
 fn period(kind: TrajectoryKind) -> f64 {
     match kind {
-        TrajectoryKind::FigureEight { omega, .. } => 4.0 * PI / omega as f64,
+        TrajectoryKind::FigureEight(FigureEight { omega, .. }) => 4.0 * PI / omega as f64,
         _ => TAU / base_omega(kind),
     }
 }

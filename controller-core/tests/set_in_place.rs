@@ -4,6 +4,7 @@
 //! same error for a refused mission, and a trajectory that samples as `Trajectory::EMPTY` (the
 //! origin held) after a refusal.
 
+use controller_core::trajectory::{Circle, Helix};
 use controller_core::trajectory::{
     HeadingMode, Mission, SpeedList, Table1Case, Trajectory, TrajectoryError, TrajectoryKind,
     WaypointList, MAX_WAYPOINTS,
@@ -80,22 +81,22 @@ fn missions() -> Vec<Mission> {
         mission(Table1Case::FigureEight30x30.kind(), Tangent, 3.0),
         mission(Table1Case::LawnMower30x15.kind(), Tangent, 1.0),
         mission(
-            TrajectoryKind::Helix {
+            TrajectoryKind::Helix(Helix {
                 radius: 8.0,
                 omega: 0.1,
                 depth: 3.0,
                 depth_rate: 0.05,
-            },
+            }),
             Tangent,
             1.5,
         ),
         mission(
-            TrajectoryKind::Helix {
+            TrajectoryKind::Helix(Helix {
                 radius: 8.0,
                 omega: 0.1,
                 depth: 3.0,
                 depth_rate: -0.05,
-            },
+            }),
             Paper,
             1.0,
         ),
@@ -163,22 +164,22 @@ fn refused() -> Vec<Mission> {
     fast[2] = 2.0;
     vec![
         mission(
-            TrajectoryKind::Circle {
+            TrajectoryKind::Circle(Circle {
                 radius: -1.0,
                 omega: 0.1,
                 depth: 5.0,
-            },
+            }),
             Paper,
             1.0,
         ),
         mission(Table1Case::Circular10R.kind(), Paper, 0.5),
         mission(Table1Case::Circular10R.kind(), Paper, f32::NAN),
         mission(
-            TrajectoryKind::Circle {
+            TrajectoryKind::Circle(Circle {
                 radius: 0.1,
                 omega: 0.1,
                 depth: 5.0,
-            },
+            }),
             Tangent,
             1.0,
         ),

@@ -8,11 +8,13 @@
 //! | 0..8   | `ticks: u64` |
 //! | 8..32  | η: 6 × u32 → f32 |
 //! | 32..56 | ν: 6 × u32 → f32 |
-//! | 56     | Table-1 case: `Table1Case::ALL[b % 6]` |
+//! | 56     | Table-1 case: `Table1Case::ALL[b % 6]` (`% Table1Case::ALL.len()`) |
 //! | 57     | flags: bit 0 robust (Δu on), bit 1 custom trajectory, bit 2 `ticks %= 2²⁰`, |
 //! |        | bit 3 scaled, bit 4 relative (see below) |
-//! | 58     | custom trajectory kind: `b % 4` = circle, figure-eight, lawn-mower, helix |
-//! | 59..75 | custom trajectory parameters: 4 × u32 → f32 (size, ω, depth, depth rate) |
+//! | 58     | custom trajectory kind: `b % n`, the n closed forms of `TrajectoryKind::EXAMPLES` in order |
+//! |        | (today n = 4: circle, figure-eight, lawn-mower, helix) |
+//! | 59..   | its parameters in field order (`TrajectoryKind::parameters`), one u32 → f32 each, as |
+//! |        | many words as the most any closed form has (today 4: 59..75; size, ω, depth, depth rate) |
 //!
 //! Missing bytes read as zero, extra bytes are ignored, all little-endian.
 //!

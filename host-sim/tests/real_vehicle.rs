@@ -2,6 +2,7 @@
 //! scenario keys, the preflight check against closed forms and against the flown outcome,
 //! and `host-sim check`'s exit codes. Runs are short (seconds of simulated time).
 
+use controller_core::trajectory::Circle;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
@@ -363,11 +364,11 @@ fn what_check_calls_feasible_flies_within_the_bound_and_static_infeasibility_doe
         .iter()
         .filter(|s| {
             s.config().trajectory
-                != TrajectoryKind::Circle {
+                != TrajectoryKind::Circle(Circle {
                     radius: 10.0,
                     omega: 0.1,
                     depth: 5.0,
-                }
+                })
         })
         .take(4)
     {

@@ -1,5 +1,6 @@
 //! Scenario files: the shipped Table-1 files, the example, unknown keys and bad values.
 
+use controller_core::trajectory::{Circle, FigureEight, Helix};
 use std::path::{Path, PathBuf};
 
 use controller_core::model::ParamVariation;
@@ -121,7 +122,7 @@ fn example_file_parses_with_every_section() {
     let s = s.config();
     assert_eq!(s.name, "example-all-knobs");
     assert_eq!(s.case, None);
-    assert!(matches!(s.trajectory, TrajectoryKind::Helix { .. }));
+    assert!(matches!(s.trajectory, TrajectoryKind::Helix(_)));
     assert!(matches!(s.current, CurrentModel::GaussMarkov { .. }));
     assert!(s.noise.is_some());
     assert_eq!(s.thruster_lag, Some(0.02));
@@ -218,11 +219,11 @@ fn every_knob_is_read() {
     assert_eq!(s.thruster_lag, Some(0.1));
     assert_eq!(
         s.trajectory,
-        TrajectoryKind::FigureEight {
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude: 12.0,
             omega: 0.2,
             depth: 3.0
-        }
+        })
     );
     let max = ParamVariation {
         mass: 10.0,
@@ -388,12 +389,12 @@ fn trajectory_defaults_are_the_papers_per_kind() {
     );
     assert_eq!(
         kind("[trajectory]\nkind = \"helix\"\nradius = 5\ndepth_rate = -0.1\n"),
-        TrajectoryKind::Helix {
+        TrajectoryKind::Helix(Helix {
             radius: 5.0,
             omega: 0.1,
             depth: 5.0,
             depth_rate: -0.1
-        }
+        })
     );
 }
 
@@ -634,11 +635,11 @@ fn a_scenario_built_in_code_is_validated_the_same_way() {
     c.controller.k2[5] = 0.0;
     assert_eq!(key(c), "controller.k2[5]");
     let mut c = base.clone();
-    c.trajectory = TrajectoryKind::Circle {
+    c.trajectory = TrajectoryKind::Circle(Circle {
         radius: 10.0,
         omega: -1.0,
         depth: 5.0,
-    };
+    });
     assert_eq!(key(c), "trajectory.omega");
     let mut c = base.clone();
     c.name = "a/b".into();

@@ -17,7 +17,7 @@
 //! ([`MissionSpec::Waypoints`]), so core → wire computes that CRC, and wire → core needs the
 //! board's [`UploadBuffer`] ([`MissionPlan::resolve`]; without it, [`Uploaded`]).
 
-use controller_core::{HeadingMode, Mission, TrajectoryKind};
+use controller_core::{trajectory, HeadingMode, Mission, TrajectoryKind};
 
 use crate::heading::Heading;
 use crate::msg::{AxisPriority, MissionPlan, MissionSpec, ThrustUnit};
@@ -32,7 +32,7 @@ macro_rules! field_for_field {
         impl From<TrajectoryKind> for MissionSpec {
             fn from(kind: TrajectoryKind) -> Self {
                 match kind {
-                    $(TrajectoryKind::$variant { $($field),+ } => MissionSpec::$variant { $($field),+ },)+
+                    $(TrajectoryKind::$variant(trajectory::$variant { $($field),+ }) => MissionSpec::$variant { $($field),+ },)+
                     // A bare path is the paper's mission (k = 1); `MissionPlan::from(Mission)`
                     // names the mission's own upload.
                     path @ TrajectoryKind::$big { .. } => MissionSpec::$big {
@@ -46,7 +46,7 @@ macro_rules! field_for_field {
             type Error = Uploaded;
             fn try_from(spec: MissionSpec) -> Result<Self, Uploaded> {
                 match spec {
-                    $(MissionSpec::$variant { $($field),+ } => Ok(TrajectoryKind::$variant { $($field),+ }),)+
+                    $(MissionSpec::$variant { $($field),+ } => Ok(TrajectoryKind::$variant(trajectory::$variant { $($field),+ })),)+
                     MissionSpec::$big { crc } => Err(Uploaded { crc }),
                 }
             }

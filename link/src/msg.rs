@@ -10,7 +10,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::heading::Heading;
 use crate::refusal::Refusal;
-use crate::upload::{UploadPart, UploadStatus};
+use crate::upload::{UploadChunk, UploadPart, UploadStatus, CHUNK_WORDS};
 
 /// The protocol version this crate speaks; sent as the first byte of every frame.
 ///
@@ -147,6 +147,46 @@ impl Command {
             MissionPlan::MAX_SIZE,
             max(ConfigPatch::MAX_SIZE, UploadPart::MAX_SIZE),
         );
+
+    /// One command of each variant, in wire order (`EXAMPLES[i]` is variant `i`): what the
+    /// link's tests, the supervisor's fuzz generator and the board's tests iterate instead of
+    /// counting the variants by hand. A new variant does not compile until
+    /// [`wire_index`](Self::wire_index) gives it its index, and the link's tests fail until it
+    /// has its example here (`no_command_variant_lacks_an_example`).
+    pub const EXAMPLES: [Command; 6] = {
+        let examples = [
+            Command::Arm,
+            Command::Disarm,
+            Command::StartMission(MissionPlan::EXAMPLE),
+            Command::StopMission,
+            Command::SetConfig(ConfigPatch::EMPTY),
+            Command::Upload(UploadPart::Chunk(UploadChunk {
+                index: 0,
+                words: [0.0; CHUNK_WORDS],
+            })),
+        ];
+        let mut i = 0;
+        while i < examples.len() {
+            assert!(
+                examples[i].wire_index() as usize == i,
+                "EXAMPLES in wire order"
+            );
+            i += 1;
+        }
+        examples
+    };
+
+    /// The variant's index on the wire (postcard's enum tag: declaration order).
+    pub const fn wire_index(&self) -> u8 {
+        match self {
+            Command::Arm => 0,
+            Command::Disarm => 1,
+            Command::StartMission(_) => 2,
+            Command::StopMission => 3,
+            Command::SetConfig(_) => 4,
+            Command::Upload(_) => 5,
+        }
+    }
 }
 
 /// A mission as the board flies it: the wire form of `controller_core::Mission` — the path
@@ -167,6 +207,19 @@ pub struct MissionPlan {
 impl MissionPlan {
     /// Worst-case postcard size of a `MissionPlan` (bytes).
     pub const MAX_SIZE: usize = MissionSpec::MAX_SIZE + Heading::MAX_SIZE + F32;
+
+    /// The paper's 10 m circle, its own heading, k = 1 (the example of
+    /// [`Command::StartMission`] in [`Command::EXAMPLES`]; every path kind's example is
+    /// `controller_core::TrajectoryKind::EXAMPLES`, through `From`).
+    pub const EXAMPLE: MissionPlan = MissionPlan {
+        path: MissionSpec::Circle {
+            radius: 10.0,
+            omega: 0.1,
+            depth: 5.0,
+        },
+        heading: Heading::Paper,
+        time_scale: 1.0,
+    };
 }
 
 /// The wire form of `controller_core::ThrustUnit`, the unit Eqs 31–32 are read in (variant

@@ -6,104 +6,81 @@ use auv_link::{
     decode_frame, encode, AxisPriority, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg,
     ThrustUnit, MAX_FRAME,
 };
+use controller_core::trajectory::{Circle, FigureEight, Helix, LawnMower};
 use controller_core::{HeadingMode, Mission, Table1Case, Trajectory, TrajectoryKind};
 
-/// Which kind a mission is. Exhaustive on purpose: a kind added to the core does not compile
-/// here until this test (and so the round trip) covers it.
+/// The kind's place in `TrajectoryKind::EXAMPLES` (declaration order: its wire variant index).
 fn kind_index(k: &TrajectoryKind) -> usize {
-    match k {
-        TrajectoryKind::Circle { .. } => 0,
-        TrajectoryKind::FigureEight { .. } => 1,
-        TrajectoryKind::LawnMower { .. } => 2,
-        TrajectoryKind::Helix { .. } => 3,
-        // Crosses as a mission upload named by its CRC (tests/upload.rs).
-        TrajectoryKind::Waypoints { .. } => KINDS,
-    }
+    TrajectoryKind::NAMES
+        .iter()
+        .position(|name| *name == k.name())
+        .expect("every kind is listed")
 }
-/// The kinds that cross in one `StartMission` frame.
-const KINDS: usize = 4;
 
-/// Missions of every kind: the six Table-1 cases, a helix, and odd values (negative depth,
-/// a rising helix, a subnormal, a NaN with a payload — the link carries bits, `Trajectory::new`
-/// judges them).
+/// The kinds that cross in one `StartMission` frame: the closed forms (the waypoint path crosses
+/// as a mission upload named by its CRC: tests/upload.rs), first in declaration order.
+fn closed_forms() -> Vec<TrajectoryKind> {
+    TrajectoryKind::EXAMPLES
+        .into_iter()
+        .filter(|k| !matches!(k, TrajectoryKind::Waypoints { .. }))
+        .collect()
+}
+
+/// Missions of every closed-form kind: the six Table-1 cases, each kind's example, and odd
+/// values (negative depth, a rising helix, a subnormal, a NaN with a payload — the link carries
+/// bits, `Trajectory::new` judges them).
 fn missions() -> Vec<TrajectoryKind> {
     let mut m: Vec<TrajectoryKind> = Table1Case::ALL.iter().map(|c| c.kind()).collect();
+    m.extend(closed_forms());
     m.extend([
-        TrajectoryKind::Helix {
+        TrajectoryKind::Helix(Helix {
             radius: 10.0,
             omega: 0.1,
             depth: 5.0,
             depth_rate: 0.2,
-        },
-        TrajectoryKind::Helix {
+        }),
+        TrajectoryKind::Helix(Helix {
             radius: 3.5,
             omega: 0.25,
             depth: 40.0,
             depth_rate: -0.05,
-        },
-        TrajectoryKind::Circle {
+        }),
+        TrajectoryKind::Circle(Circle {
             radius: 1e-3,
             omega: f32::from_bits(1),
             depth: -2.0,
-        },
-        TrajectoryKind::FigureEight {
+        }),
+        TrajectoryKind::FigureEight(FigureEight {
             amplitude: f32::from_bits(0x7FC0_1234),
             omega: 0.1,
             depth: 0.0,
-        },
-        TrajectoryKind::LawnMower {
+        }),
+        TrajectoryKind::LawnMower(LawnMower {
             scale: 2.5,
             omega: 0.02,
             depth: 12.0,
-        },
+        }),
     ]);
     m
 }
 
+/// The fields in declaration order (`TrajectoryKind::parameters`).
+fn fields(k: &TrajectoryKind) -> Vec<f32> {
+    let mut k = *k;
+    let mut v = Vec::new();
+    k.parameters(&mut |_, x| v.push(*x));
+    v
+}
+
 /// Bitwise equality (NaN payloads included).
 fn same_bits(a: &TrajectoryKind, b: &TrajectoryKind) -> bool {
-    fields(a).map(f32::to_bits) == fields(b).map(f32::to_bits) && kind_index(a) == kind_index(b)
-}
-
-/// The fields in declaration order, padded with 0.0 to four.
-fn fields(k: &TrajectoryKind) -> [f32; 4] {
-    match *k {
-        TrajectoryKind::Circle {
-            radius,
-            omega,
-            depth,
-        } => [radius, omega, depth, 0.0],
-        TrajectoryKind::FigureEight {
-            amplitude,
-            omega,
-            depth,
-        } => [amplitude, omega, depth, 0.0],
-        TrajectoryKind::LawnMower {
-            scale,
-            omega,
-            depth,
-        } => [scale, omega, depth, 0.0],
-        TrajectoryKind::Helix {
-            radius,
-            omega,
-            depth,
-            depth_rate,
-        } => [radius, omega, depth, depth_rate],
-        TrajectoryKind::Waypoints { .. } => unreachable!("not a one-frame kind"),
-    }
-}
-
-fn field_count(k: &TrajectoryKind) -> usize {
-    if kind_index(k) == 3 {
-        4
-    } else {
-        3
-    }
+    let bits = |k| fields(k).into_iter().map(f32::to_bits).collect::<Vec<_>>();
+    kind_index(a) == kind_index(b) && bits(a) == bits(b)
 }
 
 #[test]
 fn every_kind_round_trips_through_a_frame() {
-    let mut seen = [false; KINDS];
+    let mut seen = vec![false; closed_forms().len()];
     for (seq, kind) in missions().into_iter().enumerate() {
         seen[kind_index(&kind)] = true;
         for (heading, time_scale) in [(HeadingMode::Paper, 1.0), (HeadingMode::Tangent, 3.25)] {
@@ -133,7 +110,7 @@ fn every_kind_round_trips_through_a_frame() {
             }
         }
     }
-    assert_eq!(seen, [true; KINDS], "some kind never crossed the link");
+    assert!(seen.iter().all(|s| *s), "some kind never crossed the link");
     // A bare path is the paper's mission.
     assert_eq!(
         Mission::try_from(MissionPlan::from(Table1Case::Circular10R.kind())).expect("closed form"),
@@ -155,11 +132,11 @@ fn every_kind_round_trips_through_a_frame() {
 #[test]
 fn wire_bytes_are_the_documented_layout() {
     // postcard: the variant index (declaration order: circle 0, figure-eight 1, lawn-mower 2,
-    // helix 3) as one byte, then each f32 little-endian in field order. These are the bytes
+    // helix 3, …) as one byte, then each f32 little-endian in field order. These are the bytes
     // the protocol has always had; the conversion must not change them.
     for kind in missions() {
         let mut want = vec![kind_index(&kind) as u8];
-        for x in &fields(&kind)[..field_count(&kind)] {
+        for x in fields(&kind) {
             want.extend(x.to_le_bytes());
         }
         let mut buf = [0u8; MissionSpec::MAX_SIZE];
@@ -184,12 +161,12 @@ fn wire_bytes_are_the_documented_layout() {
 fn the_receiver_validates_what_it_converts() {
     // A valid helix builds the same trajectory on both sides of the conversion; a negative
     // radius converts (the link carries it) and is refused by Trajectory::new.
-    let helix = TrajectoryKind::Helix {
+    let helix = TrajectoryKind::Helix(Helix {
         radius: 10.0,
         omega: 0.1,
         depth: 5.0,
         depth_rate: 0.2,
-    };
+    });
     let spec = MissionSpec::from(helix);
     assert_eq!(
         Trajectory::new(TrajectoryKind::try_from(spec).expect("closed form")),

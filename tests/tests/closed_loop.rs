@@ -1,6 +1,7 @@
 //! Closed loop across crates: the f32 controller-core around the f64 host-sim plant, on the
 //! paper's missions (docs/design.md §6–§7).
 
+use controller_core::trajectory::Helix;
 use controller_core::{Table1Case, TrajectoryKind};
 use host_sim::plant::CurrentModel;
 use host_sim::scenario::paper;
@@ -60,12 +61,12 @@ fn a_mission_in_a_current_still_converges() {
 fn helix_mission_tracks_depth() {
     let mut cfg = SimConfig::new(
         "helix",
-        TrajectoryKind::Helix {
+        TrajectoryKind::Helix(Helix {
             radius: 10.0,
             omega: 0.1,
             depth: 5.0,
             depth_rate: 0.2,
-        },
+        }),
     );
     cfg.duration = 60.0;
     let r = run(cfg);

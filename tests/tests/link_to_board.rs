@@ -6,6 +6,7 @@ use auv_link::{
     encode, Command, Envelope, FrameDecoder, MissionSpec, Msg, MAX_FRAME, PROTOCOL_VERSION,
 };
 use controller_core::kinematics::{self, Attitude};
+use controller_core::trajectory::Helix;
 use controller_core::{
     Controller, ControllerConfig, Status, Table1Case, Trajectory, TrajectoryKind,
 };
@@ -20,12 +21,12 @@ fn missions() -> Vec<(String, Trajectory)> {
         .iter()
         .map(|&c| (c.name().to_string(), Trajectory::table1(c)))
         .collect();
-    let helix = TrajectoryKind::Helix {
+    let helix = TrajectoryKind::Helix(Helix {
         radius: 12.0,
         omega: 0.08,
         depth: 4.0,
         depth_rate: 0.15,
-    };
+    });
     m.push((
         "helix".into(),
         Trajectory::new(helix).expect("a valid helix"),

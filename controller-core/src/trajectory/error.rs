@@ -1,26 +1,22 @@
-//! Why a mission is refused ([`TrajectoryError`]), and the two range checks every path kind's
-//! parameters go through.
+//! Why a mission is refused ([`TrajectoryError`]), and the ranges a path kind's parameters
+//! are checked against ([`Parameter`], [`ParameterRange`]).
 
 use core::fmt;
 
 use crate::readable::Readable;
+use crate::trajectory::limits::{MAX_SLOPE, MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG};
 
-#[cfg(doc)]
-use crate::trajectory::{
-    Mission, Trajectory, TrajectoryKind, MAX_SLOPE, MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG,
-};
-
-/// Why a [`TrajectoryKind`] was rejected by [`Trajectory::new`].
+/// Why a [`TrajectoryKind`](crate::TrajectoryKind) was rejected by [`Trajectory::new`](crate::Trajectory::new).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum TrajectoryError {
     /// The parameter is NaN or infinite.
     NonFinite {
-        /// Field name in [`TrajectoryKind`].
+        /// Field name in [`TrajectoryKind`](crate::TrajectoryKind).
         parameter: &'static str,
     },
     /// A size or frequency that must be strictly positive is zero or negative.
     NotPositive {
-        /// Field name in [`TrajectoryKind`].
+        /// Field name in [`TrajectoryKind`](crate::TrajectoryKind).
         parameter: &'static str,
         /// The rejected value.
         value: f32,
@@ -28,7 +24,7 @@ pub enum TrajectoryError {
     /// The parameter lies outside [min, max] (for a positive parameter `min` is 0 and exclusive;
     /// values at or below it are reported as [`TrajectoryError::NotPositive`]).
     OutOfRange {
-        /// Field name in [`TrajectoryKind`].
+        /// Field name in [`TrajectoryKind`](crate::TrajectoryKind).
         parameter: &'static str,
         /// The rejected value.
         value: f32,
@@ -38,11 +34,11 @@ pub enum TrajectoryError {
         max: f32,
     },
     /// A tangent-heading mission whose horizontal speed falls below
-    /// [`Trajectory::MIN_TANGENT_SPEED`] somewhere (the course is undefined at zero speed).
+    /// [`Trajectory::MIN_TANGENT_SPEED`](crate::Trajectory::MIN_TANGENT_SPEED) somewhere (the course is undefined at zero speed).
     TooSlowForTangent {
         /// The path's minimum horizontal speed at its time scale (m/s).
         min_speed: f32,
-        /// [`Trajectory::MIN_TANGENT_SPEED`].
+        /// [`Trajectory::MIN_TANGENT_SPEED`](crate::Trajectory::MIN_TANGENT_SPEED).
         threshold: f32,
     },
     /// A waypoint path with fewer than 2 or more than [`MAX_WAYPOINTS`] points.
@@ -97,7 +93,7 @@ pub enum TrajectoryError {
 }
 
 impl TrajectoryError {
-    /// The rejected field of [`TrajectoryKind`] or [`Mission`], e.g. `"radius"` (a scenario's
+    /// The rejected field of [`TrajectoryKind`](crate::TrajectoryKind) or [`Mission`](crate::Mission), e.g. `"radius"` (a scenario's
     /// `trajectory.radius`), `"time_scale"` or `"heading"`.
     pub fn parameter(&self) -> &'static str {
         match *self {
@@ -144,19 +140,19 @@ impl fmt::Display for TrajectoryError {
             Self::WaypointCount { count } => write!(
                 f,
                 "a waypoint path needs 2 to {} points; this one has {count}",
-                crate::trajectory::MAX_WAYPOINTS
+                MAX_WAYPOINTS
             ),
             Self::RepeatedWaypoint { index } => write!(
                 f,
                 "waypoint {index} repeats waypoint {} (closer than {} m)",
                 index - 1,
-                crate::trajectory::MIN_LEG
+                MIN_LEG
             ),
             Self::TurnTooSharp { index, degrees } => write!(
                 f,
                 "the turn at waypoint {index} is {}°, sharper than the {}° the path allows (add a waypoint to split it)",
                 Readable(degrees),
-                crate::trajectory::MAX_TURN_DEGREES
+                MAX_TURN_DEGREES
             ),
             Self::LegTooShort { leg, needs, has } => write!(
                 f,
@@ -180,8 +176,45 @@ impl fmt::Display for TrajectoryError {
                 "leg {leg} (waypoints {leg} to {}) climbs or dives at slope {}, steeper than {} (the heading needs horizontal motion)",
                 leg + 1,
                 Readable(slope),
-                crate::trajectory::MAX_SLOPE
+                MAX_SLOPE
             ),
+        }
+    }
+}
+
+/// A parameter of a closed-form path kind: its field's name and the values
+/// [`Trajectory::new`](crate::Trajectory::new) accepts
+/// ([`TrajectoryKind::parameters`](crate::TrajectoryKind::parameters) lists them).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Parameter {
+    /// The field's name, as scenario files spell it and [`TrajectoryError::parameter`] names it.
+    pub name: &'static str,
+    /// The values accepted.
+    pub range: ParameterRange,
+}
+
+/// The values a [`Parameter`] accepts (every one finite).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ParameterRange {
+    /// (0, max]: a size or a frequency.
+    Positive(f32),
+    /// [−max, max]: a depth or a rate of either sign.
+    Symmetric(f32),
+}
+
+impl Parameter {
+    /// The largest magnitude accepted.
+    pub const fn max(&self) -> f32 {
+        match self.range {
+            ParameterRange::Positive(max) | ParameterRange::Symmetric(max) => max,
+        }
+    }
+
+    /// `value` finite and in range; the error names the parameter.
+    pub fn check(&self, value: f32) -> Result<(), TrajectoryError> {
+        match self.range {
+            ParameterRange::Positive(max) => positive(self.name, value, max),
+            ParameterRange::Symmetric(max) => symmetric(self.name, value, max),
         }
     }
 }

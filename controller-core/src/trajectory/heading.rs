@@ -5,7 +5,7 @@
 
 use core::fmt;
 
-use crate::trajectory::paths;
+use crate::trajectory::paths::PathKind;
 use crate::trajectory::phases::tangent;
 use crate::trajectory::Trajectory;
 
@@ -66,11 +66,11 @@ impl Trajectory {
         for j in 0..TANGENT_BOUND_SAMPLES {
             // One period of the path's course, in TANGENT_BOUND_SAMPLES steps of the phase.
             let a = j.wrapping_mul(u32::MAX / TANGENT_BOUND_SAMPLES + 1);
-            let Some(ph) = paths::course_period_phases(&self.mission.path, a) else {
+            let Some(ph) = self.mission.path.course_period_phases(a) else {
                 // The course turns at a constant rate: ψ̈_d = 0.
                 return 0.0;
             };
-            let (_, _, accel) = tangent(&paths::planar(self, &ph));
+            let (_, _, accel) = tangent(&self.mission.path.planar(self, &ph));
             let accel = libm::fabsf(accel);
             if accel > max {
                 max = accel;

@@ -49,37 +49,41 @@
 //! series, a loop over a constant five harmonics), never allocates and never panics.
 //!
 //! **Files.** This file: [`Trajectory`] (validate, precompute, sample) and [`Desired`].
-//! `kind.rs` the path kinds as data ([`TrajectoryKind`]); `paths/` one file per path kind
-//! (its checks, the path at a sample, its minimum speed and acceleration bound) and the
-//! `match` that dispatches to them, so that a new path kind is one more file there;
-//! `heading.rs` [`HeadingMode`] and the tangent heading; `series.rs` the paper's heading
-//! series; `phases.rs` a sample's phases and harmonics; `mission.rs` [`Mission`];
-//! `table1.rs` [`Table1Case`]; `error.rs` [`TrajectoryError`] and the range checks.
+//! `paths/` the path kinds: [`TrajectoryKind`], declared with its dispatch from one list in
+//! `paths/mod.rs`, and one file per kind (its parameters, the path at a sample, its minimum
+//! speed and acceleration bound), so that a new closed-form kind is its file and one line of
+//! the list; `heading.rs` [`HeadingMode`] and the tangent heading; `series.rs` the paper's
+//! heading series; `phases.rs` a sample's phases and harmonics; `mission.rs` [`Mission`];
+//! `table1.rs` [`Table1Case`]; `error.rs` [`TrajectoryError`] and the parameter ranges;
+//! `limits.rs` the waypoint path's limits (a leaf: the refusals name them).
 
 mod error;
 mod heading;
-mod kind;
+mod limits;
 mod mission;
 mod paths;
 mod phases;
 mod series;
 mod table1;
 
-pub use error::TrajectoryError;
+pub use error::{Parameter, ParameterRange, TrajectoryError};
 pub use heading::HeadingMode;
-pub use kind::TrajectoryKind;
-pub use mission::Mission;
-pub use paths::time_law::{SpeedList, TimeLaw, DEFAULT_SPEED_CHANGE, MAX_PARTS, MAX_SPEED_CHANGE};
-pub use paths::waypoints::{
-    turn_radius, PathPoint, Route, WaypointList, MAX_SEGMENTS, MAX_SLOPE, MAX_SPEED,
+pub use limits::{
+    DEFAULT_SPEED_CHANGE, MAX_PARTS, MAX_SEGMENTS, MAX_SLOPE, MAX_SPEED, MAX_SPEED_CHANGE,
     MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG, MIN_TURN_RADIUS, TURN_ACCEL,
 };
+pub use mission::Mission;
+pub use paths::time_law::{SpeedList, TimeLaw};
+pub use paths::waypoints::{turn_radius, PathPoint, Route, WaypointList};
+// Every kind's parameter struct (declared by the list in `paths/mod.rs`) and `TrajectoryKind`.
+pub use paths::*;
 pub use table1::Table1Case;
 
 use nalgebra::Vector6;
 
 use crate::math;
 use crate::phase::{Frequency, LinearRate, MissionTime};
+use paths::PathKind;
 use phases::tangent;
 use phases::{Harmonics, Phases};
 use series::{series_coefficients, ODD_TERMS};
@@ -161,11 +165,11 @@ impl Trajectory {
     /// `memset` instead of copying 8.6 kB from flash.
     pub const EMPTY: Trajectory = Trajectory {
         mission: Mission {
-            path: TrajectoryKind::Circle {
+            path: TrajectoryKind::Circle(Circle {
                 radius: 0.0,
                 omega: 0.0,
                 depth: 0.0,
-            },
+            }),
             heading: HeadingMode::Paper,
             time_scale: 0.0,
         },
@@ -219,7 +223,7 @@ impl Trajectory {
 
     /// [`Trajectory::set`] before its clean-up on an error.
     fn try_set(&mut self, mission: &Mission) -> Result<(), TrajectoryError> {
-        paths::build_into(&mission.path, &mut self.route, &mut self.law)?;
+        mission.path.build_into(&mut self.route, &mut self.law)?;
         let k = mission.time_scale;
         if !k.is_finite() {
             return Err(TrajectoryError::NonFinite {
@@ -256,7 +260,7 @@ impl Trajectory {
     /// time law are already built (empty for the closed forms).
     fn precompute(&mut self, mission: &Mission) {
         let k = mission.time_scale as f64;
-        let (omega, rate) = paths::rates(&mission.path);
+        let (omega, rate) = mission.path.rates();
         // η_d(t/k): every frequency and every linear rate over k (exact for k = 1).
         let omega_f64 = omega as f64 / k;
         let rate_f64 = rate as f64 / k;
@@ -264,10 +268,10 @@ impl Trajectory {
         self.mission = *mission;
         self.omega = omega;
         self.theta = Frequency::from_rad_per_s(omega_f64);
-        self.half = paths::half_frequency(&mission.path, omega_f64);
+        self.half = mission.path.half_frequency(omega_f64);
         self.rate = rate_f64 as f32;
-        self.position_rate = paths::position_rate(&mission.path, rate_f64);
-        self.psi = match paths::heading_series(&mission.path) {
+        self.position_rate = mission.path.position_rate(rate_f64);
+        self.psi = match mission.path.heading_series() {
             Some(series) => series_coefficients(series, omega),
             None => [[0.0; 3]; ODD_TERMS],
         };
@@ -291,7 +295,7 @@ impl Trajectory {
             self.accel_bound = sqrt_upper(accel);
             return;
         }
-        self.min_speed = paths::min_speed(self);
+        self.min_speed = mission.path.min_speed(self);
         let heading_bound = match mission.heading {
             HeadingMode::Paper => {
                 let mut series_bound = 0.0f32;
@@ -302,7 +306,7 @@ impl Trajectory {
             }
             HeadingMode::Tangent => self.tangent_accel_bound(),
         };
-        let (x, y) = paths::accel(&mission.path, omega);
+        let (x, y) = mission.path.accel(omega);
         self.accel_bound = sqrt_upper(x * x + y * y + heading_bound * heading_bound);
     }
 
@@ -325,12 +329,12 @@ impl Trajectory {
     /// Helix: circle of radius `radius`, ω = 0.1 rad/s, starting at depth 5 m and descending at
     /// `depth_rate` m/s (negative rises).
     pub fn helix(radius: f32, depth_rate: f32) -> Result<Self, TrajectoryError> {
-        Self::new(TrajectoryKind::Helix {
+        Self::new(TrajectoryKind::Helix(Helix {
             radius,
             omega: Self::PAPER_OMEGA,
             depth: Self::PAPER_DEPTH,
             depth_rate,
-        })
+        }))
     }
 
     /// One of the paper's Table-1 missions (always valid, so no `Result`).

@@ -1,7 +1,7 @@
 //! The six missions of the paper's Table 1 (docs/design.md §6–7 **Choice**: R = 10, 20;
 //! A = 15, 20; s = 2/3, 1), with the paper's frequencies and depth.
 
-use crate::trajectory::{Trajectory, TrajectoryKind};
+use crate::trajectory::{Circle, FigureEight, LawnMower, Trajectory, TrajectoryKind};
 
 /// The six missions of the paper's Table 1 (docs/design.md §6–7).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -63,25 +63,25 @@ impl Table1Case {
 }
 
 pub(super) const fn circle_kind(radius: f32) -> TrajectoryKind {
-    TrajectoryKind::Circle {
+    TrajectoryKind::Circle(Circle {
         radius,
         omega: Trajectory::PAPER_OMEGA,
         depth: Trajectory::PAPER_DEPTH,
-    }
+    })
 }
 
 pub(super) const fn figure_eight_kind(amplitude: f32) -> TrajectoryKind {
-    TrajectoryKind::FigureEight {
+    TrajectoryKind::FigureEight(FigureEight {
         amplitude,
         omega: Trajectory::PAPER_OMEGA,
         depth: Trajectory::PAPER_DEPTH,
-    }
+    })
 }
 
 pub(super) const fn lawn_mower_kind(scale: f32) -> TrajectoryKind {
-    TrajectoryKind::LawnMower {
+    TrajectoryKind::LawnMower(LawnMower {
         scale,
         omega: Trajectory::PAPER_LAWN_MOWER_OMEGA,
         depth: Trajectory::PAPER_DEPTH,
-    }
+    })
 }

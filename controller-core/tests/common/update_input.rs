@@ -38,6 +38,24 @@ struct Input {
     custom: Option<TrajectoryKind>,
 }
 
+/// The closed-form kinds of `TrajectoryKind::EXAMPLES`, in declaration order.
+fn closed_forms() -> Vec<TrajectoryKind> {
+    TrajectoryKind::EXAMPLES
+        .into_iter()
+        .filter(|k| !matches!(k, TrajectoryKind::Waypoints { .. }))
+        .collect()
+}
+
+/// The most parameters any of `kinds` has: the words the input holds for them.
+fn max_parameters(kinds: &[TrajectoryKind]) -> usize {
+    let count = |mut k: TrajectoryKind| {
+        let mut n = 0;
+        k.parameters(&mut |_, _| n += 1);
+        n
+    };
+    kinds.iter().map(|k| count(*k)).max().unwrap_or(0)
+}
+
 /// Reads the input front to back; past the end every byte is zero.
 struct Reader<'a> {
     data: &'a [u8],
@@ -76,7 +94,7 @@ fn parse(data: &[u8]) -> Input {
     let mut r = Reader { data, pos: 0 };
     let mut ticks = r.u64();
     let raw: [u32; 12] = core::array::from_fn(|_| r.u32());
-    let case = Table1Case::ALL[usize::from(r.u8()) % 6];
+    let case = Table1Case::ALL[usize::from(r.u8()) % Table1Case::ALL.len()];
     let flags = r.u8();
     let robust = flags & 1 != 0;
     let custom_on = flags & 2 != 0;
@@ -102,40 +120,16 @@ fn parse(data: &[u8]) -> Input {
     let eta = core::array::from_fn(|i| x[i]);
     let nu = core::array::from_fn(|i| x[6 + i]);
 
-    let kind = r.u8() % 4;
-    let p: [u32; 4] = core::array::from_fn(|_| r.u32());
-    let size_limit = if kind == 2 {
-        Trajectory::MAX_SIZE / 15.0
-    } else {
-        Trajectory::MAX_SIZE
-    };
-    let size = to_f32(p[0], scaled, 1.05 * size_limit);
-    let omega = to_f32(p[1], scaled, 1.05 * Trajectory::MAX_OMEGA);
-    let depth = to_f32(p[2], scaled, 1.05 * Trajectory::MAX_DEPTH);
-    let depth_rate = to_f32(p[3], scaled, 1.05 * Trajectory::MAX_DEPTH_RATE);
-    let custom = custom_on.then_some(match kind {
-        0 => TrajectoryKind::Circle {
-            radius: size,
-            omega,
-            depth,
-        },
-        1 => TrajectoryKind::FigureEight {
-            amplitude: size,
-            omega,
-            depth,
-        },
-        2 => TrajectoryKind::LawnMower {
-            scale: size,
-            omega,
-            depth,
-        },
-        _ => TrajectoryKind::Helix {
-            radius: size,
-            omega,
-            depth,
-            depth_rate,
-        },
+    // A closed form of `TrajectoryKind::EXAMPLES` (declaration order), its parameters in field
+    // order from the next words, each scaled to 1.05 × its own limit.
+    let closed = closed_forms();
+    let mut custom = closed[usize::from(r.u8()) % closed.len()];
+    let words: Vec<u32> = (0..max_parameters(&closed)).map(|_| r.u32()).collect();
+    let mut next = words.iter();
+    custom.parameters(&mut |param, value| {
+        *value = to_f32(*next.next().unwrap_or(&0), scaled, 1.05 * param.max());
     });
+    let custom = custom_on.then_some(custom);
     Input {
         ticks,
         eta,

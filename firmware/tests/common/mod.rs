@@ -4,10 +4,7 @@
 #![allow(dead_code)]
 
 use auv_link::sign::{Direction, LinkKey, Signer};
-use auv_link::{
-    encode, encode_signed, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg, StateFrame,
-    MAX_FRAME,
-};
+use auv_link::{encode, encode_signed, Command, Envelope, MissionPlan, Msg, StateFrame, MAX_FRAME};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Controller, ControllerConfig, Table1Case, Trajectory};
 use firmware::board::{self, LinkBuffers};
@@ -40,15 +37,7 @@ pub fn supervisor() -> Supervisor {
 
 /// The mission every test flies: the paper's 10 m circle, as the paper flies it (its heading,
 /// time scale 1).
-pub const CIRCLE: MissionPlan = MissionPlan {
-    path: MissionSpec::Circle {
-        radius: 10.0,
-        omega: 0.1,
-        depth: 5.0,
-    },
-    heading: Heading::Paper,
-    time_scale: 1.0,
-};
+pub const CIRCLE: MissionPlan = MissionPlan::EXAMPLE;
 
 /// A state frame on the circle at tick `k` (the vehicle exactly on its reference).
 pub fn state(k: u64) -> StateFrame {

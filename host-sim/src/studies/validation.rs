@@ -15,6 +15,7 @@
 //! abs-sin or staircase profile, a constant current), each deterministic from (seed, index).
 
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
+use controller_core::trajectory::{Circle, FigureEight, LawnMower};
 use controller_core::uncertainty::ParamBox;
 use controller_core::{HeadingMode, TrajectoryKind};
 use rand::{RngExt, SeedableRng};
@@ -163,37 +164,8 @@ fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
     let base = real_vehicle::real_scenarios()?.remove(0);
     loop {
         let speed = 0.5 + 2.0 * rng.random::<f64>();
-        // The size, and ω from the speed: R ω (circle), A ω (figure-eight), 15 s ω (the
-        // lawn-mower's cross-track legs).
-        let path = match rng.random_range(0..3u32) {
-            0 => {
-                let radius = 8.0 + 32.0 * rng.random::<f64>();
-                let omega = (speed / radius) as f32;
-                TrajectoryKind::Circle {
-                    radius: radius as f32,
-                    omega,
-                    depth: 5.0,
-                }
-            }
-            1 => {
-                let amplitude = 10.0 + 30.0 * rng.random::<f64>();
-                let omega = (speed / amplitude) as f32;
-                TrajectoryKind::FigureEight {
-                    amplitude: amplitude as f32,
-                    omega,
-                    depth: 5.0,
-                }
-            }
-            _ => {
-                let scale = 0.5 + rng.random::<f64>();
-                let omega = (speed / (15.0 * scale)).clamp(0.02, 0.08) as f32;
-                TrajectoryKind::LawnMower {
-                    scale: scale as f32,
-                    omega,
-                    depth: 5.0,
-                }
-            }
-        };
+        let kinds = random_kinds();
+        let path = kinds[rng.random_range(0..kinds.len() as u32) as usize](speed, &mut rng);
         let mask = rng.random_range(0..1u8 << THRUSTERS);
         let payload = ParamBox::table3().lerp(&std::array::from_fn(|_| rng.random::<f64>()));
         let variation = match rng.random_range(0..3u32) {
@@ -233,6 +205,53 @@ fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
             Err(e) => return Err(e),
         }
     }
+}
+
+/// Draws a random path of one kind for a horizontal speed (m/s): its size, and ω from the
+/// speed.
+type DrawPath = fn(f64, &mut rand::rngs::StdRng) -> TrajectoryKind;
+
+/// The kinds the random missions fly, in `TrajectoryKind::EXAMPLES`' order, each with its
+/// draw. A new kind does not compile here until it says whether they fly it (the match is
+/// exhaustive); flying one more kind draws other missions for every seed.
+fn random_kinds() -> Vec<DrawPath> {
+    TrajectoryKind::EXAMPLES
+        .iter()
+        .filter_map(|kind| -> Option<DrawPath> {
+            match kind {
+                // R ω = speed.
+                TrajectoryKind::Circle(_) => Some(|speed, rng| {
+                    let radius = 8.0 + 32.0 * rng.random::<f64>();
+                    TrajectoryKind::Circle(Circle {
+                        radius: radius as f32,
+                        omega: (speed / radius) as f32,
+                        depth: 5.0,
+                    })
+                }),
+                // A ω = speed.
+                TrajectoryKind::FigureEight(_) => Some(|speed, rng| {
+                    let amplitude = 10.0 + 30.0 * rng.random::<f64>();
+                    TrajectoryKind::FigureEight(FigureEight {
+                        amplitude: amplitude as f32,
+                        omega: (speed / amplitude) as f32,
+                        depth: 5.0,
+                    })
+                }),
+                // 15 s ω = speed on the cross-track legs, ω within the paper's range.
+                TrajectoryKind::LawnMower(_) => Some(|speed, rng| {
+                    let scale = 0.5 + rng.random::<f64>();
+                    TrajectoryKind::LawnMower(LawnMower {
+                        scale: scale as f32,
+                        omega: (speed / (15.0 * scale)).clamp(0.02, 0.08) as f32,
+                        depth: 5.0,
+                    })
+                }),
+                // Level paths only: the contract's random missions hold their depth. The
+                // waypoint missions have their own speed profiles (`host-sim check`).
+                TrajectoryKind::Helix(_) | TrajectoryKind::Waypoints { .. } => None,
+            }
+        })
+        .collect()
 }
 
 /// `base` at time scale `k`: the same path (its duration scaled).

@@ -17,26 +17,17 @@
 //! ([`MissionTime::linear_since`]), so the path position keeps the precision of the constant
 //! speed path (Choice 153).
 
-use super::waypoints::{
-    segment_bounds, turn_radius, PathPoint, Route, WaypointList, MAX_SEGMENTS, MAX_SPEED,
-    MAX_WAYPOINTS,
-};
+use super::waypoints::{segment_bounds, PathPoint, Route};
 use crate::phase::{LinearRate, MissionTime};
 use crate::trajectory::error::{positive, TrajectoryError};
+use crate::trajectory::limits::{MAX_PARTS, MAX_SEGMENTS, MAX_SPEED, MAX_SPEED_CHANGE};
 use crate::trajectory::phases::Planar;
-use crate::trajectory::Trajectory;
 
-/// Parts of a path of [`MAX_WAYPOINTS`] points: its legs and its turns, alternating.
-pub const MAX_PARTS: usize = 2 * MAX_WAYPOINTS - 3;
 /// Pieces of a time law: a speed-up, a cruise and a slowdown per segment.
 pub const MAX_PIECES: usize = 3 * MAX_SEGMENTS;
 /// Steps of the binary search over the pieces: 2^PIECE_SEARCH_STEPS ≥ [`MAX_PIECES`].
 const PIECE_SEARCH_STEPS: u32 = 8;
 const _: () = assert!(1 << PIECE_SEARCH_STEPS >= MAX_PIECES);
-/// `speed_change` when not given (m/s²): the largest |σ̈| of a change of speed.
-pub const DEFAULT_SPEED_CHANGE: f32 = 0.05;
-/// Largest `speed_change` (m/s²), a sanity limit.
-pub const MAX_SPEED_CHANGE: f32 = 10.0;
 /// Peak of the smoothstep's derivative, S′(½) = 15/8: T = (15/8)·|Δv|/A.
 const PEAK: f32 = 15.0 / 8.0;
 
@@ -309,43 +300,6 @@ impl TimeLaw {
         };
         (pp, rates)
     }
-}
-
-/// Checks a waypoint path's parameters and builds its route and time law in place
-/// (Choice 180: validation is the build, nothing is built twice or on the stack): speed in
-/// (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then the
-/// points ([`Route::build_into`]), then the time law if there is one ([`TimeLaw::build_into`];
-/// else [`TimeLaw::EMPTY`], with `speed_change` still checked if given). After an error the
-/// route and the law are unspecified but safe to sample.
-pub(super) fn build_into(
-    path: &Waypoints,
-    route: &mut Route,
-    law: &mut TimeLaw,
-) -> Result<(), TrajectoryError> {
-    positive("speed", path.speed, MAX_SPEED)?;
-    if let Some(r) = path.turn_radius {
-        positive("turn_radius", r, Trajectory::MAX_SIZE)?;
-    }
-    route.build_into(path.points, turn_radius(path.speed, path.turn_radius))?;
-    match path.speeds {
-        Some(s) => law.build_into(route, s, path.speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
-        None => {
-            law.clear();
-            match path.speed_change {
-                Some(a) => positive("speed_change", a, MAX_SPEED_CHANGE),
-                None => Ok(()),
-            }
-        }
-    }
-}
-
-/// The fields of a [`TrajectoryKind::Waypoints`], borrowed (no copy of its lists).
-pub(super) struct Waypoints<'a> {
-    pub(super) points: &'a WaypointList,
-    pub(super) speed: f32,
-    pub(super) turn_radius: Option<f32>,
-    pub(super) speeds: Option<&'a SpeedList>,
-    pub(super) speed_change: Option<f32>,
 }
 
 /// The smallest horizontal speed and the square of K_d (Assumption 1) of the path flown at

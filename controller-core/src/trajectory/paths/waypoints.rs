@@ -38,34 +38,15 @@
 use crate::math;
 use crate::phase::{LinearRate, MissionTime};
 use crate::trajectory::error::TrajectoryError;
+use crate::trajectory::limits::{
+    MAX_COORDINATE, MAX_SEGMENTS, MAX_SLOPE, MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG,
+    MIN_TURN_RADIUS, TURN_ACCEL,
+};
 use crate::trajectory::phases::Planar;
 
-/// Most waypoints in one mission (Choice 152), on every target: the board builds a
-/// trajectory in place ([`crate::Trajectory::set`], Choice 180), so the capacity costs it the
-/// `Trajectory`'s static size but no stack copies of it.
-pub const MAX_WAYPOINTS: usize = 32;
-/// Segments of a path of [`MAX_WAYPOINTS`] points: its legs and the blends between them.
-pub const MAX_SEGMENTS: usize = 2 * MAX_WAYPOINTS - 3;
 /// Steps of the binary search: 2^SEARCH_STEPS ≥ [`MAX_SEGMENTS`].
 const SEARCH_STEPS: u32 = 6;
 const _: () = assert!(1 << SEARCH_STEPS >= MAX_SEGMENTS);
-/// Shortest leg (m): two consecutive waypoints closer than this are one point repeated.
-pub const MIN_LEG: f32 = 0.1;
-/// Sharpest turn at a waypoint (degrees): the blend's cut grows as sin(Δ/2)/cos²(Δ/2), 6.5 turn
-/// radii at 120°, 27 at 150°.
-pub const MAX_TURN_DEGREES: f32 = 120.0;
-/// Steepest leg, |Δz| / horizontal length (1: 45°).
-pub const MAX_SLOPE: f32 = 1.0;
-/// Largest coordinate magnitude (m), a sanity limit.
-pub const MAX_COORDINATE: f32 = 100_000.0;
-/// Fastest path speed (m/s), a sanity limit.
-pub const MAX_SPEED: f32 = 10.0;
-/// The centripetal acceleration (m/s²) of the default turn radius, turn_radius = speed²/
-/// TURN_ACCEL (Choice 151): the paper's circle of 10 m at ω = 0.1 rad/s (Rω² = 0.1 m/s²), which
-/// the real vehicle flies within its bound.
-pub const TURN_ACCEL: f32 = 0.1;
-/// The smallest default turn radius (m).
-pub const MIN_TURN_RADIUS: f32 = 1.0;
 /// The smallest cut, in turn radii (Choice 151).
 const MIN_CUT: f32 = 0.5;
 /// A straight remainder of a leg shorter than this (m) is not a segment of its own.
@@ -95,6 +76,22 @@ impl WaypointList {
         };
         list.points[..points.len()].copy_from_slice(points);
         Ok(list)
+    }
+
+    /// The points of a list known at compile time (at most [`MAX_WAYPOINTS`]: more is a
+    /// compile error where it is evaluated as a constant).
+    pub(crate) const fn from_array<const N: usize>(points: [[f32; 3]; N]) -> Self {
+        assert!(N <= MAX_WAYPOINTS);
+        let mut list = WaypointList {
+            len: N as u8,
+            points: [[0.0; 3]; MAX_WAYPOINTS],
+        };
+        let mut i = 0;
+        while i < N {
+            list.points[i] = points[i];
+            i += 1;
+        }
+        list
     }
 
     /// The points, in order.

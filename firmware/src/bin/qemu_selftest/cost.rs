@@ -104,12 +104,12 @@ pub fn stages(
         let Some((counts, total)) = step_counts(counter, c, &tr, g) else {
             continue;
         };
-        // The per-mission rows are the Table-1 paths (either heading) and the survey; the
-        // helix counts in the per-stage maxima below only.
-        let row = if g.waypoints {
+        // The per-mission rows are the Table-1 paths (either heading) and the survey; the other
+        // kinds' examples count in the per-stage maxima below only.
+        let row = if g.is_survey() {
             Some(Table1Case::ALL.len())
         } else {
-            g.helix.is_none().then_some(g.case)
+            g.case()
         };
         for (i, &n) in counts.iter().enumerate() {
             stage[i].add(n);

@@ -12,6 +12,7 @@ mod golden;
 mod kernels;
 mod selftest;
 mod stack;
+mod vector;
 
 use cortex_m_rt::entry;
 use defmt_semihosting as _;

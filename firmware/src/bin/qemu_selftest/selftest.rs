@@ -110,7 +110,7 @@ fn golden_vectors() -> (bool, u32, u32) {
         }
         let (mut same, exact, diff) = compare(&o, status, g);
         worst_ulps = worst_ulps.max(diff);
-        if g.waypoints {
+        if g.is_survey() {
             survey += 1;
             survey_exact += u32::from(exact);
             same &= exact;
@@ -189,15 +189,8 @@ fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
     }
 }
 
-const MISSION: MissionPlan = MissionPlan {
-    path: MissionSpec::Circle {
-        radius: 10.0,
-        omega: 0.1,
-        depth: 5.0,
-    },
-    heading: Heading::Paper,
-    time_scale: 1.0,
-};
+/// The paper's 10 m circle, as the paper flies it.
+const MISSION: MissionPlan = MissionPlan::EXAMPLE;
 
 fn board_info(signing: bool) -> BoardInfo {
     BoardInfo {

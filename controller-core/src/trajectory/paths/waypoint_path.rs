@@ -1,0 +1,99 @@
+//! The waypoint path as a [`PathKind`] (docs/design.md §27): the fields of a
+//! [`TrajectoryKind::Waypoints`](crate::TrajectoryKind::Waypoints), borrowed, checked and built
+//! into the trajectory's route and time law in place, and flown along them.
+
+use super::kind::PathKind;
+use super::time_law::{self, SpeedList, TimeLaw};
+use super::waypoints::{self, turn_radius, Route, WaypointList};
+use crate::trajectory::error::{positive, Parameter, TrajectoryError};
+use crate::trajectory::limits::{DEFAULT_SPEED_CHANGE, MAX_SPEED, MAX_SPEED_CHANGE};
+use crate::trajectory::phases::{tangent, Harmonics, Phases, Planar};
+use crate::trajectory::{Trajectory, TrajectoryKind};
+
+/// The fields of a [`TrajectoryKind::Waypoints`], borrowed (no copy of its lists).
+#[derive(Clone, Copy)]
+pub(super) struct WaypointPath<'a> {
+    pub(super) points: &'a WaypointList,
+    pub(super) speed: f32,
+    pub(super) turn_radius: Option<f32>,
+    pub(super) speeds: Option<&'a SpeedList>,
+    pub(super) speed_change: Option<f32>,
+}
+
+/// The waypoint path of [`TrajectoryKind::EXAMPLES`]: three points, two legs and the 90° turn
+/// between them, at 0.5 m/s.
+pub(super) const EXAMPLE: TrajectoryKind = TrajectoryKind::Waypoints {
+    points: WaypointList::from_array([[0.0, 10.0, 5.0], [60.0, 10.0, 5.0], [60.0, 60.0, 5.0]]),
+    speed: 0.5,
+    turn_radius: None,
+    speeds: None,
+    speed_change: None,
+};
+
+impl PathKind for WaypointPath<'_> {
+    /// None: the points and the options are checked as the route is built.
+    fn parameters(&mut self, _visit: &mut dyn FnMut(&Parameter, &mut f32)) {}
+
+    /// Checks the path's parameters and builds its route and time law in place (Choice 180:
+    /// validation is the build, nothing is built twice or on the stack): speed in
+    /// (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then the
+    /// points ([`Route::build_into`]), then the time law if there is one
+    /// ([`TimeLaw::build_into`]; else [`TimeLaw::EMPTY`], with `speed_change` still checked if
+    /// given). After an error the route and the law are unspecified but safe to sample.
+    fn build_into(&self, route: &mut Route, law: &mut TimeLaw) -> Result<(), TrajectoryError> {
+        positive("speed", self.speed, MAX_SPEED)?;
+        if let Some(r) = self.turn_radius {
+            positive("turn_radius", r, Trajectory::MAX_SIZE)?;
+        }
+        route.build_into(self.points, turn_radius(self.speed, self.turn_radius))?;
+        match self.speeds {
+            Some(s) => law.build_into(route, s, self.speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
+            None => {
+                law.clear();
+                match self.speed_change {
+                    Some(a) => positive("speed_change", a, MAX_SPEED_CHANGE),
+                    None => Ok(()),
+                }
+            }
+        }
+    }
+
+    /// No angular frequency; the path speed σ̇.
+    fn rates(&self) -> (f32, f32) {
+        (0.0, self.speed)
+    }
+
+    /// None in closed form: its bound is its route's ([`waypoints::bounds`], in
+    /// [`Trajectory`]'s precompute).
+    fn accel(&self, _omega: f32) -> (f32, f32) {
+        (0.0, 0.0)
+    }
+
+    /// Its route's, sampled ([`waypoints::bounds`]).
+    fn min_speed(&self, t: &Trajectory) -> f32 {
+        waypoints::bounds(&t.route).0 * t.rate
+    }
+
+    /// Along the route, at constant speed or by the time law. Inlined into the dispatch, so
+    /// that the borrowed fields it does not read are never formed on the tick path.
+    #[inline(always)]
+    fn planar(&self, t: &Trajectory, ph: &Phases) -> Planar {
+        match t.law.is_set() {
+            true => time_law::timed(&t.route, &t.law, &ph.time, &t.position_rate, t.rate),
+            false => waypoints::planar(&t.route, &ph.time, &t.position_rate, t.rate),
+        }
+    }
+
+    /// The waypoint path has no heading of its own in the paper: its "paper" heading is its
+    /// course, as the tangent heading (Choice 154).
+    #[inline(always)]
+    fn paper_heading(
+        &self,
+        _t: &Trajectory,
+        _theta: u32,
+        _h: &Harmonics,
+        p: &Planar,
+    ) -> (f32, f32, f32) {
+        tangent(p)
+    }
+}
