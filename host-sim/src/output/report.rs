@@ -332,7 +332,7 @@ struct RunWarning {
 }
 
 /// The report's warnings about runs, in the order they are given.
-const RUN_WARNINGS: [RunWarning; 6] = [
+const RUN_WARNINGS: [RunWarning; 7] = [
     RunWarning {
         heading: |n| {
             format!(
@@ -350,6 +350,16 @@ const RUN_WARNINGS: [RunWarning; 6] = [
             )
         },
         detail: |r| r.diverged().then(|| r.outcome.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "**Warning: {n} run(s) lost their board** (PIL, HIL: the board went silent, \
+                 its link went away, or it flew another configuration) — their metrics cover \
+                 only the time before they stopped:"
+            )
+        },
+        detail: |r| r.lost_board().then(|| r.outcome.to_string()),
     },
     RunWarning {
         heading: |n| {
@@ -390,7 +400,8 @@ const RUN_WARNINGS: [RunWarning; 6] = [
 ];
 
 /// The report's warnings, each a heading and a list, for what the reader must not miss: outputs
-/// not written, runs interrupted, diverged, missed or in fail-safe (expected or not).
+/// not written, runs interrupted, diverged, that lost their board, missed or in fail-safe
+/// (expected or not).
 fn warnings(runs: &[&RunResult], incomplete: &[String]) -> String {
     let mut s = String::new();
     let mut warn = |head: String, items: Vec<String>| {
