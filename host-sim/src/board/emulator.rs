@@ -16,6 +16,32 @@ use super::image::check_flying_image;
 use super::pacing::Pacing;
 use crate::interrupt;
 
+/// The longest the runner waits for QEMU to connect its UART or name its pty.
+const QEMU_WAIT: Duration = Duration::from_secs(30);
+
+/// What `poll` finds (polled every 20 ms), within [`QEMU_WAIT`] (else `timed_out(QEMU_WAIT)`);
+/// a stop request ends the wait ([`Error::Interrupted`]).
+pub(super) fn wait_for_qemu<T>(
+    timed_out: impl FnOnce(Duration) -> Error,
+    mut poll: impl FnMut() -> Result<Option<T>, Error>,
+) -> Result<T, Error> {
+    let deadline = Instant::now() + QEMU_WAIT;
+    loop {
+        if let Some(found) = poll()? {
+            return Ok(found);
+        }
+        if interrupt::requested() {
+            return Err(Error::Interrupted {
+                waiting_for: "QEMU",
+            });
+        }
+        if Instant::now() > deadline {
+            return Err(timed_out(QEMU_WAIT));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
 /// QEMU started by [`spawn_qemu`]: its process group, ended when this is dropped (or at
 /// [`Qemu::stop`]).
 pub struct Qemu {
@@ -134,35 +160,27 @@ impl QemuPty {
             io,
         })?;
         let qemu = spawn_qemu(elf, runner, qemu_runner::SERIAL_PTY, pacing, log, key)?;
-        let mut q = QemuPty {
-            qemu,
-            port: PathBuf::new(),
-        };
-        let deadline = Instant::now() + Duration::from_secs(30);
-        loop {
-            let text = std::fs::read_to_string(log_path).unwrap_or_default();
-            if let Some(port) = pty_of_log(&text) {
-                q.port = port;
-                return Ok(q);
-            }
-            if let Some(status) = q.qemu.ended() {
-                return Err(Error::QemuEnded {
-                    status,
-                    log: log_path.to_path_buf(),
-                });
-            }
-            if interrupt::requested() {
-                return Err(Error::Interrupted {
-                    waiting_for: "QEMU",
-                });
-            }
-            if Instant::now() > deadline {
-                return Err(Error::QemuNoPty {
-                    log: log_path.to_path_buf(),
-                });
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
+        let mut qemu = qemu;
+        let port = wait_for_qemu(
+            |waited| Error::QemuNoPty {
+                waited,
+                log: log_path.to_path_buf(),
+            },
+            || {
+                let text = std::fs::read_to_string(log_path).unwrap_or_default();
+                if let Some(port) = pty_of_log(&text) {
+                    return Ok(Some(port));
+                }
+                match qemu.ended() {
+                    Some(status) => Err(Error::QemuEnded {
+                        status,
+                        log: log_path.to_path_buf(),
+                    }),
+                    None => Ok(None),
+                }
+            },
+        )?;
+        Ok(QemuPty { qemu, port })
     }
 
     /// Ends QEMU now (the board's port goes away); dropping it does too.

@@ -46,11 +46,11 @@ pub enum Error {
     #[error("{op}: {io}")]
     QemuIo { op: &'static str, io: io::Error },
     /// QEMU did not connect its UART to the loopback socket in time.
-    #[error("QEMU did not connect its UART within 30 s (see {})", log.display())]
-    QemuNoUart { log: PathBuf },
+    #[error("QEMU did not connect its UART within {} s (see {})", waited.as_secs(), log.display())]
+    QemuNoUart { waited: Duration, log: PathBuf },
     /// QEMU did not name its pseudo-terminal in time.
-    #[error("QEMU did not name its pty within 30 s (see {})", log.display())]
-    QemuNoPty { log: PathBuf },
+    #[error("QEMU did not name its pty within {} s (see {})", waited.as_secs(), log.display())]
+    QemuNoPty { waited: Duration, log: PathBuf },
     /// QEMU ended before naming its pseudo-terminal.
     #[error("QEMU ended ({status}) before naming its pty (see {})", log.display())]
     QemuEnded { status: ExitStatus, log: PathBuf },

@@ -11,7 +11,7 @@ use std::time::{Duration, Instant};
 use auv_link::sign::LinkKey;
 use auv_link::{Msg, StateFrame, MAX_FRAME};
 
-use super::emulator::{spawn_qemu, Qemu};
+use super::emulator::{spawn_qemu, wait_for_qemu, Qemu};
 use super::error::Error;
 use super::faults::{Faults, PeriodFaults};
 use super::image::check_flying_image;
@@ -21,15 +21,12 @@ use super::period::Periods;
 use super::session::Session;
 use super::stats::BoardStats;
 use super::transport::{Serial, Transport};
-use crate::interrupt;
 use crate::scenario::{LinkFaults, Scenario};
 use crate::sim::{ControlOut, ControlSource, ControlStatus, Stop};
 
 /// How long PIL waits for valid telemetry before it gives up on QEMU (an idle QEMU under
 /// `-icount` on a loaded host is slow; the board itself answers every period).
 pub const PIL_REPLY_TIMEOUT: Duration = Duration::from_secs(10);
-/// How long PIL waits for QEMU to connect its UART to the loopback socket.
-const QEMU_CONNECT_WAIT: Duration = Duration::from_secs(30);
 
 /// An open byte transport to a board, and how to name it in figures and messages.
 struct Wire {
@@ -282,32 +279,21 @@ fn socket(op: &'static str) -> impl FnOnce(std::io::Error) -> Error {
     move |io| Error::QemuIo { op, io }
 }
 
-/// QEMU's UART connection to `listener`, within [`QEMU_CONNECT_WAIT`] (its log at `log_path`
-/// says why not).
+/// QEMU's UART connection to `listener` ([`wait_for_qemu`]: its log at `log_path` says why
+/// not).
 fn accept(listener: &TcpListener, log_path: &Path) -> Result<TcpStream, Error> {
-    let deadline = Instant::now() + QEMU_CONNECT_WAIT;
-    loop {
-        match listener.accept() {
-            Ok((s, _)) => return Ok(s),
-            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
-                if interrupt::requested() {
-                    return Err(Error::Interrupted {
-                        waiting_for: "QEMU",
-                    });
-                }
-                if Instant::now() > deadline {
-                    return Err(Error::QemuNoUart {
-                        log: log_path.to_path_buf(),
-                    });
-                }
-                std::thread::sleep(Duration::from_millis(20));
-            }
-            Err(io) => {
-                return Err(Error::QemuIo {
-                    op: "accepting QEMU's UART",
-                    io,
-                })
-            }
-        }
-    }
+    wait_for_qemu(
+        |waited| Error::QemuNoUart {
+            waited,
+            log: log_path.to_path_buf(),
+        },
+        || match listener.accept() {
+            Ok((s, _)) => Ok(Some(s)),
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => Ok(None),
+            Err(io) => Err(Error::QemuIo {
+                op: "accepting QEMU's UART",
+                io,
+            }),
+        },
+    )
 }
