@@ -19,6 +19,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use anyhow::{anyhow, Context};
 use auv_link::sign::LinkKey;
 use auv_link::{BoardStatus, FailSafeReason};
 use firmware::qemu_runner;
@@ -62,7 +63,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
     let key = match board.key_file.map(read_key).transpose() {
         Ok(k) => k,
         Err(e) => {
-            ci.fail(format!("HIL {}: {e}", board.name));
+            ci.fail(format!("HIL {}: {e:#}", board.name));
             return;
         }
     };
@@ -380,9 +381,9 @@ fn last_status(log: &str) -> Option<String> {
 }
 
 /// The link key in a key file (firmware/README.md, "Link key"), for QEMU's command line.
-fn read_key(path: &Path) -> Result<LinkKey, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    LinkKey::from_key_file(&text).map_err(|e| format!("{}: {e}", path.display()))
+fn read_key(path: &Path) -> anyhow::Result<LinkKey> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    LinkKey::from_key_file(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 #[cfg(test)]
