@@ -483,7 +483,45 @@ pub fn du_label(robust: bool) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::Metrics;
+    use super::*;
+
+    /// A run that lost its board is its own outcome, not a divergence: its summary (and JSON)
+    /// has `lost_board` with the cause in kebab-case and no `diverged`, and its outcome prints
+    /// on one line.
+    #[test]
+    fn a_lost_board_is_not_a_divergence_in_the_summary_and_json() {
+        let reason = "the board's link went away (Broken pipe):\n  the port was unplugged";
+        let run = RunResult {
+            name: "lost".to_string(),
+            case: None,
+            robust: true,
+            outcome: Outcome::LostBoard {
+                t: 3.0,
+                cause: BoardLoss::LinkGone,
+                reason: reason.to_string(),
+            },
+            metrics: Metrics::NONE,
+            faults: FaultCounts::default(),
+            faults_expected: false,
+            miss_expected: false,
+            samples: Vec::new(),
+            plant_factorisations: 0,
+        };
+        assert!(run.lost_board() && !run.diverged() && !run.interrupted());
+        let json = serde_json::to_value(run.summary()).expect("a summary serialises");
+        assert_eq!(json.get("diverged"), None);
+        assert_eq!(json["lost_board"]["cause"], "link-gone");
+        assert_eq!(json["lost_board"]["t"], 3.0);
+        assert_eq!(json["lost_board"]["reason"], reason);
+        let back: RunSummary = serde_json::from_value(json).expect("and reads back");
+        assert_eq!(back.lost_board.map(|l| l.cause), Some(BoardLoss::LinkGone));
+        let shown = run.outcome.to_string();
+        assert!(!shown.contains('\n'), "{shown}");
+        assert!(
+            shown.starts_with("LOST THE BOARD at t = 3.00 s: "),
+            "{shown}"
+        );
+    }
 
     /// The name table is the struct's: each name is the key serde writes for the value at the
     /// same index (ten distinct values, so a swapped or misspelt name cannot pass).
