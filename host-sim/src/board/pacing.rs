@@ -1,6 +1,6 @@
 //! How a board in the loop is paced ([`Pacing`]), and the timing figures of a real-time run
 //! ([`RealTimeStats`]) with the pacer that takes them ([`RealTime`], used by
-//! `super::period`). docs/design.md §21.
+//! period.rs). docs/design.md §21.
 
 use std::time::{Duration, Instant};
 

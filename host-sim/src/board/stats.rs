@@ -92,7 +92,7 @@ pub struct BoardStats {
     pub realtime: Option<RealTimeStats>,
 }
 
-/// What a mission upload cost on the link (`super::upload`).
+/// What a mission upload cost on the link (upload.rs).
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct UploadStats {
     /// The mission's CRC (`StartMission` names it).
