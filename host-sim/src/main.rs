@@ -1,9 +1,9 @@
 //! `host-sim`: software-in-the-loop runs of the AUV-150 controller against the 6-DOF plant.
 //! Parses the command line, installs the Ctrl-C/SIGTERM handler ([`host_sim::interrupt`]) and
 //! maps the outcome to the exit code; the commands are [`host_sim::cli`]'s, which documents
-//! the codes (0 done, 1 a run diverged or PIL ≠ SIL or `check` found the mission infeasible,
-//! 2 bad input, I/O error or an incomplete output, 3 an unexpected controller fault, 4 a run
-//! missed its bound, 130 interrupted).
+//! the codes (0 done, 1 a run diverged or lost its board, or PIL ≠ SIL, or `check` found the
+//! mission infeasible, 2 bad input, I/O error or an incomplete output, 3 an unexpected
+//! controller fault, 4 a run missed its bound, 130 interrupted).
 
 use std::process::ExitCode;
 

@@ -1,23 +1,34 @@
 //! `host-sim hil` against serial ports that are not a healthy board, without hardware or
 //! QEMU: a port that does not exist, a pseudo-terminal nobody writes to (a silent board) and
-//! one that carries only noise (a wrong baud rate). Each must end, within a bound, with a
-//! message that says which it is and a non-zero exit. And a board made of the firmware's own
+//! one that carries only noise (a wrong baud rate); a scripted board that refuses the set-up,
+//! reports another mounting or thrust unit, signs when this end does not, or goes silent,
+//! changes its unit or hangs up mid-mission. Each must end, within a bound, with the runner's
+//! error variant for it ([`board::Error`]) and, mid-mission, a run that lost its board
+//! ([`Outcome::LostBoard`]) — never one that diverged. And a board made of the firmware's own
 //! supervisor on a host thread, whose UART takes one frame a period (real time's period 0).
-//! (The QEMU boards, and a port that goes away mid-mission, are flown by `cargo xtask pil`.)
+//! (The QEMU boards, and a QEMU port that goes away mid-mission, are flown by `cargo xtask pil`.)
 
 use std::collections::VecDeque;
 use std::io::{Read, Write};
+use std::os::fd::AsRawFd;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
 use std::time::{Duration, Instant};
 
+use auv_link::sign::{Direction, LinkKey, Signer};
+use auv_link::{
+    encode, encode_signed, BoardStatus, Command as LinkCommand, Envelope, FrameDecoder, Msg,
+    Refusal, Telemetry, ThrustUnit, UploadStatus, MAX_FRAME, PROTOCOL_VERSION,
+};
 use controller_core::{Controller, ControllerConfig};
 use firmware::board::{receive, LinkBuffers};
 use firmware::supervisor::{BoardInfo, Supervisor};
-use host_sim::board::BoardComparison;
+use host_sim::board::{self, BoardComparison, BoardInTheLoop, Pacing};
 use host_sim::cli::Cases;
+use host_sim::scenario::{load_scenario, LinkFaults, Scenario};
+use host_sim::sim::{self, BoardLoss, Outcome, Recording};
 use serialport::{SerialPort, TTYPort};
 
 /// The reply timeout the tests give `hil` (s).
@@ -59,33 +70,68 @@ fn stderr(o: &Output) -> String {
 /// `hil` to open (the pair's own slave handle is closed: it holds the port exclusively).
 fn pty() -> (TTYPort, String) {
     let (master, slave) = TTYPort::pair().expect("a pseudo-terminal pair");
+    // Not inherited by the `host-sim` processes the tests start (this test's or another's): a
+    // board that hangs up must close the master's last copy.
+    // SAFETY: fcntl(2) on a descriptor the pair owns.
+    unsafe {
+        libc::fcntl(master.as_raw_fd(), libc::F_SETFD, libc::FD_CLOEXEC);
+    }
     let path = slave.name().expect("the slave's path");
     drop(slave);
     (master, path)
 }
 
+/// The one-second lawn-mower mission the tests fly.
+fn short_mission() -> Scenario {
+    let path = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/lawn-mower-20x10.toml");
+    load_scenario(&path)
+        .and_then(|s| s.with(|c| c.duration = 1.0))
+        .expect("the lawn-mower scenario")
+}
+
+/// The runner on `port` (lock-step, the tests' reply timeout, unsigned unless `key`), and how
+/// long its set-up took.
+fn connect(port: &str, key: Option<&LinkKey>) -> (Result<BoardInTheLoop, board::Error>, Duration) {
+    let t0 = Instant::now();
+    let timeout = Duration::from_secs_f64(REPLY_TIMEOUT.parse().expect("a number"));
+    let b = BoardInTheLoop::over_serial(
+        port,
+        115_200,
+        &short_mission(),
+        LinkFaults::default(),
+        Pacing::Lockstep,
+        timeout,
+        key,
+    );
+    (b, t0.elapsed())
+}
+
+/// A missing port is named as such, and `hil` exits 2 with the runner's message.
 #[test]
 fn a_missing_port_is_named() {
-    let (o, t) = hil("/dev/auv150-no-such-port", "missing", &[]);
+    let port = "/dev/auv150-no-such-port";
+    let (b, t) = connect(port, None);
+    let e = match b {
+        Err(e @ board::Error::NoPort { .. }) => e,
+        other => panic!("expected NoPort, got {:?}", other.err()),
+    };
+    assert!(t < BOUND, "took {t:?}");
+    let (o, _) = hil(port, "missing", &[]);
     let err = stderr(&o);
     assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("/dev/auv150-no-such-port does not exist"),
-        "{err}"
-    );
-    assert!(t < BOUND, "took {t:?}");
+    assert!(err.contains(&e.to_string()), "{err}");
 }
 
 #[test]
 fn a_silent_board_times_out() {
     let (_master, path) = pty();
-    let (o, t) = hil(&path, "silent", &[]);
-    let err = stderr(&o);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("no telemetry from the board for 0.5 s: it sent nothing"),
-        "{err}"
-    );
+    let (b, t) = connect(&path, None);
+    match b {
+        Err(board::Error::Silent { waited, .. }) => {
+            assert_eq!(waited, Duration::from_millis(500))
+        }
+        other => panic!("expected Silent, got {:?}", other.err()),
+    }
     assert!(t < BOUND, "took {t:?}");
 }
 
@@ -118,25 +164,17 @@ fn noise_on_the_line_is_counted_and_named() {
             written
         })
     };
-    let (o, t) = hil(&path, "noise", &[]);
+    let (b, t) = connect(&path, None);
     stop.store(true, Ordering::Relaxed);
     let written = noise.join().expect("the noise thread");
-    let err = stderr(&o);
     assert!(written > 0);
-    assert_eq!(o.status.code(), Some(2), "{err}");
-    assert!(
-        err.contains("no valid telemetry from the board for 0.5 s"),
-        "{err}"
-    );
     // The decoder's refusals are counted: noise with delimiters in it makes frames that fail.
-    let refused: u64 = err
-        .split(" frames that did not decode")
-        .next()
-        .and_then(|s| s.rsplit(' ').next())
-        .and_then(|n| n.parse().ok())
-        .unwrap_or_else(|| panic!("no count of refused frames in: {err}"));
-    assert!(refused > 0, "{err}");
-    assert!(err.contains("wrong baud rate"), "{err}");
+    match b {
+        Err(board::Error::Noise { bytes, refused, .. }) => {
+            assert!(bytes > 0 && refused > 0, "{bytes} bytes, {refused} refused")
+        }
+        other => panic!("expected Noise, got {:?}", other.err()),
+    }
     assert!(t < BOUND, "took {t:?}");
 }
 
@@ -259,4 +297,268 @@ fn an_interrupt_ends_the_wait_for_a_silent_board() {
         "{report}"
     );
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// How the scripted board ([`scripted_board`]) departs from a healthy one.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Script {
+    /// Not at all.
+    Healthy,
+    /// Refuses the `SetConfig` with this reason.
+    RefuseConfig(Refusal),
+    /// Flies this reversed-thruster mask, whatever it is told.
+    Mounting(u8),
+    /// Reports this thrust unit, whatever it is told.
+    Unit(ThrustUnit),
+    /// Answers `.0` state frames, then reports this thrust unit.
+    UnitAfter(u64, ThrustUnit),
+    /// Signs its telemetry with this key.
+    Signs([u8; 32]),
+    /// Answers `.0` state frames, then says nothing more.
+    SilentAfter(u64),
+    /// Answers `.0` state frames, then hangs up (its side of the pty closes).
+    HangUpAfter(u64),
+}
+
+/// The telemetry of a fresh board that has done nothing: disarmed, no counts, no output.
+fn fresh_telemetry() -> Telemetry {
+    // From the largest report, so that a field the protocol adds has a value here.
+    let mut t = Telemetry::LARGEST;
+    t.tick = 0;
+    t.status = BoardStatus::Disarmed;
+    t.voltages = [0.0; 5];
+    t.thrusts = [0.0; 5];
+    t.tau = [0.0; 6];
+    t.saturated = 0;
+    (t.delta, t.delta_clamped, t.w_norm) = (0.0, false, 0.0);
+    (t.controller_fault, t.loop_overruns, t.worst_update_ticks) = (0, 0, 0);
+    (
+        t.rx_frames,
+        t.rx_errors,
+        t.rx_stale,
+        t.rx_auth_errors,
+        t.rx_ahead,
+    ) = (0, 0, 0, 0, 0);
+    (t.last_state_seq, t.last_rx_seq) = (0, 0);
+    t.latched = None;
+    (t.refused_commands, t.last_refusal) = (0, None);
+    t.signing = false;
+    (t.thrust_unit, t.reversed_thrusters) = (ThrustUnit::Kgf, 0);
+    t.upload = UploadStatus::default();
+    t
+}
+
+/// A board that speaks the link the simplest way, as `script` says: it takes `Disarm`,
+/// `SetConfig` (its unit and mounting), `Arm` and `StartMission`, answers each state frame at
+/// once (lock-step) and sends its status every 5 ms otherwise. Its voltages are 0: nothing it
+/// does makes the vehicle diverge in a second.
+fn scripted_board(mut port: TTYPort, script: Script, stop: Arc<AtomicBool>) {
+    let mut t = fresh_telemetry();
+    let mut signer = match script {
+        Script::Signs(key) => Some(Signer::new(&LinkKey::new(key), Direction::FromBoard)),
+        _ => None,
+    };
+    let mut decoder = FrameDecoder::new();
+    let (mut seq, mut states) = (0u16, 0u64);
+    let _ = port.set_timeout(Duration::from_millis(1));
+    let mut chunk = [0u8; 256];
+    let mut next = Instant::now();
+    while !stop.load(Ordering::Relaxed) {
+        let mut answer = false;
+        // A master reads EIO while no one holds the slave (before the runner opens it).
+        let n = port.read(&mut chunk).unwrap_or(0);
+        for &b in &chunk[..n] {
+            let Some(Ok(env)) = decoder.push(b) else {
+                continue;
+            };
+            t.rx_frames += 1;
+            t.last_rx_seq = env.seq;
+            match env.msg {
+                Msg::Command(LinkCommand::Disarm) => t.status = BoardStatus::Disarmed,
+                Msg::Command(LinkCommand::SetConfig(c)) => match script {
+                    Script::RefuseConfig(r) => {
+                        t.refused_commands += 1;
+                        t.last_refusal = Some(r);
+                    }
+                    _ => {
+                        t.thrust_unit = c.thrust_unit.unwrap_or(t.thrust_unit);
+                        t.reversed_thrusters = c.reversed_thrusters.unwrap_or(0);
+                    }
+                },
+                Msg::Command(LinkCommand::Arm) => t.status = BoardStatus::Armed,
+                Msg::Command(LinkCommand::StartMission(_)) => t.status = BoardStatus::Running,
+                Msg::State(_) => {
+                    t.last_state_seq = env.seq;
+                    states += 1;
+                    answer = true;
+                }
+                _ => {}
+            }
+        }
+        match script {
+            Script::Mounting(m) => t.reversed_thrusters = m,
+            Script::Unit(unit) => t.thrust_unit = unit,
+            Script::UnitAfter(n, unit) if states > n => t.thrust_unit = unit,
+            Script::SilentAfter(n) if states > n => continue,
+            Script::HangUpAfter(n) if states > n => return,
+            _ => {}
+        }
+        if !answer && Instant::now() < next {
+            continue;
+        }
+        next = Instant::now() + Duration::from_millis(5);
+        t.tick += 1;
+        let env = Envelope {
+            version: PROTOCOL_VERSION,
+            seq,
+            msg: Msg::Telemetry(t),
+        };
+        seq = seq.wrapping_add(1);
+        let mut buf = [0u8; MAX_FRAME];
+        let n = match &mut signer {
+            Some(s) => {
+                s.advance_to(u64::from(seq));
+                encode_signed(&env, s, &mut buf)
+            }
+            None => encode(&env, &mut buf),
+        };
+        if let Ok(n) = n {
+            // Nobody listening yet: the frame is lost, as on a real line.
+            let _ = port.write_all(&buf[..n]);
+        }
+    }
+}
+
+/// `script`'s board on a pty, and the runner connected to it (signed with `key`, if given).
+fn with_scripted_board<R>(
+    script: Script,
+    key: Option<&LinkKey>,
+    then: impl FnOnce(Result<BoardInTheLoop, board::Error>) -> R,
+) -> R {
+    let (master, path) = pty();
+    let stop = Arc::new(AtomicBool::new(false));
+    let board = {
+        let stop = Arc::clone(&stop);
+        std::thread::spawn(move || scripted_board(master, script, stop))
+    };
+    let (b, t) = connect(&path, key);
+    let r = then(b);
+    stop.store(true, Ordering::Relaxed);
+    let _ = board.join();
+    assert!(t < BOUND, "the set-up took {t:?}");
+    r
+}
+
+/// The set-up's failures, each its own variant: a refusal with the board's reason, another
+/// mounting, another thrust unit, and telemetry signed when this end is not (or the reverse).
+#[test]
+fn a_set_up_the_board_does_not_take_says_why() {
+    let err = |script, key| with_scripted_board(script, key, |b| b.err());
+    let c = *short_mission().controller().config();
+    let (unit, mounting) = (
+        ThrustUnit::from(c.thrust_unit),
+        c.geometry.auv150_reversed(),
+    );
+    let other_unit = match unit {
+        ThrustUnit::Kgf => ThrustUnit::Newton,
+        ThrustUnit::Newton => ThrustUnit::Kgf,
+    };
+    let other_mounting = mounting.expect("the AUV-150 layout") ^ 0b1;
+    // A healthy board is flown: the script's board is one.
+    assert!(err(Script::Healthy, None).is_none());
+    let refused = err(Script::RefuseConfig(Refusal::RateTooHigh), None);
+    assert!(
+        matches!(
+            refused,
+            Some(board::Error::Refused {
+                reason: Some(Refusal::RateTooHigh)
+            })
+        ),
+        "{refused:?}"
+    );
+    let m = err(Script::Mounting(other_mounting), None);
+    assert!(
+        matches!(m, Some(board::Error::Mounting { board, .. }) if board == other_mounting),
+        "{m:?}"
+    );
+    let u = err(Script::Unit(other_unit), None);
+    assert!(
+        matches!(u, Some(board::Error::ThrustUnit { board, plant, .. }) if board == other_unit && plant == unit),
+        "{u:?}"
+    );
+    let key = [7u8; 32];
+    let signed = err(Script::Signs(key), None);
+    assert!(
+        matches!(signed, Some(board::Error::Signing { .. })),
+        "{signed:?}"
+    );
+    let unsigned = err(Script::Healthy, Some(&LinkKey::new(key)));
+    assert!(
+        matches!(unsigned, Some(board::Error::Signing { .. })),
+        "{unsigned:?}"
+    );
+}
+
+/// A board lost mid-mission ends the run [`Outcome::LostBoard`] with the cause — silent, its
+/// unit changed, hung up — after the periods it answered, never [`Outcome::Diverged`].
+#[test]
+fn a_board_lost_mid_mission_ends_the_run_as_lost_not_diverged() {
+    let s = short_mission();
+    let other_unit = match ThrustUnit::from(s.controller().config().thrust_unit) {
+        ThrustUnit::Kgf => ThrustUnit::Newton,
+        ThrustUnit::Newton => ThrustUnit::Kgf,
+    };
+    for (script, cause) in [
+        (Script::SilentAfter(30), BoardLoss::Silent),
+        (Script::UnitAfter(30, other_unit), BoardLoss::Misconfigured),
+        (Script::HangUpAfter(30), BoardLoss::LinkGone),
+    ] {
+        let run = with_scripted_board(script, None, |b| {
+            let mut b = b.unwrap_or_else(|e| panic!("{script:?}: the set-up failed: {e}"));
+            let run = sim::fly(&s, &mut b, &mut (), Recording::MetricsOnly);
+            b.finish();
+            run
+        });
+        match &run.outcome {
+            Outcome::LostBoard { t, cause: c, .. } => {
+                assert_eq!(*c, cause, "{script:?}: {}", run.outcome);
+                // Period 30 is the first the board did not answer as it should.
+                assert_eq!(
+                    (t / s.period()).round(),
+                    30.0,
+                    "{script:?}: {}",
+                    run.outcome
+                );
+            }
+            other => panic!("{script:?}: expected a lost board, got {other}"),
+        }
+        assert!(run.lost_board() && !run.diverged(), "{script:?}");
+        let summary = run.summary();
+        assert!(summary.diverged.is_none(), "{script:?}");
+        assert_eq!(summary.lost_board.map(|l| l.cause), Some(cause));
+    }
+}
+
+/// `hil` on a board that hangs up mid-mission: exit 1, the partial run in the JSON marked as
+/// having lost the board with the link gone (not diverged), its reason on stderr.
+#[test]
+fn hil_reports_a_lost_board_in_its_json_and_exits_1() {
+    let (master, path) = pty();
+    let stop = Arc::new(AtomicBool::new(false));
+    let board = {
+        let stop = Arc::clone(&stop);
+        std::thread::spawn(move || scripted_board(master, Script::HangUpAfter(30), stop))
+    };
+    let (o, _) = hil(&path, "hang-up", &[]);
+    stop.store(true, Ordering::Relaxed);
+    let _ = board.join();
+    let err = stderr(&o);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    let report: Cases<BoardComparison> = serde_json::from_slice(&o.stdout)
+        .unwrap_or_else(|e| panic!("no JSON report ({e}); stderr:\n{err}"));
+    let run = &report.cases[0].run;
+    assert!(run.diverged.is_none(), "{run:?}");
+    let lost = run.lost_board.as_ref().expect("the run lost its board");
+    assert_eq!(lost.cause, BoardLoss::LinkGone, "{lost:?}");
+    assert!(err.contains(&lost.reason), "{err}");
 }

@@ -35,7 +35,7 @@ impl Mode {
 /// max path error and the difference, and the board and link figures.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct BoardComparison {
-    /// The PIL run (`case`, `robust`, metrics, `diverged`).
+    /// The PIL run (`case`, `robust`, metrics, `diverged`, `lost_board`).
     #[serde(flatten)]
     pub run: RunSummary,
     pub mode: Mode,

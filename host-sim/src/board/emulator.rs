@@ -11,9 +11,71 @@ use std::time::{Duration, Instant};
 use auv_link::sign::LinkKey;
 use firmware_images::qemu_runner;
 
+use super::error::Error;
 use super::image::check_flying_image;
 use super::pacing::Pacing;
 use crate::interrupt;
+
+/// The longest the runner waits for QEMU to connect its UART or name its pty.
+const QEMU_WAIT: Duration = Duration::from_secs(30);
+
+/// What `poll` finds (polled every 20 ms), within [`QEMU_WAIT`] (else `timed_out(QEMU_WAIT)`);
+/// a stop request ends the wait ([`Error::Interrupted`]).
+pub(super) fn wait_for_qemu<T>(
+    timed_out: impl FnOnce(Duration) -> Error,
+    mut poll: impl FnMut() -> Result<Option<T>, Error>,
+) -> Result<T, Error> {
+    let deadline = Instant::now() + QEMU_WAIT;
+    loop {
+        if let Some(found) = poll()? {
+            return Ok(found);
+        }
+        if interrupt::requested() {
+            return Err(Error::Interrupted {
+                waiting_for: "QEMU",
+            });
+        }
+        if Instant::now() > deadline {
+            return Err(timed_out(QEMU_WAIT));
+        }
+        std::thread::sleep(Duration::from_millis(20));
+    }
+}
+
+/// QEMU started by [`spawn_qemu`]: its process group, ended when this is dropped (or at
+/// [`Qemu::stop`]).
+pub struct Qemu {
+    child: Child,
+    stopped: bool,
+}
+
+impl Qemu {
+    /// Ends QEMU's process group (bash runner, timeout, QEMU, defmt-print) and reaps its
+    /// leader; once.
+    pub fn stop(&mut self) {
+        if std::mem::replace(&mut self.stopped, true) {
+            return;
+        }
+        let _ = Command::new("kill")
+            .arg("-TERM")
+            .arg("--")
+            .arg(format!("-{}", self.child.id()))
+            .status();
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+
+    /// QEMU's exit status, if it has ended.
+    fn ended(&mut self) -> Option<std::process::ExitStatus> {
+        self.child.try_wait().ok().flatten()
+    }
+}
+
+impl Drop for Qemu {
+    fn drop(&mut self) {
+        self.stop();
+    }
+}
 
 /// Starts the QEMU flying image through `runner` (`scripts/qemu-run.sh`) in its own process
 /// group, with UART0 on `serial` (QEMU's `-serial` argument: `tcp:…` for PIL, `pty` for HIL)
@@ -27,8 +89,11 @@ pub fn spawn_qemu(
     pacing: Pacing,
     log: std::fs::File,
     key: Option<&LinkKey>,
-) -> Result<Child, String> {
-    let log_err = log.try_clone().map_err(|e| e.to_string())?;
+) -> Result<Qemu, Error> {
+    let log_err = log.try_clone().map_err(|io| Error::QemuIo {
+        op: "sharing QEMU's log between its stdout and stderr",
+        io,
+    })?;
     let mut qemu = Command::new("bash");
     qemu
         // Its own process group, so that ending it ends QEMU too (the runner starts QEMU
@@ -51,19 +116,14 @@ pub fn spawn_qemu(
         .stdout(Stdio::from(log))
         .stderr(Stdio::from(log_err))
         .spawn()
-        .map_err(|e| format!("starting QEMU through {}: {e}", runner.display()))
-}
-
-/// Ends a process group started by [`spawn_qemu`] (bash runner, timeout, QEMU, defmt-print)
-/// and reaps its leader.
-pub fn stop_group(child: &mut Child) {
-    let _ = Command::new("kill")
-        .arg("-TERM")
-        .arg("--")
-        .arg(format!("-{}", child.id()))
-        .status();
-    let _ = child.kill();
-    let _ = child.wait();
+        .map(|child| Qemu {
+            child,
+            stopped: false,
+        })
+        .map_err(|io| Error::QemuStart {
+            runner: runner.to_path_buf(),
+            io,
+        })
 }
 
 /// The QEMU flying image with its UART0 on a pseudo-terminal (`-serial pty`): a real tty that
@@ -74,7 +134,7 @@ pub fn stop_group(child: &mut Child) {
 /// and names it on stderr, since QEMU prints its own `char device redirected to` line on
 /// stdout, into the defmt stream; real time runs QEMU without `-icount`.
 pub struct QemuPty {
-    child: Child,
+    qemu: Qemu,
     /// The pty's device (`/dev/pts/N`).
     pub port: PathBuf,
 }
@@ -93,50 +153,39 @@ impl QemuPty {
         log_path: &Path,
         pacing: Pacing,
         key: Option<&LinkKey>,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, Error> {
         check_flying_image(elf)?;
-        let log = std::fs::File::create(log_path)
-            .map_err(|e| format!("creating {}: {e}", log_path.display()))?;
-        let child = spawn_qemu(elf, runner, qemu_runner::SERIAL_PTY, pacing, log, key)?;
-        let mut q = QemuPty {
-            child,
-            port: PathBuf::new(),
-        };
-        let deadline = Instant::now() + Duration::from_secs(30);
-        loop {
-            let text = std::fs::read_to_string(log_path).unwrap_or_default();
-            if let Some(port) = pty_of_log(&text) {
-                q.port = port;
-                return Ok(q);
-            }
-            if let Ok(Some(status)) = q.child.try_wait() {
-                return Err(format!(
-                    "QEMU ended ({status}) before naming its pty (see {})",
-                    log_path.display()
-                ));
-            }
-            if interrupt::requested() {
-                return Err("interrupted while waiting for QEMU".to_string());
-            }
-            if Instant::now() > deadline {
-                return Err(format!(
-                    "QEMU did not name its pty within 30 s (see {})",
-                    log_path.display()
-                ));
-            }
-            std::thread::sleep(Duration::from_millis(20));
-        }
+        let log = std::fs::File::create(log_path).map_err(|io| Error::QemuLog {
+            path: log_path.to_path_buf(),
+            io,
+        })?;
+        let qemu = spawn_qemu(elf, runner, qemu_runner::SERIAL_PTY, pacing, log, key)?;
+        let mut qemu = qemu;
+        let port = wait_for_qemu(
+            |waited| Error::QemuNoPty {
+                waited,
+                log: log_path.to_path_buf(),
+            },
+            || {
+                let text = std::fs::read_to_string(log_path).unwrap_or_default();
+                if let Some(port) = pty_of_log(&text) {
+                    return Ok(Some(port));
+                }
+                match qemu.ended() {
+                    Some(status) => Err(Error::QemuEnded {
+                        status,
+                        log: log_path.to_path_buf(),
+                    }),
+                    None => Ok(None),
+                }
+            },
+        )?;
+        Ok(QemuPty { qemu, port })
     }
 
-    /// Ends QEMU now (the board's port goes away).
+    /// Ends QEMU now (the board's port goes away); dropping it does too.
     pub fn kill(&mut self) {
-        stop_group(&mut self.child);
-    }
-}
-
-impl Drop for QemuPty {
-    fn drop(&mut self) {
-        stop_group(&mut self.child);
+        self.qemu.stop();
     }
 }
 

@@ -7,15 +7,19 @@
 //!
 //! | module | owns |
 //! |---|---|
-//! | [`runner`] | [`BoardInTheLoop`]: start (QEMU on a socket, a serial port), the set-up, the end |
-//! | `send`, `receive`, `period` | its frames out, its telemetry in, and one control period (lock-step or real time) |
-//! | [`transport`] | the byte transport under the link: a TCP socket or a serial device |
+//! | [`runner`] | [`BoardInTheLoop`]: start (QEMU on a socket, a serial port), one control period as the loop's [`ControlSource`](crate::sim::ControlSource), the end; it composes the parts below |
+//! | `link` | the link's state: framing, signing, this end's sequence numbers, the decoder and the board's numbers, the reply timeout and what came instead (silence or noise) |
+//! | `faults` | the scenario's link faults per period, and the recent states a delay sends |
+//! | `session` | what the run asks of the board (configuration, mission, unit, mounting) and the set-up, the mission's start and the re-arm after a fail-safe |
+//! | [`upload`] | a waypoint mission's chunked upload before `Arm`, resent until verified |
+//! | `period` | the board's answer to each period, lock-step or real time, and its newest telemetry |
 //! | [`pacing`] | lock-step or real time, and a real-time run's timing figures |
+//! | [`stats`], [`comparison`] | a run's link and board figures (an upload's too); the board run against SIL |
+//! | [`error`] | how a board in the loop fails ([`Error`]), and how a run ends on it |
+//! | [`transport`] | the byte transport under the link: a TCP socket or a serial device |
 //! | [`emulator`] | QEMU launched through the runner script: on a socket or a pty |
 //! | [`image`] | which firmware ELF may fly (its image marker), and where the build leaves it |
 //! | [`frames`] | the navigation computer's side of the wire: state frames, signing time |
-//! | [`stats`], [`comparison`] | a run's link and board figures; the board run against SIL |
-//! | [`upload`] | a waypoint mission's chunked upload before `Arm`, resent until verified |
 //!
 //! Set-up: the runner waits for the board's first telemetry and numbers its own frames from the
 //! board's `last_rx_seq` on (a restarted runner is heard again: `auv_link::seq`), then sends
@@ -51,25 +55,29 @@
 //! newest telemetry it has when the next period is due ([`RealTimeStats`]).
 //!
 //! Every wait is bounded: no valid telemetry for the reply timeout (10 s for PIL,
-//! `hil --reply-timeout`) ends the run with a message that says whether the board sent
-//! nothing (not powered, not wired, wrong port) or only bytes that did not decode (a wrong
-//! baud rate or key); a link that closes or a port that goes away ends it at once.
+//! `hil --reply-timeout`) ends the run with an error that says whether the board sent
+//! nothing (not powered, not wired, wrong port: [`Error::Silent`]) or only bytes that did not
+//! decode (a wrong baud rate or key: [`Error::Noise`]); a link that closes or a port that goes
+//! away ends it at once ([`Error::LinkGone`]). A run that fails so ends
+//! [`Outcome::LostBoard`](crate::sim::Outcome::LostBoard), not diverged (Choice 200).
 
 pub mod comparison;
 pub mod emulator;
+pub mod error;
+mod faults;
 pub mod frames;
 pub mod image;
+mod link;
 pub mod pacing;
 mod period;
-mod receive;
 pub mod runner;
-mod send;
+mod session;
 pub mod stats;
 pub mod transport;
 pub mod upload;
 
 pub use comparison::{BoardComparison, Mode, PIL_SIL_TOLERANCE};
+pub use error::Error;
 pub use pacing::{Pacing, RealTimeStats};
 pub use runner::BoardInTheLoop;
-pub use stats::{BoardStats, FailSafeEvent, FailSafeEventKind};
-pub use upload::UploadStats;
+pub use stats::{BoardStats, FailSafeEvent, FailSafeEventKind, UploadStats};

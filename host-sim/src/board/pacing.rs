@@ -1,6 +1,6 @@
 //! How a board in the loop is paced ([`Pacing`]), and the timing figures of a real-time run
 //! ([`RealTimeStats`]) with the pacer that takes them ([`RealTime`], used by
-//! [`super::BoardInTheLoop`]). docs/design.md §21.
+//! period.rs). docs/design.md §21.
 
 use std::time::{Duration, Instant};
 
@@ -87,7 +87,7 @@ impl std::fmt::Display for RealTimeStats {
 
 /// Telemetry frames the host listens to once the board is armed at the mission's rate, before
 /// a real-time mission starts, to find the board's period phase ([`board_edge`]).
-pub(crate) const PHASE_FRAMES: usize = 8;
+pub(super) const PHASE_FRAMES: usize = 8;
 
 /// One of the board's period boundaries as the host sees it, from the arrival times of
 /// telemetry the board sends once per period, just after each boundary. A frame is only ever
@@ -98,7 +98,7 @@ pub(crate) const PHASE_FRAMES: usize = 8;
 /// reads as one that came just before its boundary; the set-up's frames, read as they come,
 /// are not.) `None` without arrivals. **Choice 78**,
 /// docs/design.md §21.
-pub(crate) fn board_edge(arrivals: &[Instant], period: Duration) -> Option<Instant> {
+pub(super) fn board_edge(arrivals: &[Instant], period: Duration) -> Option<Instant> {
     let (&first, _) = arrivals.split_first()?;
     let p = period.as_nanos().max(1);
     let phases: Vec<u128> = arrivals.iter().map(|&a| phase(a, first, period)).collect();
@@ -114,22 +114,22 @@ fn phase(at: Instant, from: Instant, period: Duration) -> u128 {
 }
 
 /// The real-time pacer and its accumulators.
-pub(crate) struct RealTime {
-    pub(crate) period: Duration,
+pub(super) struct RealTime {
+    period: Duration,
     /// The wall-clock time of period 0 (set on the first period).
-    pub(crate) origin: Option<Instant>,
+    origin: Option<Instant>,
     /// One of the board's period boundaries ([`board_edge`]), if the set-up found it.
-    pub(crate) edge: Option<Instant>,
+    edge: Option<Instant>,
     /// The last state frames sent (sequence number, when), not yet answered.
-    pub(crate) sent: std::collections::VecDeque<(u16, Instant)>,
-    pub(crate) latencies: Vec<f64>,
+    sent: std::collections::VecDeque<(u16, Instant)>,
+    latencies: Vec<f64>,
     last_arrival: Option<Instant>,
     intervals: Vec<f64>,
-    pub(crate) stats: RealTimeStats,
+    stats: RealTimeStats,
 }
 
 impl RealTime {
-    pub(crate) fn new(rate_hz: u32) -> Self {
+    pub(super) fn new(rate_hz: u32) -> Self {
         RealTime {
             period: Duration::from_secs_f64(1.0 / f64::from(rate_hz.max(1))),
             origin: None,
@@ -142,11 +142,23 @@ impl RealTime {
         }
     }
 
+    /// The board's period boundary, from the `arrivals` of the frames it sent once armed
+    /// ([`board_edge`]).
+    pub(super) fn find_edge(&mut self, arrivals: &[Instant]) {
+        self.edge = board_edge(arrivals, self.period);
+    }
+
+    /// Starts the run's clock from the board's answer to the first state frame at `answer`
+    /// ([`RealTime::origin_after`]).
+    pub(super) fn start_after(&mut self, answer: Instant) {
+        self.origin = Some(self.origin_after(answer));
+    }
+
     /// The run's clock, from the board's answer to the first state frame at `answer`: half a
     /// period after the board's boundary that answer followed, so that the host's periods fall
     /// between the board's (Choice 66). The boundary is the set-up's [`board_edge`] carried
     /// forward, or, without one, the answer itself (which is late by whatever delayed it).
-    pub(crate) fn origin_after(&self, answer: Instant) -> Instant {
+    fn origin_after(&self, answer: Instant) -> Instant {
         let boundary = match self.edge {
             Some(edge) if answer >= edge => {
                 answer - Duration::from_nanos(phase(answer, edge, self.period) as u64)
@@ -157,13 +169,13 @@ impl RealTime {
     }
 
     /// When period `k` is due.
-    pub(crate) fn due(&mut self, k: u64) -> Instant {
+    pub(super) fn due(&mut self, k: u64) -> Instant {
         let origin = *self.origin.get_or_insert_with(Instant::now);
         origin + self.period.mul_f64(k as f64)
     }
 
     /// Sleeps until period `k` is due; counts it missed if the host is a period late.
-    pub(crate) fn pace(&mut self, k: u64) {
+    pub(super) fn pace(&mut self, k: u64) {
         let due = self.due(k);
         let now = Instant::now();
         if now < due {
@@ -175,7 +187,7 @@ impl RealTime {
     }
 
     /// State frame `seq` was sent now.
-    pub(crate) fn sent(&mut self, seq: u16) {
+    pub(super) fn sent(&mut self, seq: u16) {
         // A reply more than 16 periods late counts as none.
         if self.sent.len() == 16 {
             self.sent.pop_front();
@@ -185,7 +197,7 @@ impl RealTime {
 
     /// Telemetry computed from state frame `seq` arrived at `at`: the first such reply gives
     /// that frame's latency (a late one too).
-    pub(crate) fn answered(&mut self, seq: u16, at: Instant) {
+    pub(super) fn answered(&mut self, seq: u16, at: Instant) {
         if let Some(i) = self.sent.iter().position(|&(s, _)| s == seq) {
             let (_, sent) = self.sent[i];
             self.latencies.push((at - sent).as_secs_f64());
@@ -196,7 +208,7 @@ impl RealTime {
 
     /// A telemetry frame arrived at `at`. The intervals count from the first period on
     /// (the set-up's frames come at the board's default rate).
-    pub(crate) fn arrived(&mut self, at: Instant) {
+    pub(super) fn arrived(&mut self, at: Instant) {
         if self.origin.is_none() {
             return;
         }
@@ -205,8 +217,18 @@ impl RealTime {
         }
     }
 
+    /// A state frame's answer had not come when the next period was due.
+    pub(super) fn late_frame(&mut self) {
+        self.stats.late_frames += 1;
+    }
+
+    /// `n` of the board's periods sent no telemetry.
+    pub(super) fn board_missed(&mut self, n: u64) {
+        self.stats.board_missed_periods += n;
+    }
+
     /// The figures, from the samples.
-    pub(crate) fn finish(&mut self) -> RealTimeStats {
+    pub(super) fn finish(&mut self) -> RealTimeStats {
         let mut s = std::mem::take(&mut self.stats);
         let mut l = std::mem::take(&mut self.latencies);
         l.sort_by(f64::total_cmp);

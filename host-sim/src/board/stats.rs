@@ -1,8 +1,12 @@
 //! The link and board figures of one run with a board in the loop: frames, the board's own
-//! counters as its telemetry reports them, fail-safe entries and exits, real-time timing.
+//! counters as its telemetry reports them, fail-safe entries and exits, a mission upload's
+//! cost, real-time timing.
 
+use auv_link::Telemetry;
+use firmware_images::qemu_clock::INSTRUCTIONS_PER_TICK;
 use serde::{Deserialize, Serialize};
 
+use super::error::unit_name;
 use super::pacing::{Pacing, RealTimeStats};
 
 /// Whether the board entered or left fail-safe.
@@ -45,7 +49,7 @@ pub struct BoardStats {
     pub failsafe_events: Vec<FailSafeEvent>,
     /// The waypoint mission's upload, if it had one.
     #[serde(default)]
-    pub upload: Option<super::upload::UploadStats>,
+    pub upload: Option<UploadStats>,
     /// The link was signed (both ends).
     #[serde(default)]
     pub signed: bool,
@@ -86,6 +90,42 @@ pub struct BoardStats {
     /// The timing of a real-time run.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub realtime: Option<RealTimeStats>,
+}
+
+/// What a mission upload cost on the link (upload.rs).
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub struct UploadStats {
+    /// The mission's CRC (`StartMission` names it).
+    pub crc: u32,
+    /// Chunks of the mission.
+    pub chunks: u32,
+    /// Frames sent (the `Begin`, every chunk, every resend).
+    pub frames: u32,
+    /// Their bytes on the wire.
+    pub bytes: u64,
+    /// Rounds until the board verified it (1: nothing lost).
+    pub rounds: u32,
+    /// Chunks sent again.
+    pub resent: u32,
+    /// Wall-clock time from the `Begin` to the board's verification (s).
+    pub seconds: f64,
+}
+
+impl BoardStats {
+    /// The board's own counters, as telemetry frame `t` reports them.
+    pub(super) fn reported(&mut self, t: &Telemetry) {
+        self.board_rx_errors = t.rx_errors;
+        self.board_rx_stale = t.rx_stale;
+        self.board_rx_auth_errors = t.rx_auth_errors;
+        self.board_rx_ahead = t.rx_ahead;
+        self.board_refused_commands = t.refused_commands;
+        self.board_last_refusal = t.last_refusal.map(|r| r.as_str().to_string());
+        self.board_loop_overruns = t.loop_overruns;
+        self.board_thrust_unit = Some(unit_name(t.thrust_unit).to_string());
+        self.board_reversed_thrusters = Some(t.reversed_thrusters);
+        self.worst_update_board_ticks = u64::from(t.worst_update_ticks);
+        self.worst_update_instructions = t.worst_update_ticks as u64 * INSTRUCTIONS_PER_TICK as u64;
+    }
 }
 
 impl FailSafeEventKind {

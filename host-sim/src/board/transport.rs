@@ -11,6 +11,8 @@ use std::io::{self, Read, Write};
 use std::net::TcpStream;
 use std::time::Duration;
 
+use super::error::Error;
+
 /// What the runner needs from a byte transport.
 ///
 /// **Choice 62** (docs/design.md §21): one runner over this seam, not a runner per transport.
@@ -66,12 +68,12 @@ impl Serial {
     /// which a pseudo-terminal would otherwise apply (the board's frames would come back).
     ///
     /// **Choice 63**: 8N1, no flow control, raw, exclusive (serialport's default), both
-    /// buffers cleared; the caller's default baud is the STM32's 460 800.
-    pub fn open(path: &str, baud: u32) -> Result<Serial, String> {
+    /// buffers cleared; the caller's default baud is the STM32's (`firmware_images::LINK_BAUD`).
+    pub fn open(path: &str, baud: u32) -> Result<Serial, Error> {
         if !std::path::Path::new(path).exists() {
-            return Err(format!(
-                "serial port {path} does not exist: is the USB-serial adapter plugged in (see `ls /dev/ttyUSB* /dev/ttyACM*`), or, for QEMU, is the path its `char device redirected to` line printed?"
-            ));
+            return Err(Error::NoPort {
+                path: path.to_string(),
+            });
         }
         let port = serialport::new(path, baud)
             .data_bits(serialport::DataBits::Eight)
@@ -80,7 +82,11 @@ impl Serial {
             .flow_control(serialport::FlowControl::None)
             .timeout(Duration::from_millis(100))
             .open()
-            .map_err(|e| format!("cannot open serial port {path} at {baud} baud: {e}"))?;
+            .map_err(|error| Error::PortOpen {
+                path: path.to_string(),
+                baud,
+                error,
+            })?;
         // Bytes left from before this run (an earlier run, the board's boot) are not ours.
         let _ = port.clear(serialport::ClearBuffer::All);
         Ok(Serial { port })

@@ -12,7 +12,7 @@ use controller_core::{Table1Case, DEFAULT_V_LIMIT};
 use super::common::{load, periods, report_incomplete, run_into, runs_exit, Incomplete};
 use super::json::{print_json, Cases};
 use super::Exit;
-use crate::board::{BoardComparison, BoardInTheLoop, Mode, Pacing};
+use crate::board::{self, BoardComparison, BoardInTheLoop, Mode, Pacing};
 use crate::interrupt;
 use crate::output::{self, atomic, sections, OutputDir, ReportRow};
 use crate::scenario::{paper, LinkFaults, Scenario, TickRange};
@@ -123,18 +123,29 @@ pub(super) struct Started {
     pub(super) log: Option<(atomic::Pending, PathBuf)>,
 }
 
-/// The runs of `pil` and `hil`: each scenario in SIL, then with the board `start` connects,
-/// compared; the report, and how the command ended. A run that loses its board keeps what it
-/// recorded (its CSV, its row in the report, marked diverged with the reason) and is named on
-/// stderr (**Choice 72**); a real-time run is compared with SIL but need not agree with it
-/// (**Choice 69**; docs/design.md §21).
+/// How `pil` and `hil` take a board that did not start for the scenario `name`: a stop
+/// requested during the set-up leaves the scenario unflown (`Ok(None)`); any other failure is
+/// the command's error, named for the scenario (exit 2).
+pub(super) fn not_started(name: &str, e: board::Error) -> Result<Option<Started>> {
+    match e {
+        board::Error::Interrupted { .. } => Ok(None),
+        e => Err(anyhow!("{name}: {e}")),
+    }
+}
+
+/// The runs of `pil` and `hil`: each scenario in SIL, then with the board `start` connects
+/// (`None`: a stop was requested during its set-up), compared; the report, and how the command
+/// ended. A run that loses its board keeps what it recorded (its CSV, its row in the report,
+/// marked as having lost the board, with the reason) and is named on stderr (**Choice 72**);
+/// a real-time run is compared with SIL but need not agree with it (**Choice 69**;
+/// docs/design.md §21).
 pub(super) fn fly(
     args: &LoopArgs,
     scenarios: &[Scenario],
     dir: &OutputDir,
     mode: Mode,
     stdout: &mut dyn Write,
-    mut start: impl FnMut(&Scenario, &OutputDir) -> Result<Started>,
+    mut start: impl FnMut(&Scenario, &OutputDir) -> Result<Option<Started>>,
 ) -> Result<Exit> {
     let title = match mode {
         Mode::Pil => "AUV-150 processor in the loop (firmware in QEMU)",
@@ -153,14 +164,10 @@ pub(super) fn fly(
             not_flown.push(s.config().name.as_str());
             continue;
         }
-        let started = match start(s, dir) {
-            Ok(started) => started,
+        let Some(started) = start(s, dir)? else {
             // The set-up gave up waiting for the board because a stop was requested.
-            Err(_) if interrupt::requested() => {
-                not_flown.push(s.config().name.as_str());
-                continue;
-            }
-            Err(e) => return Err(e),
+            not_flown.push(s.config().name.as_str());
+            continue;
         };
         let (c, board_run, ok) = fly_one(s, started, dir, mode, &progress, &incomplete);
         failed |= !ok;
@@ -205,7 +212,8 @@ pub(super) fn fly(
 }
 
 /// One scenario in SIL, then with the board `started` for it; returns the comparison, the
-/// board's run, and whether it passed (did not diverge, and agreed with SIL where it must).
+/// board's run, and whether it passed (did not diverge or lose its board, and agreed with SIL
+/// where it must).
 fn fly_one(
     s: &Scenario,
     started: Started,
@@ -229,13 +237,17 @@ fn fly_one(
             incomplete.push(format!("{} was not written: {e}", log_path.display()));
         }
     }
-    if let Some(d) = board_run.summary().diverged {
+    let summary = board_run.summary();
+    let stopped = match (summary.diverged, summary.lost_board) {
+        (Some(d), _) => Some((d.t, d.reason)),
+        (None, Some(l)) => Some((l.t, l.reason)),
+        (None, None) => None,
+    };
+    if let Some((t, reason)) = stopped {
         eprintln!(
-            "host-sim: error: {} {}: stopped at t = {:.2} s: {} (what was recorded is kept in {})",
+            "host-sim: error: {} {}: stopped at t = {t:.2} s: {reason} (what was recorded is kept in {})",
             mode.name(),
             cfg.name,
-            d.t,
-            d.reason,
             dir.path().display()
         );
     }
@@ -245,7 +257,7 @@ fn fly_one(
     // not required to agree.
     let must_agree = c.pil.pacing == Pacing::Lockstep && cfg.link_faults.is_empty();
     let disagrees = must_agree && !interrupted && !c.agrees();
-    let ok = !(board_run.diverged() || disagrees);
+    let ok = !(board_run.diverged() || board_run.lost_board() || disagrees);
     (c, board_run, ok)
 }
 

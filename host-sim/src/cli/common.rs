@@ -185,7 +185,7 @@ pub(super) fn runs_exit<'a>(
     Exit::of(
         incomplete,
         runs.clone().any(RunResult::interrupted) || interrupt::requested(),
-        failed || runs.clone().any(RunResult::diverged),
+        failed || runs.clone().any(|r| r.diverged() || r.lost_board()),
         runs.clone().any(RunResult::faulted_unexpectedly),
         runs.clone().any(RunResult::missed_unexpectedly),
     )

@@ -3,11 +3,11 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{bail, Result};
 use clap::Args;
 use controller_core::readable::Readable;
 
-use super::board_loop::{fly, link_key, loop_scenarios, LoopArgs, Started};
+use super::board_loop::{fly, link_key, loop_scenarios, not_started, LoopArgs, Started};
 use super::Exit;
 use crate::board::{BoardInTheLoop, Mode, Pacing};
 use crate::output::OutputDir;
@@ -77,8 +77,10 @@ pub fn hil(args: &HilArgs, stdout: &mut dyn Write) -> Result<Exit> {
                 timeout,
                 key.as_ref(),
             )
-            .map(|board| Started { board, log: None })
-            .map_err(|e| anyhow!("{}: {e}", cfg.name))
+            .map_or_else(
+                |e| not_started(&cfg.name, e),
+                |board| Ok(Some(Started { board, log: None })),
+            )
         },
     )
 }

@@ -80,7 +80,8 @@ pub use validate::{validate_preflight, Mountings, ValidateArgs};
 pub enum Exit {
     /// Every run completed, no unexpected controller fault (and PIL agreed with SIL): exit 0.
     Success,
-    /// A run diverged, or PIL disagreed with SIL: exit 1 (the outputs are written).
+    /// A run diverged or lost its board, or PIL disagreed with SIL: exit 1 (the outputs are
+    /// written).
     RunFailed,
     /// An output could not be written completely (named on stderr and in the report): exit 2.
     OutputIncomplete,

@@ -3,10 +3,12 @@
 use std::io::Write;
 use std::path::PathBuf;
 
-use anyhow::{anyhow, bail, Context, Result};
+use anyhow::{Context, Result};
 use clap::Args;
 
-use super::board_loop::{fly, link_key, loop_scenarios, workspace_root, LoopArgs, Started};
+use super::board_loop::{
+    fly, link_key, loop_scenarios, not_started, workspace_root, LoopArgs, Started,
+};
 use super::Exit;
 use crate::board::image::{check_flying_image, default_elf};
 use crate::board::{BoardInTheLoop, Mode};
@@ -27,13 +29,13 @@ pub struct PilArgs {
     pub elf: Option<PathBuf>,
 }
 
-/// `pil`. Exits 1 if a run diverged, or if a run without link faults differs from SIL by more
-/// than [`PIL_SIL_TOLERANCE`](crate::board::PIL_SIL_TOLERANCE).
+/// `pil`. Exits 1 if a run diverged or lost its board, or if a run without link faults differs
+/// from SIL by more than [`PIL_SIL_TOLERANCE`](crate::board::PIL_SIL_TOLERANCE).
 pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let scenarios = loop_scenarios(&args.common)?;
     let root = workspace_root();
     let elf = args.elf.clone().unwrap_or_else(|| default_elf(&root));
-    check_flying_image(&elf).map_err(|e| anyhow!(e))?;
+    check_flying_image(&elf)?;
     let runner = root.join(firmware_images::qemu_runner::SCRIPT);
     let key = link_key(&args.common)?;
     let dir = OutputDir::prepare(&args.out)?;
@@ -57,14 +59,14 @@ pub fn pil(args: &PilArgs, stdout: &mut dyn Write) -> Result<Exit> {
                 &log_path,
                 key.as_ref(),
             ) {
-                Ok(board) => Ok(Started {
+                Ok(board) => Ok(Some(Started {
                     board,
                     log: Some((log, log_path)),
-                }),
+                })),
                 Err(e) => {
                     // Keep QEMU's log: it says why.
                     let _ = log.commit();
-                    bail!("{}: {e}", cfg.name);
+                    not_started(&cfg.name, e)
                 }
             }
         },

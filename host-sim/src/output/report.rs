@@ -270,8 +270,8 @@ pub fn write_report(
 
 /// The text of `report.md` in `dir`: `# title`, a line on how to read the table, then the
 /// warnings — outputs that are `incomplete` (each line says which file and why), runs that
-/// were interrupted (the report is then **partial**), diverged, or had the controller in
-/// fail-safe (unexpectedly, or as the scenario expected) —, [`table_markdown`], `sections`
+/// were interrupted (the report is then **partial**), diverged, lost their board, or had the
+/// controller in fail-safe (unexpectedly, or as the scenario expected) —, [`table_markdown`], `sections`
 /// verbatim (Markdown with its own headings: the preflight verdicts, the real-vehicle table),
 /// each plot embedded as `![file](path)` (relative to `dir` when inside it) under its file
 /// name, and `notes` verbatim under "## Notes" (omitted if empty).
@@ -332,7 +332,7 @@ struct RunWarning {
 }
 
 /// The report's warnings about runs, in the order they are given.
-const RUN_WARNINGS: [RunWarning; 6] = [
+const RUN_WARNINGS: [RunWarning; 7] = [
     RunWarning {
         heading: |n| {
             format!(
@@ -350,6 +350,16 @@ const RUN_WARNINGS: [RunWarning; 6] = [
             )
         },
         detail: |r| r.diverged().then(|| r.outcome.to_string()),
+    },
+    RunWarning {
+        heading: |n| {
+            format!(
+                "**Warning: {n} run(s) lost their board** (PIL, HIL: the board went silent, \
+                 its link went away, or it flew another configuration) — their metrics cover \
+                 only the time before they stopped:"
+            )
+        },
+        detail: |r| r.lost_board().then(|| r.outcome.to_string()),
     },
     RunWarning {
         heading: |n| {
@@ -390,7 +400,8 @@ const RUN_WARNINGS: [RunWarning; 6] = [
 ];
 
 /// The report's warnings, each a heading and a list, for what the reader must not miss: outputs
-/// not written, runs interrupted, diverged, missed or in fail-safe (expected or not).
+/// not written, runs interrupted, diverged, that lost their board, missed or in fail-safe
+/// (expected or not).
 fn warnings(runs: &[&RunResult], incomplete: &[String]) -> String {
     let mut s = String::new();
     let mut warn = |head: String, items: Vec<String>| {
@@ -562,4 +573,48 @@ pub fn real_table_text(rows: &[RealRow]) -> String {
         s.push_str(&line(r));
     }
     s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::sim::record::{FaultCounts, Metrics, Outcome};
+    use crate::sim::BoardLoss;
+
+    fn run(outcome: Outcome) -> RunResult {
+        RunResult {
+            name: "r".to_string(),
+            case: None,
+            robust: true,
+            outcome,
+            metrics: Metrics::NONE,
+            faults: FaultCounts::default(),
+            faults_expected: false,
+            miss_expected: false,
+            samples: Vec::new(),
+            plant_factorisations: 0,
+        }
+    }
+
+    /// A run that lost its board is warned of as such, and one that diverged as such: each
+    /// under its own heading, never the other's.
+    #[test]
+    fn a_lost_board_and_a_divergence_are_warned_of_apart() {
+        let lost = run(Outcome::LostBoard {
+            t: 1.0,
+            cause: BoardLoss::Silent,
+            reason: "no telemetry".to_string(),
+        });
+        let diverged = run(Outcome::Diverged {
+            t: 2.0,
+            reason: "plant state is not finite".to_string(),
+        });
+        let w = warnings(&[&lost], &[]);
+        assert!(w.contains("1 run(s) lost their board"), "{w}");
+        assert!(w.contains(&lost.outcome.to_string()), "{w}");
+        assert!(!w.contains("diverged**"), "{w}");
+        let w = warnings(&[&diverged], &[]);
+        assert!(w.contains("1 run(s) diverged**"), "{w}");
+        assert!(!w.contains("lost their board"), "{w}");
+    }
 }

@@ -5,7 +5,7 @@
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::{Controller, Trajectory};
 
-use super::record::ControlStatus;
+use super::record::{BoardLoss, ControlStatus};
 use crate::scenario::Scenario;
 
 /// What one control period returns, whether the law ran here (SIL) or on the board (PIL).
@@ -23,11 +23,23 @@ pub struct ControlOut {
     pub w_norm: f32,
 }
 
+/// Why a control source has no control for a period: the run ends there, and what was
+/// recorded before is kept.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Stop {
+    /// A stop was requested (Ctrl-C, SIGTERM) while the source waited for its answer: the run
+    /// ends [`Outcome::Interrupted`](super::Outcome::Interrupted).
+    Interrupted,
+    /// The board in the loop is lost: the run ends
+    /// [`Outcome::LostBoard`](super::Outcome::LostBoard) with `cause` and the runner's message.
+    LostBoard { cause: BoardLoss, reason: String },
+}
+
 /// Where the control law runs.
 pub trait ControlSource {
-    /// The control for period `k` from the measured state. An `Err` ends the run (e.g. the
-    /// board's link is gone) with the message as the reason; what was recorded is kept.
-    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String>;
+    /// The control for period `k` from the measured state. An `Err` ends the run ([`Stop`]);
+    /// what was recorded is kept.
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, Stop>;
 }
 
 /// The f32 core on the host, as the firmware runs it (software in the loop): the scenario's
@@ -47,7 +59,7 @@ impl<'a> LocalController<'a> {
 }
 
 impl ControlSource for LocalController<'_> {
-    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, String> {
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, Stop> {
         let out = self.controller.update(k, eta, nu, self.trajectory);
         Ok(ControlOut {
             status: ControlStatus::Law(out.status),

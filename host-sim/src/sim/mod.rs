@@ -5,7 +5,7 @@
 //!
 //! | module | owns |
 //! |---|---|
-//! | [`control`] | where the law runs: [`ControlSource`], [`LocalController`] (SIL), [`ControlOut`] |
+//! | [`control`] | where the law runs: [`ControlSource`], [`LocalController`] (SIL), [`ControlOut`], why a source stops ([`Stop`]) |
 //! | [`navigation`] | what the law is told: measured η, ν (heading as navigation reports it, noise) |
 //! | [`thrusters`] | what the thrusters deliver (ideal or the real chain), their lag, B·thrust |
 //! | [`vehicle`] | the plant with its parameter profile and current, stepped by RK4 |
@@ -16,7 +16,8 @@
 //! | [`bound`] | the bound a real-vehicle run must fly within |
 //!
 //! A non-finite state, a plant fault or a position error beyond `divergence_limit` stops the
-//! run with a reason; every sample recorded until then is kept. An interrupt
+//! run with a reason; every sample recorded until then is kept. A board in the loop that is
+//! lost stops it too ([`Outcome::LostBoard`], not a divergence: [`Stop`]). An interrupt
 //! ([`crate::interrupt`]) stops it at the period it is in.
 
 pub mod bound;
@@ -34,9 +35,9 @@ pub mod vehicle;
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::Desired;
 
-pub use control::{ControlOut, ControlSource, LocalController};
+pub use control::{ControlOut, ControlSource, LocalController, Stop};
 pub use observer::Observer;
-pub use record::{ControlStatus, Metrics, Outcome, RunResult, Sample};
+pub use record::{BoardLoss, ControlStatus, Metrics, Outcome, RunResult, Sample};
 pub use recorder::Recording;
 
 use crate::interrupt;
@@ -89,12 +90,12 @@ pub fn fly(
         let out = match source.control(k, &eta, &nu) {
             Ok(out) => out,
             // A board's wait for its answer gives up on a stop request.
-            Err(_) if interrupt::requested() => {
+            Err(Stop::Interrupted) => {
                 outcome = Outcome::Interrupted { t };
                 break;
             }
-            Err(reason) => {
-                outcome = Outcome::Diverged { t, reason };
+            Err(Stop::LostBoard { cause, reason }) => {
+                outcome = Outcome::LostBoard { t, cause, reason };
                 break;
             }
         };

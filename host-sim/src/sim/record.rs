@@ -96,6 +96,16 @@ pub enum Outcome {
         t: f64,
         reason: String,
     },
+    /// Stopped at `t` because the board in the loop (PIL, HIL) was lost or no longer flies
+    /// what the plant reads: `cause` says how, `reason` is the runner's message (what to check).
+    /// Everything recorded before `t` is kept. The vehicle did not diverge: the run has no
+    /// verdict on the controller, and the command exits 1 as for a divergence
+    /// ([`crate::cli::Exit::RunFailed`]; Choice 200).
+    LostBoard {
+        t: f64,
+        cause: BoardLoss,
+        reason: String,
+    },
     /// Stopped at `t` on request (Ctrl-C, SIGTERM: [`crate::interrupt`]); everything recorded
     /// before `t` is kept and every output says it is partial.
     Interrupted {
@@ -108,15 +118,43 @@ pub enum Outcome {
     },
 }
 
+/// How a run lost its board ([`Outcome::LostBoard`]), as the JSON's `lost_board.cause` names
+/// it (kebab-case): what to look at first. The runner's message says the rest
+/// (`crate::board::Error`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum BoardLoss {
+    /// Nothing at all came for the reply timeout: the board stopped, lost power, or is not
+    /// wired to this port.
+    Silent,
+    /// Bytes came but no valid telemetry: a wrong baud rate or link key, another device.
+    Noise,
+    /// The link closed or its port went away (unplugged, powered off, the emulator ended).
+    LinkGone,
+    /// The board does not fly the configuration the run needs: another thrust unit or
+    /// mounting, a refused set-up, a mission it did not take.
+    Misconfigured,
+    /// Anything else on the way to the board: an I/O error, the emulator or port not starting.
+    Failed,
+}
+
+/// A reason on one line (the outcome's line in tables and on stderr).
+fn one_line(reason: &str) -> String {
+    reason.split_whitespace().collect::<Vec<_>>().join(" ")
+}
+
 impl fmt::Display for Outcome {
-    /// "completed", "DIVERGED at t = … s: reason" (the reason on one line),
-    /// "INTERRUPTED at t = … s (partial)" or "MISSED its bound: reason".
+    /// "completed", "DIVERGED at t = … s: reason" (the reason on one line), "LOST THE BOARD at
+    /// t = … s: reason" (the same), "INTERRUPTED at t = … s (partial)" or "MISSED its bound:
+    /// reason".
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
             Outcome::Completed => f.write_str("completed"),
             Outcome::Diverged { t, reason } => {
-                let reason = reason.split_whitespace().collect::<Vec<_>>().join(" ");
-                write!(f, "DIVERGED at t = {t:.2} s: {reason}")
+                write!(f, "DIVERGED at t = {t:.2} s: {}", one_line(reason))
+            }
+            Outcome::LostBoard { t, reason, .. } => {
+                write!(f, "LOST THE BOARD at t = {t:.2} s: {}", one_line(reason))
             }
             Outcome::Interrupted { t } => write!(f, "INTERRUPTED at t = {t:.2} s (partial)"),
             Outcome::Missed { reason } => write!(f, "MISSED its bound: {reason}"),
@@ -298,7 +336,8 @@ pub struct RunResult {
 }
 
 /// A run as the commands report it in JSON (`--json`): `{"case": name, "robust", the
-/// [`Metrics`] fields, "diverged": {"t", "reason"} if it stopped early}`.
+/// [`Metrics`] fields, "diverged": {"t", "reason"} if it diverged, "lost_board": {"t", "cause",
+/// "reason"} if it lost its board}`.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct RunSummary {
     /// The run's name ([`RunResult::name`]).
@@ -309,6 +348,9 @@ pub struct RunSummary {
     pub metrics: Metrics,
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub diverged: Option<Divergence>,
+    /// When, how and why the run lost its board, if it did (PIL, HIL).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub lost_board: Option<LostBoard>,
     /// The time the run was interrupted at (Ctrl-C), if it was: its metrics cover [0, t).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub interrupted: Option<f64>,
@@ -333,6 +375,14 @@ pub struct Divergence {
     pub reason: String,
 }
 
+/// When, how and why a run lost its board ([`Outcome::LostBoard`]).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LostBoard {
+    pub t: f64,
+    pub cause: BoardLoss,
+    pub reason: String,
+}
+
 impl RunResult {
     /// The run's [`RunSummary`].
     pub fn summary(&self) -> RunSummary {
@@ -343,6 +393,14 @@ impl RunResult {
             diverged: match &self.outcome {
                 Outcome::Diverged { t, reason } => Some(Divergence {
                     t: *t,
+                    reason: reason.clone(),
+                }),
+                _ => None,
+            },
+            lost_board: match &self.outcome {
+                Outcome::LostBoard { t, cause, reason } => Some(LostBoard {
+                    t: *t,
+                    cause: *cause,
                     reason: reason.clone(),
                 }),
                 _ => None,
@@ -364,6 +422,11 @@ impl RunResult {
     /// True if the run stopped early because it diverged.
     pub fn diverged(&self) -> bool {
         matches!(self.outcome, Outcome::Diverged { .. })
+    }
+
+    /// True if the run stopped early because it lost its board.
+    pub fn lost_board(&self) -> bool {
+        matches!(self.outcome, Outcome::LostBoard { .. })
     }
 
     /// True if the run was interrupted (its outputs are partial).
@@ -420,7 +483,45 @@ pub fn du_label(robust: bool) -> &'static str {
 
 #[cfg(test)]
 mod tests {
-    use super::Metrics;
+    use super::*;
+
+    /// A run that lost its board is its own outcome, not a divergence: its summary (and JSON)
+    /// has `lost_board` with the cause in kebab-case and no `diverged`, and its outcome prints
+    /// on one line.
+    #[test]
+    fn a_lost_board_is_not_a_divergence_in_the_summary_and_json() {
+        let reason = "the board's link went away (Broken pipe):\n  the port was unplugged";
+        let run = RunResult {
+            name: "lost".to_string(),
+            case: None,
+            robust: true,
+            outcome: Outcome::LostBoard {
+                t: 3.0,
+                cause: BoardLoss::LinkGone,
+                reason: reason.to_string(),
+            },
+            metrics: Metrics::NONE,
+            faults: FaultCounts::default(),
+            faults_expected: false,
+            miss_expected: false,
+            samples: Vec::new(),
+            plant_factorisations: 0,
+        };
+        assert!(run.lost_board() && !run.diverged() && !run.interrupted());
+        let json = serde_json::to_value(run.summary()).expect("a summary serialises");
+        assert_eq!(json.get("diverged"), None);
+        assert_eq!(json["lost_board"]["cause"], "link-gone");
+        assert_eq!(json["lost_board"]["t"], 3.0);
+        assert_eq!(json["lost_board"]["reason"], reason);
+        let back: RunSummary = serde_json::from_value(json).expect("and reads back");
+        assert_eq!(back.lost_board.map(|l| l.cause), Some(BoardLoss::LinkGone));
+        let shown = run.outcome.to_string();
+        assert!(!shown.contains('\n'), "{shown}");
+        assert!(
+            shown.starts_with("LOST THE BOARD at t = 3.00 s: "),
+            "{shown}"
+        );
+    }
 
     /// The name table is the struct's: each name is the key serde writes for the value at the
     /// same index (ten distinct values, so a swapped or misspelt name cannot pass).

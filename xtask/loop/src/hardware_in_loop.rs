@@ -12,13 +12,14 @@
 //!    missed periods — and must be present; they are not held to a bound (they measure this
 //!    machine's load as much as the loop);
 //! 3. the board's port goes away mid-mission (QEMU killed): `hil` must end within
-//!    [`LOST_BOUND_S`] with a message, a non-zero exit, and the partial run kept (its CSV and
-//!    its JSON case, marked as stopped early).
+//!    [`LOST_BOUND_S`] with a non-zero exit, the partial run kept (its CSV, and its JSON case
+//!    marked as having lost the board with the link gone) and the reason on stderr.
 
 use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Output, Stdio};
 use std::time::{Duration, Instant};
 
+use anyhow::{anyhow, Context};
 use auv_link::sign::LinkKey;
 use auv_link::{BoardStatus, FailSafeReason};
 use firmware::qemu_runner;
@@ -26,6 +27,7 @@ use host_sim::board::emulator::QemuPty;
 use host_sim::board::Pacing;
 use host_sim::board::{BoardComparison, Mode};
 use host_sim::cli::Cases;
+use host_sim::sim::BoardLoss;
 use xtask::ci::Ci;
 
 /// The mission HIL flies (workspace-relative), and for how long (s): 500 periods.
@@ -61,7 +63,7 @@ fn checks_of(ci: &mut Ci, host_sim: &Path, board: &Board, port_lost: bool) {
     let key = match board.key_file.map(read_key).transpose() {
         Ok(k) => k,
         Err(e) => {
-            ci.fail(format!("HIL {}: {e}", board.name));
+            ci.fail(format!("HIL {}: {e:#}", board.name));
             return;
         }
     };
@@ -293,7 +295,7 @@ fn stale_state_reached(ci: &mut Ci, who: &str, status: Option<&str>, log: &Path)
 }
 
 /// 3. The board's port goes away mid-mission (QEMU killed): `hil` must end within
-///    [`LOST_BOUND_S`] with a message, a non-zero exit, and the partial run kept.
+///    [`LOST_BOUND_S`] with a non-zero exit, the partial run kept, and the lost link named.
 fn port_goes_away(ci: &mut Ci, hil: &Hil) {
     let who = hil.board.name;
     let Some(mut f) = hil.start(ci, "lost", Pacing::Lockstep, LONG_SECONDS) else {
@@ -333,14 +335,11 @@ fn ends_within(child: &mut Child, deadline: Instant) -> bool {
     }
 }
 
-/// A run that lost its board: a non-zero exit, a `link went away` message, the partial CSV in
-/// `out` and a JSON case marked stopped early.
+/// A run that lost its board: a non-zero exit, the partial CSV in `out`, a JSON case whose
+/// outcome is the lost board with the link gone (the port's going away noticed as such, not
+/// as silence after the reply timeout), and that reason on stderr.
 fn stopped_early(ci: &mut Ci, who: &str, noticed: f64, o: &Output, out: &Path) {
     let err = String::from_utf8_lossy(&o.stderr);
-    let message = err
-        .lines()
-        .find(|l| l.contains("link went away"))
-        .map(str::to_string);
     let csv_rows = std::fs::read_dir(out)
         .into_iter()
         .flatten()
@@ -350,16 +349,20 @@ fn stopped_early(ci: &mut Ci, who: &str, noticed: f64, o: &Output, out: &Path) {
         .map(|t| t.lines().count().saturating_sub(1))
         .max()
         .unwrap_or(0);
-    let stopped = report(ci, &format!("{who} port lost"), o).and_then(|c| c.run.diverged);
+    let lost = report(ci, &format!("{who} port lost"), o).and_then(|c| c.run.lost_board);
     println!(
-        "{who} port lost: host-sim ended {noticed:.2} s after QEMU, exit {}, {csv_rows} CSV rows kept, run stopped at {:?}; message: {}",
+        "{who} port lost: host-sim ended {noticed:.2} s after QEMU, exit {}, {csv_rows} CSV rows kept, run stopped at {:?} ({:?}): {}",
         o.status,
-        stopped.as_ref().map(|d| d.t),
-        message.as_deref().unwrap_or("(none)")
+        lost.as_ref().map(|l| l.t),
+        lost.as_ref().map(|l| l.cause),
+        lost.as_ref().map_or("(no reason)", |l| l.reason.as_str())
     );
-    if o.status.success() || message.is_none() || csv_rows == 0 || stopped.is_none() {
+    let link_gone = lost
+        .as_ref()
+        .is_some_and(|l| l.cause == BoardLoss::LinkGone && err.contains(&l.reason));
+    if o.status.success() || !link_gone || csv_rows == 0 {
         ci.fail(format!(
-            "HIL {who} port lost: expected a non-zero exit, a `link went away` message, the partial CSV and a JSON case marked stopped early; got exit {}, message {message:?}, {csv_rows} CSV rows, stopped {stopped:?}; stderr:\n{err}",
+            "HIL {who} port lost: expected a non-zero exit, the partial CSV and a JSON case that lost its board with the link gone, its reason on stderr; got exit {}, {csv_rows} CSV rows, lost board {lost:?}; stderr:\n{err}",
             o.status
         ));
     }
@@ -378,9 +381,9 @@ fn last_status(log: &str) -> Option<String> {
 }
 
 /// The link key in a key file (firmware/README.md, "Link key"), for QEMU's command line.
-fn read_key(path: &Path) -> Result<LinkKey, String> {
-    let text = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    LinkKey::from_key_file(&text).map_err(|e| format!("{}: {e}", path.display()))
+fn read_key(path: &Path) -> anyhow::Result<LinkKey> {
+    let text = std::fs::read_to_string(path).with_context(|| path.display().to_string())?;
+    LinkKey::from_key_file(&text).map_err(|e| anyhow!("{}: {e}", path.display()))
 }
 
 #[cfg(test)]

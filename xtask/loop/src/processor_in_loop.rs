@@ -106,7 +106,7 @@ impl Pil<'_> {
                 return None;
             }
         };
-        // host-sim prints its report even when it exits 1 (PIL ≠ SIL, or diverged).
+        // host-sim prints its report even when it exits 1 (PIL ≠ SIL, diverged, lost its board).
         match serde_json::from_slice::<Cases<BoardComparison>>(&output.stdout) {
             Ok(r) if r.cases.len() == 1 => {
                 let case = r.cases.into_iter().next()?;
