@@ -204,13 +204,41 @@ impl Controller {
     /// Validates `config` and precomputes the law's constants. Every check of docs/design.md §4
     /// and §8 is made here; see [`ConfigError`] for the list.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
+        Self::build(config, None)
+    }
+
+    /// The controller [`Controller::new`] gives for `config`, the same in every bit, reusing
+    /// this one's suprema over the parameter box ([`UncertaintyBounds`]) when `config` has the
+    /// same vehicle parameters and box: they depend on nothing else, and they are nearly all
+    /// of `new`'s cost (2⁹ corners, each with its eigen-decompositions: ≈ 26 M instructions on
+    /// the board's Cortex-M4F, ≥ 156 ms at 168 MHz). Every other check is made again.
+    ///
+    /// **Choice 225:** what a board does when its configuration changes over the link, which
+    /// can set the rate, Δu, δ_max, the voltage limit, the thrust unit, the mounting and the
+    /// axis priority but never the vehicle or the box: the bounds are computed once, at boot,
+    /// before the watchdog starts, and a change costs a fraction of a control period.
+    pub fn reconfigure(&self, config: ControllerConfig) -> Result<Self, ConfigError> {
+        let same_box =
+            config.params == self.config.params && config.uncertainty == self.config.uncertainty;
+        Self::build(config, same_box.then_some(self.bounds))
+    }
+
+    /// `new`, with the bounds over the box given (`Some`: computed before for the same
+    /// parameters and box) or computed here.
+    fn build(
+        config: ControllerConfig,
+        bounds: Option<UncertaintyBounds<f32>>,
+    ) -> Result<Self, ConfigError> {
         config.check_scalars()?;
         let allocation = PseudoInverse::new(&config.geometry)?;
         let maps = thruster::default_maps();
         let envelope = ThrustEnvelope::new(&maps, config.thrust_unit, config.voltage_limit);
         let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
-        let bounds = UncertaintyBounds::compute(&config.params, &config.uncertainty)?;
+        let bounds = match bounds {
+            Some(b) => b,
+            None => UncertaintyBounds::compute(&config.params, &config.uncertainty)?,
+        };
         let beta_hat = bounds.beta_hat;
         if !(beta_hat < 1.0 && beta_hat <= config.beta) {
             return Err(ConfigError::Assumption2 {
