@@ -29,7 +29,7 @@
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 174 bytes on the wire, delimiter included
+//! - **Size:** at most [`MAX_FRAME`] = 179 bytes on the wire, delimiter included
 //!   ([`Envelope::MAX_SIZE`] = 157 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
 //!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
 //!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
@@ -91,6 +91,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod config;
 mod frame;
 mod heading;
 pub mod mission;
@@ -100,6 +101,7 @@ pub mod seq;
 pub mod sign;
 pub mod upload;
 
+pub use config::{mounting_of, ConfigMismatch};
 pub use frame::{
     decode_frame, decode_frame_signed, encode, encode_signed, FrameDecoder, LinkError, CRC_LEN,
     MAX_BODY, MAX_FRAME,

@@ -90,6 +90,7 @@ fn telemetry(status: BoardStatus) -> Telemetry {
             received: 0b1_0110,
             verified: false,
         },
+        config_digest: 0x0BAD_F00D,
     }
 }
 
@@ -358,10 +359,11 @@ fn largest_message_fits_max_frame_exactly() {
     // Protocol 5's upload chunk: the command's tag, the part's tag, the index, 32 words.
     assert_eq!(Command::MAX_SIZE, 1 + 1 + 1 + 32 * 4);
     // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes); protocol 5's
-    // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes).
-    assert_eq!(Envelope::MAX_SIZE, 145 + 12);
-    assert_eq!(MAX_BODY, 160 + 12);
-    assert_eq!(MAX_FRAME, 162 + 12);
+    // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes); protocol 6's
+    // configuration digest one u32 varint more (5 bytes).
+    assert_eq!(Envelope::MAX_SIZE, 145 + 12 + 5);
+    assert_eq!(MAX_BODY, 160 + 12 + 5);
+    assert_eq!(MAX_FRAME, 162 + 12 + 5);
     // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
     // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
@@ -418,7 +420,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 1, 2, 3, 4, 6, 0x7F, 0xFF] {
+    for version in [0u8, 1, 2, 3, 4, 5, 7, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -435,30 +437,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[6, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[7, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 6 })]
+        vec![Err(LinkError::Version { got: 7 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 5, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    assert_eq!(PROTOCOL_VERSION, 5);
-    let wire = frame_from_body(&[5, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 6, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 6);
+    let wire = frame_from_body(&[6, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
     // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
     // short: Deserialize.
     for body in [
-        &[5, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[&[5, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
-        &[&[5, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
-        &[5, 0x00, 0x03][..],
-        &[5, 0x00, 0x01, 0x06][..],
-        &[5, 0x00, 0x00, 0x01][..],
-        &[5][..],
+        &[6, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[6, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[6, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[6, 0x00, 0x03][..],
+        &[6, 0x00, 0x01, 0x06][..],
+        &[6, 0x00, 0x00, 0x01][..],
+        &[6][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -467,7 +469,7 @@ fn hand_made_frames_match_the_documented_format() {
         );
     }
     // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
-    let signed = [&[5, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    let signed = [&[6, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
     assert_eq!(
         decode_stream(&frame_from_body(&signed)),
         vec![Err(LinkError::Auth(AuthError::SigningOff))]
@@ -755,6 +757,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<u8>(),
             any::<u32>(),
             any_upload_status(),
+            any::<u32>(),
         ),
     )
         .prop_map(
@@ -781,6 +784,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     reversed_thrusters,
                     rx_ahead,
                     upload,
+                    config_digest,
                 ),
             )| Telemetry {
                 tick,
@@ -809,6 +813,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 reversed_thrusters,
                 rx_ahead,
                 upload,
+                config_digest,
             },
         )
         .boxed()

@@ -3,6 +3,8 @@
 
 #![allow(dead_code)]
 
+pub mod bench;
+
 use auv_link::sign::{Direction, LinkKey, Signer};
 use auv_link::{
     encode, encode_signed, Command, Envelope, Heading, MissionPlan, MissionSpec, Msg, StateFrame,

@@ -45,8 +45,8 @@
 //!   (174 years at 200 Hz).
 //! - **Thrusters off unless armed with a fresh, in-order state:** a period with any voltage ≠ 0
 //!   (or reported `Running`) needs the model armed, with a mission, nothing latched, no overrun,
-//!   and an accepted state frame at most `stale_periods` periods old (in lock-step, accepted
-//!   since the mission started).
+//!   and an accepted state frame at most `stale_periods` periods old, accepted since the
+//!   mission started.
 //! - **A latched fail-safe never clears without disarm + arm:** once a period reports
 //!   `FailSafe(r)`, every telemetry frame reports `latched = r` and no thrust, and a lone `Arm`
 //!   is refused, until an accepted `Disarm` followed by an accepted `Arm`.
@@ -190,8 +190,8 @@ struct Model {
     counted: u64,
     /// Authentic frames refused as too far ahead.
     ahead: u32,
-    /// Periods run since the last accepted state frame (`None`: none, or, in lock-step, none
-    /// since the mission started).
+    /// Periods run since the last accepted state frame (`None`: none, or none since the
+    /// mission started).
     periods_since_state: Option<u64>,
     /// Lock-step mission clock: the last accepted tick, and periods since.
     clock: Option<(u64, u64)>,
@@ -835,9 +835,9 @@ impl Harness {
                     m.mission = true;
                     m.mission_periods = 0;
                     m.clock = None;
-                    if m.lockstep {
-                        m.periods_since_state = None;
-                    }
+                    // A new mission counts from its start, in either pacing (Choice 227): a
+                    // state from before it is not its state.
+                    m.periods_since_state = None;
                 }
             }
             Command::Upload(_) => {
