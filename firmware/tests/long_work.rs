@@ -61,6 +61,18 @@ impl Rig {
         self.period()
     }
 
+    /// `burst` in a late period, then `n` periods with a state frame each (ticks from 1):
+    /// whether each period flew, and its telemetry.
+    fn burst_then_states(&mut self, burst: &[Msg], n: u64) -> Vec<(bool, Telemetry)> {
+        self.send(burst);
+        let mut periods = vec![self.late_period()];
+        for k in 1..=n {
+            self.send(&[Msg::State(state(k))]);
+            periods.push(self.period());
+        }
+        periods
+    }
+
     /// `n` periods with a state frame each (ticks from `k`); each must fly, unlatched.
     fn fly(&mut self, k: u64, n: u64) -> Telemetry {
         let mut last = None;
@@ -97,31 +109,33 @@ fn law_change() -> ConfigPatch {
 #[test]
 fn a_configuration_sent_with_arm_and_start_never_latches_the_mission() {
     let mut r = Rig::new();
-    r.send(&[
-        Msg::Command(Command::SetConfig(law_change())),
-        Msg::Command(Command::Arm),
-        Msg::Command(Command::StartMission(CIRCLE)),
-        Msg::State(state(0)),
-    ]);
-    let (on, t) = r.late_period();
-    assert!(!on, "the period that rebuilt the controller does not fly");
-    assert_eq!(
-        t.status,
-        BoardStatus::Disarmed,
-        "Arm waits for the next period"
+    let periods = r.burst_then_states(
+        &[
+            Msg::Command(Command::SetConfig(law_change())),
+            Msg::Command(Command::Arm),
+            Msg::Command(Command::StartMission(CIRCLE)),
+            Msg::State(state(0)),
+        ],
+        20,
     );
+    let latched: Vec<_> = periods.iter().map(|(_, t)| t.latched).collect();
+    assert!(latched.iter().all(Option::is_none), "{latched:?}");
+    // The period that rebuilt the controller applied it and did not fly; Arm and the rest
+    // waited for the next period, which flies on the state the burst carried.
+    let (on, t) = periods[0];
+    assert!(!on);
+    assert_eq!(t.thrust_unit, ThrustUnit::Newton, "applied");
+    assert_eq!(t.status, BoardStatus::Disarmed, "Arm waits a period");
+    for (on, t) in &periods[1..] {
+        assert!(on);
+        assert_eq!(t.status, BoardStatus::Running);
+    }
+    let last = periods[20].1;
     assert_eq!(
-        t.thrust_unit,
-        ThrustUnit::Newton,
-        "the configuration is applied"
+        last.loop_overruns, 1,
+        "counted, in the period that did the work"
     );
-    // The next period takes the rest of the burst and flies on the state it carried.
-    let (on, t) = r.period();
-    assert_eq!((t.status, t.latched), (BoardStatus::Running, None));
-    assert!(on);
-    assert_eq!(t.loop_overruns, 1, "counted where it happened");
-    let t = r.fly(1, 20);
-    assert_eq!((t.loop_overruns, t.refused_commands), (1, 0));
+    assert_eq!(last.refused_commands, 0);
 }
 
 /// The survey's upload (12 points, tangent heading: two chunks).
@@ -159,8 +173,8 @@ fn start_upload(up: &MissionUpload) -> Msg {
     }))
 }
 
-/// Uploaded and verified (its build the period's long job), armed, flying the circle (which
-/// took the trajectory's slot) for five periods; the last period's telemetry.
+/// Uploaded and verified, armed, flying the circle (which took the trajectory's slot) for five
+/// periods; the last period's telemetry.
 fn flying_the_circle_with_an_upload_held(up: &MissionUpload) -> (Rig, Telemetry) {
     let mut r = Rig::new();
     r.send(&[Msg::Command(Command::Upload(UploadPart::Begin(
@@ -172,13 +186,8 @@ fn flying_the_circle_with_an_upload_held(up: &MissionUpload) -> (Rig, Telemetry)
         )))]);
     }
     r.send(&[Msg::Command(Command::Arm)]);
-    let (_, t) = r.late_period();
+    let (_, t) = r.period();
     assert!(t.upload.verified);
-    assert_eq!(
-        t.status,
-        BoardStatus::Disarmed,
-        "Arm waits for the next period"
-    );
     r.send(&[Msg::Command(Command::StartMission(CIRCLE))]);
     let t = r.fly(0, 5);
     (r, t)
@@ -193,21 +202,26 @@ fn starting_an_upload_that_must_be_built_never_latches_the_mission() {
     let up = survey();
     let (mut r, before) = flying_the_circle_with_an_upload_held(&up);
     let builds = r.sup.trajectory_builds();
-    r.send(&[
-        Msg::Command(Command::StopMission),
-        start_upload(&up),
-        Msg::State(state(0)),
-    ]);
-    let (on, t) = r.late_period();
+    let periods = r.burst_then_states(
+        &[
+            Msg::Command(Command::StopMission),
+            start_upload(&up),
+            Msg::State(state(0)),
+        ],
+        10,
+    );
+    let latched: Vec<_> = periods.iter().map(|(_, t)| t.latched).collect();
+    assert!(latched.iter().all(Option::is_none), "{latched:?}");
     assert_eq!(
         r.sup.trajectory_builds(),
         builds + 1,
         "StartMission built it"
     );
+    let (on, t) = periods[0];
     assert!(!on, "the period that built it does not fly");
-    assert_eq!((t.status, t.latched), (BoardStatus::Running, None));
-    let t = r.fly(1, 10);
-    assert_eq!(t.loop_overruns, before.loop_overruns + 1);
+    assert_eq!(t.status, BoardStatus::Running);
+    assert!(periods[1..].iter().all(|(on, _)| *on));
+    assert_eq!(periods[10].1.loop_overruns, before.loop_overruns + 1);
 }
 
 /// Regression (issue 29, item 15): the idle rebuild of the upload (a closed form took its slot)
