@@ -214,6 +214,14 @@ pub struct Supervisor {
 
 pub use auv_link::{mounting_of, NOT_AUV150};
 
+/// The digest telemetry reports of the whole configuration `config`, `stale_periods`,
+/// `lockstep` ([`ConfigPatch::digest`]; a whole patch always has one).
+fn digest_of(config: &ControllerConfig, stale_periods: u8, lockstep: bool) -> u32 {
+    ConfigPatch::whole(config, stale_periods, lockstep)
+        .digest()
+        .unwrap_or_default()
+}
+
 /// Bits of a valid reversed-thruster mask: one per thruster.
 const MOUNTING_BITS: u8 = (1 << THRUSTERS) - 1;
 
@@ -231,8 +239,7 @@ impl Supervisor {
     pub fn new(controller: Controller, board: BoardInfo) -> Self {
         Supervisor {
             mounting: mounting_of(controller.config()),
-            config_digest: ConfigPatch::whole(controller.config(), DEFAULT_STALE_PERIODS, false)
-                .digest(),
+            config_digest: digest_of(controller.config(), DEFAULT_STALE_PERIODS, false),
             long_job: false,
             controller,
             board,
@@ -611,8 +618,7 @@ impl Supervisor {
         }
         self.stale_periods = stale_periods;
         self.lockstep = lockstep;
-        self.config_digest =
-            ConfigPatch::whole(self.controller.config(), stale_periods, lockstep).digest();
+        self.config_digest = digest_of(self.controller.config(), stale_periods, lockstep);
         Ok(())
     }
 

@@ -7,13 +7,19 @@
 //! ([`Telemetry::config_digest`]), so a navigation computer that sent a whole patch confirms
 //! every field it set by comparing one number ([`ConfigPatch::confirm`]): a board that reset
 //! (its watchdog, a brown-out) is back on its defaults, and says so in its next frame.
+//!
+//! **The digest** is the CRC-32/ISO-HDLC (the mission upload's, [`crate::upload`]) of the
+//! whole configuration's fields in declaration order, each as fixed bytes: `rate_hz` (u32,
+//! little-endian), `robust` (1 byte, 0 or 1), `delta_max` and `voltage_limit` (f32, their four
+//! little-endian bytes), `stale_periods` (1 byte), `lockstep` (0 or 1), the thrust unit (its
+//! wire index: 0 kgf, 1 newton), `reversed_thrusters` (1 byte), then the priority's six ranks
+//! (1 byte each) and six weights (f32 each): 47 bytes. Written field by field, not through
+//! postcard, so that the board carries no serializer for a message it only receives.
 
 use controller_core::ControllerConfig;
 
 use crate::msg::{ConfigPatch, Telemetry, ThrustUnit, NOT_AUV150};
-
-/// CRC-32/ISO-HDLC, as the mission upload's (`crate::upload`).
-const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
+use crate::upload::CRC32;
 
 /// The thruster mounting a board that flies `config` reports: the AUV-150 layout's
 /// reversed-thruster mask ([`Telemetry::reversed_thrusters`]), or [`NOT_AUV150`] for a geometry
@@ -40,38 +46,62 @@ impl ConfigPatch {
         }
     }
 
-    /// Every field is set: the patch is a whole configuration, and its digest is what a board
-    /// that took it reports.
-    pub const fn is_whole(&self) -> bool {
-        self.rate_hz.is_some()
-            && self.robust.is_some()
-            && self.delta_max.is_some()
-            && self.voltage_limit.is_some()
-            && self.stale_periods.is_some()
-            && self.lockstep.is_some()
-            && self.thrust_unit.is_some()
-            && self.reversed_thrusters.is_some()
-            && self.priority.is_some()
+    /// Every field is set: the patch is a whole configuration, and has a digest.
+    pub fn is_whole(&self) -> bool {
+        self.digest().is_some()
     }
 
-    /// The CRC-32 (ISO-HDLC) of the patch's postcard encoding: its fields in order, each f32
-    /// as its four bytes, so two patches have the same digest exactly when they encode the
-    /// same (a 2⁻³² chance otherwise). For a whole patch, what [`Telemetry::config_digest`]
-    /// reports of a board that flies it.
-    pub fn digest(&self) -> u32 {
-        let mut buf = [0u8; ConfigPatch::MAX_SIZE];
-        // A patch always fits MAX_SIZE (the link's tests hold the bound exact), so the empty
-        // slice of a failed encoding is never digested in place of one.
-        let bytes = postcard::to_slice(self, &mut buf).map_or(&[][..], |b| &b[..]);
-        CRC32.checksum(bytes)
+    /// The digest of a whole configuration (module docs; `None` if a field is unset): what
+    /// [`Telemetry::config_digest`] reports of a board that flies it. Two configurations
+    /// with the same digest are the same, bit for bit, but for a 2⁻³² chance.
+    pub fn digest(&self) -> Option<u32> {
+        let (
+            Some(rate_hz),
+            Some(robust),
+            Some(delta_max),
+            Some(voltage_limit),
+            Some(stale_periods),
+            Some(lockstep),
+            Some(unit),
+            Some(mounting),
+            Some(priority),
+        ) = (
+            self.rate_hz,
+            self.robust,
+            self.delta_max,
+            self.voltage_limit,
+            self.stale_periods,
+            self.lockstep,
+            self.thrust_unit,
+            self.reversed_thrusters,
+            self.priority,
+        )
+        else {
+            return None;
+        };
+        let unit = match unit {
+            ThrustUnit::Kgf => 0u8,
+            ThrustUnit::Newton => 1,
+        };
+        let mut d = CRC32.digest();
+        d.update(&rate_hz.to_le_bytes());
+        d.update(&[u8::from(robust)]);
+        d.update(&delta_max.to_le_bytes());
+        d.update(&voltage_limit.to_le_bytes());
+        d.update(&[stale_periods, u8::from(lockstep), unit, mounting]);
+        d.update(&priority.rank);
+        for w in priority.weight {
+            d.update(&w.to_le_bytes());
+        }
+        Some(d.finalize())
     }
 
     /// Confirms that the board whose telemetry is `t` flies this whole patch: its thrust unit
     /// and mounting (named in every frame) and then every field through the digest.
     pub fn confirm(&self, t: &Telemetry) -> Result<(), ConfigMismatch> {
-        if !self.is_whole() {
+        let Some(sent) = self.digest() else {
             return Err(ConfigMismatch::NotWhole);
-        }
+        };
         if let Some(sent) = self.thrust_unit {
             if t.thrust_unit != sent {
                 return Err(ConfigMismatch::ThrustUnit {
@@ -88,7 +118,6 @@ impl ConfigPatch {
                 });
             }
         }
-        let sent = self.digest();
         if t.config_digest != sent {
             return Err(ConfigMismatch::Digest {
                 sent,

@@ -50,7 +50,7 @@ const _: () = assert!(MAX_CHUNKS <= 32, "one bit per chunk in a u32");
 const NO_SPEEDS: u8 = u8::MAX;
 
 /// CRC-32/ISO-HDLC (the zip/Ethernet CRC; check value 0xCBF43926).
-const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
+pub(crate) const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
 
 /// What a mission upload is: its counts, the path's scalars and the whole mission's CRC.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]

@@ -50,20 +50,41 @@ fn the_whole_configuration_sets_every_field_from_the_core_and_the_board() {
 }
 
 #[test]
-fn the_digest_is_the_crc32_of_the_patchs_documented_bytes() {
-    // Nine `None` options: nine zero bytes.
-    assert_eq!(ConfigPatch::EMPTY.digest(), crc32_by_hand(&[0; 9]));
-    // rate 200 (varint C8 01), Δu off, δ_max 0.5, then six `None`s; laid out from the docs.
-    let p = ConfigPatch {
-        rate_hz: Some(200),
-        robust: Some(false),
-        delta_max: Some(0.5),
-        ..ConfigPatch::EMPTY
+fn the_digest_is_the_crc32_of_the_documented_bytes() {
+    // The defaults, laid out from the module docs: rate 100, Δu on, δ_max, the voltage limit,
+    // 2 stale periods, free-running, kgf, the AUV-150 mask, then the priority.
+    let c = ControllerConfig::default();
+    let w = defaults();
+    let p = w.priority.unwrap();
+    let mut bytes = Vec::new();
+    bytes.extend_from_slice(&100u32.to_le_bytes());
+    bytes.push(1);
+    bytes.extend_from_slice(&c.delta_max.to_le_bytes());
+    bytes.extend_from_slice(&c.voltage_limit.to_le_bytes());
+    bytes.extend_from_slice(&[2, 0, 0, controller_core::effectiveness::AUV150_REVERSED]);
+    bytes.extend_from_slice(&p.rank);
+    for x in p.weight {
+        bytes.extend_from_slice(&x.to_le_bytes());
+    }
+    assert_eq!(bytes.len(), 47);
+    assert_eq!(w.digest(), Some(crc32_by_hand(&bytes)));
+    // Newton is the unit's wire index 1.
+    let newton = ConfigPatch {
+        thrust_unit: Some(ThrustUnit::Newton),
+        ..w
     };
-    let mut bytes = vec![1, 0xC8, 0x01, 1, 0, 1];
-    bytes.extend_from_slice(&0.5f32.to_le_bytes());
-    bytes.extend_from_slice(&[0; 6]);
-    assert_eq!(p.digest(), crc32_by_hand(&bytes));
+    bytes[15] = 1;
+    assert_eq!(newton.digest(), Some(crc32_by_hand(&bytes)));
+    // A patch that is not whole has none.
+    assert_eq!(ConfigPatch::EMPTY.digest(), None);
+    assert_eq!(
+        ConfigPatch {
+            lockstep: None,
+            ..w
+        }
+        .digest(),
+        None
+    );
 }
 
 #[test]
@@ -109,8 +130,8 @@ fn every_field_moves_the_digest() {
             ..w
         },
     ];
-    let mut digests: Vec<u32> = changed.iter().map(ConfigPatch::digest).collect();
-    digests.push(w.digest());
+    let mut digests: Vec<u32> = changed.iter().filter_map(ConfigPatch::digest).collect();
+    digests.extend(w.digest());
     let n = digests.len();
     digests.sort_unstable();
     digests.dedup();
@@ -125,7 +146,7 @@ fn telemetry_of(applied: &ConfigPatch) -> Telemetry {
     Telemetry {
         thrust_unit: applied.thrust_unit.unwrap(),
         reversed_thrusters: applied.reversed_thrusters.unwrap(),
-        config_digest: applied.digest(),
+        config_digest: applied.digest().unwrap(),
         ..Telemetry::LARGEST
     }
 }
@@ -168,8 +189,8 @@ fn confirm_accepts_the_board_that_flies_what_was_sent_and_names_what_differs() {
     assert_eq!(
         err,
         ConfigMismatch::Digest {
-            sent: sent.digest(),
-            board: slower.digest()
+            sent: sent.digest().unwrap(),
+            board: slower.digest().unwrap()
         }
     );
     assert!(err.to_string().contains("reset to its defaults"), "{err}");
