@@ -21,6 +21,9 @@ use controller_core::ControllerConfig;
 use crate::msg::{ConfigPatch, Telemetry, ThrustUnit, NOT_AUV150};
 use crate::upload::CRC32;
 
+/// Bytes the digest covers (module docs).
+const DIGEST_BYTES: usize = 4 + 1 + 4 + 4 + 1 + 1 + 1 + 1 + 6 + 6 * 4;
+
 /// The thruster mounting a board that flies `config` reports: the AUV-150 layout's
 /// reversed-thruster mask ([`Telemetry::reversed_thrusters`]), or [`NOT_AUV150`] for a geometry
 /// that is not the AUV-150 layout (a board built with another geometry; the link cannot set
@@ -79,21 +82,23 @@ impl ConfigPatch {
         else {
             return None;
         };
-        let unit = match unit {
-            ThrustUnit::Kgf => 0u8,
+        let mut bytes = [0u8; DIGEST_BYTES];
+        bytes[..4].copy_from_slice(&rate_hz.to_le_bytes());
+        bytes[4] = u8::from(robust);
+        bytes[5..9].copy_from_slice(&delta_max.to_le_bytes());
+        bytes[9..13].copy_from_slice(&voltage_limit.to_le_bytes());
+        bytes[13] = stale_periods;
+        bytes[14] = u8::from(lockstep);
+        bytes[15] = match unit {
+            ThrustUnit::Kgf => 0,
             ThrustUnit::Newton => 1,
         };
-        let mut d = CRC32.digest();
-        d.update(&rate_hz.to_le_bytes());
-        d.update(&[u8::from(robust)]);
-        d.update(&delta_max.to_le_bytes());
-        d.update(&voltage_limit.to_le_bytes());
-        d.update(&[stale_periods, u8::from(lockstep), unit, mounting]);
-        d.update(&priority.rank);
-        for w in priority.weight {
-            d.update(&w.to_le_bytes());
+        bytes[16] = mounting;
+        bytes[17..23].copy_from_slice(&priority.rank);
+        for (i, w) in priority.weight.iter().enumerate() {
+            bytes[23 + 4 * i..27 + 4 * i].copy_from_slice(&w.to_le_bytes());
         }
-        Some(d.finalize())
+        Some(CRC32.checksum(&bytes))
     }
 
     /// Confirms that the board whose telemetry is `t` flies this whole patch: its thrust unit
