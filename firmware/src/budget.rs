@@ -1,5 +1,6 @@
-//! Instruction budgets of one control step on the target, in total and per stage, for each
-//! math backend of the core: the one place they are written.
+//! Instruction budgets on the target, the one place they are written: one control step, in
+//! total and per stage, for each math backend of the core; and the board's long jobs and one
+//! period's work, against the flight board's watchdog at its clock.
 //!
 //! The self-test (`firmware-qemu-selftest`) counts, under QEMU's `-icount`, the instructions of
 //! `Controller::update` and of each of its stages ([`Stage`]) on the golden vectors; the counts
@@ -73,9 +74,73 @@ pub fn for_backend(backend: &str) -> Option<&'static StepBudget> {
     BUDGETS.iter().find(|b| b.backend == backend)
 }
 
+// ---------------------------------------------------------------------------------------------
+// The board's long jobs and one period's work (Choices 225–226), against the watchdog
+//
+// The self-test counts them under `-icount` (`src/bin/qemu_selftest/flight.rs`) and fails
+// itself over a budget; the test below holds every budget against the STM32 board's watchdog
+// at its clock (`crate::watchdog`) for every rate the board accepts.
+
+/// Instructions of the costliest `SetConfig` (the self-test's `SetConfig instructions by field`
+/// line; each field that changes the law is a controller rebuild, Choice 225): decode,
+/// validation, `Controller::reconfigure` and the digest. Measured 22 600 (the whole patch
+/// host-sim sends; 19 600–22 040 for one law field), ≈ 26.3 M before Choice 225 (the bounds
+/// over the box recomputed: ≥ 156 ms at 168 MHz, more than four times the watchdog's
+/// shortest timeout).
+pub const SET_CONFIG_BUDGET: u32 = 26_000;
+
+/// Instructions of the largest waypoint build (32 points, 61 parts: the self-test's
+/// `Trajectory::set of the largest waypoint path` line, measured 1 051 160): longer than a
+/// period at 200 Hz, so it is the period's one long job and its overrun that period's.
+pub const BUILD_BUDGET: u32 = 1_200_000;
+
+/// The most one period may take from the end of its wait to the watchdog's feed
+/// (instructions): what a full receive queue of small signed frames costs the pump, then the
+/// period's one long job, the step and the telemetry. The self-test's loop at the flight clock
+/// measures its longest period (`flight clock, longest period's work`) over the issue's
+/// sequences and that costliest one: 1 218 200.
+pub const PERIOD_WORK_BUDGET: u32 = 1_400_000;
+
+/// Cycles allowed per instruction when the budgets are held against the watchdog at the flight
+/// clock: the Cortex-M4 retires most instructions in one cycle; loads, and flash wait states
+/// (5 at 168 MHz, behind the ART accelerator), cost more. Twice the count is the margin.
+pub const CYCLES_PER_INSTRUCTION: u64 = 2;
+
+/// The longest the watchdog goes unfed at `rate_hz` if a period's work reaches
+/// [`PERIOD_WORK_BUDGET`] (µs at the flight clock, [`CYCLES_PER_INSTRUCTION`] a cycle): a
+/// feed ends one period's work, the next comes after at most one period's wait (the boundary;
+/// after an overrun the next boundary, since `board::period` takes the long job's own) and
+/// the next period's work.
+pub fn longest_unfed_us(rate_hz: u32) -> u64 {
+    crate::watchdog::period_us(rate_hz)
+        + crate::watchdog::flight_us(u64::from(PERIOD_WORK_BUDGET) * CYCLES_PER_INSTRUCTION)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 29, item 14: at every rate the board accepts, the most a period may do keeps the
+    /// watchdog fed within its shortest timeout (the fastest LSI), with twice the instruction
+    /// count as cycles; a configuration change fits one period at the highest rate, and each
+    /// long job fits a period's work.
+    #[test]
+    fn a_periods_work_keeps_the_watchdog_fed_at_every_rate() {
+        use crate::limits::MAX_RATE_HZ;
+        use crate::watchdog::{flight_us, period_us, shortest_timeout_us};
+        for rate in 1..=MAX_RATE_HZ {
+            let (unfed, timeout) = (longest_unfed_us(rate), shortest_timeout_us(rate));
+            assert!(
+                unfed < timeout,
+                "{rate} Hz: {unfed} µs unfed, timeout {timeout} µs"
+            );
+        }
+        let rebuild = flight_us(u64::from(SET_CONFIG_BUDGET) * CYCLES_PER_INSTRUCTION);
+        assert!(rebuild < period_us(MAX_RATE_HZ), "{rebuild} µs");
+        assert!(SET_CONFIG_BUDGET < PERIOD_WORK_BUDGET && BUILD_BUDGET < PERIOD_WORK_BUDGET);
+        // The configuration change before Choice 225 (26.3 M instructions) does not fit.
+        assert!(flight_us(26_284_600) > shortest_timeout_us(100));
+    }
 
     #[test]
     fn every_backend_of_the_core_has_a_budget_and_the_stages_fit_the_total() {

@@ -4,7 +4,8 @@
 //! refusals), [`limits`] (what the board's configuration may be), [`budget`] (the control
 //! step's instruction budgets on the target), [`pwm`] (voltage → H-bridge duty), [`board`]
 //! (the board trait and one control period),
-//! [`serial`] (the UART's byte queues between interrupt and loop), [`image`] (which images
+//! [`serial`] (the UART's byte queues between interrupt and loop), [`watchdog`] (the flight
+//! board's watchdog and clock in numbers), [`image`] (which images
 //! exist and how to tell their ELFs apart), [`qemu_clock`] (QEMU's instruction counts) and
 //! [`qemu_runner`] (what `scripts/qemu-run.sh` reads).
 //!
@@ -23,6 +24,7 @@ pub mod limits;
 pub mod pwm;
 pub mod serial;
 pub mod supervisor;
+pub mod watchdog;
 
 // Their own crate, without this package's build script, so that host-sim can use them alone.
 pub use firmware_images::{image, qemu_clock, qemu_runner, LINK_KEY_VAR, LINK_UNSIGNED_VAR};
