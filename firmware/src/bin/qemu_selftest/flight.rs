@@ -20,8 +20,8 @@ use core::ptr::{read_volatile, write_volatile};
 
 use auv_link::sign::{Direction, LinkKey, Signer};
 use auv_link::{
-    encode, encode_signed, AxisPriority, Command, ConfigPatch, Envelope, Heading, MissionPlan,
-    MissionSpec, MissionUpload, Msg, ThrustUnit, UploadPart, MAX_FRAME,
+    encode, encode_signed, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, Heading,
+    MissionPlan, MissionSpec, MissionUpload, Msg, ThrustUnit, UploadPart, MAX_FRAME,
 };
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOINTS};
@@ -242,7 +242,9 @@ impl Rig<'_, '_> {
             self.board.set_rate(hz);
         }
         out.periods += 1;
-        out.latched |= step.telemetry.latched.is_some();
+        // A fail-safe entered while armed (a latch from before, reported while disarmed until
+        // the next Arm, is not this scenario's).
+        out.latched |= matches!(step.telemetry.status, BoardStatus::FailSafe(_));
         out.overruns = step.telemetry.loop_overruns;
         step.voltages.iter().any(|v| *v != 0.0)
     }
@@ -515,9 +517,11 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
         ok &= good;
     };
 
-    // 1. At 100 Hz: a law-changing SetConfig (to 200 Hz) with Arm, StartMission and a state.
+    // 1. At 100 Hz: a law-changing SetConfig with Arm, StartMission and a state (not the
+    // rate: a new rate restarts the period timer, which hid the overrun before Choice 226).
     let law = ConfigPatch {
-        rate_hz: Some(200),
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(0),
         priority: Some(other_priority()),
         ..ConfigPatch::EMPTY
     };
@@ -533,12 +537,20 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
     );
     report("SetConfig + Arm + StartMission in one burst at 100 Hz", &o);
 
-    // 2. At 200 Hz, disarmed: the largest upload, its last chunk after a receive queue full of
-    // small signed frames (the costliest period the link can make), then Arm + StartMission of
-    // a closed form, which takes the slot.
+    // 2. Disarmed, to 200 Hz: the largest upload, its last chunk after a receive queue full
+    // of small signed frames (the costliest period the link can make), then Arm +
+    // StartMission of a closed form, which takes the slot.
     let mut out = Outcome::default();
-    let mut sent = rig.nav.send(rig.board, &[cmd(Command::Disarm)]);
+    let faster = ConfigPatch {
+        rate_hz: Some(200),
+        ..ConfigPatch::EMPTY
+    };
+    let mut sent = rig.nav.send(
+        rig.board,
+        &[cmd(Command::Disarm), cmd(Command::SetConfig(faster))],
+    );
     rig.period(&mut out);
+    sent &= rig.sup.rate_hz() == 200;
     sent &= rig.nav.send(
         &mut rig.board,
         &[cmd(Command::Upload(UploadPart::Begin(up.header())))],
