@@ -584,7 +584,17 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
         &o,
     );
 
+    // Each scenario from an unlatched board flying the circle (a latch of the one before, on a
+    // board without Choice 226, would otherwise carry over).
+    let restart = [
+        cmd(Command::Disarm),
+        cmd(Command::Arm),
+        cmd(Command::StartMission(circle_plan)),
+    ];
+
     // 3. StopMission + StartMission of the upload (the slot holds the circle: built now).
+    rig.k = 0;
+    rig.burst_then_fly(&restart, 3);
     rig.k = 0;
     let o = rig.burst_then_fly(
         &[
@@ -600,13 +610,7 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
 
     // 4. The circle again, then StopMission: the idle rebuild; then StartMission of the upload.
     rig.k = 0;
-    let mut o = rig.burst_then_fly(
-        &[
-            cmd(Command::StopMission),
-            cmd(Command::StartMission(circle_plan)),
-        ],
-        5,
-    );
+    let mut o = rig.burst_then_fly(&restart, 5);
     let sent = rig.nav.send(rig.board, &[cmd(Command::StopMission)]);
     rig.period(&mut o);
     rig.k = 0;
