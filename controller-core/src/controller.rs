@@ -239,19 +239,7 @@ impl Controller {
             Some(b) => b,
             None => UncertaintyBounds::compute(&config.params, &config.uncertainty)?,
         };
-        let beta_hat = bounds.beta_hat;
-        if !(beta_hat < 1.0 && beta_hat <= config.beta) {
-            return Err(ConfigError::Assumption2 {
-                beta_hat,
-                beta: config.beta,
-            });
-        }
-        if !bounds.theorem2.holds() {
-            return Err(ConfigError::Theorem2 {
-                lhs: bounds.theorem2.lhs,
-                rhs: bounds.theorem2.rhs,
-            });
-        }
+        check_feasible(&bounds, config.beta)?;
 
         let mut lyapunov = [AxisLyapunov::default(); 6];
         let mut k_norm = 0.0f32;
@@ -595,6 +583,21 @@ pub struct StepLaw {
     pub delta_clamped: bool,
     pub w_norm: f32,
     pub e1: Vector6<f32>,
+}
+
+/// Assumption 2 (Eq 20: β̂ < 1 and β̂ ≤ the configured β) and Theorem 2 (Eq 25) over the box.
+fn check_feasible(bounds: &UncertaintyBounds<f32>, beta: f32) -> Result<(), ConfigError> {
+    let beta_hat = bounds.beta_hat;
+    if !(beta_hat < 1.0 && beta_hat <= beta) {
+        return Err(ConfigError::Assumption2 { beta_hat, beta });
+    }
+    if !bounds.theorem2.holds() {
+        return Err(ConfigError::Theorem2 {
+            lhs: bounds.theorem2.lhs,
+            rhs: bounds.theorem2.rhs,
+        });
+    }
+    Ok(())
 }
 
 fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {

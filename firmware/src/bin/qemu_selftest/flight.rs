@@ -21,7 +21,7 @@ use core::ptr::{read_volatile, write_volatile};
 use auv_link::sign::{Direction, LinkKey, Signer};
 use auv_link::{
     encode, encode_signed, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, Heading,
-    MissionPlan, MissionSpec, MissionUpload, Msg, ThrustUnit, UploadPart, MAX_FRAME,
+    MissionPlan, MissionSpec, MissionUpload, Msg, StateFrame, ThrustUnit, UploadPart, MAX_FRAME,
 };
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOINTS};
@@ -39,7 +39,9 @@ use firmware::supervisor::{BoardInfo, Supervisor};
 use firmware::watchdog::{flight_us, shortest_timeout_us, FLIGHT_CLOCK_HZ};
 
 use crate::counter::{elapsed, start_counter};
-use crate::selftest::circle_state;
+
+/// The vehicle's state on a mission at a tick (the self-test's: on the reference).
+pub type StateOf = fn(&Trajectory, u64) -> StateFrame;
 
 /// CMSDK APB TIMER0 of mps2-an386: a 32-bit down-counter at the 25 MHz peripheral clock.
 const TIMER0: usize = 0x4000_0000;
@@ -121,7 +123,26 @@ struct FlightBoard<'a> {
     unfed_too_long: bool,
 }
 
-impl FlightBoard<'_> {
+impl<'a> FlightBoard<'a> {
+    /// Not yet started: `set_rate` starts its periods.
+    fn new(syst: &'a mut SYST) -> Self {
+        FlightBoard {
+            syst,
+            thrusters: [MemPwm::neutral(1000); THRUSTERS],
+            link: Script {
+                buf: [0; RX_CAPACITY],
+                len: 0,
+                at: 0,
+            },
+            rate: 0,
+            work_start: now(),
+            fed: now(),
+            longest_work: 0,
+            longest_gap: (0, 0, 0),
+            unfed_too_long: false,
+        }
+    }
+
     fn feed(&mut self) {
         let t = now();
         let gap = t - self.fed;
@@ -219,6 +240,7 @@ struct Rig<'a, 'b> {
     link: &'a mut LinkBuffers,
     nav: Nav,
     circle: &'a Trajectory,
+    state: StateOf,
     /// Mission tick of the next state frame.
     k: u64,
 }
@@ -233,6 +255,11 @@ struct Outcome {
 }
 
 impl Rig<'_, '_> {
+    /// The navigation computer sends `msgs`, back to back; false if they did not fit.
+    fn send(&mut self, msgs: &[Msg]) -> bool {
+        self.nav.send(self.board, msgs)
+    }
+
     /// One period of the loop as `rt::fly` runs it (the rate followed when a `SetConfig`
     /// changed it); true if it flew.
     fn period(&mut self, out: &mut Outcome) -> bool {
@@ -253,13 +280,13 @@ impl Rig<'_, '_> {
     /// `n − 1` periods all flew).
     fn burst_then_fly(&mut self, burst: &[Msg], n: u32) -> Outcome {
         let mut out = Outcome::default();
-        let mut ok = self.nav.send(self.board, burst);
+        let mut ok = self.send(burst);
         self.period(&mut out);
         let mut flew = true;
         for i in 0..n {
-            let s = Msg::State(circle_state(self.circle, self.k));
+            let s = Msg::State((self.state)(self.circle, self.k));
             self.k += 1;
-            ok &= self.nav.send(self.board, &[s]);
+            ok &= self.send(&[s]);
             let on = self.period(&mut out);
             flew &= on || i == 0;
         }
@@ -331,9 +358,45 @@ fn set_config_cost(
     elapsed(t0, t1) * INSTRUCTIONS_PER_TICK
 }
 
+/// One field changed from nothing (the rest `None`).
+fn one(set: fn(&mut ConfigPatch)) -> ConfigPatch {
+    let mut p = ConfigPatch::EMPTY;
+    set(&mut p);
+    p
+}
+
+/// Each field the link sets, changed alone from the defaults, and the whole patch host-sim's
+/// set-up sends (with the rate, unit, mounting and priority changed).
+fn field_patches(defaults: ConfigPatch) -> [(&'static str, ConfigPatch); 10] {
+    [
+        ("rate_hz", one(|p| p.rate_hz = Some(200))),
+        ("robust", one(|p| p.robust = Some(false))),
+        ("delta_max", one(|p| p.delta_max = Some(12.5))),
+        ("voltage_limit", one(|p| p.voltage_limit = Some(20.0))),
+        (
+            "thrust_unit",
+            one(|p| p.thrust_unit = Some(ThrustUnit::Newton)),
+        ),
+        ("mounting", one(|p| p.reversed_thrusters = Some(0))),
+        ("priority", one(|p| p.priority = Some(other_priority()))),
+        ("stale_periods", one(|p| p.stale_periods = Some(3))),
+        ("lockstep", one(|p| p.lockstep = Some(true))),
+        (
+            "whole",
+            ConfigPatch {
+                rate_hz: Some(200),
+                thrust_unit: Some(ThrustUnit::Newton),
+                reversed_thrusters: Some(0),
+                priority: Some(other_priority()),
+                ..defaults
+            },
+        ),
+    ]
+}
+
 /// What a `SetConfig` costs the board, field by field from the defaults (each a rebuild but
-/// the stale limit and the pacing), and what the bounds over the box cost once at boot.
-/// Returns the largest, or `None` if a patch was refused.
+/// the stale limit and the pacing), and what `Controller::reconfigure` alone costs. Returns the
+/// largest, or `None` if a patch was refused.
 #[inline(never)]
 fn config_costs(syst: &mut SYST) -> Option<u32> {
     start_counter(syst);
@@ -355,81 +418,7 @@ fn config_costs(syst: &mut SYST) -> Option<u32> {
     let mut link = LinkBuffers::new();
     let mut seq = 0u16;
     let defaults = ConfigPatch::whole(&cfg, auv_link::DEFAULT_STALE_PERIODS, false);
-    let fields: [(&str, ConfigPatch); 10] = [
-        (
-            "rate_hz",
-            ConfigPatch {
-                rate_hz: Some(200),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "robust",
-            ConfigPatch {
-                robust: Some(false),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "delta_max",
-            ConfigPatch {
-                delta_max: Some(12.5),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "voltage_limit",
-            ConfigPatch {
-                voltage_limit: Some(20.0),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "thrust_unit",
-            ConfigPatch {
-                thrust_unit: Some(ThrustUnit::Newton),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "mounting",
-            ConfigPatch {
-                reversed_thrusters: Some(0),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "priority",
-            ConfigPatch {
-                priority: Some(other_priority()),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "stale_periods",
-            ConfigPatch {
-                stale_periods: Some(3),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "lockstep",
-            ConfigPatch {
-                lockstep: Some(true),
-                ..ConfigPatch::EMPTY
-            },
-        ),
-        (
-            "whole",
-            ConfigPatch {
-                rate_hz: Some(200),
-                thrust_unit: Some(ThrustUnit::Newton),
-                reversed_thrusters: Some(0),
-                priority: Some(other_priority()),
-                ..defaults
-            },
-        ),
-    ];
+    let fields = field_patches(defaults);
     let mut costs = [0u32; 10];
     for ((_, p), cost) in fields.iter().zip(costs.iter_mut()) {
         *cost = set_config_cost(&mut sup, &mut link, &mut seq, *p);
@@ -451,9 +440,132 @@ fn config_costs(syst: &mut SYST) -> Option<u32> {
     costs.iter().copied().max()
 }
 
+fn cmd(c: Command) -> Msg {
+    Msg::Command(c)
+}
+
+/// The missions the scenarios fly: the paper's circle, and the largest upload by its CRC.
+struct Plans {
+    circle: MissionPlan,
+    upload: MissionPlan,
+}
+
+impl Plans {
+    fn new(up: &MissionUpload) -> Plans {
+        Plans {
+            circle: MissionPlan {
+                path: MissionSpec::Circle {
+                    radius: 10.0,
+                    omega: 0.1,
+                    depth: 5.0,
+                },
+                heading: Heading::Paper,
+                time_scale: 1.0,
+            },
+            upload: MissionPlan {
+                path: MissionSpec::Waypoints { crc: up.crc() },
+                heading: Heading::Tangent,
+                time_scale: 1.0,
+            },
+        }
+    }
+
+    /// Disarm, arm, start the circle: each scenario starts from an unlatched board (a latch of
+    /// the one before, on a board without Choice 226, would otherwise carry over).
+    fn restart(&self) -> [Msg; 3] {
+        [
+            cmd(Command::Disarm),
+            cmd(Command::Arm),
+            cmd(Command::StartMission(self.circle)),
+        ]
+    }
+}
+
+/// 1. At 100 Hz: a law-changing `SetConfig` with `Arm`, `StartMission` and a state (not the
+/// rate: a new rate restarts the period timer, which hid the overrun before Choice 226).
+fn config_burst(rig: &mut Rig, plans: &Plans) -> Outcome {
+    let law = ConfigPatch {
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(0),
+        priority: Some(other_priority()),
+        ..ConfigPatch::EMPTY
+    };
+    let first = Msg::State((rig.state)(rig.circle, 0));
+    rig.k = 1;
+    rig.burst_then_fly(
+        &[
+            cmd(Command::SetConfig(law)),
+            cmd(Command::Arm),
+            cmd(Command::StartMission(plans.circle)),
+            first,
+        ],
+        20,
+    )
+}
+
+/// 2. Disarmed, to 200 Hz: the largest upload, its last chunk after a receive queue full of
+/// small signed frames (the costliest period the link can make); then the circle, which takes
+/// the trajectory's slot.
+fn upload_after_a_full_queue(rig: &mut Rig, up: &MissionUpload, plans: &Plans) -> Outcome {
+    let mut out = Outcome::default();
+    let faster = one(|p| p.rate_hz = Some(200));
+    let mut ok = rig.send(&[cmd(Command::Disarm), cmd(Command::SetConfig(faster))]);
+    rig.period(&mut out);
+    ok &= rig.sup.rate_hz() == 200;
+    ok &= rig.send(&[cmd(Command::Upload(UploadPart::Begin(up.header())))]);
+    let last = up.chunks() - 1;
+    for i in 0..last {
+        ok &= rig.send(&[cmd(Command::Upload(UploadPart::Chunk(up.chunk(i))))]);
+        rig.period(&mut out);
+    }
+    while rig.board.link.len + MAX_FRAME + 32 <= RX_CAPACITY {
+        ok &= rig.send(&[cmd(Command::Disarm)]);
+    }
+    ok &= rig.send(&[cmd(Command::Upload(UploadPart::Chunk(up.chunk(last))))]);
+    let builds = rig.sup.trajectory_builds();
+    rig.period(&mut out);
+    ok &= rig.sup.trajectory_builds() == builds + 1;
+    rig.k = 0;
+    let mut o = rig.burst_then_fly(
+        &[cmd(Command::Arm), cmd(Command::StartMission(plans.circle))],
+        10,
+    );
+    o.flew_last &= ok;
+    o
+}
+
+/// 3. `StopMission` + `StartMission` of the upload, which the slot does not hold (the circle
+/// took it): built in that period.
+fn start_upload_to_build(rig: &mut Rig, plans: &Plans) -> Outcome {
+    rig.k = 0;
+    rig.burst_then_fly(&plans.restart(), 3);
+    rig.k = 0;
+    rig.burst_then_fly(
+        &[
+            cmd(Command::StopMission),
+            cmd(Command::StartMission(plans.upload)),
+        ],
+        10,
+    )
+}
+
+/// 4. The circle, then `StopMission` alone: the idle rebuild of the upload in that period;
+/// then `StartMission` of it.
+fn idle_rebuild_then_start(rig: &mut Rig, plans: &Plans) -> Outcome {
+    rig.k = 0;
+    let mut o = rig.burst_then_fly(&plans.restart(), 5);
+    let sent = rig.send(&[cmd(Command::StopMission)]);
+    rig.period(&mut o);
+    rig.k = 0;
+    let mut o2 = rig.burst_then_fly(&[cmd(Command::StartMission(plans.upload))], 10);
+    o2.latched |= o.latched;
+    o2.flew_last &= o.flew_last && sent;
+    o2
+}
+
 /// The sequences through the loop at the flight clock; true if every one held.
 #[inline(never)]
-fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
+fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
     };
@@ -462,21 +574,7 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
     };
     let key = LinkKey::new(KEY);
     start_timer();
-    let mut board = FlightBoard {
-        syst,
-        thrusters: [MemPwm::neutral(1000); THRUSTERS],
-        link: Script {
-            buf: [0; RX_CAPACITY],
-            len: 0,
-            at: 0,
-        },
-        rate: 0,
-        work_start: now(),
-        fed: now(),
-        longest_work: 0,
-        longest_gap: (0, 0, 0),
-        unfed_too_long: false,
-    };
+    let mut board = FlightBoard::new(syst);
     let mut sup = Supervisor::new(controller, board_info());
     let mut link = LinkBuffers::signed(&key);
     let mut rig = Rig {
@@ -488,140 +586,38 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
             seq: 0,
         },
         circle,
+        state,
         k: 0,
     };
     let rate = rig.sup.rate_hz();
     rig.board.set_rate(rate);
-    let cmd = |c: Command| Msg::Command(c);
-    let circle_plan = MissionPlan {
-        path: MissionSpec::Circle {
-            radius: 10.0,
-            omega: 0.1,
-            depth: 5.0,
-        },
-        heading: Heading::Paper,
-        time_scale: 1.0,
-    };
-    let upload_plan = MissionPlan {
-        path: MissionSpec::Waypoints { crc: up.crc() },
-        heading: Heading::Tangent,
-        time_scale: 1.0,
-    };
+    let plans = Plans::new(&up);
+    let outcomes = [
+        (
+            "SetConfig + Arm + StartMission in one burst at 100 Hz",
+            config_burst(&mut rig, &plans),
+        ),
+        (
+            "the largest upload after a full queue, then the circle at 200 Hz",
+            upload_after_a_full_queue(&mut rig, &up, &plans),
+        ),
+        (
+            "StopMission + StartMission of the upload, built in its period",
+            start_upload_to_build(&mut rig, &plans),
+        ),
+        (
+            "StopMission (the idle rebuild), then StartMission of the upload",
+            idle_rebuild_then_start(&mut rig, &plans),
+        ),
+    ];
     let mut ok = true;
-    let mut report = |name: &str, o: &Outcome| {
-        let good = !o.latched && o.flew_last;
+    for (name, o) in &outcomes {
         info!(
             "flight clock, {=str}: {} periods, never latched {}, flew on {}",
             name, o.periods, !o.latched, o.flew_last
         );
-        ok &= good;
-    };
-
-    // 1. At 100 Hz: a law-changing SetConfig with Arm, StartMission and a state (not the
-    // rate: a new rate restarts the period timer, which hid the overrun before Choice 226).
-    let law = ConfigPatch {
-        thrust_unit: Some(ThrustUnit::Newton),
-        reversed_thrusters: Some(0),
-        priority: Some(other_priority()),
-        ..ConfigPatch::EMPTY
-    };
-    rig.k = 1;
-    let o = rig.burst_then_fly(
-        &[
-            cmd(Command::SetConfig(law)),
-            cmd(Command::Arm),
-            cmd(Command::StartMission(circle_plan)),
-            Msg::State(circle_state(circle, 0)),
-        ],
-        20,
-    );
-    report("SetConfig + Arm + StartMission in one burst at 100 Hz", &o);
-
-    // 2. Disarmed, to 200 Hz: the largest upload, its last chunk after a receive queue full
-    // of small signed frames (the costliest period the link can make), then Arm +
-    // StartMission of a closed form, which takes the slot.
-    let mut out = Outcome::default();
-    let faster = ConfigPatch {
-        rate_hz: Some(200),
-        ..ConfigPatch::EMPTY
-    };
-    let mut sent = rig.nav.send(
-        rig.board,
-        &[cmd(Command::Disarm), cmd(Command::SetConfig(faster))],
-    );
-    rig.period(&mut out);
-    sent &= rig.sup.rate_hz() == 200;
-    sent &= rig.nav.send(
-        &mut rig.board,
-        &[cmd(Command::Upload(UploadPart::Begin(up.header())))],
-    );
-    for i in 0..up.chunks() - 1 {
-        sent &= rig.nav.send(
-            &mut rig.board,
-            &[cmd(Command::Upload(UploadPart::Chunk(up.chunk(i))))],
-        );
-        rig.period(&mut out);
+        ok &= !o.latched && o.flew_last;
     }
-    // The receive queue holds RX_CAPACITY bytes: small signed frames up to the last chunk.
-    let last = cmd(Command::Upload(UploadPart::Chunk(
-        up.chunk(up.chunks() - 1),
-    )));
-    while rig.board.link.len + MAX_FRAME + 32 <= RX_CAPACITY {
-        sent &= rig.nav.send(rig.board, &[cmd(Command::Disarm)]);
-    }
-    sent &= rig.nav.send(rig.board, &[last]);
-    let builds = rig.sup.trajectory_builds();
-    rig.period(&mut out);
-    let verified = rig.sup.trajectory_builds() == builds + 1;
-    rig.k = 0;
-    let mut o = rig.burst_then_fly(
-        &[cmd(Command::Arm), cmd(Command::StartMission(circle_plan))],
-        10,
-    );
-    o.flew_last &= sent && verified;
-    report(
-        "the largest upload after a full queue, then the circle at 200 Hz",
-        &o,
-    );
-
-    // Each scenario from an unlatched board flying the circle (a latch of the one before, on a
-    // board without Choice 226, would otherwise carry over).
-    let restart = [
-        cmd(Command::Disarm),
-        cmd(Command::Arm),
-        cmd(Command::StartMission(circle_plan)),
-    ];
-
-    // 3. StopMission + StartMission of the upload (the slot holds the circle: built now).
-    rig.k = 0;
-    rig.burst_then_fly(&restart, 3);
-    rig.k = 0;
-    let o = rig.burst_then_fly(
-        &[
-            cmd(Command::StopMission),
-            cmd(Command::StartMission(upload_plan)),
-        ],
-        10,
-    );
-    report(
-        "StopMission + StartMission of the upload, built in its period",
-        &o,
-    );
-
-    // 4. The circle again, then StopMission: the idle rebuild; then StartMission of the upload.
-    rig.k = 0;
-    let mut o = rig.burst_then_fly(&restart, 5);
-    let sent = rig.nav.send(rig.board, &[cmd(Command::StopMission)]);
-    rig.period(&mut o);
-    rig.k = 0;
-    let mut o2 = rig.burst_then_fly(&[cmd(Command::StartMission(upload_plan))], 10);
-    o2.latched |= o.latched;
-    o2.flew_last &= o.flew_last && sent;
-    report(
-        "StopMission (the idle rebuild), then StartMission of the upload",
-        &o2,
-    );
-
     let b = &*rig.board;
     let (gap, timeout_us, at) = b.longest_gap;
     info!(
@@ -632,7 +628,7 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
         flight_us(gap),
         timeout_us,
         at,
-        o2.overruns
+        outcomes[3].1.overruns
     );
     let within = b.longest_work <= u64::from(PERIOD_WORK_BUDGET) && !b.unfed_too_long;
     if !within {
@@ -641,9 +637,9 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory) -> bool {
     ok && within
 }
 
-/// The configuration costs and the flight-clock loop; true if both held. Leaves SysTick
-/// counting as `counter::start_counter` sets it.
-pub fn run(syst: &mut SYST, circle: &Trajectory) -> bool {
+/// The configuration costs and the flight-clock loop, on the paper's `circle` with its states
+/// from `state`; true if both held. Leaves SysTick counting as `counter::start_counter` sets it.
+pub fn run(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
     let set_config = config_costs(syst);
     let config_ok = set_config.is_some_and(|n| n <= SET_CONFIG_BUDGET);
     if !config_ok {
@@ -652,7 +648,7 @@ pub fn run(syst: &mut SYST, circle: &Trajectory) -> bool {
             SET_CONFIG_BUDGET
         );
     }
-    let loop_ok = flight_loop(syst, circle);
+    let loop_ok = flight_loop(syst, circle, state);
     start_counter(syst);
     config_ok && loop_ok
 }

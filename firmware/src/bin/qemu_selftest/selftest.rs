@@ -179,7 +179,7 @@ fn circle() -> Option<&'static Trajectory> {
 
 /// The state on the paper's circle (`circle`: its trajectory, built once by [`run`]: a
 /// trajectory is 8.6 kB, docs/design.md §27) at tick `k`.
-pub(crate) fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
+fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
     let d = circle.sample(k, 100);
     let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
     StateFrame {
@@ -712,7 +712,7 @@ pub fn run(mut syst: SYST) -> bool {
         && real_chain_exercise()
         && upload_exercise();
     let signing_ok = signing_cost(circle).is_some();
-    let flight_ok = crate::flight::run(&mut syst, circle);
+    let flight_ok = crate::flight::run(&mut syst, circle, circle_state);
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
     if wrong {
