@@ -195,8 +195,9 @@ impl BoardInTheLoop {
         let upload = MissionUpload::of(&scenario.trajectory().mission());
         let lose = faults.lose_upload_chunks.clone();
         let mut b = Self::new(wire, scenario, faults, pacing, reply_timeout, key, mission);
-        let (arm_seq, refused_before) = b.configure(c, mounting, upload.as_ref(), &lose)?;
-        b.wait_armed(arm_seq, refused_before, mounting)?;
+        let patch = b.setup_patch(c, mounting);
+        let (arm_seq, refused_before) = b.configure(&patch, upload.as_ref(), &lose)?;
+        b.wait_armed(arm_seq, refused_before, &patch)?;
         if b.rt.is_some() {
             b.find_phase()?;
         }
@@ -259,10 +260,25 @@ impl BoardInTheLoop {
     ///
     /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
     /// from a run before, and refuses a configuration while armed).
+    /// The whole configuration the set-up sends: the scenario's validated controller, the
+    /// default stale limit, the pacing, the plant's thrust unit and the mounting.
+    fn setup_patch(&self, c: &ControllerConfig, mounting: u8) -> ConfigPatch {
+        ConfigPatch {
+            rate_hz: Some(c.rate_hz),
+            robust: Some(c.robust),
+            delta_max: Some(c.delta_max),
+            voltage_limit: Some(c.voltage_limit),
+            stale_periods: Some(DEFAULT_STALE_PERIODS),
+            lockstep: Some(self.pacing == Pacing::Lockstep),
+            thrust_unit: Some(self.thrust_unit),
+            reversed_thrusters: Some(mounting),
+            priority: Some(c.priority.into()),
+        }
+    }
+
     fn configure(
         &mut self,
-        c: &ControllerConfig,
-        mounting: u8,
+        patch: &ConfigPatch,
         upload: Option<&MissionUpload>,
         lose: &[u8],
     ) -> Result<(u16, u32), String> {
@@ -276,17 +292,7 @@ impl BoardInTheLoop {
         // refuses a configuration while armed: disarm it first (a fresh board is disarmed
         // already; disarming is never refused).
         self.send(Msg::Command(LinkCommand::Disarm))?;
-        self.send(Msg::Command(LinkCommand::SetConfig(ConfigPatch {
-            rate_hz: Some(c.rate_hz),
-            robust: Some(c.robust),
-            delta_max: Some(c.delta_max),
-            voltage_limit: Some(c.voltage_limit),
-            stale_periods: Some(DEFAULT_STALE_PERIODS),
-            lockstep: Some(self.pacing == Pacing::Lockstep),
-            thrust_unit: Some(self.thrust_unit),
-            reversed_thrusters: Some(mounting),
-            priority: Some(c.priority.into()),
-        })))?;
+        self.send(Msg::Command(LinkCommand::SetConfig(*patch)))?;
         // A waypoint mission travels as an upload, taken only while disarmed (upload.rs),
         // once the board has taken the configuration (its refusals are the set-up's, those
         // of a lossy upload the upload's own).
@@ -307,7 +313,8 @@ impl BoardInTheLoop {
         Ok((arm_seq, refused))
     }
 
-    /// Waits until the board reports itself armed with the scenario's mounting and unit.
+    /// Waits until the board reports itself armed with every field of the configuration sent
+    /// ([`confirm_config`]).
     ///
     /// **Choice 65**: `Armed` counts only from telemetry whose `last_rx_seq` is the `Arm`'s
     /// (an earlier frame of a board that was armed before says nothing of this set-up).
@@ -315,7 +322,7 @@ impl BoardInTheLoop {
         &mut self,
         arm_seq: u16,
         refused_before: u32,
-        mounting: u8,
+        sent: &ConfigPatch,
     ) -> Result<(), String> {
         let deadline = Instant::now() + Duration::from_secs(30);
         loop {
@@ -327,12 +334,7 @@ impl BoardInTheLoop {
                 ));
             }
             if t.status == BoardStatus::Armed && t.last_rx_seq == arm_seq {
-                if t.reversed_thrusters != mounting {
-                    return Err(format!(
-                        "the board flies thruster mounting {:#07b}, not the scenario's {mounting:#07b}",
-                        t.reversed_thrusters
-                    ));
-                }
+                confirm_config(sent, &t)?;
                 self.check_unit(&t)?;
                 self.latest = Some(t);
                 return Ok(());
@@ -378,6 +380,15 @@ impl BoardInTheLoop {
         };
         std::mem::take(&mut self.stats)
     }
+}
+
+/// The board flies every field of the whole configuration `sent` (issue 29; protocol 6,
+/// Choice 228): its telemetry `t` names the unit and mounting, and carries the digest of the
+/// rest. A board the watchdog reset between the `SetConfig` and the `Arm` reports its defaults'
+/// digest, and the set-up stops here instead of flying them.
+pub(super) fn confirm_config(sent: &ConfigPatch, t: &Telemetry) -> Result<(), String> {
+    sent.confirm(t)
+        .map_err(|e| format!("the board does not fly the configuration sent: {e}"))
 }
 
 impl Drop for BoardInTheLoop {
