@@ -30,12 +30,12 @@
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
 //! - **Size:** at most [`MAX_FRAME`] = 179 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 157 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//!   ([`Envelope::MAX_SIZE`] = 162 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
 //!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
 //!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
-//!   board's link) the largest frame takes 3.8 ms, so a State frame in one direction and a
+//!   board's link) the largest frame takes 3.9 ms, so a State frame in one direction and a
 //!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
-//!   uses 35 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
+//!   uses 39 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
 //!
 //! # Receiving
 //!
