@@ -198,6 +198,9 @@ struct Model {
     /// Periods run since the mission started (a mission waits `stale_periods` for its first
     /// state).
     mission_periods: u64,
+    /// An accepted `SetConfig` changed the controller's configuration since the last period:
+    /// a rebuild, the period's long job (Choice 226).
+    rebuilt: bool,
 }
 
 impl Model {
@@ -216,6 +219,7 @@ impl Model {
             periods_since_state: None,
             clock: None,
             mission_periods: 0,
+            rebuilt: false,
         }
     }
 
@@ -784,6 +788,9 @@ impl Harness {
                     assert!(self.sup.last_refusal().is_some());
                 }
                 self.command(&c, refused);
+                if !refused && *self.sup.controller().config() != settings_before.0 {
+                    self.model.rebuilt = true;
+                }
                 if refused || !matches!(c, Command::SetConfig(_)) {
                     assert_eq!(
                         settings(&self.sup),
@@ -883,6 +890,13 @@ impl Harness {
             );
         }
         let on = step.voltages.iter().any(|v| *v != 0.0);
+        // A rebuild is the period's long job, and a period that ran one never flies.
+        assert!(
+            step.long_job || !self.model.rebuilt,
+            "a rebuild not counted as the period's long job"
+        );
+        assert!(!(step.long_job && on), "a period with a long job flew");
+        self.model.rebuilt = false;
         let m = self.model;
         let may_run = m.armed && m.mission && m.latched.is_none() && !overrun;
         let may_fly = may_run && m.fresh();
