@@ -481,8 +481,8 @@ impl Plans {
     }
 }
 
-/// 1. At 100 Hz: a law-changing `SetConfig` with `Arm`, `StartMission` and a state (not the
-/// rate: a new rate restarts the period timer, which hid the overrun before Choice 226).
+/// Scenario 1, at 100 Hz: a law-changing `SetConfig` with `Arm`, `StartMission` and a state (not
+/// the rate: a new rate restarts the period timer, which hid the overrun before Choice 226).
 fn config_burst(rig: &mut Rig, plans: &Plans) -> Outcome {
     let law = ConfigPatch {
         thrust_unit: Some(ThrustUnit::Newton),
@@ -503,8 +503,8 @@ fn config_burst(rig: &mut Rig, plans: &Plans) -> Outcome {
     )
 }
 
-/// 2. Disarmed, to 200 Hz: the largest upload, its last chunk after a receive queue full of
-/// small signed frames (the costliest period the link can make); then the circle, which takes
+/// Scenario 2, disarmed, to 200 Hz: the largest upload, its last chunk after a receive queue full
+/// of small signed frames (the costliest period the link can make); then the circle, which takes
 /// the trajectory's slot.
 fn upload_after_a_full_queue(rig: &mut Rig, up: &MissionUpload, plans: &Plans) -> Outcome {
     let mut out = Outcome::default();
@@ -534,8 +534,8 @@ fn upload_after_a_full_queue(rig: &mut Rig, up: &MissionUpload, plans: &Plans) -
     o
 }
 
-/// 3. `StopMission` + `StartMission` of the upload, which the slot does not hold (the circle
-/// took it): built in that period.
+/// Scenario 3: `StopMission` + `StartMission` of the upload, which the slot does not hold (the
+/// circle took it): built in that period.
 fn start_upload_to_build(rig: &mut Rig, plans: &Plans) -> Outcome {
     rig.k = 0;
     rig.burst_then_fly(&plans.restart(), 3);
@@ -549,7 +549,7 @@ fn start_upload_to_build(rig: &mut Rig, plans: &Plans) -> Outcome {
     )
 }
 
-/// 4. The circle, then `StopMission` alone: the idle rebuild of the upload in that period;
+/// Scenario 4: the circle, then `StopMission` alone: the idle rebuild of the upload in that period;
 /// then `StartMission` of it.
 fn idle_rebuild_then_start(rig: &mut Rig, plans: &Plans) -> Outcome {
     rig.k = 0;
