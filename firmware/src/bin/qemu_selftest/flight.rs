@@ -3,18 +3,18 @@
 //! images run it — on a board whose period is the STM32F405's at 168 MHz.
 //!
 //! Under `-icount shift=0` an instruction is a nanosecond and SysTick counts one per 40
-//! (`firmware::qemu_clock`), so a SysTick period of `FLIGHT_CLOCK_HZ / rate / 40` counts holds
-//! as many instructions as the flight board's core has cycles in its period, at one instruction
-//! a cycle: the flight image's instruction rate. CMSDK TIMER0 (25 MHz, 40 instructions a count
-//! too) times each period's work, from the end of its wait to its watchdog feed, and the time
-//! between two feeds. Frames go in signed, as the flight image takes them. Each scenario is
-//! one of the issue's: a law-changing `SetConfig` sent with `Arm`, `StartMission` and a state
-//! (26 M instructions before Choice 225, which latched the overrun and tripped the STM32's
-//! watchdog); the largest upload's last chunk after a full receive queue of small signed frames
-//! (the costliest period the link can make); `StopMission` + `StartMission` of an upload the
-//! slot does not hold; and the idle rebuild followed by `StartMission`. Each must never latch,
-//! fly on, keep every period's work within `budget::PERIOD_WORK_BUDGET`, and feed the watchdog
-//! within its shortest timeout (`firmware::watchdog`).
+//! (`firmware::qemu_clock`), so a SysTick period of `FLIGHT_CLOCK_HZ / rate / 40` counts holds as
+//! many instructions as the flight board's core has cycles in its period, at one instruction a
+//! cycle: the flight image's instruction rate. CMSDK TIMER0 (25 MHz, 40 instructions a count too)
+//! times each period's work, from the end of its wait to its watchdog feed, and the time between
+//! two feeds. Frames go in signed, as the flight image takes them. Each scenario is one of the
+//! issue's: a law-changing `SetConfig` sent with `Arm`, `StartMission` and a state (26 M
+//! instructions before Choice 225, which latched the overrun and tripped the STM32's watchdog); the
+//! largest upload's last chunk after a full receive queue of small signed frames (the costliest
+//! period the link can make); `StopMission` + `StartMission` of an upload the slot does not hold;
+//! and the idle rebuild followed by `StartMission`. Each must never latch, fly on, keep every
+//! period's work within its budget (`budget::WorkBudget`), and feed the watchdog within its
+//! shortest timeout (`firmware::watchdog`).
 
 use core::ptr::{read_volatile, write_volatile};
 
@@ -31,7 +31,7 @@ use cortex_m::peripheral::syst::SystClkSource;
 use cortex_m::peripheral::SYST;
 use defmt::{error, info};
 use firmware::board::{self, Board, LinkBuffers};
-use firmware::budget::{PERIOD_WORK_BUDGET, SET_CONFIG_BUDGET};
+use firmware::budget::WorkBudget;
 use firmware::pwm::MemPwm;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 use firmware::serial::RX_CAPACITY;
@@ -565,7 +565,7 @@ fn idle_rebuild_then_start(rig: &mut Rig, plans: &Plans) -> Outcome {
 
 /// The sequences through the loop at the flight clock; true if every one held.
 #[inline(never)]
-fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
+fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf, budget: &WorkBudget) -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
     };
@@ -623,14 +623,14 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
     info!(
         "flight clock, longest period's work {} instructions (budget {}); longest between watchdog feeds {} instructions = {} us at 168 MHz, the watchdog's shortest timeout {} us at {} Hz; periods that overran {} (each a long job's, counted there; instructions)",
         b.longest_work,
-        PERIOD_WORK_BUDGET,
+        budget.period,
         gap,
         flight_us(gap),
         timeout_us,
         at,
         outcomes[3].1.overruns
     );
-    let within = b.longest_work <= u64::from(PERIOD_WORK_BUDGET) && !b.unfed_too_long;
+    let within = b.longest_work <= u64::from(budget.period) && !b.unfed_too_long;
     if !within {
         error!("a period's work is over its budget, or the watchdog went unfed past its timeout");
     }
@@ -640,15 +640,23 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
 /// The configuration costs and the flight-clock loop, on the paper's `circle` with its states
 /// from `state`; true if both held. Leaves SysTick counting as `counter::start_counter` sets it.
 pub fn run(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
+    let backend = controller_core::math::BACKEND;
+    let Some(budget) = firmware::budget::for_backend(backend).map(|b| b.work) else {
+        error!(
+            "no budget for the {=str} backend (firmware::budget)",
+            backend
+        );
+        return false;
+    };
     let set_config = config_costs(syst);
-    let config_ok = set_config.is_some_and(|n| n <= SET_CONFIG_BUDGET);
+    let config_ok = set_config.is_some_and(|n| n <= budget.set_config);
     if !config_ok {
         error!(
             "a SetConfig costs more than its budget of {} instructions (firmware/src/budget.rs)",
-            SET_CONFIG_BUDGET
+            budget.set_config
         );
     }
-    let loop_ok = flight_loop(syst, circle, state);
+    let loop_ok = flight_loop(syst, circle, state, &budget);
     start_counter(syst);
     config_ok && loop_ok
 }

@@ -487,7 +487,7 @@ fn upload_exercise() -> bool {
 }
 
 /// Instructions of `Trajectory::set` on the largest waypoint path the board takes
-/// (`flight::largest_waypoints`: 32 points, 61 parts), within `budget::BUILD_BUDGET`.
+/// (`flight::largest_waypoints`: 32 points, 61 parts), within its budget (`budget::WorkBudget`).
 #[inline(never)]
 fn largest_set_cost() -> Option<u32> {
     let mission = crate::flight::largest_waypoints()?;
@@ -500,13 +500,15 @@ fn largest_set_cost() -> Option<u32> {
         "Trajectory::set of the largest waypoint path (32 points, 61 parts): {} instructions, valid {}",
         n, ok
     );
-    if n > firmware::budget::BUILD_BUDGET {
+    let budget =
+        firmware::budget::for_backend(controller_core::math::BACKEND).map_or(0, |b| b.work.build);
+    if n > budget {
         error!(
             "the largest waypoint build is over its budget of {} instructions (firmware/src/budget.rs)",
-            firmware::budget::BUILD_BUDGET
+            budget
         );
     }
-    (ok && n <= firmware::budget::BUILD_BUDGET).then_some(n)
+    (ok && n <= budget).then_some(n)
 }
 
 /// A signed link: an unsigned frame, a replayed signed frame and one stamped at 2⁴⁸ − 1 are
