@@ -13,8 +13,6 @@ use auv_link::{
     AxisPriority, BoardStatus, Command, ConfigPatch, FailSafeReason, Heading, MissionPlan,
     MissionSpec, MissionUpload, Msg, Telemetry, ThrustUnit, UploadPart,
 };
-use controller_core::trajectory::WaypointList;
-use controller_core::{HeadingMode, Mission, TrajectoryKind};
 use firmware::board::{self, LinkBuffers};
 use firmware::supervisor::Supervisor;
 
@@ -140,29 +138,7 @@ fn a_configuration_sent_with_arm_and_start_never_latches_the_mission() {
 
 /// The survey's upload (12 points, tangent heading: two chunks).
 fn survey() -> MissionUpload {
-    let mut points = Vec::new();
-    for row in 0..6 {
-        let y = 20.0 * row as f32;
-        let (a, b) = if row % 2 == 0 {
-            (0.0, 60.0)
-        } else {
-            (60.0, 0.0)
-        };
-        points.push([a, y, 5.0]);
-        points.push([b, y, 5.0]);
-    }
-    MissionUpload::of(&Mission {
-        path: TrajectoryKind::Waypoints {
-            points: WaypointList::new(&points).expect("12 points"),
-            speed: 0.8,
-            turn_radius: Some(3.5),
-            speeds: None,
-            speed_change: None,
-        },
-        heading: HeadingMode::Tangent,
-        time_scale: 1.0,
-    })
-    .expect("a waypoint path")
+    MissionUpload::of(&common::survey()).expect("a waypoint path")
 }
 
 fn start_upload(up: &MissionUpload) -> Msg {

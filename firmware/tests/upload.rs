@@ -17,34 +17,8 @@ use firmware::supervisor::{Mode, Supervisor};
 mod common;
 use common::{controller, supervisor, Host, NOW};
 
-/// A lawn-mower survey of 12 waypoints (60 m legs, 20 m apart), its speeds unset: three chunks.
-fn survey() -> TrajectoryKind {
-    let mut points = Vec::new();
-    for row in 0..6 {
-        let y = 20.0 * row as f32;
-        let (a, b) = if row % 2 == 0 {
-            (0.0, 60.0)
-        } else {
-            (60.0, 0.0)
-        };
-        points.push([a, y, 5.0]);
-        points.push([b, y, 5.0]);
-    }
-    TrajectoryKind::Waypoints {
-        points: WaypointList::new(&points).expect("12 points"),
-        speed: 0.8,
-        turn_radius: Some(3.5),
-        speeds: None,
-        speed_change: None,
-    }
-}
-
 fn mission() -> Mission {
-    Mission {
-        path: survey(),
-        heading: HeadingMode::Tangent,
-        time_scale: 1.0,
-    }
+    common::survey()
 }
 
 fn start(crc: u32) -> Command {

@@ -43,6 +43,13 @@ use crate::counter::{elapsed, start_counter};
 /// The vehicle's state on a mission at a tick (the self-test's: on the reference).
 pub type StateOf = fn(&Trajectory, u64) -> StateFrame;
 
+/// The self-test's circle: its plan on the link, its trajectory, and the state on it at a tick.
+pub struct Circle<'a> {
+    pub plan: MissionPlan,
+    pub trajectory: &'a Trajectory,
+    pub state: StateOf,
+}
+
 /// CMSDK APB TIMER0 of mps2-an386: a 32-bit down-counter at the 25 MHz peripheral clock.
 const TIMER0: usize = 0x4000_0000;
 const TIMER_CTRL: usize = 0x0;
@@ -182,13 +189,13 @@ impl Board for FlightBoard<'_> {
     fn period_elapsed(&mut self) -> bool {
         self.syst.has_wrapped()
     }
-    /// Polls the flag every 1000 cycles, as the QEMU board does (each read of a device
+    /// Polls the flag every `WAIT_POLL_CYCLES`, as the QEMU board does (each read of a device
     /// register leaves QEMU's translated code).
     fn wait_period(&mut self) -> bool {
         let overrun = self.period_elapsed();
         if !overrun {
             while !self.period_elapsed() {
-                cortex_m::asm::delay(1000);
+                cortex_m::asm::delay(firmware::mps2_an386::WAIT_POLL_CYCLES);
             }
         }
         self.work_start = now();
@@ -451,17 +458,9 @@ struct Plans {
 }
 
 impl Plans {
-    fn new(up: &MissionUpload) -> Plans {
+    fn new(circle: MissionPlan, up: &MissionUpload) -> Plans {
         Plans {
-            circle: MissionPlan {
-                path: MissionSpec::Circle {
-                    radius: 10.0,
-                    omega: 0.1,
-                    depth: 5.0,
-                },
-                heading: Heading::Paper,
-                time_scale: 1.0,
-            },
+            circle,
             upload: MissionPlan {
                 path: MissionSpec::Waypoints { crc: up.crc() },
                 heading: Heading::Tangent,
@@ -565,7 +564,7 @@ fn idle_rebuild_then_start(rig: &mut Rig, plans: &Plans) -> Outcome {
 
 /// The sequences through the loop at the flight clock; true if every one held.
 #[inline(never)]
-fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf, budget: &WorkBudget) -> bool {
+fn flight_loop(syst: &mut SYST, circle: &Circle, budget: &WorkBudget) -> bool {
     let Ok(controller) = Controller::new(ControllerConfig::default()) else {
         return false;
     };
@@ -585,13 +584,13 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf, budget: &Wo
             signer: Signer::new(&key, Direction::ToBoard),
             seq: 0,
         },
-        circle,
-        state,
+        circle: circle.trajectory,
+        state: circle.state,
         k: 0,
     };
     let rate = rig.sup.rate_hz();
     rig.board.set_rate(rate);
-    let plans = Plans::new(&up);
+    let plans = Plans::new(circle.plan, &up);
     let outcomes = [
         (
             "SetConfig + Arm + StartMission in one burst at 100 Hz",
@@ -637,9 +636,9 @@ fn flight_loop(syst: &mut SYST, circle: &Trajectory, state: StateOf, budget: &Wo
     ok && within
 }
 
-/// The configuration costs and the flight-clock loop, on the paper's `circle` with its states
-/// from `state`; true if both held. Leaves SysTick counting as `counter::start_counter` sets it.
-pub fn run(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
+/// The configuration costs and the flight-clock loop, on the self-test's `circle`; true if both
+/// held. Leaves SysTick counting as `counter::start_counter` sets it.
+pub fn run(syst: &mut SYST, circle: &Circle) -> bool {
     let backend = controller_core::math::BACKEND;
     let Some(budget) = firmware::budget::for_backend(backend).map(|b| b.work) else {
         error!(
@@ -656,7 +655,7 @@ pub fn run(syst: &mut SYST, circle: &Trajectory, state: StateOf) -> bool {
             budget.set_config
         );
     }
-    let loop_ok = flight_loop(syst, circle, state, &budget);
+    let loop_ok = flight_loop(syst, circle, &budget);
     start_counter(syst);
     config_ok && loop_ok
 }

@@ -714,7 +714,14 @@ pub fn run(mut syst: SYST) -> bool {
         && real_chain_exercise()
         && upload_exercise();
     let signing_ok = signing_cost(circle).is_some();
-    let flight_ok = crate::flight::run(&mut syst, circle, circle_state);
+    let flight_ok = crate::flight::run(
+        &mut syst,
+        &crate::flight::Circle {
+            plan: MISSION,
+            trajectory: circle,
+            state: circle_state,
+        },
+    );
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
     if wrong {
