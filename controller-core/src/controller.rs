@@ -204,26 +204,42 @@ impl Controller {
     /// Validates `config` and precomputes the law's constants. Every check of docs/design.md §4
     /// and §8 is made here; see [`ConfigError`] for the list.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
+        Self::build(config, None)
+    }
+
+    /// The controller [`Controller::new`] gives for `config`, the same in every bit, reusing
+    /// this one's suprema over the parameter box ([`UncertaintyBounds`]) when `config` has the
+    /// same vehicle parameters and box: they depend on nothing else, and they are nearly all
+    /// of `new`'s cost (2⁹ corners, each with its eigen-decompositions: ≈ 26 M instructions on
+    /// the board's Cortex-M4F, ≥ 156 ms at 168 MHz). Every other check is made again.
+    ///
+    /// **Choice 225:** what a board does when its configuration changes over the link, which
+    /// can set the rate, Δu, δ_max, the voltage limit, the thrust unit, the mounting and the
+    /// axis priority but never the vehicle or the box: the bounds are computed once, at boot,
+    /// before the watchdog starts, and a change costs a fraction of a control period.
+    pub fn reconfigure(&self, config: ControllerConfig) -> Result<Self, ConfigError> {
+        let same_box =
+            config.params == self.config.params && config.uncertainty == self.config.uncertainty;
+        Self::build(config, same_box.then_some(self.bounds))
+    }
+
+    /// `new`, with the bounds over the box given (`Some`: computed before for the same
+    /// parameters and box) or computed here.
+    fn build(
+        config: ControllerConfig,
+        bounds: Option<UncertaintyBounds<f32>>,
+    ) -> Result<Self, ConfigError> {
         config.check_scalars()?;
         let allocation = PseudoInverse::new(&config.geometry)?;
         let maps = thruster::default_maps();
         let envelope = ThrustEnvelope::new(&maps, config.thrust_unit, config.voltage_limit);
         let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
-        let bounds = UncertaintyBounds::compute(&config.params, &config.uncertainty)?;
-        let beta_hat = bounds.beta_hat;
-        if !(beta_hat < 1.0 && beta_hat <= config.beta) {
-            return Err(ConfigError::Assumption2 {
-                beta_hat,
-                beta: config.beta,
-            });
-        }
-        if !bounds.theorem2.holds() {
-            return Err(ConfigError::Theorem2 {
-                lhs: bounds.theorem2.lhs,
-                rhs: bounds.theorem2.rhs,
-            });
-        }
+        let bounds = match bounds {
+            Some(b) => b,
+            None => UncertaintyBounds::compute(&config.params, &config.uncertainty)?,
+        };
+        check_feasible(&bounds, config.beta)?;
 
         let mut lyapunov = [AxisLyapunov::default(); 6];
         let mut k_norm = 0.0f32;
@@ -567,6 +583,21 @@ pub struct StepLaw {
     pub delta_clamped: bool,
     pub w_norm: f32,
     pub e1: Vector6<f32>,
+}
+
+/// Assumption 2 (Eq 20: β̂ < 1 and β̂ ≤ the configured β) and Theorem 2 (Eq 25) over the box.
+fn check_feasible(bounds: &UncertaintyBounds<f32>, beta: f32) -> Result<(), ConfigError> {
+    let beta_hat = bounds.beta_hat;
+    if !(beta_hat < 1.0 && beta_hat <= beta) {
+        return Err(ConfigError::Assumption2 { beta_hat, beta });
+    }
+    if !bounds.theorem2.holds() {
+        return Err(ConfigError::Theorem2 {
+            lhs: bounds.theorem2.lhs,
+            rhs: bounds.theorem2.rhs,
+        });
+    }
+    Ok(())
 }
 
 fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {

@@ -198,3 +198,94 @@ fn degenerate_thruster_geometry_is_rejected() {
     c.geometry.direction[2] = c.geometry.direction[1];
     assert!(matches!(err(c), ConfigError::Allocation(_)));
 }
+
+/// Every setting a board can change over the link (Choice 225), one at a time and all at once:
+/// `reconfigure` gives the controller `new` gives, in every bit (`Debug` prints each f32 so
+/// that it reads back exactly), and refuses what `new` refuses with the same error.
+#[test]
+fn reconfigure_gives_what_new_gives_for_every_link_setting() {
+    use controller_core::allocation::AxisPriority;
+    use controller_core::effectiveness::ThrusterGeometry;
+    use controller_core::thruster::ThrustUnit;
+    let base = Controller::new(ControllerConfig::default()).unwrap();
+    let d = ControllerConfig::default();
+    let mut priority = AxisPriority::default();
+    priority.rank = [1, 1, 3, 0, 2, 2];
+    priority.weight[0] = 2.5;
+    let changes: Vec<ControllerConfig> = vec![
+        ControllerConfig { rate_hz: 200, ..d },
+        ControllerConfig { rate_hz: 25, ..d },
+        ControllerConfig { robust: false, ..d },
+        ControllerConfig {
+            delta_max: 0.25,
+            ..d
+        },
+        ControllerConfig {
+            voltage_limit: 12.0,
+            ..d
+        },
+        ControllerConfig {
+            thrust_unit: ThrustUnit::Newton,
+            ..d
+        },
+        ControllerConfig {
+            geometry: ThrusterGeometry::auv150(0),
+            ..d
+        },
+        ControllerConfig { priority, ..d },
+        ControllerConfig {
+            rate_hz: 50,
+            robust: false,
+            delta_max: 2.0,
+            voltage_limit: 18.0,
+            thrust_unit: ThrustUnit::Newton,
+            geometry: ThrusterGeometry::auv150(0b10101),
+            priority,
+            ..d
+        },
+    ];
+    for cfg in changes {
+        let fresh = Controller::new(cfg).unwrap();
+        let reused = base.reconfigure(cfg).unwrap();
+        assert_eq!(format!("{reused:?}"), format!("{fresh:?}"), "{cfg:?}");
+        // And back: the bounds carried along are still the defaults'.
+        let back = reused.reconfigure(d).unwrap();
+        assert_eq!(format!("{back:?}"), format!("{base:?}"));
+    }
+    // Refused the same way: the loop-rate rule, a non-finite δ_max, a bad weight.
+    let mut bad_weight = AxisPriority::default();
+    bad_weight.weight[2] = 0.0;
+    for cfg in [
+        ControllerConfig { rate_hz: 1, ..d },
+        ControllerConfig {
+            delta_max: f32::NAN,
+            ..d
+        },
+        ControllerConfig {
+            priority: bad_weight,
+            ..d
+        },
+    ] {
+        let fresh = Controller::new(cfg).map(|_| ()).unwrap_err();
+        let reused = base.reconfigure(cfg).map(|_| ()).unwrap_err();
+        assert_eq!(format!("{reused:?}"), format!("{fresh:?}"), "{cfg:?}");
+    }
+}
+
+/// A configuration with another vehicle or box is not given the old bounds: `reconfigure`
+/// computes them again (here a heavier vehicle, whose ΔM over the same box is the same but
+/// whose β̂ and M⁻¹ bounds are not).
+#[test]
+fn reconfigure_recomputes_the_bounds_for_another_vehicle_or_box() {
+    let base = Controller::new(ControllerConfig::default()).unwrap();
+    let mut heavier = ControllerConfig::default();
+    heavier.params.mass *= 1.05;
+    let fresh = Controller::new(heavier).unwrap();
+    assert_ne!(fresh.bounds(), base.bounds());
+    assert_eq!(base.reconfigure(heavier).unwrap().bounds(), fresh.bounds());
+    let mut narrower = ControllerConfig::default();
+    narrower.uncertainty.upper = narrower.uncertainty.lower;
+    let fresh = Controller::new(narrower).unwrap();
+    assert_ne!(fresh.bounds(), base.bounds());
+    assert_eq!(base.reconfigure(narrower).unwrap().bounds(), fresh.bounds());
+}

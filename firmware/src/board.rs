@@ -43,12 +43,21 @@ pub trait Board {
     fn feed_watchdog(&mut self) {}
 }
 
+/// Bytes the board reads from its link at a time.
+const READ_CHUNK: usize = 64;
+
 /// The board's end of the link: the streaming decoder (with the verifier if signing is on),
-/// one frame of transmit space, and the signer if signing is on.
+/// one frame of transmit space, the signer if signing is on, and the last read's bytes not yet
+/// decoded.
 pub struct LinkBuffers {
     pub decoder: FrameDecoder,
     pub tx: [u8; MAX_FRAME],
     signer: Option<Signer>,
+    /// The last read, and how far it is decoded: the bytes after a frame whose command ran the
+    /// period's long job wait here for the next period ([`pump`], Choice 226).
+    rx: [u8; READ_CHUNK],
+    rx_next: usize,
+    rx_end: usize,
 }
 
 impl LinkBuffers {
@@ -58,6 +67,9 @@ impl LinkBuffers {
             decoder: FrameDecoder::new(),
             tx: [0; MAX_FRAME],
             signer: None,
+            rx: [0; READ_CHUNK],
+            rx_next: 0,
+            rx_end: 0,
         }
     }
 
@@ -66,9 +78,9 @@ impl LinkBuffers {
     /// — and telemetry is signed with it.
     pub fn signed(key: &LinkKey) -> Self {
         LinkBuffers {
-            decoder: FrameDecoder::signed(Verifier::bounded(key, Direction::ToBoard)),
-            tx: [0; MAX_FRAME],
             signer: Some(Signer::new(key, Direction::FromBoard)),
+            decoder: FrameDecoder::signed(Verifier::bounded(key, Direction::ToBoard)),
+            ..Self::new()
         }
     }
 
@@ -105,6 +117,29 @@ impl LinkBuffers {
         let units = UNITS_PER_SECOND.div_ceil(u64::from(rate_hz.max(1)));
         self.decoder.elapse(units);
     }
+
+    /// One received byte to the decoder, and what it completes to the supervisor.
+    fn push(&mut self, sup: &mut Supervisor, b: u8) {
+        match self.decoder.push(b) {
+            Some(Ok(env)) => sup.on_envelope(&env),
+            Some(Err(e)) => sup.on_link_error(&e),
+            None => {}
+        }
+    }
+
+    /// Decodes what is left of the last read, up to its end or until the period's long job
+    /// ran; true if the period may read more.
+    fn decode_held(&mut self, sup: &mut Supervisor) -> bool {
+        while self.rx_next < self.rx_end {
+            if sup.built_this_period() {
+                return false;
+            }
+            let b = self.rx[self.rx_next];
+            self.rx_next += 1;
+            self.push(sup, b);
+        }
+        !sup.built_this_period()
+    }
 }
 
 impl Default for LinkBuffers {
@@ -114,41 +149,52 @@ impl Default for LinkBuffers {
 }
 
 /// Feeds received bytes to the decoder and each result to the supervisor: frames to
-/// [`Supervisor::on_envelope`], errors to [`Supervisor::on_link_error`].
+/// [`Supervisor::on_envelope`], errors to [`Supervisor::on_link_error`]. All of them (the
+/// tests' and the self-test's way in; the loop reads through [`pump`]).
 pub fn receive(sup: &mut Supervisor, bufs: &mut LinkBuffers, bytes: &[u8]) {
     for &b in bytes {
-        match bufs.decoder.push(b) {
-            Some(Ok(env)) => sup.on_envelope(&env),
-            Some(Err(e)) => sup.on_link_error(&e),
-            None => {}
-        }
+        bufs.push(sup, b);
     }
 }
 
-/// Reads whatever bytes are waiting (without blocking) into the supervisor.
+/// Reads whatever bytes are waiting (without blocking) into the supervisor, until the
+/// period's long job ran.
+///
+/// **Choice 226:** a build (the controller's, or a waypoint trajectory's) is the period's one
+/// long job. Once it ran, no further byte is decoded in the period: the rest of the read waits
+/// in [`LinkBuffers`] (and the rest of the link in its queue) for the next period, which
+/// starts after the job's overrun was counted where it happened ([`period`]). So a `SetConfig`,
+/// `Arm`, `StartMission` and state frame sent together never fly in the period that rebuilt
+/// the controller, a flood of configurations costs one rebuild per period, and the watchdog
+/// is fed after at most one long job.
 ///
 /// A read error means the byte stream is broken at that point (a UART line error: overrun,
 /// framing, noise, or bytes dropped on a full queue, see [`crate::serial`]): the frame in
 /// progress has lost bytes, so the decoder is resynchronised (it drops everything up to the
 /// next delimiter) and the loss is counted as one receive error.
 pub fn pump<L: Read + ReadReady>(link: &mut L, sup: &mut Supervisor, bufs: &mut LinkBuffers) {
-    let mut chunk = [0u8; 64];
-    // Bounded: at most 16 chunks per period, so a flooding link cannot stall the loop.
+    // What the last read left after a long job first.
+    if !bufs.decode_held(sup) {
+        return;
+    }
+    // Bounded: at most 16 reads per period, so a flooding link cannot stall the loop.
     for _ in 0..16 {
         match link.read_ready() {
             Ok(true) => {}
             _ => return,
         }
-        let n = match link.read(&mut chunk) {
+        match link.read(&mut bufs.rx) {
             Ok(0) => return,
-            Ok(n) => n,
+            Ok(n) => (bufs.rx_next, bufs.rx_end) = (0, n),
             Err(_) => {
                 bufs.decoder.resync();
                 sup.on_rx_error();
                 continue;
             }
         };
-        receive(sup, bufs, &chunk[..n]);
+        if !bufs.decode_held(sup) {
+            return;
+        }
     }
 }
 
@@ -191,6 +237,14 @@ pub fn period<B: Board>(board: &mut B, sup: &mut Supervisor, bufs: &mut LinkBuff
         let _ = board.link().write_all(frame);
     }
     bufs.period_passed(sup.rate_hz());
+    if step.long_job && board.period_elapsed() {
+        // The boundary passed during this period's long job, in a period that did not fly:
+        // the overrun is counted here, where the work was, and the next period starts on the
+        // next boundary instead of latching a mission started meanwhile (Choice 226). The link
+        // counts the period the job took.
+        sup.long_job_overran();
+        bufs.period_passed(sup.rate_hz());
+    }
     board.feed_watchdog();
     step
 }

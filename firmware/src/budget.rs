@@ -1,5 +1,6 @@
-//! Instruction budgets of one control step on the target, in total and per stage, for each
-//! math backend of the core: the one place they are written.
+//! Instruction budgets on the target, the one place they are written: one control step, in
+//! total and per stage, for each math backend of the core; and the board's long jobs and one
+//! period's work, against the flight board's watchdog at its clock.
 //!
 //! The self-test (`firmware-qemu-selftest`) counts, under QEMU's `-icount`, the instructions of
 //! `Controller::update` and of each of its stages ([`Stage`]) on the golden vectors; the counts
@@ -21,6 +22,31 @@ pub struct StepBudget {
     pub update: u32,
     /// Each stage, in [`Stage::ALL`]'s order, counted per call (40 calls of one SysTick count).
     pub stages: [u32; Stage::ALL.len()],
+    /// The board's long jobs and one period's work with this backend.
+    pub work: WorkBudget,
+}
+
+/// The board's long jobs and one period's work (Choices 225–226), in instructions, which the
+/// self-test counts under `-icount` (`src/bin/qemu_selftest/flight.rs`) and fails itself over;
+/// the test below holds them against the STM32 board's watchdog at its clock
+/// (`crate::watchdog`) at every rate the board accepts.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WorkBudget {
+    /// The costliest `SetConfig` (the self-test's `SetConfig instructions by field` line; a
+    /// field that changes the law is a controller rebuild): decode, validation,
+    /// `Controller::reconfigure` and the digest. ≈ 26.3 M before Choice 225, which recomputed
+    /// the bounds over the box (≥ 156 ms at 168 MHz, four times the watchdog's shortest
+    /// timeout).
+    pub set_config: u32,
+    /// The largest waypoint build (32 points, 61 parts: the `Trajectory::set of the largest
+    /// waypoint path` line): longer than a 200 Hz period, so the period's one long job and its
+    /// overrun that period's.
+    pub build: u32,
+    /// The most one period may take from the end of its wait to the watchdog's feed: a full
+    /// receive queue of small signed frames for the pump, then the period's one long job, the
+    /// step and the telemetry (the `flight clock, longest period's work` line, over the
+    /// issue's sequences and that costliest one).
+    pub period: u32,
 }
 
 impl StepBudget {
@@ -52,12 +78,26 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/design.md §27) measured 642 on the survey's golden vectors,
         // against 468 for the closed forms.
         stages: [560, 720, 760, 1_000, 1_250],
+        // Measured 22 600 (the whole patch host-sim sends; 19 600–22 080 for one law field),
+        // 1 051 160 and 1 218 200.
+        work: WorkBudget {
+            set_config: 26_000,
+            build: 1_200_000,
+            period: 1_400_000,
+        },
     },
     // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
     StepBudget {
         backend: "libm",
         update: 25_000,
         stages: [8_400, 6_200, 1_000, 1_000, 8_000],
+        // Measured 34 720, 1 281 440 and 1 448 480 (libm's cosf in the rebuild, its sin/cos in
+        // the waypoint build).
+        work: WorkBudget {
+            set_config: 40_000,
+            build: 1_450_000,
+            period: 1_650_000,
+        },
     },
     // micromath takes the kernels' cbrt (it has none), so its maps cost the kernels'.
     StepBudget {
@@ -65,6 +105,12 @@ pub const BUDGETS: [StepBudget; 3] = [
         update: 4_200,
         // The waypoint path's trajectory stage: 600 measured (docs/design.md §27).
         stages: [500, 680, 780, 1_000, 1_250],
+        // Measured as the kernels: 22 600, 1 051 200 and 1 218 200.
+        work: WorkBudget {
+            set_config: 26_000,
+            build: 1_200_000,
+            period: 1_400_000,
+        },
     },
 ];
 
@@ -73,9 +119,56 @@ pub fn for_backend(backend: &str) -> Option<&'static StepBudget> {
     BUDGETS.iter().find(|b| b.backend == backend)
 }
 
+/// Cycles allowed per instruction when the budgets are held against the watchdog at the flight
+/// clock: the Cortex-M4 retires most instructions in one cycle; loads, and flash wait states
+/// (5 at 168 MHz, behind the ART accelerator), cost more. Twice the count is the margin.
+pub const CYCLES_PER_INSTRUCTION: u64 = 2;
+
+impl WorkBudget {
+    /// The longest the watchdog goes unfed at `rate_hz` if a period's work reaches
+    /// [`period`](Self::period) (µs at the flight clock, [`CYCLES_PER_INSTRUCTION`] a cycle): a
+    /// feed ends one period's work, the next comes after at most one period's wait (the
+    /// boundary; after an overrun the next boundary, since `board::period` takes the long
+    /// job's own) and the next period's work.
+    pub fn longest_unfed_us(&self, rate_hz: u32) -> u64 {
+        crate::watchdog::period_us(rate_hz)
+            + crate::watchdog::flight_us(u64::from(self.period) * CYCLES_PER_INSTRUCTION)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Issue 29, item 14: at every rate the board accepts, the most a period may do keeps the
+    /// watchdog fed within its shortest timeout (the fastest LSI), with twice the instruction
+    /// count as cycles; a configuration change fits one period at the highest rate, and each
+    /// long job fits a period's work.
+    #[test]
+    fn a_periods_work_keeps_the_watchdog_fed_at_every_rate() {
+        use crate::limits::MAX_RATE_HZ;
+        use crate::watchdog::{flight_us, period_us, shortest_timeout_us};
+        for b in &BUDGETS {
+            let w = b.work;
+            for rate in 1..=MAX_RATE_HZ {
+                let (unfed, timeout) = (w.longest_unfed_us(rate), shortest_timeout_us(rate));
+                assert!(
+                    unfed < timeout,
+                    "{}: {rate} Hz: {unfed} µs unfed, timeout {timeout} µs",
+                    b.backend
+                );
+            }
+            let rebuild = flight_us(u64::from(w.set_config) * CYCLES_PER_INSTRUCTION);
+            assert!(
+                rebuild < period_us(MAX_RATE_HZ),
+                "{}: {rebuild} µs",
+                b.backend
+            );
+            assert!(w.set_config < w.period && w.build < w.period, "{b:?}");
+        }
+        // The configuration change before Choice 225 (26.3 M instructions) does not fit.
+        assert!(flight_us(26_284_600) > shortest_timeout_us(100));
+    }
 
     #[test]
     fn every_backend_of_the_core_has_a_budget_and_the_stages_fit_the_total() {

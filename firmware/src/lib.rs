@@ -1,12 +1,13 @@
 //! AUV-150 thruster-board firmware: a thin fixed-rate shell around `controller-core`.
 //!
 //! Hardware-free parts, tested on the host: [`supervisor`] (arming, missions, fail-safe,
-//! refusals), [`limits`] (what the board's configuration may be), [`budget`] (the control
-//! step's instruction budgets on the target), [`pwm`] (voltage → H-bridge duty), [`board`]
-//! (the board trait and one control period),
-//! [`serial`] (the UART's byte queues between interrupt and loop), [`image`] (which images
-//! exist and how to tell their ELFs apart), [`qemu_clock`] (QEMU's instruction counts) and
-//! [`qemu_runner`] (what `scripts/qemu-run.sh` reads).
+//! refusals), [`limits`] (what the board's configuration may be), [`budget`] (the
+//! instruction budgets on the target: the control step, the long jobs, a period's work),
+//! [`pwm`] (voltage → H-bridge duty), [`board`] (the board trait and one control period),
+//! [`serial`] (the UART's byte queues between interrupt and loop), [`watchdog`] (the flight
+//! board's watchdog and clock in numbers), [`image`] (which images exist and how to tell
+//! their ELFs apart), [`qemu_clock`] (QEMU's instruction counts) and [`qemu_runner`] (what
+//! `scripts/qemu-run.sh` reads).
 //!
 //! Target only (`thumbv7em-none-eabihf`): `rt` (boot, the flying loop, fault reports) and one
 //! module per board, each behind its feature — `mps2_an386` (feature `qemu`) and `stm32f405`, whose
@@ -23,6 +24,7 @@ pub mod limits;
 pub mod pwm;
 pub mod serial;
 pub mod supervisor;
+pub mod watchdog;
 
 // Their own crate, without this package's build script, so that host-sim can use them alone.
 pub use firmware_images::{image, qemu_clock, qemu_runner, LINK_KEY_VAR, LINK_UNSIGNED_VAR};

@@ -6,9 +6,9 @@
 /// Highest loop rate (Hz) the board accepts.
 ///
 /// **Choice:** 200 Hz. One period must carry a telemetry frame out and a state frame in; the
-/// largest frame (`auv_link::MAX_FRAME` = 174 bytes, signed, protocol 5) takes 3.8 ms at the
+/// largest frame (`auv_link::MAX_FRAME` = 179 bytes, signed, protocol 6) takes 3.9 ms at the
 /// STM32 board's 460 800 baud ([`crate::serial::LINK_BAUD`]), so the link alone allows at most
-/// ≈ 265 Hz, and
+/// ≈ 257 Hz, and
 /// 200 Hz (5 ms) leaves room for the update and the state frame's own latency. The core's
 /// `update` costs ≈ 0.2 ms on the 168 MHz M4F (firmware/README.md). Before this limit the
 /// board accepted 4 294 967 295 Hz.

@@ -33,7 +33,7 @@ pub use firmware_images::LINK_BAUD;
 /// Received bytes (and line errors) the queue holds: 11 ms of line at 460 800 baud, longer
 /// than a 100 Hz control period.
 pub const RX_CAPACITY: usize = 512;
-/// Bytes to send the queue holds: more than one telemetry frame (`auv_link::MAX_FRAME`, 174
+/// Bytes to send the queue holds: more than one telemetry frame (`auv_link::MAX_FRAME`, 179
 /// bytes signed).
 pub const TX_CAPACITY: usize = 512;
 

@@ -42,6 +42,9 @@ pub struct Step {
     /// Voltage per thruster (0 V = neutral duty in fail-safe).
     pub voltages: [f32; THRUSTERS],
     pub telemetry: Telemetry,
+    /// The period ran its long job ([`Supervisor::built_this_period`]) and did not fly: if its
+    /// boundary passed meanwhile, the overrun is this period's ([`crate::board::period`]).
+    pub long_job: bool,
 }
 
 /// What the supervisor needs to know about its board.
@@ -170,10 +173,19 @@ pub struct Supervisor {
     /// and fail-safes, dropped by the next upload's `Begin`.
     upload: UploadBuffer,
     /// The upload `trajectory` was last built from (its CRC) and how that went; `None` when it
-    /// holds anything else (Choice 169).
+    /// holds anything else (Choice 169), or the upload's data changed since (Choice 229).
     built: Option<(u32, Result<(), Refusal>)>,
     /// Trajectories built since boot (for tests and the self-test).
     builds: u32,
+    /// A build ran in this period: the controller's (a `SetConfig` that changes the law) or a
+    /// waypoint trajectory's (a verified upload, `StartMission` of one not built, or the idle
+    /// rebuild). It is the period's **long job** (Choice 226): the board reads no further frame
+    /// in the period ([`crate::board::pump`]), the step does not fly, and an overrun it causes
+    /// is counted in this period rather than latching the next.
+    long_job: bool,
+    /// [`ConfigPatch::digest`] of the whole configuration flown ([`ConfigPatch::whole`]),
+    /// reported in every telemetry frame (protocol 6, Choice 228).
+    config_digest: u32,
     clock: MissionClock,
     armed: bool,
     latched: Option<Latch>,
@@ -200,14 +212,15 @@ pub struct Supervisor {
     mounting: u8,
 }
 
-/// The reversed-thruster mask [`Telemetry::reversed_thrusters`] reports for `config`: the
-/// AUV-150 layout's mask, or [`NOT_AUV150`] for a geometry that is not the AUV-150 layout (a
-/// board built with another geometry; the link cannot set one).
-pub fn mounting_of(config: &ControllerConfig) -> u8 {
-    config.geometry.auv150_reversed().unwrap_or(NOT_AUV150)
-}
+pub use auv_link::{mounting_of, NOT_AUV150};
 
-pub use auv_link::NOT_AUV150;
+/// The digest telemetry reports of the whole configuration `config`, `stale_periods`,
+/// `lockstep` ([`ConfigPatch::digest`]; a whole patch always has one).
+fn digest_of(config: &ControllerConfig, stale_periods: u8, lockstep: bool) -> u32 {
+    ConfigPatch::whole(config, stale_periods, lockstep)
+        .digest()
+        .unwrap_or_default()
+}
 
 /// Bits of a valid reversed-thruster mask: one per thruster.
 const MOUNTING_BITS: u8 = (1 << THRUSTERS) - 1;
@@ -226,6 +239,8 @@ impl Supervisor {
     pub fn new(controller: Controller, board: BoardInfo) -> Self {
         Supervisor {
             mounting: mounting_of(controller.config()),
+            config_digest: digest_of(controller.config(), DEFAULT_STALE_PERIODS, false),
+            long_job: false,
             controller,
             board,
             mission: None,
@@ -401,7 +416,16 @@ impl Supervisor {
             // running loop (Choice 164).
             Command::Upload(_) if self.armed => Err(Refusal::WhileArmed),
             Command::Upload(part) => {
-                self.upload.take(part)?;
+                // A part that changes the upload's data (a `Begin`, a chunk with other words)
+                // leaves the slot standing for data the buffer no longer holds: the next build
+                // validates what it then holds (Choice 229). Keyed by the CRC alone, an upload
+                // with the built mission's CRC-32 was never validated and flew the old path.
+                let revision = self.upload.revision();
+                let taken = self.upload.take(part);
+                if self.upload.revision() != revision {
+                    self.built = None;
+                }
+                taken?;
                 // Verified: built now, disarmed, so that `StartMission` costs it nothing (a
                 // 32-point path is ~1 M instructions, more than a 200 Hz period).
                 self.build_upload()
@@ -447,10 +471,11 @@ impl Supervisor {
             // CRC covers the heading and time scale, and `resolve` checked the plan's).
             (Some(crc), Some((b, result))) if b == crc => result?,
             // No mission runs here, so the slot is free to build into (a refused mission
-            // leaves it unflown).
+            // leaves it unflown). A waypoint path's build is the period's long job.
             _ => {
                 self.built = None;
                 self.builds = self.builds.wrapping_add(1);
+                self.long_job |= uploaded.is_some();
                 self.trajectory
                     .set(&mission)
                     .map_err(|e| mission_refusal(&e))?;
@@ -459,17 +484,18 @@ impl Supervisor {
         }
         self.mission = Some(self.tick);
         self.clock = MissionClock::START;
-        if self.lockstep {
-            // A state frame from before the mission is not on its clock.
-            self.state = None;
-        }
+        // A state frame from before the mission is not its state, in either pacing (Choice 227:
+        // "a new mission counts from its start"): the mission waits for its first with the
+        // `stale_periods` grace. Kept, an old frame made a free-running mission latch stale
+        // state in its first period; in lock-step it is also off the mission clock.
+        self.state = None;
         Ok(())
     }
 
     /// Builds the verified upload into the trajectory slot unless it holds it already
     /// (Choice 169); the core's refusal of it is kept, and returned now and by `StartMission`.
-    /// Called only while no mission runs: the build's cost (up to ~1 M instructions) lands in
-    /// a period whose overrun changes nothing.
+    /// Called only while no mission runs; the build (up to ~1 M instructions) is the period's
+    /// long job (Choice 226).
     fn build_upload(&mut self) -> Result<(), Refusal> {
         let Some(crc) = self.upload.verified() else {
             return Ok(());
@@ -482,6 +508,7 @@ impl Supervisor {
         let result = match self.upload.mission(crc) {
             Ok(m) => {
                 self.builds = self.builds.wrapping_add(1);
+                self.long_job = true;
                 self.trajectory.set(&m).map_err(|e| mission_refusal(&e))
             }
             Err(r) => Err(r),
@@ -495,6 +522,26 @@ impl Supervisor {
         self.builds
     }
 
+    /// The period's long job ran (Choice 226): a controller rebuild or a waypoint trajectory's
+    /// build since the last [`step`](Self::step). The board then reads no further frame in the
+    /// period, and the step does not fly.
+    pub fn built_this_period(&self) -> bool {
+        self.long_job
+    }
+
+    /// The boundary of a period that ran its long job passed during it ([`Step::long_job`]):
+    /// the overrun is counted here, in the period that did the work, which did not fly; it
+    /// latches nothing (Choice 226).
+    pub fn long_job_overran(&mut self) {
+        self.loop_overruns = self.loop_overruns.saturating_add(1);
+    }
+
+    /// [`ConfigPatch::digest`] of the whole configuration the board flies, as telemetry
+    /// reports it.
+    pub fn config_digest(&self) -> u32 {
+        self.config_digest
+    }
+
     /// Validates the whole patch against the board's limits and the core, then applies all of
     /// it, or nothing. Refused while armed, whatever it holds.
     ///
@@ -503,7 +550,9 @@ impl Supervisor {
     /// [`Refusal::InvalidMounting`]) and the allocator's axis priority (a weight the core
     /// refuses is [`Refusal::InvalidPriority`]). Each changes the controller's configuration,
     /// so the core revalidates all of it (the envelope and the allocator's blocks are rebuilt
-    /// in `Controller::new`) before anything is applied.
+    /// by `Controller::reconfigure`, which keeps the suprema over the parameter box computed
+    /// at boot: Choice 225) before anything is applied. A rebuild is the period's long job
+    /// (Choice 226).
     fn configure(&mut self, p: &ConfigPatch) -> Result<(), Refusal> {
         if self.armed {
             return Err(Refusal::WhileArmed);
@@ -536,8 +585,8 @@ impl Supervisor {
         let stale_periods = p.stale_periods.unwrap_or(self.stale_periods);
         let lockstep = p.lockstep.unwrap_or(self.lockstep);
 
-        // The board's limits first (cheap), then the core's validation (bounds over the box:
-        // costly, and only if the law changes).
+        // The board's limits first, then the core's validation (only if the law changes; the
+        // bounds over the box are reused, Choice 225).
         if cfg.rate_hz > limits::MAX_RATE_HZ {
             return Err(Refusal::RateTooHigh);
         }
@@ -551,19 +600,25 @@ impl Supervisor {
         let controller = if cfg == *self.controller.config() {
             None
         } else {
-            Some(Controller::new(cfg).map_err(|e| match e.field() {
-                Some(f) if f.name == "priority" => Refusal::InvalidPriority,
-                _ => Refusal::ControllerConfig,
-            })?)
+            Some(
+                self.controller
+                    .reconfigure(cfg)
+                    .map_err(|e| match e.field() {
+                        Some(f) if f.name == "priority" => Refusal::InvalidPriority,
+                        _ => Refusal::ControllerConfig,
+                    })?,
+            )
         };
 
         // Everything validated: apply all of it.
         if let Some(c) = controller {
             self.mounting = mounting_of(c.config());
             self.controller = c;
+            self.long_job = true;
         }
         self.stale_periods = stale_periods;
         self.lockstep = lockstep;
+        self.config_digest = digest_of(self.controller.config(), stale_periods, lockstep);
         Ok(())
     }
 
@@ -571,9 +626,10 @@ impl Supervisor {
     /// free-running up-counting timer (any unit) to time `update`.
     pub fn step(&mut self, overrun: bool, now: &dyn Fn() -> u32) -> Step {
         self.state_fresh = false;
-        if self.mission.is_none() {
+        if self.mission.is_none() && !self.long_job {
             // A closed-form mission flown since the upload was built took its slot: rebuilt
-            // here, with no mission running, so that starting the upload again is free.
+            // here, with no mission running, so that starting the upload again is free; the
+            // period's long job, unless it had one already (then the next period's).
             let _ = self.build_upload();
         }
         if overrun {
@@ -587,6 +643,7 @@ impl Supervisor {
         Step {
             voltages: control.voltages,
             telemetry,
+            long_job: core::mem::take(&mut self.long_job),
         }
     }
 
@@ -603,6 +660,9 @@ impl Supervisor {
             (true, Some(l), _, _) => (BoardStatus::FailSafe(l.reason), off),
             (true, None, None, _) => (BoardStatus::Armed, off),
             (true, None, Some(_), _) if overrun => (self.latch(FailSafeReason::Overrun, 0), off),
+            // The period's long job ran (a mission can only have started after it): its output
+            // would be late, so the mission flies from the next period (Choice 226).
+            (true, None, Some(_), _) if self.long_job => (BoardStatus::Running, off),
             // A mission still waiting for its first state frame: StartMission and that frame
             // may straddle a period edge, so the mission gets the same `stale_periods` grace
             // as a state that stops arriving (thrusters off meanwhile), then latches.
@@ -683,6 +743,7 @@ impl Supervisor {
             reversed_thrusters: self.mounting,
             rx_ahead: self.rx_ahead,
             upload: self.upload.status(),
+            config_digest: self.config_digest,
         }
     }
 

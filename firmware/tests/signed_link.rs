@@ -1,104 +1,17 @@
 //! The board's signed end of the link through its whole loop (`board::period` on a bench board
-//! made of queues): how far ahead of the last accepted stamp a navigation computer's frames may
-//! run (Choices 95–96, docs/design.md §20). A silence the board lived through is counted, a clock
+//! made of queues, `common::bench`): how far ahead of the last accepted stamp a navigation
+//! computer's frames may run (Choices 95–96, docs/design.md §20). A silence the board lived through is counted, a clock
 //! that jumped ahead of that count is refused and counted, the board then fails safe on the
 //! silence and keeps signing its telemetry, and a reset takes the new clock.
 
-use std::collections::VecDeque;
-use std::convert::Infallible;
-
 use auv_link::sign::{Direction, Verifier, CEILING, MAX_LEAD, UNITS_PER_SECOND};
 use auv_link::{BoardStatus, Command, FailSafeReason, FrameDecoder, Msg, Telemetry};
-use embedded_hal::pwm::{ErrorType, SetDutyCycle};
-use firmware::board::{self, Board, LinkBuffers};
+use firmware::board::{self, LinkBuffers};
 use firmware::supervisor::Supervisor;
 
 mod common;
-use common::{board_info, controller, state, Host, CIRCLE, KEY, SUPPLY};
-
-/// A thruster channel that keeps its duty.
-struct Channel(u16);
-
-impl ErrorType for Channel {
-    type Error = Infallible;
-}
-
-impl SetDutyCycle for Channel {
-    fn max_duty_cycle(&self) -> u16 {
-        1000
-    }
-    fn set_duty_cycle(&mut self, duty: u16) -> Result<(), Infallible> {
-        self.0 = duty;
-        Ok(())
-    }
-}
-
-/// The link as two queues: bytes to the board, bytes from it.
-#[derive(Default)]
-struct Wire {
-    to_board: VecDeque<u8>,
-    from_board: Vec<u8>,
-}
-
-impl embedded_io::ErrorType for Wire {
-    type Error = Infallible;
-}
-
-impl embedded_io::Read for Wire {
-    fn read(&mut self, buf: &mut [u8]) -> Result<usize, Infallible> {
-        let n = buf.len().min(self.to_board.len());
-        for (slot, b) in buf.iter_mut().zip(self.to_board.drain(..n)) {
-            *slot = b;
-        }
-        Ok(n)
-    }
-}
-
-impl embedded_io::ReadReady for Wire {
-    fn read_ready(&mut self) -> Result<bool, Infallible> {
-        Ok(!self.to_board.is_empty())
-    }
-}
-
-impl embedded_io::Write for Wire {
-    fn write(&mut self, buf: &[u8]) -> Result<usize, Infallible> {
-        self.from_board.extend_from_slice(buf);
-        Ok(buf.len())
-    }
-    fn flush(&mut self) -> Result<(), Infallible> {
-        Ok(())
-    }
-}
-
-/// A board whose period boundary passes at the second poll of each period (no overruns).
-struct Bench {
-    thrusters: [Channel; 5],
-    wire: Wire,
-    boundary: bool,
-}
-
-impl Board for Bench {
-    type Thruster = Channel;
-    type Link = Wire;
-
-    fn supply_voltage(&self) -> f32 {
-        SUPPLY
-    }
-    fn thrusters(&mut self) -> &mut [Channel; 5] {
-        &mut self.thrusters
-    }
-    fn link(&mut self) -> &mut Wire {
-        &mut self.wire
-    }
-    fn set_rate(&mut self, _hz: u32) {}
-    fn period_elapsed(&mut self) -> bool {
-        self.boundary = !self.boundary;
-        self.boundary
-    }
-    fn now(&self) -> u32 {
-        0
-    }
-}
+use common::bench::Bench;
+use common::{board_info, controller, state, Host, CIRCLE, KEY};
 
 /// A signed board on the bench, its navigation computer (stamping its own clock, in 10 µs
 /// units), and the navigation computer's end of the telemetry.
@@ -120,11 +33,7 @@ impl Rig {
     /// A board just reset, its peer's clock at `clock`.
     fn new(clock: u64) -> Rig {
         Rig {
-            bench: Bench {
-                thrusters: std::array::from_fn(|_| Channel(0)),
-                wire: Wire::default(),
-                boundary: true,
-            },
+            bench: Bench::new(),
             sup: Supervisor::new(controller(), board_info(true)),
             link: LinkBuffers::signed(&KEY),
             nav: Host::signed(&KEY),

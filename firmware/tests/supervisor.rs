@@ -274,6 +274,60 @@ fn a_config_patch_is_validated_whole_and_applied_whole() {
     assert_eq!(s.refused_commands(), 1);
 }
 
+/// Protocol 6 (issue 29, item 14; Choice 228): every telemetry frame carries the digest of the
+/// whole configuration the board flies, so the navigation computer confirms every field it set.
+/// A board that took a whole patch reports that patch's digest; a partial patch moves it to
+/// the digest of the whole result; a refused one leaves it; and a board that reset (its
+/// watchdog) reports its defaults', which a host that configured it sees at once.
+#[test]
+fn telemetry_reports_the_digest_of_the_whole_configuration_flown() {
+    let mut s = supervisor();
+    let mut h = Host::new();
+    let boot = telemetry(&mut s);
+    let defaults = ConfigPatch::whole(&controller_core::ControllerConfig::default(), 2, false);
+    assert_eq!(Some(boot.config_digest), defaults.digest());
+    // A whole patch, as host-sim's set-up sends it: confirmed field for field.
+    let sent = ConfigPatch {
+        rate_hz: Some(50),
+        robust: Some(false),
+        delta_max: Some(2.0),
+        voltage_limit: Some(20.0),
+        stale_periods: Some(3),
+        lockstep: Some(true),
+        ..defaults
+    };
+    h.command(&mut s, patch(sent));
+    let t = telemetry(&mut s);
+    assert_eq!(t.refused_commands, 0);
+    assert_eq!(sent.confirm(&t), Ok(()));
+    // A board reset to its defaults does not confirm it.
+    assert!(sent.confirm(&boot).is_err());
+    // Refused: unchanged.
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            rate_hz: Some(MAX_RATE_HZ + 1),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    assert_eq!(Some(telemetry(&mut s).config_digest), sent.digest());
+    // A partial patch: the whole result's digest.
+    h.command(
+        &mut s,
+        patch(ConfigPatch {
+            stale_periods: Some(4),
+            ..ConfigPatch::EMPTY
+        }),
+    );
+    let t = telemetry(&mut s);
+    let now = ConfigPatch {
+        stale_periods: Some(4),
+        ..sent
+    };
+    assert_eq!(Some(t.config_digest), now.digest());
+    assert_ne!(Some(t.config_digest), sent.digest());
+}
+
 #[test]
 fn the_stale_limit_is_checked_in_time_at_the_resulting_rate() {
     let mut s = supervisor();
@@ -484,6 +538,48 @@ fn start_mission_in_lockstep_drops_the_state_held_from_before() {
         assert_eq!(st.voltages, [0.0; THRUSTERS]);
     }
     assert_eq!(status(&mut s), STALE);
+}
+
+/// Regression (issue 29, item 16): free-running, after a state frame and a pause longer than
+/// `stale_periods`, `Arm` + `StartMission` latched `fail-safe: stale state` in the mission's
+/// first period: the old frame was kept (only lock-step dropped it). A new mission counts from
+/// its start (Choice 227): it waits `stale_periods` periods for its first state with the
+/// thrusters off, flies on it, and fails safe only if none comes.
+#[test]
+fn start_mission_free_running_drops_the_state_held_from_before() {
+    for first_state in [true, false] {
+        let mut s = supervisor();
+        let mut h = Host::new();
+        assert!(!s.lockstep());
+        h.command(&mut s, Command::Arm);
+        h.give(&mut s, Msg::State(state(0)));
+        assert_eq!(status(&mut s), BoardStatus::Armed);
+        // A pause: the board sits armed with no mission, no state comes.
+        for _ in 0..10 {
+            assert_eq!(status(&mut s), BoardStatus::Armed);
+        }
+        h.command(&mut s, Command::StartMission(CIRCLE));
+        let st = s.step(false, NOW);
+        assert_eq!(
+            st.telemetry.status,
+            BoardStatus::Running,
+            "its first period"
+        );
+        assert_eq!(st.telemetry.latched, None);
+        assert_eq!(st.voltages, [0.0; THRUSTERS], "no state of its own yet");
+        if first_state {
+            h.give(&mut s, Msg::State(state(1)));
+            let flying = s.step(false, NOW);
+            assert_eq!(flying.telemetry.status, BoardStatus::Running);
+            assert!(flying.voltages.iter().any(|v| *v != 0.0), "flies on it");
+        } else {
+            // The grace is `stale_periods` periods after the first, then the latch.
+            for _ in 0..2 {
+                assert_eq!(status(&mut s), BoardStatus::Running);
+            }
+            assert_eq!(status(&mut s), STALE);
+        }
+    }
 }
 
 /// Regression (issue 12, seen once in four CI runs of the real-chain PIL): `StartMission` and

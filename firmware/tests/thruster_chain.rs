@@ -102,6 +102,9 @@ fn the_board_flies_the_chain_it_reports() {
         let mut h = Host::new();
         if let Some(p) = patch {
             h.command(&mut s, Command::SetConfig(p));
+            // The rebuild is its period's long job (Choice 226): the board flies from the
+            // next period on, as its link's next frames wait for it.
+            s.step(false, NOW);
         }
         h.command(&mut s, Command::Arm);
         h.command(&mut s, Command::StartMission(CIRCLE));

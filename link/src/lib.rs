@@ -29,13 +29,13 @@
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 174 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 157 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//! - **Size:** at most [`MAX_FRAME`] = 179 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 162 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
 //!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
 //!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
-//!   board's link) the largest frame takes 3.8 ms, so a State frame in one direction and a
+//!   board's link) the largest frame takes 3.9 ms, so a State frame in one direction and a
 //!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
-//!   uses 35 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
+//!   uses 39 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
 //!
 //! # Receiving
 //!
@@ -91,6 +91,7 @@
 #![forbid(unsafe_code)]
 #![warn(missing_docs)]
 
+mod config;
 mod frame;
 mod heading;
 pub mod mission;
@@ -100,6 +101,7 @@ pub mod seq;
 pub mod sign;
 pub mod upload;
 
+pub use config::{mounting_of, ConfigMismatch};
 pub use frame::{
     decode_frame, decode_frame_signed, encode, encode_signed, FrameDecoder, LinkError, CRC_LEN,
     MAX_BODY, MAX_FRAME,

@@ -28,7 +28,11 @@ use crate::upload::{UploadChunk, UploadPart, UploadStatus, CHUNK_WORDS};
 /// 5: the chunked mission upload ([`crate::upload`]): `Command::Upload`, the waypoint path
 /// named by its CRC (`MissionSpec::Waypoints`), the upload's acknowledgement in every
 /// `Telemetry` ([`Telemetry::upload`]), and the upload's refusals.
-pub const PROTOCOL_VERSION: u8 = 5;
+///
+/// 6: `Telemetry` carries the digest of the whole configuration the board flies
+/// ([`Telemetry::config_digest`], [`ConfigPatch::digest`]), so that the navigation computer
+/// confirms every field it set (Choice 228).
+pub const PROTOCOL_VERSION: u8 = 6;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -451,6 +455,11 @@ pub struct Telemetry {
     // Protocol 5: appended fields.
     /// What the board holds of a mission upload: the acknowledgement the sender resends by.
     pub upload: UploadStatus,
+    // Protocol 6: appended fields.
+    /// [`ConfigPatch::digest`] of the board's whole configuration
+    /// ([`ConfigPatch::whole`]): a navigation computer that sent a whole patch confirms with it
+    /// that the board flies every field it set ([`ConfigPatch::confirm`]).
+    pub config_digest: u32,
 }
 
 impl Telemetry {
@@ -490,6 +499,7 @@ impl Telemetry {
             received: u32::MAX,
             verified: true,
         },
+        config_digest: u32::MAX,
     };
 }
 
@@ -516,7 +526,8 @@ impl Telemetry {
         + ThrustUnit::MAX_SIZE
         + U8
         + U32
-        + UploadStatus::MAX_SIZE;
+        + UploadStatus::MAX_SIZE
+        + U32;
 
     /// The controller fault this report carries (`None`: no fault, or a code this crate does
     /// not know).

@@ -50,7 +50,7 @@ const _: () = assert!(MAX_CHUNKS <= 32, "one bit per chunk in a u32");
 const NO_SPEEDS: u8 = u8::MAX;
 
 /// CRC-32/ISO-HDLC (the zip/Ethernet CRC; check value 0xCBF43926).
-const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
+pub(crate) const CRC32: crc::Crc<u32> = crc::Crc::<u32>::new(&crc::CRC_32_ISO_HDLC);
 
 /// What a mission upload is: its counts, the path's scalars and the whole mission's CRC.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -266,6 +266,8 @@ pub struct UploadBuffer {
     words: [f32; MAX_WORDS],
     received: u32,
     verified: bool,
+    /// Moves whenever the header or a word changes ([`UploadBuffer::revision`]).
+    revision: u32,
 }
 
 impl Default for UploadBuffer {
@@ -281,6 +283,7 @@ impl UploadBuffer {
         words: [0.0; MAX_WORDS],
         received: 0,
         verified: false,
+        revision: 0,
     };
 
     /// Takes one part: a `Begin` drops the upload before and starts this one (refused whole,
@@ -295,8 +298,10 @@ impl UploadBuffer {
                 if !h.fits() {
                     return Err(Refusal::InvalidUpload);
                 }
+                let revision = self.revision.wrapping_add(1);
                 *self = Self::EMPTY;
                 self.header = Some(*h);
+                self.revision = revision;
                 Ok(())
             }
             UploadPart::Chunk(c) => self.chunk(c),
@@ -312,7 +317,15 @@ impl UploadBuffer {
         }
         let start = c.index as usize * CHUNK_WORDS;
         let end = (start + CHUNK_WORDS).min(h.words());
-        self.words[start..end].copy_from_slice(&c.words[..end - start]);
+        let new = &c.words[..end - start];
+        let same = self.words[start..end]
+            .iter()
+            .zip(new)
+            .all(|(a, b)| a.to_bits() == b.to_bits());
+        if !same {
+            self.revision = self.revision.wrapping_add(1);
+        }
+        self.words[start..end].copy_from_slice(new);
         self.received |= 1 << c.index;
         self.verified = false;
         if self.received == all(h.chunks()) {
@@ -374,6 +387,16 @@ impl UploadBuffer {
     /// The CRC of the verified upload, if there is one.
     pub fn verified(&self) -> Option<u32> {
         self.header.filter(|_| self.verified).map(|h| h.crc)
+    }
+
+    /// A number that moves whenever the upload's data changes: at every accepted `Begin`
+    /// (even of the same header: its chunks are dropped) and at every chunk whose words differ,
+    /// bit for bit, from those held; not at a chunk resent unchanged. What a cache of the
+    /// mission built from this buffer is keyed by, beside the CRC, so that it never stands for
+    /// data it did not check (two missions may share a CRC-32: Choice 229). It wraps after
+    /// 2³² changes: compare it across one [`take`](Self::take), not across a long history.
+    pub fn revision(&self) -> u32 {
+        self.revision
     }
 }
 

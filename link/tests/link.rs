@@ -170,10 +170,11 @@ fn largest_message_fits_max_frame_exactly() {
     // Protocol 5's upload chunk: the command's tag, the part's tag, the index, 32 words.
     assert_eq!(Command::MAX_SIZE, 1 + 1 + 1 + 32 * 4);
     // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes); protocol 5's
-    // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes).
-    assert_eq!(Envelope::MAX_SIZE, 145 + 12);
-    assert_eq!(MAX_BODY, 160 + 12);
-    assert_eq!(MAX_FRAME, 162 + 12);
+    // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes); protocol 6's
+    // configuration digest one u32 varint more (5 bytes).
+    assert_eq!(Envelope::MAX_SIZE, 145 + 12 + 5);
+    assert_eq!(MAX_BODY, 160 + 12 + 5);
+    assert_eq!(MAX_FRAME, 162 + 12 + 5);
     // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
     // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();

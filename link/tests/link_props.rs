@@ -239,6 +239,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
             any::<u8>(),
             any::<u32>(),
             any_upload_status(),
+            any::<u32>(),
         ),
     )
         .prop_map(
@@ -265,6 +266,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                     reversed_thrusters,
                     rx_ahead,
                     upload,
+                    config_digest,
                 ),
             )| Telemetry {
                 tick,
@@ -293,6 +295,7 @@ fn any_telemetry() -> BoxedStrategy<Telemetry> {
                 reversed_thrusters,
                 rx_ahead,
                 upload,
+                config_digest,
             },
         )
         .boxed()

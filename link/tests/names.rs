@@ -80,6 +80,7 @@ fn telemetry_fault_code_is_the_cores() {
         reversed_thrusters: 0,
         rx_ahead: 0,
         upload: auv_link::UploadStatus::NONE,
+        config_digest: 0,
     };
     assert_eq!(t.fault(), None);
     for f in Fault::ALL {

@@ -13,6 +13,10 @@ use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOI
 use controller_core::{HeadingMode, Mission, TrajectoryKind};
 use proptest::prelude::*;
 
+#[path = "common/frames.rs"]
+mod frames;
+use frames::crc32_by_hand;
+
 /// The largest mission: MAX_WAYPOINTS points, MAX_PARTS speeds, every optional field set,
 /// values with awkward bits (a subnormal, a negative zero, a NaN payload: the link carries
 /// bits, the core judges them).
@@ -101,23 +105,6 @@ fn over_the_wire(part: UploadPart, seq: u16) -> UploadPart {
         Msg::Command(Command::Upload(p)) => p,
         other => panic!("decoded {other:?}"),
     }
-}
-
-/// A bitwise CRC-32/ISO-HDLC (reflected polynomial 0xEDB88320, init and final XOR all ones),
-/// written from the definition, not from the crate the link uses.
-fn crc32_by_hand(bytes: &[u8]) -> u32 {
-    let mut c = u32::MAX;
-    for &b in bytes {
-        c ^= b as u32;
-        for _ in 0..8 {
-            c = if c & 1 != 0 {
-                (c >> 1) ^ 0xEDB8_8320
-            } else {
-                c >> 1
-            };
-        }
-    }
-    !c
 }
 
 #[test]
@@ -336,4 +323,67 @@ proptest! {
         let back = board.mission(up.crc()).expect("verified");
         prop_assert_eq!(bits(&back.path), bits(&kind));
     }
+}
+
+/// Choice 229: the revision moves whenever the upload's data changes and only then, so that a
+/// board keys what it built by it: a `Begin` (even the same header again: its chunks are
+/// dropped), a chunk with any other bit; not a chunk resent unchanged, nor a refused part.
+#[test]
+fn the_revision_moves_exactly_when_the_uploads_data_changes() {
+    let up = MissionUpload::of(&mission(small())).expect("waypoints");
+    let mut board = UploadBuffer::EMPTY;
+    let mut last = board.revision();
+    let mut moved = |board: &UploadBuffer| {
+        let m = board.revision() != last;
+        last = board.revision();
+        m
+    };
+    board.take(&UploadPart::Begin(up.header())).expect("fits");
+    assert!(moved(&board), "a Begin");
+    for i in 0..up.chunks() {
+        board
+            .take(&UploadPart::Chunk(up.chunk(i)))
+            .expect("a chunk");
+        assert!(moved(&board), "chunk {i}, new words");
+    }
+    assert!(board.status().verified);
+    // Every chunk again, unchanged: still verified, the same data.
+    for i in 0..up.chunks() {
+        board
+            .take(&UploadPart::Chunk(up.chunk(i)))
+            .expect("a chunk");
+        assert!(!moved(&board), "chunk {i} resent unchanged");
+    }
+    assert!(board.status().verified);
+    // One bit of one word: moved (and refused by the CRC).
+    let mut flipped = up.chunk(0);
+    flipped.words[3] = f32::from_bits(flipped.words[3].to_bits() ^ 1);
+    assert_eq!(
+        board.take(&UploadPart::Chunk(flipped)),
+        Err(Refusal::UploadCrc)
+    );
+    assert!(moved(&board), "one bit changed");
+    // −0 for +0 is another bit pattern, though equal as numbers.
+    let mut zero = up.chunk(0);
+    let i = zero
+        .words
+        .iter()
+        .position(|w| *w == 0.0)
+        .expect("a zero word");
+    zero.words[i] = -zero.words[i];
+    let _ = board.take(&UploadPart::Chunk(zero));
+    assert!(moved(&board), "-0 for +0");
+    // The same header again drops the chunks: moved.
+    board.take(&UploadPart::Begin(up.header())).expect("fits");
+    assert!(moved(&board), "the same Begin again");
+    // A refused part changes nothing.
+    let too_many = auv_link::UploadHeader {
+        points: MAX_WAYPOINTS as u8 + 1,
+        ..up.header()
+    };
+    assert_eq!(
+        board.take(&UploadPart::Begin(too_many)),
+        Err(Refusal::InvalidUpload)
+    );
+    assert!(!moved(&board), "a refused Begin");
 }

@@ -16,8 +16,13 @@ use xtask::ci::Ci;
 pub const FLASH_BUDGET: u64 = 128 * 1024;
 /// Flash budget of the self-test image, which never flies: it runs only in QEMU's mps2-an386
 /// (4 MiB of flash) and carries what the flying images do not — the golden and kernel vectors,
-/// libm's f32 functions and the signing exercise beside the core's own, to measure them.
-pub const SELFTEST_FLASH_BUDGET: u64 = 192 * 1024;
+/// libm's f32 functions and the signing exercise beside the core's own, to measure them, and
+/// the loop at the flight clock (`flight.rs`, issue 29: ~17 kB).
+///
+/// **Choice 230:** 256 KiB (was 192 KiB, 178 308 B used before `flight.rs`, 201 228 B with it):
+/// the self-test's size does not reach a board, and a test that does not fit is worse than a
+/// larger image in QEMU's 4 MiB. The flying images keep [`FLASH_BUDGET`].
+pub const SELFTEST_FLASH_BUDGET: u64 = 256 * 1024;
 /// Static RAM budget of every image (bytes): a quarter of the STM32F405's 128 KiB SRAM, the
 /// rest is stack (the self-test measures its high-water mark).
 pub const RAM_BUDGET: u64 = 32 * 1024;

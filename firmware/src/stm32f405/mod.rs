@@ -103,8 +103,9 @@ pub mod emulator;
 
 /// HSE crystal frequency (Hz). **Assumption: an 8 MHz crystal.**
 pub const HSE_HZ: u32 = 8_000_000;
-/// Core clock SYSCLK = HCLK (Hz); also the unit of [`Board::now`] (CPU cycles).
-pub const SYSCLK_HZ: u32 = 168_000_000;
+/// Core clock SYSCLK = HCLK (Hz); also the unit of [`Board::now`] (CPU cycles). The flight
+/// clock the budgets are checked against (`crate::watchdog`).
+pub const SYSCLK_HZ: u32 = crate::watchdog::FLIGHT_CLOCK_HZ;
 /// APB1 clock (USART2; APB1 timers run at twice this).
 pub const PCLK1_HZ: u32 = 42_000_000;
 /// APB2 clock (TIM1, TIM8 run at twice this: 168 MHz).
@@ -120,11 +121,9 @@ pub const SUPPLY_VOLTAGE: f32 = controller_core::DEFAULT_V_LIMIT;
 /// Control rate set up by [`Stm32Board::init`] (Hz), the controller's default; call
 /// [`Board::set_rate`] for another.
 pub const DEFAULT_RATE_HZ: u32 = 100;
-/// Shortest watchdog timeout (ms, nominal at a 32 kHz LSI).
-pub const WATCHDOG_MIN_MS: u32 = 50;
+pub use crate::watchdog::WATCHDOG_MIN_MS;
+use crate::watchdog::{timeout_ms as watchdog_timeout_ms, LSI_HZ};
 
-/// Nominal LSI frequency (Hz) clocking the IWDG.
-const LSI_HZ: u32 = 32_000;
 /// IWDG prescaler /32: one watchdog count per ms at the nominal LSI.
 const IWDG_DIV: u32 = 32;
 
@@ -391,12 +390,6 @@ impl<T: ThrusterOutputs> Stm32Board<T> {
         while self.iwdg.sr().read().bits() != 0 {}
         self.iwdg.kr().write(|w| w.key().feed());
     }
-}
-
-/// Nominal watchdog timeout (ms) for a control rate: four periods, at least 50 ms, at most
-/// what the /32 prescaler reaches (4096 ms).
-fn watchdog_timeout_ms(rate_hz: u32) -> u32 {
-    (4000 / rate_hz.max(1)).clamp(WATCHDOG_MIN_MS, 4096)
 }
 
 impl<T: ThrusterOutputs> Board for Stm32Board<T> {

@@ -3,6 +3,8 @@
 
 #![allow(dead_code)]
 
+pub mod bench;
+
 use auv_link::sign::{Direction, LinkKey, Signer};
 use auv_link::{encode, encode_signed, Command, Envelope, MissionPlan, Msg, StateFrame, MAX_FRAME};
 use controller_core::kinematics::{self, Attitude};
@@ -38,6 +40,33 @@ pub fn supervisor() -> Supervisor {
 /// The mission every test flies: the paper's 10 m circle, as the paper flies it (its heading,
 /// time scale 1).
 pub const CIRCLE: MissionPlan = MissionPlan::EXAMPLE;
+
+/// A lawn-mower survey of 12 waypoints (60 m legs, 20 m apart), its speeds unset (two
+/// upload chunks), flown with the tangent heading at the paper's speed.
+pub fn survey() -> controller_core::Mission {
+    let mut points = Vec::new();
+    for row in 0..6 {
+        let y = 20.0 * row as f32;
+        let (a, b) = if row % 2 == 0 {
+            (0.0, 60.0)
+        } else {
+            (60.0, 0.0)
+        };
+        points.push([a, y, 5.0]);
+        points.push([b, y, 5.0]);
+    }
+    controller_core::Mission {
+        path: controller_core::TrajectoryKind::Waypoints {
+            points: controller_core::trajectory::WaypointList::new(&points).expect("12 points"),
+            speed: 0.8,
+            turn_radius: Some(3.5),
+            speeds: None,
+            speed_change: None,
+        },
+        heading: controller_core::HeadingMode::Tangent,
+        time_scale: 1.0,
+    }
+}
 
 /// A state frame on the circle at tick `k` (the vehicle exactly on its reference).
 pub fn state(k: u64) -> StateFrame {

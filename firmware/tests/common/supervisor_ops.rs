@@ -45,8 +45,8 @@
 //!   (174 years at 200 Hz).
 //! - **Thrusters off unless armed with a fresh, in-order state:** a period with any voltage ≠ 0
 //!   (or reported `Running`) needs the model armed, with a mission, nothing latched, no overrun,
-//!   and an accepted state frame at most `stale_periods` periods old (in lock-step, accepted
-//!   since the mission started).
+//!   and an accepted state frame at most `stale_periods` periods old, accepted since the
+//!   mission started.
 //! - **A latched fail-safe never clears without disarm + arm:** once a period reports
 //!   `FailSafe(r)`, every telemetry frame reports `latched = r` and no thrust, and a lone `Arm`
 //!   is refused, until an accepted `Disarm` followed by an accepted `Arm`.

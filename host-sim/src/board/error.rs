@@ -118,6 +118,11 @@ pub enum Error {
     /// The board flies another thruster mounting than the scenario's.
     #[error("the board flies thruster mounting {board:#07b}, not the scenario's {scenario:#07b}")]
     Mounting { board: u8, scenario: u8 },
+    /// The board does not fly every field of the configuration sent: its telemetry's digest
+    /// of the whole configuration is another (protocol 6, Choice 228), e.g. a board its
+    /// watchdog reset to its defaults between the `SetConfig` and the `Arm`.
+    #[error("the board does not fly the configuration sent: {mismatch}")]
+    Config { mismatch: auv_link::ConfigMismatch },
     /// The board reports another thrust unit than the plant reads its voltages in
     /// (docs/design.md §9): at the set-up or in any period.
     #[error("the board reports thrust unit {}, but the plant reads its voltages in {} (tick {tick})", unit_name(*board), unit_name(*plant))]
@@ -158,6 +163,7 @@ impl From<Error> for Stop {
             Error::LinkGone { .. } => BoardLoss::LinkGone,
             Error::ThrustUnit { .. }
             | Error::Mounting { .. }
+            | Error::Config { .. }
             | Error::Refused { .. }
             | Error::UploadNotVerified { .. }
             | Error::NotArmed { .. }

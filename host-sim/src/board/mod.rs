@@ -25,8 +25,9 @@
 //! board's `last_rx_seq` on (a restarted runner is heard again: `auv_link::seq`), then sends
 //! `SetConfig { lockstep, rate, Δu on/off, δ_max, voltage limit, stale periods, thrust unit,
 //! thruster mounting, axis priority }` from the scenario's validated controller and `Arm`,
-//! and waits for the board to report itself armed with that thrust unit and mounting (a
-//! refused command is reported with the board's reason; a waypoint mission is uploaded
+//! and waits for the board to report itself armed with that configuration, every field of it
+//! (its unit, its mounting, and the digest of the whole, `Session::set_up`; a refused
+//! command is reported with the board's reason; a waypoint mission is uploaded
 //! between the `SetConfig` and the `Arm`, [`upload`]); then `StartMission` with the
 //! scenario's validated mission (path, heading, time scale) and the first state frame. Every
 //! telemetry frame must name the thrust unit the plant reads the voltages in, or the run

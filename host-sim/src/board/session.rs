@@ -89,7 +89,9 @@ impl Session {
     /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
     /// from a run before, and refuses a configuration while armed); `Armed` counts only from
     /// telemetry whose `last_rx_seq` is the `Arm`'s (an earlier frame of a board that was
-    /// armed before says nothing of this set-up).
+    /// armed before says nothing of this set-up). Armed, the board must fly every field of
+    /// the configuration sent (its mounting and unit by name, the rest by the digest of the
+    /// whole, Choice 228).
     pub(super) fn set_up(&mut self, link: &mut Link, lose: &[u8]) -> Result<SetUp, Error> {
         // Continue the board's numbering: a board that already heard a runner (this one
         // restarted) drops frames numbered at or before its last (auv_link::seq).
@@ -141,6 +143,10 @@ impl Session {
                     });
                 }
                 self.check_unit(&t)?;
+                // Every other field, through the digest of the whole configuration sent.
+                self.config
+                    .confirm(&t)
+                    .map_err(|mismatch| Error::Config { mismatch })?;
                 return Ok(t);
             }
             if Instant::now() > deadline {

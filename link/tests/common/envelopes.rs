@@ -88,6 +88,7 @@ pub fn telemetry(status: BoardStatus) -> Telemetry {
             received: 0b1_0110,
             verified: false,
         },
+        config_digest: 0x0BAD_F00D,
     }
 }
 

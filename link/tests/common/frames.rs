@@ -1,6 +1,6 @@
 //! What the link's fuzz target (`fuzz/fuzz_targets/frame_decoder.rs`) and its stable proptest
 //! twin (`link/tests/fuzz_props.rs`) share, as source (both `#[path]`-include this file): the
-//! decoder's reference model, the re-encode check, an independent CRC-16 and COBS stuffer, and
+//! decoder's reference model, the re-encode check, an independent CRC-16, CRC-32 and COBS stuffer, and
 //! bitwise (NaN-safe) equality of envelopes with exhaustive destructuring, so that a new field
 //! fails to compile here.
 
@@ -75,6 +75,23 @@ pub fn crc16(bytes: &[u8]) -> [u8; 2] {
         }
     }
     crc.to_le_bytes()
+}
+
+/// A bitwise CRC-32/ISO-HDLC (reflected polynomial 0xEDB88320, init and final XOR all ones),
+/// written from the definition, not from the crate the link uses.
+pub fn crc32_by_hand(bytes: &[u8]) -> u32 {
+    let mut c = u32::MAX;
+    for &b in bytes {
+        c ^= b as u32;
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                (c >> 1) ^ 0xEDB8_8320
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
 }
 
 /// Plain COBS plus the `0x00` delimiter.
@@ -257,8 +274,10 @@ pub fn same_telemetry(a: &Telemetry, b: &Telemetry) -> bool {
         reversed_thrusters,
         rx_ahead,
         upload,
+        config_digest,
     } = a;
-    *upload == b.upload
+    *config_digest == b.config_digest
+        && *upload == b.upload
         && *thrust_unit == b.thrust_unit
         && *rx_ahead == b.rx_ahead
         && *reversed_thrusters == b.reversed_thrusters

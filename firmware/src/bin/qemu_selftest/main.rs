@@ -1,6 +1,7 @@
 //! The QEMU self-test image (`cargo fw-test`): checks the core on the target against the host,
 //! counts the instructions of `update`, of each of its stages and of the math kernels,
-//! exercises the link and the fail-safe, reports the stack high-water mark, and exits through
+//! exercises the link and the fail-safe, flies the loop at the flight clock (`flight`),
+//! reports the stack high-water mark, and exits through
 //! semihosting (0 = every check passed). `cargo xtask firmware` compares its decoded log with
 //! `firmware/snapshots/selftest-*.log` and checks the counts against `firmware::budget`.
 #![no_std]
@@ -8,6 +9,7 @@
 
 mod cost;
 mod counter;
+mod flight;
 mod golden;
 mod kernels;
 mod selftest;

@@ -479,33 +479,11 @@ fn upload_exercise() -> bool {
     armed_refused && one_missing && verified && flying && largest.is_some()
 }
 
-/// Instructions of `Trajectory::set` on the largest waypoint path the board takes: 32 points
-/// (a lawn-mower of 16 rows of 60 m, 20 m apart), a time law of 61 parts, tangent heading.
+/// Instructions of `Trajectory::set` on the largest waypoint path the board takes
+/// (`flight::largest_waypoints`: 32 points, 61 parts), within its budget (`budget::WorkBudget`).
 #[inline(never)]
 fn largest_set_cost() -> Option<u32> {
-    let mut points = [[0.0f32; 3]; controller_core::trajectory::MAX_WAYPOINTS];
-    for (i, p) in points.iter_mut().enumerate() {
-        let row = (i / 2) as f32;
-        let east = (i % 2 == 0) == ((i / 2) % 2 == 0);
-        *p = [if east { 0.0 } else { 60.0 }, 20.0 * row, 5.0];
-    }
-    let mut speeds = [0.5f32; controller_core::trajectory::MAX_PARTS];
-    for (i, v) in speeds.iter_mut().enumerate() {
-        if i % 4 == 0 {
-            *v = 0.8;
-        }
-    }
-    let mission = controller_core::Mission {
-        path: controller_core::TrajectoryKind::Waypoints {
-            points: controller_core::trajectory::WaypointList::new(&points).ok()?,
-            speed: 0.5,
-            turn_radius: Some(3.0),
-            speeds: Some(controller_core::trajectory::SpeedList::new(&speeds).ok()?),
-            speed_change: None,
-        },
-        heading: controller_core::HeadingMode::Tangent,
-        time_scale: 1.0,
-    };
+    let mission = crate::flight::largest_waypoints()?;
     let slot = cortex_m::singleton!(: Trajectory = Trajectory::EMPTY)?;
     let t0 = SYST::get_current();
     let ok = slot.set(&mission).is_ok();
@@ -515,7 +493,15 @@ fn largest_set_cost() -> Option<u32> {
         "Trajectory::set of the largest waypoint path (32 points, 61 parts): {} instructions, valid {}",
         n, ok
     );
-    ok.then_some(n)
+    let budget =
+        firmware::budget::for_backend(controller_core::math::BACKEND).map_or(0, |b| b.work.build);
+    if n > budget {
+        error!(
+            "the largest waypoint build is over its budget of {} instructions (firmware/src/budget.rs)",
+            budget
+        );
+    }
+    (ok && n <= budget).then_some(n)
 }
 
 /// A signed link: an unsigned frame, a replayed signed frame and one stamped at 2⁴⁸ − 1 are
@@ -721,12 +707,27 @@ pub fn run(mut syst: SYST) -> bool {
         && real_chain_exercise()
         && upload_exercise();
     let signing_ok = signing_cost(circle).is_some();
+    let flight_ok = crate::flight::run(
+        &mut syst,
+        &crate::flight::Circle {
+            plan: MISSION,
+            trajectory: circle,
+            state: circle_state,
+        },
+    );
     let pwm_ok = pwm_mapping();
     info!("stack high-water mark: {} bytes", stack::high_water());
     if wrong {
         error!("injected wrong answer: treating the golden vectors as failed");
     }
-    let ok = config_ok && golden_ok && !wrong && budget_ok && link_ok && signing_ok && pwm_ok;
+    let ok = config_ok
+        && golden_ok
+        && !wrong
+        && budget_ok
+        && link_ok
+        && signing_ok
+        && flight_ok
+        && pwm_ok;
     if ok {
         info!("self-test passed");
     } else {

@@ -247,6 +247,9 @@ impl Harness {
                     assert!(self.sup.last_refusal().is_some());
                 }
                 self.command(&c, refused);
+                if !refused && *self.sup.controller().config() != settings_before.0 {
+                    self.model.rebuilt = true;
+                }
                 if refused || !matches!(c, Command::SetConfig(_)) {
                     assert_eq!(
                         settings(&self.sup),

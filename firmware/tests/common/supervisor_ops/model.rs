@@ -21,14 +21,17 @@ pub(super) struct Model {
     pub(super) counted: u64,
     /// Authentic frames refused as too far ahead.
     pub(super) ahead: u32,
-    /// Periods run since the last accepted state frame (`None`: none, or, in lock-step, none
-    /// since the mission started).
+    /// Periods run since the last accepted state frame (`None`: none, or none since the
+    /// mission started).
     pub(super) periods_since_state: Option<u64>,
     /// Lock-step mission clock: the last accepted tick, and periods since.
     pub(super) clock: Option<(u64, u64)>,
     /// Periods run since the mission started (a mission waits `stale_periods` for its first
     /// state).
     pub(super) mission_periods: u64,
+    /// An accepted `SetConfig` changed the controller's configuration since the last period:
+    /// a rebuild, the period's long job (Choice 226).
+    pub(super) rebuilt: bool,
 }
 
 impl Model {
@@ -47,6 +50,7 @@ impl Model {
             periods_since_state: None,
             clock: None,
             mission_periods: 0,
+            rebuilt: false,
         }
     }
 
@@ -111,9 +115,9 @@ impl Harness {
                     m.mission = true;
                     m.mission_periods = 0;
                     m.clock = None;
-                    if m.lockstep {
-                        m.periods_since_state = None;
-                    }
+                    // A new mission counts from its start, in either pacing (Choice 227): a
+                    // state from before it is not its state.
+                    m.periods_since_state = None;
                 }
             }
             Command::Upload(_) => {
@@ -159,6 +163,13 @@ impl Harness {
             );
         }
         let on = step.voltages.iter().any(|v| *v != 0.0);
+        // A rebuild is the period's long job, and a period that ran one never flies.
+        assert!(
+            step.long_job || !self.model.rebuilt,
+            "a rebuild not counted as the period's long job"
+        );
+        assert!(!(step.long_job && on), "a period with a long job flew");
+        self.model.rebuilt = false;
         let m = self.model;
         let may_run = m.armed && m.mission && m.latched.is_none() && !overrun;
         let may_fly = may_run && m.fresh();
