@@ -1,8 +1,8 @@
 //! QGroundControl `.plan` import and export (docs/design.md §27): geodetic → NED against known
 //! lengths of a degree, the round trip, the errors, and the shipped example as a scenario.
 
-use host_sim::scenario::{parse_scenario, ScenarioFile};
 use host_sim::scenario::plan::{self, Origin};
+use host_sim::scenario::{parse_scenario, ScenarioFile};
 use std::path::Path;
 use std::process::Command;
 
