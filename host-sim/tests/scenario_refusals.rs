@@ -215,3 +215,11 @@ fn missing_file_error_names_the_path() {
     assert!(e.to_string().contains("no-such-scenario.toml"), "{e}");
     assert!(std::error::Error::source(&e).is_some());
 }
+
+/// `trajectory.origin` is three numbers exactly, like every array of the file: a fourth used
+/// to be dropped without a word.
+#[test]
+fn an_origin_of_four_numbers_is_a_toml_error_naming_the_key() {
+    let e = toml_error(&circle_with("origin = [43.0, 5.0, 0.0, 1.0]\n"));
+    assert!(e.contains("origin") && e.contains("exactly 3"), "{e}");
+}
