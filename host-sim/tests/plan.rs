@@ -211,6 +211,22 @@ fn import_plan(plan: &Path, args: &[&str]) -> std::process::Output {
         .unwrap()
 }
 
+/// `import-plan` on a plan file named `file_name` holding `text`, in a scratch folder.
+fn import_plan_named(file_name: &str, text: &str) -> std::process::Output {
+    let dir = std::env::temp_dir().join(format!("host-sim-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan = dir.join(file_name);
+    std::fs::write(&plan, text).unwrap();
+    let out = import_plan(&plan, &[]);
+    let _ = std::fs::remove_file(&plan);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
 fn harbour_wall() -> std::path::PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/plans/harbour-wall.plan")
 }
@@ -263,18 +279,8 @@ fn import_plan_writes_a_name_as_data_and_refuses_one_that_is_no_file_name() {
 /// scenario has no `duration` (the default).
 #[test]
 fn import_plan_writes_the_plans_file_name_into_a_comment_that_cannot_end_early() {
-    let dir = std::env::temp_dir().join(format!("host-sim-plan-name-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let plan = dir.join("w\nduration = 1 #.plan");
-    std::fs::copy(harbour_wall(), &plan).unwrap();
-    let out = import_plan(&plan, &[]);
-    let _ = std::fs::remove_dir_all(&dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
-    );
+    let wall = std::fs::read_to_string(harbour_wall()).unwrap();
+    let out = import_plan_named("w\nduration = 1 #.plan", &wall);
     let text = String::from_utf8(out.stdout).unwrap();
     let s = parse_scenario(&text).unwrap();
     let default = host_sim::scenario::SimConfig::new("x", s.config().trajectory).duration;
@@ -286,31 +292,19 @@ fn import_plan_writes_the_plans_file_name_into_a_comment_that_cannot_end_early()
 /// in `origin`: every number is written readable (`1e300`) and reads back as itself.
 #[test]
 fn import_plan_writes_huge_numbers_readable() {
-    let dir = std::env::temp_dir().join(format!("host-sim-plan-huge-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    let plan = dir.join("high.plan");
     let item = |lat: f64| {
         format!(
             r#"{{"type": "SimpleItem", "command": 16, "params": [0, 0, 0, null, {lat}, 5.0, 1e300]}}"#
         )
     };
-    std::fs::write(
-        &plan,
-        format!(
+    let out = import_plan_named(
+        "high.plan",
+        &format!(
             r#"{{"fileType": "Plan", "mission": {{"plannedHomePosition": [43.0, 5.0, 1e300],
             "items": [{}, {}]}}}}"#,
             item(43.0),
             item(43.001)
         ),
-    )
-    .unwrap();
-    let out = import_plan(&plan, &[]);
-    let _ = std::fs::remove_dir_all(&dir);
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
     );
     let text = String::from_utf8(out.stdout).unwrap();
     assert!(text.lines().all(|l| l.len() < 200), "{text}");
