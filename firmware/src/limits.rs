@@ -36,9 +36,7 @@ mod tests {
 
     #[test]
     fn the_largest_frame_fits_a_period_at_the_maximum_rate() {
-        // LINK_BAUD 8N1: 10 bits a byte on the wire.
-        let frame_ns =
-            auv_link::MAX_FRAME as u64 * 10 * 1_000_000_000 / crate::serial::LINK_BAUD as u64;
+        let frame_ns = firmware_images::wire_nanos(auv_link::MAX_FRAME as u64);
         let period_ns = 1_000_000_000 / MAX_RATE_HZ as u64;
         assert!(
             frame_ns < period_ns,

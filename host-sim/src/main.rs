@@ -53,7 +53,9 @@ enum Command {
     /// one report whose worst cases replay bit for bit.
     Campaign(CampaignArgs),
     /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
-    /// frame of the plan's home position. Exit 2 if the file is not a plan of waypoints
+    /// frame of the plan's home position. Exit 2 if the file is not a plan of waypoints, or on a
+    /// flag the scenario would refuse (`--speed` outside (0, 10] m/s, a `--name` that is not
+    /// a file name).
     ImportPlan(ImportPlanArgs),
 }
 

@@ -272,3 +272,34 @@ fn the_run_command_runs_in_process() {
         "{text}"
     );
 }
+
+/// The usage block of `host_sim::cli`'s documentation names every command the binary has (as
+/// `host-sim --help` lists them): it used to miss `validate-preflight` and `import-plan`.
+#[test]
+fn the_usage_block_names_every_command() {
+    let help = host_sim().arg("--help").output().unwrap();
+    let help = String::from_utf8(help.stdout).unwrap();
+    let commands: Vec<&str> = help
+        .lines()
+        .skip_while(|l| !l.starts_with("Commands:"))
+        .skip(1)
+        .take_while(|l| l.starts_with("  "))
+        .filter_map(|l| l.split_whitespace().next())
+        .filter(|c| *c != "help")
+        .collect();
+    assert!(commands.len() >= 9, "{help}");
+    let module = std::fs::read_to_string(
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src/cli/mod.rs"),
+    )
+    .unwrap();
+    let usage: Vec<&str> = module
+        .lines()
+        .filter_map(|l| l.strip_prefix("//! host-sim "))
+        .collect();
+    for c in commands {
+        assert!(
+            usage.iter().any(|u| u.split_whitespace().next() == Some(c)),
+            "`host-sim {c}` is not in the usage block of src/cli/mod.rs"
+        );
+    }
+}

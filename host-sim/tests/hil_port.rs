@@ -255,7 +255,7 @@ fn a_mission_start_that_straddles_a_board_period_flies_no_period_disarmed() {
     assert_eq!(output.status.code(), want, "stderr:\n{stderr}");
 }
 
-/// Issue 22, item 1: the board's set-up waits up to the reply timeout (here an hour) for a
+/// The board's set-up waits up to the reply timeout (here an hour) for a
 /// silent board; Ctrl-C ends the wait and the command, as any other phase: exit 130, the
 /// report says partial.
 #[test]

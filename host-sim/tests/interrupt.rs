@@ -1,4 +1,4 @@
-//! The interrupt's rules in process (issue 18; `commands.rs` signals the binary): one request
+//! The interrupt's rules in process (`signals.rs` signals the binary): one request
 //! delivered twice is one interrupt, a later second one quits, and what is being streamed is
 //! kept under its partial name first. Its own test binary: [`interrupt::keep_streamed`]
 //! renames every stream of the process.

@@ -1,4 +1,4 @@
-//! Long runs in bounded memory (issue 10): the plots keep a decimated series that still holds
+//! Long runs in bounded memory: the plots keep a decimated series that still holds
 //! every bucket's extremes, the CSV streams every period, and a mission long enough for the
 //! heading to pass the controller's angle limit still flies.
 

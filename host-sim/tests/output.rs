@@ -262,20 +262,132 @@ fn plot_case_without_the_comparison_run() {
     assert_pngs(&files, &dir, "figure-eight-30x30");
 }
 
+/// A figure's panels as drawn, read from its pixels (independently of the plotting code):
+/// a panel is a **chart** when its cell holds the mesh's light grid lines, and says **no
+/// data** when it has no mesh and its centre holds the message's grey text.
+#[derive(Clone, Debug, PartialEq)]
+enum Drawn {
+    Chart,
+    NoData,
+    Neither,
+}
+
+/// A PNG decoded to RGB.
+struct Image {
+    width: usize,
+    height: usize,
+    rgb: Vec<[u8; 3]>,
+}
+
+/// The light grid of a chart's mesh and the grey of the "no data" message (plot.rs).
+const GRID: [u8; 3] = [238, 238, 238];
+const MESSAGE_GREY: [u8; 3] = [120, 120, 120];
+/// The figures' title, subtitle and legend: the panels share the rows below (measured on the
+/// 900-pixel figures; a panel's centre is found within ±40 px of it).
+const HEADER: usize = 84;
+
+impl Image {
+    fn read(path: &Path) -> Image {
+        let decoder = png::Decoder::new(std::fs::File::open(path).unwrap());
+        let mut reader = decoder.read_info().unwrap();
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).unwrap();
+        assert_eq!(info.bit_depth, png::BitDepth::Eight, "{}", path.display());
+        let rgb: Vec<[u8; 3]> = buf[..info.buffer_size()]
+            .chunks(info.color_type.samples())
+            .map(|p| [p[0], p[1], p[2]])
+            .collect();
+        Image {
+            width: info.width as usize,
+            height: rgb.len() / info.width as usize,
+            rgb,
+        }
+    }
+
+    /// Pixels of exactly `colour` in columns `xs` and rows `ys`.
+    fn count(
+        &self,
+        colour: [u8; 3],
+        xs: std::ops::Range<usize>,
+        ys: std::ops::Range<usize>,
+    ) -> usize {
+        ys.flat_map(|y| xs.clone().map(move |x| (x, y)))
+            .filter(|&(x, y)| self.rgb[y * self.width + x] == colour)
+            .count()
+    }
+
+    /// The panels of a `rows` × `cols` grid below the header, row by row.
+    fn panels(&self, rows: usize, cols: usize) -> Vec<Drawn> {
+        let (w, h) = (self.width / cols, (self.height - HEADER) / rows);
+        let mut out = Vec::new();
+        for r in 0..rows {
+            for c in 0..cols {
+                let (x0, y0) = (c * w, HEADER + r * h);
+                let grid = self.count(GRID, x0..x0 + w, y0..y0 + h);
+                let (cx, cy) = (x0 + w / 2, y0 + h / 2);
+                let grey = self.count(MESSAGE_GREY, cx - 80..cx + 80, cy - 40..cy + 40);
+                out.push(match (grid > 2000, grey > 60) {
+                    (true, _) => Drawn::Chart,
+                    (false, true) => Drawn::NoData,
+                    (false, false) => Drawn::Neither,
+                });
+            }
+        }
+        out
+    }
+}
+
+/// The panels of each of `plot_case`'s five figures (its documentation): the XY plane, the
+/// errors' 3 × 2 grid, the payload, the heading, and the actuators (a voltage panel per run,
+/// then δ).
+fn drawn(files: &[PathBuf], with_comparison: bool) -> Vec<Vec<Drawn>> {
+    let layout = [
+        (1, 1),
+        (3, 2),
+        (1, 1),
+        (1, 1),
+        (if with_comparison { 3 } else { 2 }, 1),
+    ];
+    files
+        .iter()
+        .zip(layout)
+        .map(|(f, (rows, cols))| Image::read(f).panels(rows, cols))
+        .collect()
+}
+
 #[test]
 fn plot_case_survives_empty_single_and_nan_runs() {
+    use Drawn::{Chart, NoData};
     let dir = scratch("plots-degenerate");
-    // Empty: every figure says "no data".
+    let charts = |n: usize| vec![Chart; n];
+    // Empty: every panel of every figure says "no data".
     let empty = synthetic("empty", true, 0, 1.0);
     let files = plot_case(&dir, &empty, Some(&empty)).unwrap();
     assert_pngs(&files, &dir, "empty");
+    for (f, panels) in files.iter().zip(drawn(&files, true)) {
+        assert!(
+            panels.iter().all(|p| *p == NoData),
+            "{}: {panels:?}",
+            f.display()
+        );
+    }
 
-    // One sample against an empty comparison.
+    // One sample against an empty comparison: charts, but the comparison's voltages say
+    // "no data".
     let one = synthetic("one", true, 1, 1.0);
     let files = plot_case(&dir, &one, Some(&empty)).unwrap();
     assert_pngs(&files, &dir, "one");
+    let want = [
+        charts(1),
+        charts(6),
+        charts(1),
+        charts(1),
+        vec![Chart, NoData, Chart],
+    ];
+    assert_eq!(drawn(&files, true), want);
 
-    // NaN and infinities scattered through, and a comparison run that is all NaN.
+    // NaN and infinities scattered through, and a comparison run that is all NaN: the run's
+    // curves are drawn (broken at the holes), the comparison's voltages say "no data".
     let mut holes = synthetic("holes", true, 200, 1.0);
     for (k, s) in holes.samples.iter_mut().enumerate() {
         if k % 7 == 3 {
@@ -298,8 +410,9 @@ fn plot_case_survives_empty_single_and_nan_runs() {
     }
     let files = plot_case_with_limit(&dir, &holes, Some(&all_nan), f64::NAN).unwrap();
     assert_pngs(&files, &dir, "holes");
+    assert_eq!(drawn(&files, true), want);
 
-    // Constant signals (zero span) and a name that is not a file name.
+    // Constant signals (zero span) and a name that is not a file name: charts everywhere.
     let mut flat = synthetic("a/b c", true, 50, 0.0);
     for s in &mut flat.samples {
         s.eta = [3.0; 6];
@@ -308,6 +421,8 @@ fn plot_case_survives_empty_single_and_nan_runs() {
     }
     let files = plot_case(&dir, &flat, None).unwrap();
     assert_pngs(&files, &dir, "a_b_c");
+    let want = [charts(1), charts(6), charts(1), charts(1), charts(2)];
+    assert_eq!(drawn(&files, false), want);
 }
 
 #[test]
@@ -516,7 +631,7 @@ fn the_manifest_does_not_depend_on_the_order_files_were_claimed() {
     }
 }
 
-/// Issue 22, item 4: a run that recorded no period (it stopped at t = 0) has no metrics; they
+/// A run that recorded no period (it stopped at t = 0) has no metrics; they
 /// used to print as 0.000 beside the DIVERGED flag, which read as a perfect run.
 #[test]
 fn a_run_with_no_sample_shows_no_metric_as_a_number() {

@@ -1,8 +1,8 @@
 //! QGroundControl `.plan` import and export (docs/design.md §27): geodetic → NED against known
 //! lengths of a degree, the round trip, the errors, and the shipped example as a scenario.
 
-use host_sim::scenario::parse_scenario;
 use host_sim::scenario::plan::{self, Origin};
+use host_sim::scenario::{parse_scenario, ScenarioFile};
 use std::path::Path;
 use std::process::Command;
 
@@ -199,4 +199,116 @@ fn the_shipped_pipeline_is_its_plan_imported() {
         // Within 400 m of the home: the flat earth is good to d²/R < 3 cm there (Choice 159).
         assert!(r[0].hypot(r[1]) < 400.0, "{r:?}");
     }
+}
+
+/// `host-sim import-plan <plan> <args…>`.
+fn import_plan(plan: &Path, args: &[&str]) -> std::process::Output {
+    Command::new(env!("CARGO_BIN_EXE_host-sim"))
+        .arg("import-plan")
+        .arg(plan)
+        .args(args)
+        .output()
+        .unwrap()
+}
+
+/// `import-plan` on a plan file named `file_name` holding `text`, in a scratch folder.
+fn import_plan_named(file_name: &str, text: &str) -> std::process::Output {
+    let dir = std::env::temp_dir().join(format!("host-sim-plan-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let plan = dir.join(file_name);
+    std::fs::write(&plan, text).unwrap();
+    let out = import_plan(&plan, &[]);
+    let _ = std::fs::remove_file(&plan);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn harbour_wall() -> std::path::PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/plans/harbour-wall.plan")
+}
+
+/// A `--speed` the scenario would refuse (NaN, ∞, 0, negative, 1e308, or beyond the core's
+/// 10 m/s) used to be written as given, exit 0 (NaN is not TOML; 1e308 printed 309 digits):
+/// it is refused, exit 2, naming the flag and the value as written.
+#[test]
+fn import_plan_refuses_a_speed_the_scenario_would_refuse_naming_the_flag() {
+    for speed in ["nan", "inf", "0", "-1", "1e308", "1e-300", "10.5"] {
+        let out = import_plan(&harbour_wall(), &[&format!("--speed={speed}")]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(2), "--speed {speed}: {err}");
+        assert!(err.contains("--speed"), "{err}");
+        assert!(out.stdout.is_empty(), "--speed {speed}");
+    }
+    // The largest speed is taken, and read back as itself (the file's shape: at 10 m/s the
+    // default corners do not fit this plan's legs, which the scenario then says).
+    let out = import_plan(&harbour_wall(), &["--speed", "10"]);
+    assert!(out.status.success());
+    let file = ScenarioFile::from_toml(&String::from_utf8(out.stdout).unwrap()).unwrap();
+    assert!(matches!(
+        file.trajectory.path,
+        controller_core::TrajectoryKind::Waypoints { speed: 10.0, .. }
+    ));
+}
+
+/// A `--name` is data: with a quote it used to break the file; with a newline it injected
+/// `[controller] k1 = …`. A quote is written escaped and reads back as the name; a newline (not
+/// a file name) is refused, exit 2, naming the flag.
+#[test]
+fn import_plan_writes_a_name_as_data_and_refuses_one_that_is_no_file_name() {
+    let name = "wall \"north\" 'b'";
+    let out = import_plan(&harbour_wall(), &["--name", name]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let s = parse_scenario(&String::from_utf8(out.stdout).unwrap()).unwrap();
+    assert_eq!(s.config().name, name);
+    let out = import_plan(&harbour_wall(), &["--name", "x\n[controller]\nk1 = 1"]);
+    let err = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(2), "{err}");
+    assert!(err.contains("--name"), "{err}");
+}
+
+/// A plan file named `w\nduration = 1 #.plan` made `run` fly 1 s: the name went into the
+/// header comment unescaped, and its second line was a key. Now the header escapes it and the
+/// scenario has no `duration` (the default).
+#[test]
+fn import_plan_writes_the_plans_file_name_into_a_comment_that_cannot_end_early() {
+    let wall = std::fs::read_to_string(harbour_wall()).unwrap();
+    let out = import_plan_named("w\nduration = 1 #.plan", &wall);
+    let text = String::from_utf8(out.stdout).unwrap();
+    let s = parse_scenario(&text).unwrap();
+    let default = host_sim::scenario::SimConfig::new("x", s.config().trajectory).duration;
+    assert_eq!(s.config().duration, default, "{text}");
+    assert!(text.contains("w\\nduration = 1 #.plan"), "{text}");
+}
+
+/// A plan whose home is 10³⁰⁰ m up used to print its altitude as 301 digits in the header and
+/// in `origin`: every number is written readable (`1e300`) and reads back as itself.
+#[test]
+fn import_plan_writes_huge_numbers_readable() {
+    let item = |lat: f64| {
+        format!(
+            r#"{{"type": "SimpleItem", "command": 16, "params": [0, 0, 0, null, {lat}, 5.0, 1e300]}}"#
+        )
+    };
+    let out = import_plan_named(
+        "high.plan",
+        &format!(
+            r#"{{"fileType": "Plan", "mission": {{"plannedHomePosition": [43.0, 5.0, 1e300],
+            "items": [{}, {}]}}}}"#,
+            item(43.0),
+            item(43.001)
+        ),
+    );
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(text.lines().all(|l| l.len() < 200), "{text}");
+    assert!(text.contains("alt 1e300 m"), "{text}");
+    let file = ScenarioFile::from_toml(&text).unwrap();
+    assert_eq!(file.trajectory.origin, Some([43.0, 5.0, 1e300]), "{text}");
 }

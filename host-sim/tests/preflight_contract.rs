@@ -27,7 +27,7 @@ fn no_mission_called_feasible_misses_the_bound_when_flown() {
     );
 }
 
-/// Issue 18's case: the real 20 m circle with the vertical pair both pushing up (the core's
+/// The real 20 m circle with the vertical pair both pushing up (the core's
 /// default before). The old preflight called it feasible at time scale 1 and it flew 6.4 m
 /// off; now `check` refuses time scale 1, proposes one, and the mission flies within the
 /// bound there.

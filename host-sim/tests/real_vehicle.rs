@@ -1,4 +1,4 @@
-//! Issue 9, the real vehicle in the simulator: trim, the thrust unit of the real chain, the
+//! The real vehicle in the simulator: trim, the thrust unit of the real chain, the
 //! scenario keys, the preflight check against closed forms and against the flown outcome,
 //! and `host-sim check`'s exit codes. Runs are short (seconds of simulated time).
 
@@ -219,14 +219,38 @@ fn bad_real_vehicle_keys_are_named() {
     }
 }
 
+/// The compiled real missions are every file of `scenarios/real/` (the folder listed, not the
+/// compiled list read back), each named for its file; the closed-form ones fly Table 1's paths
+/// in `Table1Case::ALL`'s order with the real vehicle's settings, the waypoint ones to their
+/// last waypoint.
 #[test]
-fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
-    let compiled = real_vehicle::real_scenarios().unwrap();
-    for ((file, _), s) in real_vehicle::REAL_SCENARIOS.iter().zip(&compiled) {
-        let loaded = load_scenario(&scenarios_dir().join("real").join(file)).unwrap();
-        assert_eq!(loaded.config(), s.config(), "{file}");
+fn the_compiled_real_missions_are_the_folders_files_and_fly_the_paths_of_table_1() {
+    let mut in_folder: Vec<String> = std::fs::read_dir(scenarios_dir().join("real"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().to_string_lossy().into_owned())
+        .filter(|n| n.ends_with(".toml"))
+        .collect();
+    in_folder.sort();
+    let mut compiled: Vec<String> = real_vehicle::REAL_SCENARIOS
+        .iter()
+        .chain(&real_vehicle::WAYPOINT_SCENARIOS)
+        .map(|(file, _)| file.to_string())
+        .collect();
+    compiled.sort();
+    assert_eq!(compiled, in_folder);
+    let real = real_vehicle::real_scenarios().unwrap();
+    let surveys = real_vehicle::waypoint_scenarios().unwrap();
+    let files = real_vehicle::REAL_SCENARIOS
+        .iter()
+        .chain(&real_vehicle::WAYPOINT_SCENARIOS);
+    for ((file, _), s) in files.zip(real.iter().chain(&surveys)) {
+        assert_eq!(
+            format!("real-{}", file.trim_end_matches(".toml")),
+            s.config().name,
+            "{file}"
+        );
     }
-    for (case, s) in controller_core::Table1Case::ALL.iter().zip(&compiled) {
+    for (case, s) in controller_core::Table1Case::ALL.iter().zip(&real) {
         let c = s.config();
         assert_eq!(c.trajectory, case.kind(), "{}", c.name);
         assert_eq!(c.heading, HeadingMode::Tangent);
@@ -236,18 +260,16 @@ fn shipped_real_missions_are_the_compiled_ones_and_fly_the_paths_of_table_1() {
         // The whole 70 s path of the paper, at the mission's time scale.
         assert!((c.duration - 70.0 * f64::from(c.time_scale)).abs() < 0.01);
     }
-    // The waypoint surveys too, each flown to its last waypoint (its time law's duration).
-    let surveys = real_vehicle::waypoint_scenarios().unwrap();
-    for ((file, _), s) in real_vehicle::WAYPOINT_SCENARIOS.iter().zip(&surveys) {
-        let loaded = load_scenario(&scenarios_dir().join("real").join(file)).unwrap();
-        assert_eq!(loaded.config(), s.config(), "{file}");
+    // The waypoint surveys, each flown to its last waypoint (its time law's duration).
+    for s in &surveys {
         let c = s.config();
         assert!(c.trimmed && !c.ideal_actuators && c.heading == HeadingMode::Tangent);
         let law = s.trajectory().time_law();
-        assert!(law.is_set(), "{file}: the speed profile is pinned");
+        assert!(law.is_set(), "{}: the speed profile is pinned", c.name);
         assert!(
             (c.duration - f64::from(law.duration())).abs() < 0.1,
-            "{file}"
+            "{}",
+            c.name
         );
     }
 }

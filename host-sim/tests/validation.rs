@@ -1,4 +1,4 @@
-//! Scenario values that used to load and then run badly (issue 10): arrays of the wrong
+//! Scenario values that used to load and then run badly: arrays of the wrong
 //! length, numerically unsafe values, runs too long for the step cap. Each is refused at load,
 //! naming its key and the reason.
 
@@ -140,7 +140,7 @@ fn the_step_cap_refuses_a_long_fast_run_unless_overridden() {
     }
 }
 
-/// Issue 22, item 4: finite values beyond what the vehicle can meet used to load, diverge at
+/// Finite values beyond what the vehicle can meet used to load, diverge at
 /// t = 0 and print 0.000 metrics; each is refused, naming its key, its number readable.
 #[test]
 fn absurd_finite_values_are_refused_with_their_key() {
@@ -193,7 +193,7 @@ fn absurd_finite_values_are_refused_with_their_key() {
     }
 }
 
-/// Issue 22, item 5: a number in a message reads as the user wrote it, not as 309 digits.
+/// A number in a message reads as the user wrote it, not as 309 digits.
 #[test]
 fn numbers_in_messages_are_readable() {
     let (key, message) = invalid(&circle_with(

@@ -8,9 +8,13 @@ use clap::Args;
 use controller_core::readable::Readable;
 use serde::Serialize;
 
+use controller_core::trajectory::SpeedList;
+use controller_core::TrajectoryKind;
+
 use super::common::load;
 use super::json::print_json;
 use super::Exit;
+use crate::scenario::{KeyPath, ScenarioFile};
 use crate::studies::preflight::profile::{self, SpeedProfile};
 use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 
@@ -72,7 +76,11 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
                 no_speed_profile,
             },
         )?,
-        (false, Some(s)) => writeln!(stdout, "{}", profile_table(&s))?,
+        (false, Some(s)) => writeln!(
+            stdout,
+            "{}",
+            profile_table(scenario.config().trajectory, &s)?
+        )?,
         (false, None) => {
             if let Some(why) = no_speed_profile {
                 writeln!(stdout, "{why}")?;
@@ -139,7 +147,7 @@ fn preflight_table(p: &Preflight) -> String {
 /// The speed profile's part of `check`'s text: time per part, the limiting thruster (or `cap`,
 /// `trajectory.speed_limits`, or `changes`: too short for the speed changes), the totals
 /// against the uniform time scale, and the keys that pin it.
-fn profile_table(p: &SpeedProfile) -> String {
+fn profile_table(path: TrajectoryKind, p: &SpeedProfile) -> Result<String> {
     let mut s = format!(
         "speed profile over the whole box (margin envelope, speed changes at {} m/s²):\n\
          {:<12} {:>10} {:>12} {:>10}  limited by (thruster, cap or changes)\n",
@@ -171,12 +179,43 @@ fn profile_table(p: &SpeedProfile) -> String {
             profile::VERIFY_SHRINK
         ));
     }
-    let speeds: Vec<String> = p.speeds.iter().map(|v| format!("{v:.2}")).collect();
-    s.push_str(&format!(
-        "to pin it, in [trajectory]: speeds = [{}]\nspeed_change = {}  # and duration = {:.1}\n",
-        speeds.join(", "),
-        Readable(p.speed_change),
-        p.total_time
-    ));
-    s
+    s.push_str(&pin(path, p)?);
+    Ok(s)
+}
+
+/// The lines that pin the profile `p` on the waypoint path `path`: a [`ScenarioFile`] of the
+/// path with the profile's `speeds` and `speed_change` and its `duration`, serialized, each
+/// number at the precision the table shows (speeds to the cm/s, the time to the tenth).
+fn pin(path: TrajectoryKind, p: &SpeedProfile) -> Result<String> {
+    let TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius,
+        ..
+    } = path
+    else {
+        bail!("a speed profile of a path without waypoints");
+    };
+    let speeds: Vec<f32> = p.speeds.iter().map(|&v| v as f32).collect();
+    let mut file = ScenarioFile::new(TrajectoryKind::Waypoints {
+        points,
+        speed,
+        turn_radius,
+        speeds: Some(SpeedList::new(&speeds).map_err(|e| anyhow!("the speed profile: {e}"))?),
+        speed_change: Some(p.speed_change as f32),
+    });
+    file.duration = Some(p.total_time);
+    let mut doc = file.to_document()?;
+    doc.set_numbers(KeyPath::SPEEDS, &p.speeds, |v| format!("{v:.2}"))?;
+    doc.set_numbers(KeyPath::SPEED_CHANGE, &[p.speed_change], |a| {
+        Readable(a).to_string()
+    })?;
+    doc.set_numbers(KeyPath::DURATION, &[p.total_time], |t| format!("{t:.1}"))?;
+    Ok(format!(
+        "to pin it, in [{}]: {}\n{}  # and {}\n",
+        KeyPath::SPEEDS.table.unwrap_or_default(),
+        doc.entry(KeyPath::SPEEDS)?,
+        doc.entry(KeyPath::SPEED_CHANGE)?,
+        doc.entry(KeyPath::DURATION)?
+    ))
 }

@@ -115,13 +115,14 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
         for (c, u) in uploads {
             notes += &format!(
                 "- {}: CRC {:#010x}, {} chunks in {} frames, {} bytes on the wire ({:.1} ms at \
-                 460 800 baud), verified after {} round(s), {} chunk(s) resent, {:.3} s\n",
+                 {} baud), verified after {} round(s), {} chunk(s) resent, {:.3} s\n",
                 c.run.name,
                 u.crc,
                 u.chunks,
                 u.frames,
                 u.bytes,
-                u.bytes as f64 * 10.0 / 460_800.0 * 1e3,
+                firmware_images::wire_seconds(u.bytes) * 1e3,
+                firmware_images::LinkBaud,
                 u.rounds,
                 u.resent,
                 u.seconds

@@ -3,7 +3,8 @@
 //! [`Trajectory`]) and its step counts.
 //!
 //! Two stages, each written once:
-//! - **Parsing** ([`parse_scenario`], [`load_scenario`]; `parse.rs`) is about the file's shape.
+//! - **Parsing** ([`parse_scenario`], [`load_scenario`]; [`ScenarioFile`] and `parse.rs`) is
+//!   about the file's shape.
 //!   Every table denies unknown keys (the error names the key and its line), a key that the
 //!   chosen `kind`, `profile` or `model` does not use is an error, not silently ignored, and a
 //!   required one must be there. The `[trajectory]` table is the core's own
@@ -20,125 +21,15 @@
 //!
 //! # Schema
 //!
-//! Every table is optional except `[trajectory]`. Anything left out takes the default of
+//! The file's shape is one type, [`ScenarioFile`] (`file.rs`): the reader deserializes it and
+//! every writer (`import-plan`, `check`'s pinned profile, a campaign's worst-run file)
+//! serializes one (`write.rs`). Every key with its meaning, unit, range and default is shown,
+//! runnable, in **`scenarios/example-all-knobs.toml`** (a test holds it to the type's keys).
+//! Every table is optional except `[trajectory]`; a key left out takes the default of
 //! [`SimConfig::new`] and [`ControllerConfig::default`](controller_core::ControllerConfig) (the
 //! paper's values). Integers are accepted where a number is expected (`duration = 70`).
 //!
-//! ```toml
-//! name = "circular-10R"       # file-name safe; default: the file stem (load_scenario) or "scenario"
-//! table1_case = "circular-10R" # this run is that case of the paper's Table 1: reports print
-//!                             # the paper's numbers beside ours; default: none
-//! duration = 70.0             # s, (0, 86400]; and the step cap below
-//! plant_step = 0.001          # s, (0, 0.1] and ≤ the control period 1/rate_hz
-//! ideal_actuators = true      # thrusters deliver the allocated thrust whatever the voltage limit
-//! initial_offset = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # added to η(0) = η_d(0), m and rad; the
-//!                             # position part ≤ divergence_limit in norm, roll and yaw within
-//!                             # ±π, pitch inside ±π/2
-//! divergence_limit = 50.0     # m, (0, 10000]
-//! thruster_lag = 0.1          # s, (0, 10]; leave out for no lag
-//! expect_faults = false       # true: periods with the controller in fail-safe are reported but
-//!                             # do not fail the command (else exit 3); default false
-//! initial_attitude = "trim"   # "trim" (the payload's static heel) | "level"; default trim for
-//!                             # the real chain, level for ideal actuators
-//! expect_missed = false       # true: a miss of [bound] is reported, no exit 4; default false
-//!
-//! [trajectory]                # required
-//! kind = "circle"             # "circle" | "figure-eight" | "lawn-mower" | "helix" | "waypoints"
-//! radius = 10.0               # circle, helix (required)
-//! amplitude = 15.0            # figure-eight (required)
-//! scale = 1.0                 # lawn-mower (required)
-//! depth_rate = 0.05           # helix (required), m/s, positive descends
-//! omega = 0.1                 # rad/s; default 0.1, lawn-mower 0.05
-//! depth = 5.0                 # m, positive down; default 5
-//! points = [[0.0, 0.0, 5.0], [50.0, 0.0, 5.0]]  # waypoints (required): 2 to 32 points
-//!                             # as [x, y, z] in the mission frame (m, z down; design §27)
-//! speed = 0.5                 # waypoints (required): m/s along the legs, (0, 10]
-//! turn_radius = 2.5           # waypoints, m: the corners' smallest radius; default speed²/0.1
-//! speeds = [2.11, 0.7, 1.5]   # waypoints: the flown speed profile, one per part (leg 0, turn
-//!                             # at 1, leg 1, …; 2n − 3), m/s; `check` proposes it; default none
-//! speed_change = 0.05         # waypoints: the speed changes' peak |σ̈|, m/s²; default 0.05
-//! speed_limits = [1.5, 0.8]   # waypoints: a cap per leg (n − 1 values), m/s in (0, 10]: check's
-//!                             # profile proposes no leg faster (design §27); default none
-//! heading = "paper"           # "paper" | "tangent" (ψ_d along the course); default "paper",
-//!                             # "tangent" for waypoints (their only heading)
-//! time_scale = 1.0            # k in [1, 100]: the reference is η_d(t/k); default 1
-//! origin = [43.295, 5.362, 0.0]  # the frame's origin: lat, lon (deg), alt (m); run then writes
-//!                             # the flown path as GeoJSON; default none
-//!
-//! [variation]                 # Table-3 parameter variation of the plant (not the controller)
-//! profile = "abs-sin"         # "none" | "constant" | "abs-sin" | "staircase" | "table3-staircase"
-//! trimmed = false             # true: payload ballasted to W = B (mass, inertia, CG shift act)
-//! omega = 0.1                 # abs-sin only, rad/s, default 0.1
-//! mass = 30.0                 # constant / abs-sin: Δ (abs-sin: the maximum); see below
-//! x_g = 0.05
-//! y_g = 0.02
-//! z_g = 0.02
-//! ix = 2.0
-//! iy = 5.0
-//! iz = 10.0
-//! x_udot = 3.0
-//! y_vdot = 50.0
-//! # staircase only: one table per step, Δ holds while t ≤ until; the last step's `until` may
-//! # be left out (holds for ever); a step's Δ fields are those above, 0 when left out.
-//! # [[variation.steps]]
-//! # until = 25.0
-//! # mass = 30.0
-//! # x_g = 0.05
-//! # y_g = 0.02
-//! # z_g = 0.02
-//! # ix = 2.0
-//! # iy = 5.0
-//! # iz = 10.0
-//! # x_udot = 3.0
-//! # y_vdot = 50.0
-//!
-//! [current]                   # ocean current, earth frame (NED)
-//! model = "constant"          # "none" | "constant" | "gauss-markov"
-//! velocity = [0.2, 0.1, 0.0]  # constant (required), m/s, ‖velocity‖ ≤ 5 (MAX_CURRENT_SPEED)
-//! mean = [0.0, 0.0, 0.0]      # gauss-markov, m/s, default zeros, ‖mean‖ ≤ 5
-//! sigma = [0.05, 0.05, 0.0]   # gauss-markov (required), m/s, ≥ 0, ‖sigma‖ ≤ 5
-//! tau = 30.0                  # gauss-markov (required), s, > 0
-//! seed = 1                    # gauss-markov, default 1
-//!
-//! [noise]                     # present = measurement noise on; absent = off
-//! eta_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]  # default zeros, ≥ 0; m ≤ divergence_limit, rad ≤ π
-//! nu_sigma = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0]   # default zeros, ≥ 0; m/s ≤ 50, rad/s ≤ 50
-//! seed = 1                                    # default 1
-//!
-//! [controller]
-//! robust = true               # false: u = ū only (the paper's "without Δu")
-//! law = "boundary-layer"      # "boundary-layer" (Theorem 4) | "discontinuous" (Theorem 3)
-//! k1 = [4.0, 4.0, 4.0, 0.0, 4.0, 4.0]  # controlled axes > 0, roll (index 3) = 0
-//! k2 = [4.0, 4.0, 4.0, 0.0, 4.0, 4.0]
-//! q = [1.0, 1.0]              # > 0
-//! beta = 0.605                # (0, 1)
-//! mu = 0.1                    # > 0
-//! delta_max = 25.0            # > 0
-//! rate_hz = 100               # integer ≥ 1
-//! pitch_limit_deg = 80.0      # (0, 90)
-//! voltage_limit = 24.0        # V, > 0
-//! b_bound = "controlled-rows" # "controlled-rows" | "literal"
-//! thrust_unit = "kgf"         # "kgf" | "newton": the unit of Eqs 31–32; default "kgf"
-//! axis_priority = ["pitch", "depth", "yaw", "sway", "surge"]  # the five axes, highest first
-//! reversed_thrusters = ["vert fore", "horz fore", "horz aft"]  # strong side against the
-//!                             # reference axis (+x main, +z vertical, +y horizontal); default:
-//!                             # the core's (this list: fore up, aft down, both to port)
-//!
-//! [bound]                     # a run completing outside it is "missed" (exit 4); default these
-//!                             # two for the real chain (ideal_actuators = false), none for ideal
-//! max_path = 0.05             # m, > 0
-//! saturated = 0.01            # fraction of control periods with a thruster saturated, [0, 1]
-//!
-//! [link_faults]               # processor in the loop only: tick ranges "A..B" (A included)
-//! drop = ["100..101"]         # state frames not sent
-//! corrupt = ["150..152"]      # state frames with a byte flipped
-//! delay = ["200..210"]        # the state from delay_ticks earlier is sent instead
-//! delay_ticks = 5             # default 5
-//! silent = ["300..310"]       # nothing sent at all
-//! lose_upload_chunks = [1]    # a waypoint mission's upload chunks lost on their first sending
-//! ```
-//!
-//! **Arrays** have exactly the length shown (`k1` six numbers, `q` two, `velocity` three…):
+//! **Arrays** have exactly their length (`k1` six numbers, `q` two, `velocity` three…):
 //! more or fewer entries, or an entry that is not a number, is an error at the key.
 //!
 //! **Limits checked with the run as a whole** (each refusal names its key and says why):
@@ -152,8 +43,8 @@
 //! - what the vehicle can meet (**Choice 124**): the start offset (its position part within
 //!   `divergence_limit`, which is at most the controller's 10 km; roll and yaw within ±π, pitch
 //!   inside ±π/2), the current's speed ([`MAX_CURRENT_SPEED`]), the thruster lag
-//!   ([`MAX_THRUSTER_LAG`]) and the noise σ (see the schema): 10³⁰⁸ used to pass and diverge at
-//!   t = 0;
+//!   ([`MAX_THRUSTER_LAG`]) and the noise σ (see the example): 10³⁰⁸ used to pass and diverge
+//!   at t = 0;
 //! - the reference stays inside what the controller accepts as input
 //!   (`controller_core::controller::MAX_POSITION`, `MAX_LINEAR_SPEED`, `MAX_ANGULAR_RATE`;
 //!   checked at every tick up to 10⁵ ticks, else at 10⁵ evenly spaced ones): a faster or
@@ -181,21 +72,28 @@ use controller_core::{Controller, Trajectory};
 use crate::plant::{static_heel, PlantState};
 
 mod config;
+pub mod file;
 mod fixed_arrays;
+mod from_config;
 pub mod paper;
 mod parse;
 pub mod plan;
 pub mod real_vehicle;
 mod start;
 mod validate;
+mod write;
 
 pub use config::{Bound, InitialAttitude, LinkFaults, SensorNoise, SimConfig, TickRange};
+pub use file::ScenarioFile;
+pub use from_config::Unwritable;
 pub use parse::{reversed_mask, DEFAULT_NAME, DEFAULT_SEED};
 pub use start::start_state;
+pub use validate::check_name;
 pub use validate::{
     MAX_CONTROL_PERIODS, MAX_CURRENT_SPEED, MAX_DURATION, MAX_PLANT_STEP, MAX_PLANT_STEPS,
     MAX_THRUSTER_LAG, MAX_VARIATION_OMEGA_STEP,
 };
+pub use write::{KeyPath, ScenarioDocument};
 
 /// Why a scenario could not be loaded or validated.
 #[derive(Debug)]
@@ -212,6 +110,9 @@ pub enum ScenarioError {
     /// e.g. `controller.mu`, `variation.steps[1].until`, or `controller` for a check of the
     /// controller as a whole made by [`Controller::new`].
     Invalid { key: String, message: String },
+    /// A [`ScenarioFile`] that TOML cannot hold (the `toml` crates' message), or a writer's
+    /// layout that does not match the file ([`ScenarioDocument`]).
+    Write(String),
 }
 
 impl fmt::Display for ScenarioError {
@@ -225,6 +126,7 @@ impl fmt::Display for ScenarioError {
             ScenarioError::Invalid { key, message } => {
                 write!(f, "invalid scenario value `{key}`: {message}")
             }
+            ScenarioError::Write(message) => write!(f, "cannot write the scenario: {message}"),
         }
     }
 }
@@ -360,6 +262,15 @@ impl Scenario {
             }
         }
         start_state(&self.trajectory, rate, &offset)
+    }
+}
+
+/// An f32 as the f64 of its shortest decimal (0.1, not 0.10000000149011612): the number a
+/// user wrote, which turns back into the same f32.
+pub fn f32_decimal(x: f32) -> f64 {
+    match x.to_string().parse::<f64>() {
+        Ok(d) if d as f32 == x || x.is_nan() => d,
+        _ => f64::from(x),
     }
 }
 

@@ -7,14 +7,17 @@
 //! test holds them equal to [`config`].
 
 use controller_core::model::ParamVariation;
-use controller_core::Table1Case;
+use controller_core::{Table1Case, Trajectory};
 
-use super::{Scenario, ScenarioError, SimConfig};
+use super::{f32_decimal, Scenario, ScenarioError, SimConfig};
 use crate::plant::VariationProfile;
 
 /// ω of the circles' payload profile Δp(t) = max·|sin ωt| (rad/s): the paper's circle
-/// frequency. Also the scenario files' default for `profile = "abs-sin"`.
-pub const ABS_SIN_OMEGA: f64 = 0.1;
+/// frequency, [`Trajectory::PAPER_OMEGA`] (its decimal 0.1 in f64, not the f32's
+/// 0.10000000149). Also the scenario files' default for `profile = "abs-sin"`.
+pub fn abs_sin_omega() -> f64 {
+    f32_decimal(Trajectory::PAPER_OMEGA)
+}
 
 /// Table 3's lawn-mower column: Δp piecewise constant, each row holding until its time (s);
 /// the last row holds after 50 s. Its first row (0–25 s) is Table 3's maximum.
@@ -54,7 +57,7 @@ pub fn variation(case: Table1Case) -> VariationProfile {
     match case {
         Table1Case::Circular10R | Table1Case::Circular20R => VariationProfile::AbsSin {
             max: ParamVariation::TABLE3_MAX,
-            omega: ABS_SIN_OMEGA,
+            omega: abs_sin_omega(),
         },
         Table1Case::FigureEight30x30 | Table1Case::FigureEight40x40 => {
             VariationProfile::Constant(ParamVariation::TABLE3_MAX)

@@ -1,22 +1,21 @@
-//! TOML → [`SimConfig`]: the file's shape (known keys, keys the chosen kind uses, required
-//! keys, defaults, unit conversions). Values are checked afterwards, once, by
-//! [`Scenario::new`](super::Scenario::new).
-
-use std::fmt;
+//! [`ScenarioFile`] → [`SimConfig`]: the file's shape beyond what serde checks (keys the
+//! chosen kind uses, required keys, defaults, unit conversions). Values are checked
+//! afterwards, once, by [`Scenario::new`](super::Scenario::new).
 
 use controller_core::effectiveness::ThrusterGeometry;
-use controller_core::model::{ParamVariation, VARIED_PARAMETERS, VARIED_PARAMETER_NAMES};
+use controller_core::model::{ParamVariation, VARIED_PARAMETER_NAMES};
 use controller_core::{allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
-use controller_core::{
-    BBound, ControllerConfig, HeadingMode, RobustLaw, Table1Case, ThrustUnit, TrajectoryKind,
-};
-use serde::de::{self, MapAccess, Visitor};
-use serde::{Deserialize, Deserializer};
+use controller_core::{BBound, ControllerConfig, HeadingMode, RobustLaw, Table1Case, ThrustUnit};
 
 use controller_core::effectiveness::THRUSTER_NAMES;
 
+use super::file::{
+    spelled, AttitudeName, BBoundName, ControllerTable, CurrentName, CurrentTable, Delta,
+    HeadingName, LawName, LinkFaultsTable, ProfileName, ScenarioFile, ThrustUnitName,
+    VariationTable,
+};
+use super::paper;
 use super::validate::invalid;
-use super::{fixed_arrays, paper};
 use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
 use crate::plant::{CurrentModel, VariationProfile};
 
@@ -29,290 +28,7 @@ type Res<T> = Result<T, ScenarioError>;
 
 /// Parses `text`; a scenario without `name` is called `default_name`.
 pub(super) fn parse(text: &str, default_name: &str) -> Res<SimConfig> {
-    let raw: RawScenario = toml::from_str(text).map_err(|e| ScenarioError::Toml(e.to_string()))?;
-    build(raw, default_name)
-}
-
-// ---------------------------------------------------------------------------------------------
-// Raw TOML shape.
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawScenario {
-    name: Option<String>,
-    table1_case: Option<String>,
-    duration: Option<f64>,
-    plant_step: Option<f64>,
-    ideal_actuators: Option<bool>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    initial_offset: Option<[f64; 6]>,
-    divergence_limit: Option<f64>,
-    thruster_lag: Option<f64>,
-    expect_faults: Option<bool>,
-    initial_attitude: Option<AttitudeName>,
-    expect_missed: Option<bool>,
-    bound: Option<RawBound>,
-    trajectory: RawTrajectory,
-    variation: Option<RawVariation>,
-    current: Option<RawCurrent>,
-    noise: Option<RawNoise>,
-    controller: Option<RawController>,
-    link_faults: Option<RawLinkFaults>,
-}
-
-/// `[trajectory]`: the path is the core's own type (kind-specific keys, defaults and unknown
-/// keys are its serde form's), plus how the mission is flown: `heading` and `time_scale`.
-#[derive(Deserialize)]
-struct RawTrajectory {
-    heading: Option<HeadingName>,
-    time_scale: Option<f64>,
-    origin: Option<[f64; 3]>,
-    speed_limits: Option<Vec<f64>>,
-    #[serde(flatten)]
-    path: TrajectoryKind,
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum HeadingName {
-    Paper,
-    Tangent,
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum AttitudeName {
-    Level,
-    Trim,
-}
-
-/// `[bound]`: the bound a run must fly within; a key left out takes the real vehicle's.
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawBound {
-    max_path: Option<f64>,
-    saturated: Option<f64>,
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum ThrustUnitName {
-    Kgf,
-    Newton,
-}
-
-/// `[link_faults]`: tick ranges "A..B" (processor in the loop only).
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawLinkFaults {
-    drop: Option<Vec<String>>,
-    corrupt: Option<Vec<String>>,
-    delay: Option<Vec<String>>,
-    delay_ticks: Option<u64>,
-    silent: Option<Vec<String>>,
-    lose_upload_chunks: Option<Vec<u8>>,
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum ProfileName {
-    None,
-    Constant,
-    AbsSin,
-    Staircase,
-    Table3Staircase,
-}
-
-impl ProfileName {
-    fn as_str(self) -> &'static str {
-        match self {
-            ProfileName::None => "none",
-            ProfileName::Constant => "constant",
-            ProfileName::AbsSin => "abs-sin",
-            ProfileName::Staircase => "staircase",
-            ProfileName::Table3Staircase => "table3-staircase",
-        }
-    }
-}
-
-/// The nine Δ of a table, by [`VARIED_PARAMETER_NAMES`]; `None`: not given.
-type RawDelta = [Option<f64>; VARIED_PARAMETERS];
-
-/// `[variation]`: `profile`, `omega`, `steps` and the nine Δ keys.
-struct RawVariation {
-    profile: ProfileName,
-    trimmed: Option<bool>,
-    omega: Option<f64>,
-    steps: Option<Vec<RawStep>>,
-    delta: RawDelta,
-}
-
-/// One `[[variation.steps]]`: `until` and the nine Δ keys.
-struct RawStep {
-    until: Option<f64>,
-    delta: RawDelta,
-}
-
-/// Reads a table whose keys are the nine Δ keys and the ones `own` takes (it returns false for
-/// a key it does not know); anything else is an unknown-field error.
-fn visit_delta_table<'de, A: MapAccess<'de>>(
-    map: &mut A,
-    own_keys: &str,
-    mut own: impl FnMut(&str, &mut A) -> Result<bool, A::Error>,
-) -> Result<RawDelta, A::Error> {
-    let mut delta = [None; VARIED_PARAMETERS];
-    while let Some(key) = map.next_key::<String>()? {
-        if own(&key, map)? {
-            continue;
-        }
-        match VARIED_PARAMETER_NAMES.iter().position(|n| *n == key) {
-            Some(i) => delta[i] = Some(map.next_value()?),
-            None => {
-                return Err(de::Error::custom(format_args!(
-                    "unknown field `{key}`, expected {own_keys} or one of `{}`",
-                    VARIED_PARAMETER_NAMES.join("`, `")
-                )))
-            }
-        }
-    }
-    Ok(delta)
-}
-
-impl<'de> Deserialize<'de> for RawVariation {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct Table;
-        impl<'de> Visitor<'de> for Table {
-            type Value = RawVariation;
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a [variation] table")
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawVariation, A::Error> {
-                let (mut profile, mut omega, mut steps, mut trimmed) = (None, None, None, None);
-                let own = "`profile`, `trimmed`, `omega`, `steps`";
-                let delta = visit_delta_table(&mut map, own, |k, m| {
-                    match k {
-                        "profile" => profile = Some(m.next_value()?),
-                        "trimmed" => trimmed = Some(m.next_value()?),
-                        "omega" => omega = Some(m.next_value()?),
-                        "steps" => steps = Some(m.next_value()?),
-                        _ => return Ok(false),
-                    }
-                    Ok(true)
-                })?;
-                Ok(RawVariation {
-                    profile: profile.ok_or_else(|| de::Error::missing_field("profile"))?,
-                    trimmed,
-                    omega,
-                    steps,
-                    delta,
-                })
-            }
-        }
-        deserializer.deserialize_map(Table)
-    }
-}
-
-impl<'de> Deserialize<'de> for RawStep {
-    fn deserialize<D: Deserializer<'de>>(deserializer: D) -> Result<Self, D::Error> {
-        struct Table;
-        impl<'de> Visitor<'de> for Table {
-            type Value = RawStep;
-            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
-                f.write_str("a [[variation.steps]] table")
-            }
-            fn visit_map<A: MapAccess<'de>>(self, mut map: A) -> Result<RawStep, A::Error> {
-                let mut until = None;
-                let delta = visit_delta_table(&mut map, "`until`", |k, m| {
-                    if k != "until" {
-                        return Ok(false);
-                    }
-                    until = Some(m.next_value()?);
-                    Ok(true)
-                })?;
-                Ok(RawStep { until, delta })
-            }
-        }
-        deserializer.deserialize_map(Table)
-    }
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum CurrentName {
-    None,
-    Constant,
-    GaussMarkov,
-}
-
-impl CurrentName {
-    fn as_str(self) -> &'static str {
-        match self {
-            CurrentName::None => "none",
-            CurrentName::Constant => "constant",
-            CurrentName::GaussMarkov => "gauss-markov",
-        }
-    }
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawCurrent {
-    model: CurrentName,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    velocity: Option<[f64; 3]>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    mean: Option<[f64; 3]>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    sigma: Option<[f64; 3]>,
-    tau: Option<f64>,
-    seed: Option<u64>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawNoise {
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    eta_sigma: Option<[f64; 6]>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    nu_sigma: Option<[f64; 6]>,
-    seed: Option<u64>,
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum LawName {
-    BoundaryLayer,
-    Discontinuous,
-}
-
-#[derive(Clone, Copy, Deserialize)]
-#[serde(rename_all = "kebab-case")]
-enum BBoundName {
-    ControlledRows,
-    Literal,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct RawController {
-    robust: Option<bool>,
-    law: Option<LawName>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    k1: Option<[f64; 6]>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    k2: Option<[f64; 6]>,
-    #[serde(default, deserialize_with = "fixed_arrays::option")]
-    q: Option<[f64; 2]>,
-    beta: Option<f64>,
-    mu: Option<f64>,
-    delta_max: Option<f64>,
-    rate_hz: Option<u32>,
-    pitch_limit_deg: Option<f64>,
-    voltage_limit: Option<f64>,
-    b_bound: Option<BBoundName>,
-    thrust_unit: Option<ThrustUnitName>,
-    axis_priority: Option<Vec<String>>,
-    reversed_thrusters: Option<Vec<String>>,
+    build(ScenarioFile::from_toml(text)?, default_name)
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -349,7 +65,8 @@ fn required<T: Copy>(key: &str, value: Option<T>, what: &str) -> Res<T> {
     value.ok_or_else(|| invalid(key, format!("required with {what}")))
 }
 
-fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
+/// The configuration a file describes; a file without `name` is called `default_name`.
+pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     let name = raw.name.unwrap_or_else(|| default_name.to_string());
     let mut config = SimConfig::new(name, raw.trajectory.path);
     if let Some(h) = raw.trajectory.heading {
@@ -421,7 +138,7 @@ fn build(raw: RawScenario, default_name: &str) -> Res<SimConfig> {
     Ok(config)
 }
 
-fn build_link_faults(raw: &RawLinkFaults) -> Res<LinkFaults> {
+fn build_link_faults(raw: &LinkFaultsTable) -> Res<LinkFaults> {
     let ranges = |key: &str, v: &Option<Vec<String>>| -> Res<Vec<TickRange>> {
         v.iter()
             .flatten()
@@ -442,15 +159,15 @@ fn build_link_faults(raw: &RawLinkFaults) -> Res<LinkFaults> {
 }
 
 /// Δ from its nine fields: `None` if none is given, else the given ones with the rest 0.
-fn build_delta(fields: &RawDelta) -> Option<ParamVariation<f64>> {
+fn build_delta(fields: &Delta) -> Option<ParamVariation<f64>> {
     if fields.iter().all(Option::is_none) {
         return None;
     }
     Some(ParamVariation::from_array(fields.map(|v| v.unwrap_or(0.0))))
 }
 
-fn build_variation(raw: &RawVariation) -> Res<VariationProfile> {
-    let what = format!("profile = \"{}\"", raw.profile.as_str());
+fn build_variation(raw: &VariationTable) -> Res<VariationProfile> {
+    let what = format!("profile = \"{}\"", spelled(&raw.profile));
     let uses_delta = matches!(raw.profile, ProfileName::Constant | ProfileName::AbsSin);
     if !uses_delta {
         for (key, value) in VARIED_PARAMETER_NAMES.iter().zip(&raw.delta) {
@@ -469,7 +186,7 @@ fn build_variation(raw: &RawVariation) -> Res<VariationProfile> {
         ProfileName::Constant => VariationProfile::Constant(delta()),
         ProfileName::AbsSin => VariationProfile::AbsSin {
             max: delta(),
-            omega: raw.omega.unwrap_or(paper::ABS_SIN_OMEGA),
+            omega: raw.omega.unwrap_or_else(paper::abs_sin_omega),
         },
         ProfileName::Table3Staircase => paper::table3_staircase(),
         ProfileName::Staircase => {
@@ -493,8 +210,8 @@ fn build_variation(raw: &RawVariation) -> Res<VariationProfile> {
     })
 }
 
-fn build_current(raw: &RawCurrent) -> Res<CurrentModel> {
-    let what = format!("model = \"{}\"", raw.model.as_str());
+fn build_current(raw: &CurrentTable) -> Res<CurrentModel> {
+    let what = format!("model = \"{}\"", spelled(&raw.model));
     if !matches!(raw.model, CurrentName::Constant) {
         unused("current.velocity", &raw.velocity, &what)?;
     }
@@ -518,7 +235,7 @@ fn build_current(raw: &RawCurrent) -> Res<CurrentModel> {
     })
 }
 
-fn build_controller(raw: &RawController) -> Res<ControllerConfig> {
+fn build_controller(raw: &ControllerTable) -> Res<ControllerConfig> {
     let mut c = ControllerConfig::default();
     if let Some(robust) = raw.robust {
         c.robust = robust;
@@ -612,7 +329,7 @@ pub fn reversed_mask(key: &str, names: &[String]) -> Res<u8> {
 
 /// `controller.axis_priority`: the five actuated axes by name ([`AXIS_NAMES`] without roll),
 /// each once, highest first; equal weights (docs/design.md §9).
-fn axis_priority(order: &[String]) -> Res<AxisPriority> {
+pub(super) fn axis_priority(order: &[String]) -> Res<AxisPriority> {
     let key = "controller.axis_priority";
     let actuated: Vec<&str> = AXIS_NAMES
         .iter()

@@ -11,50 +11,27 @@ use controller_core::{ControllerConfig, Table1Case};
 
 use super::{paper, parse_scenario, Scenario, ScenarioError, SimConfig};
 
+/// `[(file name, its text)]` of files of `scenarios/real/`, each name written once.
+macro_rules! shipped {
+    ($($file:literal),* $(,)?) => {
+        [$(($file, include_str!(concat!("../../scenarios/real/", $file)))),*]
+    };
+}
+
 /// The six real missions, in the order of [`Table1Case::ALL`]: (file name, its text).
-pub const REAL_SCENARIOS: [(&str, &str); 6] = [
-    (
-        "circular-10R.toml",
-        include_str!("../../scenarios/real/circular-10R.toml"),
-    ),
-    (
-        "circular-20R.toml",
-        include_str!("../../scenarios/real/circular-20R.toml"),
-    ),
-    (
-        "figure-eight-30x30.toml",
-        include_str!("../../scenarios/real/figure-eight-30x30.toml"),
-    ),
-    (
-        "figure-eight-40x40.toml",
-        include_str!("../../scenarios/real/figure-eight-40x40.toml"),
-    ),
-    (
-        "lawn-mower-20x10.toml",
-        include_str!("../../scenarios/real/lawn-mower-20x10.toml"),
-    ),
-    (
-        "lawn-mower-30x15.toml",
-        include_str!("../../scenarios/real/lawn-mower-30x15.toml"),
-    ),
+pub const REAL_SCENARIOS: [(&str, &str); 6] = shipped![
+    "circular-10R.toml",
+    "circular-20R.toml",
+    "figure-eight-30x30.toml",
+    "figure-eight-40x40.toml",
+    "lawn-mower-20x10.toml",
+    "lawn-mower-30x15.toml",
 ];
 
 /// The real vehicle's waypoint missions (docs/design.md §27), flown in the same table after
 /// [`REAL_SCENARIOS`]: (file name, its text).
-pub const WAYPOINT_SCENARIOS: [(&str, &str); 3] = [
-    (
-        "survey-200x100.toml",
-        include_str!("../../scenarios/real/survey-200x100.toml"),
-    ),
-    (
-        "harbour-wall.toml",
-        include_str!("../../scenarios/real/harbour-wall.toml"),
-    ),
-    (
-        "pipeline.toml",
-        include_str!("../../scenarios/real/pipeline.toml"),
-    ),
-];
+pub const WAYPOINT_SCENARIOS: [(&str, &str); 3] =
+    shipped!["survey-200x100.toml", "harbour-wall.toml", "pipeline.toml"];
 
 /// The waypoint missions, validated ([`WAYPOINT_SCENARIOS`]).
 pub fn waypoint_scenarios() -> Result<Vec<Scenario>, ScenarioError> {

@@ -423,7 +423,9 @@ fn check_lost_chunks(config: &SimConfig) -> Res<()> {
     }
 }
 
-fn check_name(name: &str) -> Res<()> {
+/// A scenario `name`: used in file names, so not empty, not `.` or `..`, and without `/`, `\` or
+/// a control character (the error is keyed `name`).
+pub fn check_name(name: &str) -> Res<()> {
     if name.trim().is_empty() {
         return Err(invalid("name", "must not be empty"));
     }

@@ -19,6 +19,9 @@ use rand::{RngExt, SeedableRng};
 use sha2::{Digest, Sha256};
 
 use crate::plant::{CurrentModel, VariationProfile};
+use crate::scenario::file::{
+    BoundTable, CurrentName, CurrentTable, ProfileName, ScenarioFile, VariationTable,
+};
 use crate::scenario::{Scenario, ScenarioError};
 use crate::sim::{self, LocalController, Metrics, Recording};
 
@@ -253,60 +256,46 @@ pub fn shard_indices(runs: u64, index: u64, count: u64) -> impl Iterator<Item = 
 
 impl Campaign {
     /// Run `i`'s scenario as a TOML file that `host-sim run` flies bit for bit as the campaign
-    /// did (**Choice 134**): its base's text with the draw written in (`[variation]` constant,
-    /// `[current]` constant, the noise seed, `initial_offset`, `trajectory.time_scale`, the
-    /// campaign's `[bound]`) and the run's name. Numbers are written in their shortest exact
-    /// form, so the file reads back to the same f64.
+    /// did (**Choice 134**): its base's file as written ([`ScenarioFile`]) with the draw written
+    /// in (`[variation]` constant, `[current]` constant, the noise seed, `initial_offset`,
+    /// `trajectory.time_scale`, the campaign's `[bound]`) and the run's name, serialized
+    /// ([`ScenarioFile::to_toml`]). Numbers are written in their shortest exact form, so the
+    /// file reads back to the same f64.
     pub fn scenario_text(&self, i: u64, d: &Draw) -> Result<String, String> {
-        use toml::{Table, Value};
         let base = &self.bases[self.base_of(i)];
-        let mut t: Table = base
-            .text
-            .parse()
-            .map_err(|e| format!("base {}: {e}", base.path))?;
-        let floats = |v: &[f64]| Value::Array(v.iter().map(|x| Value::Float(*x)).collect());
-        t.insert("name".into(), Value::String(self.run_name(i)));
+        let mut file =
+            ScenarioFile::from_toml(&base.text).map_err(|e| format!("base {}: {e}", base.path))?;
+        file.name = Some(self.run_name(i));
         if self.spec.draw.parameters != ParameterDraw::None {
-            let mut v = Table::new();
-            v.insert("profile".into(), Value::String("constant".into()));
-            if let Some(trimmed) = t.get("variation").and_then(|x| x.get("trimmed")) {
-                v.insert("trimmed".into(), trimmed.clone());
-            }
-            let names = controller_core::model::VARIED_PARAMETER_NAMES;
-            for (name, x) in names.iter().zip(d.variation) {
-                v.insert((*name).into(), Value::Float(x));
-            }
-            t.insert("variation".into(), Value::Table(v));
+            file.variation = Some(VariationTable {
+                profile: ProfileName::Constant,
+                trimmed: file.variation.and_then(|v| v.trimmed),
+                omega: None,
+                delta: d.variation.map(Some),
+                steps: None,
+            });
         }
         if self.spec.draw.current.is_some() {
-            let mut c = Table::new();
-            c.insert("model".into(), Value::String("constant".into()));
-            c.insert("velocity".into(), floats(&d.current));
-            t.insert("current".into(), Value::Table(c));
+            file.current = Some(CurrentTable {
+                velocity: Some(d.current),
+                ..CurrentTable::new(CurrentName::Constant)
+            });
         }
-        if let Some(Value::Table(n)) = t.get_mut("noise") {
-            let seed = i64::try_from(d.noise_seed).map_err(|e| e.to_string())?;
-            n.insert("seed".into(), Value::Integer(seed));
+        if let Some(n) = file.noise.as_mut() {
+            n.seed = Some(d.noise_seed);
         }
-        t.insert("initial_offset".into(), floats(&d.initial_offset));
+        file.initial_offset = Some(d.initial_offset);
         if self.spec.draw.mountings.is_some() {
             let names = file::mounting_names(d.mounting);
-            let list = Value::Array(names.iter().map(|n| Value::String(n.to_string())).collect());
-            let controller = t
-                .entry("controller")
-                .or_insert_with(|| Value::Table(Table::new()));
-            if let Value::Table(c) = controller {
-                c.insert("reversed_thrusters".into(), list);
-            }
+            file.controller.get_or_insert_default().reversed_thrusters =
+                Some(names.iter().map(|n| n.to_string()).collect());
         }
-        if let Some(Value::Table(tr)) = t.get_mut("trajectory") {
-            tr.insert("time_scale".into(), Value::Float(f64::from(d.time_scale)));
-        }
+        file.trajectory.time_scale = Some(f64::from(d.time_scale));
         if let Some(b) = self.spec.bound() {
-            let mut bt = Table::new();
-            bt.insert("max_path".into(), Value::Float(b.max_path));
-            bt.insert("saturated".into(), Value::Float(b.saturated));
-            t.insert("bound".into(), Value::Table(bt));
+            file.bound = Some(BoundTable {
+                max_path: Some(b.max_path),
+                saturated: Some(b.saturated),
+            });
         }
         let header = format!(
             "# Run {i} of campaign {} (hash {}), written by `host-sim campaign merge`:\n\
@@ -316,7 +305,7 @@ impl Campaign {
             self.hash,
             base.path
         );
-        toml::to_string(&t)
+        file.to_toml()
             .map(|body| header + &body)
             .map_err(|e| e.to_string())
     }
