@@ -6,14 +6,16 @@
 //! host-sim campaign merge SHARD_DIR… --out DIR [--json]
 //! ```
 //!
-//! `run` without `--shard` takes the shard from the engine (**Choice 137**): Slurm's
-//! `SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN` of `SLURM_ARRAY_TASK_COUNT`, or Kubernetes'
-//! `JOB_COMPLETION_INDEX` of `--shards N` (or `HOST_SIM_SHARDS`); with none of them it is the
-//! whole campaign, 0/1. `{shard}` in `--out` is replaced by the shard's index. A shard exits 0
-//! when it has recorded all its runs, whatever they did (the verdict is the merge's); 130 if
-//! interrupted (rerun it: it skips the runs recorded). `merge` exits 2 when the shards do not
-//! make the campaign exactly (each problem named), 4 when fewer runs than `bound.fraction` are
-//! within bound, else 0.
+//! `run` without `--shard` takes the shard from the engine (**Choice 137**, **Choice 246**):
+//! Slurm's (`SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN`) / `SLURM_ARRAY_TASK_STEP` of
+//! `SLURM_ARRAY_TASK_COUNT`, or Kubernetes' `JOB_COMPLETION_INDEX` of `--shards N` (or
+//! `HOST_SIM_SHARDS`); with none of them it is the whole campaign, 0/1. What is ambiguous is
+//! refused with the reason: a count without an index, counts that disagree, both engines, an
+//! array whose indices are not evenly spaced. `{shard}` in `--out` is replaced by the shard's
+//! index. A shard exits 0 when it has recorded all its runs, whatever they did (the verdict is
+//! the merge's); 130 if interrupted (rerun it: it skips the runs recorded). `merge` exits 2 when
+//! the shards do not make the campaign exactly (each problem named), 4 when
+//! fewer runs than `bound.fraction` are within bound, else 0.
 
 use std::collections::HashSet;
 use std::io::Write;
@@ -63,7 +65,8 @@ pub struct ShardArgs {
     /// This shard, I/N (0 ≤ I < N); default from the engine's environment.
     #[arg(long)]
     pub shard: Option<String>,
-    /// The shard count with JOB_COMPLETION_INDEX (else HOST_SIM_SHARDS).
+    /// The shard count with JOB_COMPLETION_INDEX (else HOST_SIM_SHARDS); with Slurm or
+    /// --shard it must agree with theirs.
     #[arg(long)]
     pub shards: Option<u64>,
     /// The shard's folder (`{shard}` is replaced by I). Rerun into the same folder to resume.
@@ -96,52 +99,122 @@ fn load(path: &Path) -> Result<Campaign> {
     Campaign::load(path).map_err(anyhow::Error::new)
 }
 
-/// The shard I/N from `--shard`, else the engine's environment (`env`), else 0/1.
+/// The shard I/N from `--shard`, else the engine's environment (`env`), else 0/1
+/// (**Choice 137**); what is ambiguous is refused with the reason (**Choice 246**).
 pub fn resolve_shard(
     flag: Option<&str>,
     count: Option<u64>,
     env: impl Fn(&str) -> Option<String>,
 ) -> Result<(u64, u64)> {
-    let num = |what: &str, s: &str| -> Result<u64> {
-        s.trim()
-            .parse()
-            .with_context(|| format!("{what} must be a whole number ≥ 0, got {s:?}"))
-    };
-    let (i, n) = if let Some(s) = flag {
-        let (a, b) = s
-            .split_once('/')
-            .with_context(|| format!("--shard must be I/N, got {s:?}"))?;
-        (num("--shard's I", a)?, num("--shard's N", b)?)
-    } else if let Some(id) = env("SLURM_ARRAY_TASK_ID") {
-        let min = match env("SLURM_ARRAY_TASK_MIN") {
-            Some(m) => num("SLURM_ARRAY_TASK_MIN", &m)?,
-            None => 0,
-        };
-        let n = env("SLURM_ARRAY_TASK_COUNT").context(
-            "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; give --shard I/N",
-        )?;
-        let id = num("SLURM_ARRAY_TASK_ID", &id)?;
-        let i = id
-            .checked_sub(min)
-            .context("SLURM_ARRAY_TASK_ID < SLURM_ARRAY_TASK_MIN")?;
-        (i, num("SLURM_ARRAY_TASK_COUNT", &n)?)
-    } else if let Some(idx) = env("JOB_COMPLETION_INDEX") {
-        let n = match (count, env("HOST_SIM_SHARDS")) {
-            (Some(n), _) => n,
-            (None, Some(s)) => num("HOST_SIM_SHARDS", &s)?,
-            (None, None) => bail!(
-                "JOB_COMPLETION_INDEX is set but not the shard count: give --shards N (the \
-                 Job's completions) or HOST_SIM_SHARDS"
+    let (i, n) = match (
+        flag,
+        env("SLURM_ARRAY_TASK_ID"),
+        env("JOB_COMPLETION_INDEX"),
+    ) {
+        (Some(s), _, _) => {
+            let (a, b) = s
+                .split_once('/')
+                .with_context(|| format!("--shard must be I/N, got {s:?}"))?;
+            let (i, n) = (number("--shard's I", a)?, number("--shard's N", b)?);
+            if count.is_some_and(|c| c != n) {
+                bail!(
+                    "--shard {s} and --shards {} disagree on the shard count; give one of them",
+                    count.unwrap_or_default()
+                );
+            }
+            (i, n)
+        }
+        (None, Some(_), Some(_)) => bail!(
+            "both SLURM_ARRAY_TASK_ID and JOB_COMPLETION_INDEX are set: which engine's index \
+             this shard is, is not known; give --shard I/N"
+        ),
+        (None, Some(id), None) => slurm_shard(&id, count, &env)?,
+        (None, None, Some(idx)) => {
+            let n = match (count, env("HOST_SIM_SHARDS")) {
+                (Some(n), None) => n,
+                (Some(n), Some(s)) if number("HOST_SIM_SHARDS", &s)? == n => n,
+                (Some(n), Some(s)) => bail!(
+                    "--shards {n} and HOST_SIM_SHARDS={s} disagree on the shard count; give one \
+                     of them"
+                ),
+                (None, Some(s)) => number("HOST_SIM_SHARDS", &s)?,
+                (None, None) => bail!(
+                    "JOB_COMPLETION_INDEX is set but not the shard count: give --shards N (the \
+                     Job's completions) or HOST_SIM_SHARDS"
+                ),
+            };
+            (number("JOB_COMPLETION_INDEX", &idx)?, n)
+        }
+        (None, None, None) => match count {
+            None | Some(1) => (0, 1),
+            Some(n) => bail!(
+                "--shards {n} without this shard's index: give --shard I/{n} (or run it as a \
+                 Slurm array task or a Kubernetes Indexed Job, which give the index)"
             ),
-        };
-        (num("JOB_COMPLETION_INDEX", &idx)?, n)
-    } else {
-        (0, count.unwrap_or(1))
+        },
     };
     if n == 0 || i >= n {
         bail!("shard {i}/{n}: need 0 ≤ I < N");
     }
     Ok((i, n))
+}
+
+fn number(what: &str, s: &str) -> Result<u64> {
+    s.trim()
+        .parse()
+        .with_context(|| format!("{what} must be a whole number ≥ 0, got {s:?}"))
+}
+
+/// The shard of Slurm array task `id`: (id − MIN) / STEP of COUNT, for an array of evenly
+/// spaced indices (`--array=A-B`, `--array=A-B:S`); a list that is not (`--array=0,2,3`: MAX is
+/// not MIN + (COUNT − 1)·STEP) has no shard numbering to read, and is refused.
+fn slurm_shard(
+    id: &str,
+    count: Option<u64>,
+    env: &impl Fn(&str) -> Option<String>,
+) -> Result<(u64, u64)> {
+    let var = |k: &str, default: Option<u64>| -> Result<Option<u64>> {
+        env(k)
+            .map(|v| number(k, &v))
+            .transpose()
+            .map(|v| v.or(default))
+    };
+    let id = number("SLURM_ARRAY_TASK_ID", id)?;
+    let min = var("SLURM_ARRAY_TASK_MIN", Some(0))?.unwrap_or_default();
+    let step = var("SLURM_ARRAY_TASK_STEP", Some(1))?.unwrap_or(1);
+    let n = var("SLURM_ARRAY_TASK_COUNT", None)?.context(
+        "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; give --shard I/N",
+    )?;
+    if step == 0 {
+        bail!("SLURM_ARRAY_TASK_STEP is 0; give --shard I/N");
+    }
+    let spaced = n
+        .checked_sub(1)
+        .and_then(|k| k.checked_mul(step))
+        .and_then(|k| k.checked_add(min));
+    if let Some(max) = var("SLURM_ARRAY_TASK_MAX", None)? {
+        if spaced != Some(max) {
+            bail!(
+                "the array's task indices are not evenly spaced (MIN {min}, MAX {max}, STEP \
+                 {step}, COUNT {n}: a list such as --array=0,2,3), so they do not number the \
+                 shards; submit --array=0-{} or give --shard I/N",
+                n.saturating_sub(1)
+            );
+        }
+    }
+    let offset = id
+        .checked_sub(min)
+        .context("SLURM_ARRAY_TASK_ID < SLURM_ARRAY_TASK_MIN")?;
+    if offset % step != 0 {
+        bail!("SLURM_ARRAY_TASK_ID {id} is not MIN {min} plus a multiple of STEP {step}");
+    }
+    if let Some(c) = count.filter(|c| *c != n) {
+        bail!(
+            "SLURM_ARRAY_TASK_COUNT is {n} but --shards {c}: the array has {n} tasks, one a \
+             shard; drop --shards, or submit the array with {c} tasks"
+        );
+    }
+    Ok((offset / step, n))
 }
 
 /// `campaign run`.

@@ -171,3 +171,11 @@ pub fn many_short_runs(dir: &Path) -> PathBuf {
     .unwrap();
     file
 }
+
+/// The exit code and stderr of `out`.
+pub fn refused(out: &Output) -> (Option<i32>, String) {
+    (
+        out.status.code(),
+        String::from_utf8_lossy(&out.stderr).into_owned(),
+    )
+}
