@@ -94,3 +94,39 @@ fn a_bad_campaign_file_is_refused_naming_the_key() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("base.toml") && err.contains("radios"), "{err}");
 }
+
+#[test]
+fn a_metric_listed_twice_is_refused() {
+    let dir = tempdir("metric-twice");
+    let text = campaign_text(5, 1).replace(
+        "metrics = [\"max_path\", \"rms_path\"",
+        "metrics = [\"max_path\", \"rms_path\", \"max_path\"",
+    );
+    let file = write_campaign(&dir, &text);
+    let (code, err) = refused(&run_shard(&file, "0/1", &dir.join("out")));
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains("`metrics`") && err.contains("max_path"),
+        "{err}"
+    );
+}
+
+#[test]
+fn a_base_that_is_not_a_scenario_is_named_without_echoing_its_content() {
+    let dir = tempdir("base-echo");
+    let file = write_campaign(&dir, &campaign_text(5, 1));
+    // Not TOML at all, and TOML that is not a scenario: neither line is printed.
+    for (what, text) in [
+        ("not toml", "token: s3cr3t-f1rst-l1ne\n"),
+        ("not a scenario", "password = \"s3cr3t-f1rst-l1ne\"\n"),
+    ] {
+        std::fs::write(dir.join("base.toml"), text).unwrap();
+        let (code, err) = refused(&run_shard(&file, "0/1", &dir.join("out")));
+        assert_eq!(code, Some(2), "{what}: {err}");
+        assert!(
+            err.contains("base.toml") && err.contains("line 1"),
+            "{what}: {err}"
+        );
+        assert!(!err.contains("s3cr3t"), "{what}: {err}");
+    }
+}
