@@ -17,7 +17,6 @@
 //! the shards do not make the campaign exactly (each problem named), 4 when
 //! fewer runs than `bound.fraction` are within bound, else 0.
 
-use std::collections::HashSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -32,7 +31,7 @@ use crate::output::campaign::{self as out, RecordLog};
 use crate::output::OutputDir;
 use crate::sim::progress::duration_text;
 use crate::studies::campaign::merge::{self, Manifest};
-use crate::studies::campaign::{shard_indices, Campaign};
+use crate::studies::campaign::{Campaign, Done, Shard};
 
 /// `campaign`: plan, run a shard, merge.
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -225,26 +224,24 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
         bail!("{shards} shards for {} runs: some would be empty", c.runs());
     }
     let out = PathBuf::from(a.out.replace("{shard}", &shard.to_string()));
-    let (dir, done) = resume_shard(&c, shard, shards, &out)?;
-    let todo: Vec<u64> = shard_indices(c.runs(), shard, shards)
-        .filter(|i| !done.contains(i))
-        .collect();
-    out::write_manifest(&dir, &Manifest::of(&c, shard, shards, done.len() as u64))?;
+    let part = c.shard(shard, shards);
+    let (dir, done) = resume_shard(&c, part, &out)?;
+    out::write_manifest(&dir, &Manifest::of(&c, shard, shards, done.len()))?;
+    let todo = part.len() - done.len();
     eprintln!(
-        "host-sim: campaign {} shard {shard}/{shards}: {} runs to do ({} recorded before), \
+        "host-sim: campaign {} shard {shard}/{shards}: {todo} runs to do ({} recorded before), \
          {} thread(s)",
         c.spec.name(),
-        todo.len(),
         done.len(),
         rayon::current_num_threads()
     );
     let log = RecordLog::open(&dir)?;
     let (t0, cpu0) = (Instant::now(), cpu_seconds());
-    let new = fly_logged(&c, &todo, &log, &format!("{shard}/{shards}"));
+    let new = fly_logged(&c, part, &done, todo, &log);
     let wall = t0.elapsed().as_secs_f64();
     let cpu = cpu_seconds() - cpu0;
     log.finish()?;
-    let m = Manifest::of(&c, shard, shards, done.len() as u64 + new);
+    let m = Manifest::of(&c, shard, shards, done.len() + new);
     out::write_manifest(&dir, &m)?;
     writeln!(
         stdout,
@@ -271,14 +268,11 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
 }
 
 /// The shard folder `out`, locked and kept (Choice 135): it must hold nothing or this shard of
-/// this campaign; its records read (a torn last line cut, Choice 136) and checked to be this
-/// shard's. Returns the folder and the indices recorded.
-fn resume_shard(
-    c: &Campaign,
-    shard: u64,
-    shards: u64,
-    out: &Path,
-) -> Result<(OutputDir, HashSet<u64>)> {
+/// this campaign (a manifest host-sim wrote whole, Choice 241); its records read one by one (a
+/// torn last line cut, Choice 136) and checked to be this shard's. Returns the folder and the
+/// runs recorded, a bit each (Choice 244).
+fn resume_shard(c: &Campaign, part: Shard, out: &Path) -> Result<(OutputDir, Done)> {
+    let (shard, shards) = (part.index, part.count);
     let dir = OutputDir::resume(out)?;
     if let Some(m) = out::read_manifest(out)? {
         if (m.campaign_hash.as_str(), m.shard, m.shards) != (c.hash.as_str(), shard, shards) {
@@ -293,31 +287,37 @@ fn resume_shard(
             );
         }
     }
-    let done = out::read_records(&out.join(out::RECORDS), true)?;
-    if let Some(r) = done.iter().find(|r| r.index % shards != shard) {
-        bail!(
-            "{} records run {}, which is not shard {shard}/{shards}'s",
-            out.display(),
-            r.index
-        );
-    }
-    Ok((dir, done.iter().map(|r| r.index).collect()))
+    let mut done = Done::new(part);
+    out::for_each_record(&out.join(out::RECORDS), true, |r| {
+        if !part.owns(r.index) {
+            bail!(
+                "{} records run {}, which is not shard {shard}/{shards}'s",
+                out.display(),
+                r.index
+            );
+        }
+        done.insert(r.index);
+        Ok(())
+    })?;
+    Ok((dir, done))
 }
 
-/// Flies `todo` in parallel into `log`, with a progress line on stderr every 5 % (a batch
-/// job's log has no terminal for a bar); returns how many runs were recorded.
-fn fly_logged(c: &Campaign, todo: &[u64], log: &RecordLog, shard: &str) -> u64 {
+/// Flies the `todo` runs of `part` not `done` in parallel into `log`, with a progress line on
+/// stderr every 5 % (a batch job's log has no terminal for a bar); returns how many runs were
+/// recorded.
+fn fly_logged(c: &Campaign, part: Shard, done: &Done, todo: u64, log: &RecordLog) -> u64 {
     let new = AtomicU64::new(0);
     let t0 = Instant::now();
-    let every = (todo.len() as u64).div_ceil(20).max(1);
-    c.run_indices(todo, |r| {
+    let every = todo.div_ceil(20).max(1);
+    c.run_shard(part, done, |r| {
         log.push(&r);
         let k = new.fetch_add(1, Ordering::Relaxed) + 1;
-        if k.is_multiple_of(every) && k < todo.len() as u64 {
+        if k.is_multiple_of(every) && k < todo {
             let s = t0.elapsed().as_secs_f64();
             eprintln!(
-                "host-sim: shard {shard}: {k} of {} runs, {} ({:.1} runs/s)",
-                todo.len(),
+                "host-sim: shard {}/{}: {k} of {todo} runs, {} ({:.1} runs/s)",
+                part.index,
+                part.count,
                 duration_text(s),
                 k as f64 / s.max(1e-9)
             );

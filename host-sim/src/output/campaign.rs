@@ -42,23 +42,36 @@ pub fn read_manifest(dir: &Path) -> Result<Option<Manifest>> {
     }
 }
 
-/// Reads the records of `path` (**Choice 136**). A last line without its newline, or one that
-/// does not parse, is what a killed writer left half-written: with `repair` the file is cut
-/// back to the line before it (the run is redone), else it is left out. A bad line before the
-/// last is an error naming it (the file was edited, or is not a records file).
+/// Reads the records of `path` ([`for_each_record`]), all of them.
 pub fn read_records(path: &Path, repair: bool) -> Result<Vec<Record>> {
+    let mut records = Vec::new();
+    for_each_record(path, repair, |r| {
+        records.push(r);
+        Ok(())
+    })?;
+    Ok(records)
+}
+
+/// Hands each record of `path` to `f`, line by line (**Choice 136**, **Choice 242**): a shard
+/// of 10⁹ runs resumes without holding its records. A last line without its newline is what a
+/// killed writer left half-written: with `repair` the file is cut back to the line before it
+/// (the run is done again), else it is left out. A complete line that is not a record, last or
+/// not, is an error naming it (the file was edited, or is not a records file): a writer writes
+/// the newline last, so only a line without it can be torn.
+pub fn for_each_record(
+    path: &Path,
+    repair: bool,
+    mut f: impl FnMut(Record) -> Result<()>,
+) -> Result<()> {
     use std::io::BufRead;
     let shown = path.display();
     let file = match File::open(path) {
         Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(e).with_context(|| format!("cannot read {shown}")),
     };
-    let total = file.metadata().map(|m| m.len()).unwrap_or(0);
-    // Line by line: a merge of 10⁶ runs holds the records, not their text as well.
     let mut reader = std::io::BufReader::new(file);
     let header = record::header();
-    let mut records = Vec::new();
     let (mut good, mut line_no, mut line) = (0u64, 0usize, String::new());
     loop {
         line.clear();
@@ -69,31 +82,31 @@ pub fn read_records(path: &Path, repair: bool) -> Result<Vec<Record>> {
             break;
         }
         line_no += 1;
-        let complete = line.ends_with('\n');
-        let text = line.trim_end_matches('\n');
-        let parsed = match (line_no, complete) {
-            (_, false) => None,
-            (1, true) => (text == header).then_some(None),
-            (_, true) => Record::parse(text).map(Some),
-        };
-        match parsed {
-            Some(Some(r)) => records.push(r),
-            Some(None) => {}
-            None if good + n as u64 == total && (!complete || line_no > 1) => {
-                // The last line, torn (see the doc).
-                if repair {
-                    cut(path, good)?;
-                }
-                break;
+        let Some(text) = line.strip_suffix('\n') else {
+            // Without its newline: the last line (read_line stops only at one or at the end),
+            // torn (see the doc).
+            if repair {
+                cut(path, good)?;
             }
-            None => bail!(
-                "{shown} line {line_no} is not a campaign record (the file was edited, or is \
-                 not host-sim's); move it away to rerun the shard"
+            break;
+        };
+        match line_no {
+            1 if text == header => {}
+            1 => bail!(
+                "{shown} line 1 is not the records' header (the file was edited, or is not \
+                 host-sim's); move it away to rerun the shard"
             ),
+            _ => match Record::parse(text) {
+                Some(r) => f(r)?,
+                None => bail!(
+                    "{shown} line {line_no} is not a campaign record (the file was edited, or is \
+                     not host-sim's); move it away to rerun the shard"
+                ),
+            },
         }
         good += n as u64;
     }
-    Ok(records)
+    Ok(())
 }
 
 /// Cuts the records file `path` back to its first `len` bytes (a torn last line removed).

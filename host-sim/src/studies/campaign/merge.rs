@@ -36,7 +36,7 @@ pub struct Manifest {
 impl Manifest {
     /// The manifest of `shard`/`shards` of `c` with `done` runs recorded.
     pub fn of(c: &Campaign, shard: u64, shards: u64, done: u64) -> Self {
-        let owned = super::shard_indices(c.runs(), shard, shards).count() as u64;
+        let owned = c.shard(shard, shards).len();
         Manifest {
             campaign_hash: c.hash.clone(),
             program_version: super::PROGRAM_VERSION.to_string(),
