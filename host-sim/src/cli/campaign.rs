@@ -345,18 +345,10 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .iter()
         .map(|d| out::read_shard(d))
         .collect::<Result<Vec<_>>>()?;
-    let records = merge::check(&mut shards).map_err(|e| anyhow::anyhow!("cannot merge:\n{e}"))?;
-    let m = &shards[0].manifest;
-    let c = Campaign::from_manifest(m)
-        .with_context(|| format!("the campaign kept in {}", shards[0].label))?;
-    if c.hash != m.campaign_hash {
-        bail!(
-            "the shards were made by {} and this is {}: a different program flies the runs \
-             differently; merge with the host-sim that made them",
-            m.program_version,
-            crate::studies::campaign::PROGRAM_VERSION
-        );
-    }
+    let cannot = |e: String| anyhow::anyhow!("cannot merge:\n{e}");
+    merge::same_campaign(&shards).map_err(cannot)?;
+    let c = kept_campaign(&shards[0])?;
+    let records = merge::check(&c, &mut shards).map_err(cannot)?;
     let dir = OutputDir::prepare(&a.out)?;
     let merged = out::write_report(&dir, &c, &records)?;
     for e in &merged.incomplete {
@@ -395,6 +387,32 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
     }
     writeln!(stdout, "report: {}", merged.report.display())?;
     Ok(exit)
+}
+
+/// The campaign shard `s` keeps, rebuilt from its texts: it must hash to the manifest's
+/// campaign hash. When it does not, the manifest of this program's version was edited (its
+/// hash recomputed: Choice 241 catches the rest), or another version made it.
+fn kept_campaign(s: &merge::ShardInput) -> Result<Campaign> {
+    let m = &s.manifest;
+    let c =
+        Campaign::from_manifest(m).with_context(|| format!("the campaign kept in {}", s.label))?;
+    if c.hash == m.campaign_hash {
+        return Ok(c);
+    }
+    let ours = crate::studies::campaign::PROGRAM_VERSION;
+    if m.program_version == ours {
+        bail!(
+            "the campaign kept in {}/{} does not give its campaign_hash: the manifest was \
+             edited; run the shard again into a new folder",
+            s.label,
+            out::SHARD_MANIFEST
+        );
+    }
+    bail!(
+        "the shards were made by {} and this is {ours}: a different program flies the runs \
+         differently; merge with the host-sim that made them",
+        m.program_version
+    )
 }
 
 /// `campaign plan`.

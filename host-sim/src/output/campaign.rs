@@ -30,16 +30,20 @@ pub fn write_manifest(dir: &OutputDir, m: &Manifest) -> Result<()> {
     Ok(())
 }
 
-/// Reads a manifest (`dir`/[`SHARD_MANIFEST`]); `None` if there is none.
+/// Reads a manifest (`dir`/[`SHARD_MANIFEST`]); `None` if there is none. A manifest whose
+/// fields do not give its hash, or without one (an earlier host-sim's), is an error naming it
+/// (**Choice 241**).
 pub fn read_manifest(dir: &Path) -> Result<Option<Manifest>> {
     let path = dir.join(SHARD_MANIFEST);
-    match fs::read_to_string(&path) {
+    let m: Manifest = match fs::read_to_string(&path) {
         Ok(text) => serde_json::from_str(&text)
-            .map(Some)
-            .with_context(|| format!("{} is not a shard manifest", path.display())),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(e).with_context(|| format!("cannot read {}", path.display())),
-    }
+            .with_context(|| format!("{} is not a shard manifest", path.display()))?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
+    };
+    m.verify()
+        .map_err(|e| anyhow::anyhow!("{} {e}", path.display()))?;
+    Ok(Some(m))
 }
 
 /// Reads the records of `path` ([`for_each_record`]), all of them.

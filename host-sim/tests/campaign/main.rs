@@ -10,6 +10,7 @@
 mod draws;
 mod engines;
 mod file;
+mod forged;
 mod k8s;
 mod merge;
 mod resume;

@@ -2,6 +2,9 @@
 
 use std::path::PathBuf;
 
+use host_sim::studies::campaign::merge::Manifest;
+use host_sim::studies::campaign::Campaign;
+
 use crate::support::*;
 
 #[test]
@@ -85,18 +88,16 @@ fn merge_names_missing_and_duplicate_shards_and_foreign_ones() {
         err.contains("foreign1 is a shard of another campaign"),
         "{err}"
     );
-    // A shard cut short (its last two runs lost, its manifest saying so) is named incomplete,
-    // and its runs missing.
+    // A shard cut short (its last two runs lost, its manifest saying so, as a shard interrupted
+    // after one run writes it) is named incomplete, and its runs missing.
     let cut = dir.join("cut1");
     ok(run_shard(&file, "1/3", &cut));
     let text = std::fs::read_to_string(cut.join("records.csv")).unwrap();
     let kept: Vec<&str> = text.lines().take(2).collect();
     std::fs::write(cut.join("records.csv"), kept.join("\n") + "\n").unwrap();
-    let mut m: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(cut.join("shard.json")).unwrap()).unwrap();
-    m["done"] = 1.into();
-    m["complete"] = false.into();
-    std::fs::write(cut.join("shard.json"), m.to_string()).unwrap();
+    let c = Campaign::load(&file).unwrap();
+    let m = serde_json::to_string_pretty(&Manifest::of(&c, 1, 3, 1)).unwrap();
+    std::fs::write(cut.join("shard.json"), m).unwrap();
     let out = merge(&[s[0].clone(), cut, s[2].clone()], &dir.join("m"));
     assert_eq!(out.status.code(), Some(2));
     let err = String::from_utf8_lossy(&out.stderr);

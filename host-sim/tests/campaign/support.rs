@@ -172,6 +172,46 @@ pub fn many_short_runs(dir: &Path) -> PathBuf {
     file
 }
 
+/// Copies the files of folder `from` (not its lock) into a new folder `to`.
+pub fn copy_shard(from: &Path, to: &Path) {
+    let _ = std::fs::remove_dir_all(to);
+    std::fs::create_dir_all(to).unwrap();
+    for e in std::fs::read_dir(from).unwrap() {
+        let e = e.unwrap();
+        if e.file_name() != "host-sim.lock" {
+            std::fs::copy(e.path(), to.join(e.file_name())).unwrap();
+        }
+    }
+}
+
+/// Sets column `column` (by its header name) of run `index`'s record in `dir`'s records.csv.
+pub fn edit_record(dir: &Path, index: u64, column: &str, value: &str) {
+    let path = dir.join("records.csv");
+    let text = std::fs::read_to_string(&path).unwrap();
+    let header = text.lines().next().unwrap();
+    let k = header.split(',').position(|c| c == column).unwrap();
+    let lines: Vec<String> = text
+        .lines()
+        .map(|l| {
+            let mut f: Vec<&str> = l.split(',').collect();
+            if f[0] == index.to_string() {
+                f[k] = value;
+            }
+            f.join(",")
+        })
+        .collect();
+    std::fs::write(&path, lines.join("\n") + "\n").unwrap();
+}
+
+/// Changes `dir`'s shard.json through `f`.
+pub fn edit_manifest(dir: &Path, f: impl FnOnce(&mut serde_json::Value)) {
+    let path = dir.join("shard.json");
+    let mut m: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(&path).unwrap()).unwrap();
+    f(&mut m);
+    std::fs::write(&path, m.to_string()).unwrap();
+}
+
 /// The exit code and stderr of `out`.
 pub fn refused(out: &Output) -> (Option<i32>, String) {
     (

@@ -354,6 +354,14 @@ impl Campaign {
         }
     }
 
+    /// The bound run `i` is held to: the campaign's, else its base's ([`Campaign::scenario`]
+    /// sets the campaign's on the base).
+    pub fn bound_of(&self, i: u64) -> Option<crate::scenario::Bound> {
+        self.spec
+            .bound()
+            .or_else(|| self.bases[self.base_of(i)].scenario.config().bound())
+    }
+
     /// Seconds of CPU per run, from one calibration run of each base
     /// ([`crate::studies::montecarlo::CALIBRATION_SECONDS`] of simulated time), scaled by plant
     /// steps to the bases' durations and averaged over the bases as the runs use them.
