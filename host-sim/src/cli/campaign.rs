@@ -340,6 +340,7 @@ fn cpu_seconds() -> f64 {
 
 /// `campaign merge`.
 fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    out_apart(&a.out, &a.shards)?;
     let mut shards = a
         .shards
         .iter()
@@ -413,6 +414,53 @@ fn kept_campaign(s: &merge::ShardInput) -> Result<Campaign> {
          differently; merge with the host-sim that made them",
         m.program_version
     )
+}
+
+/// The merge's `--out` must be apart from every shard folder (**Choice 243**): not one of them,
+/// not inside one, not holding one (the merge clears its output folder first). Compared as the
+/// file system resolves them (symlinks, `..`), the part of `--out` not yet made as written.
+fn out_apart(out: &Path, shards: &[PathBuf]) -> Result<()> {
+    let o = resolved(out)?;
+    for s in shards {
+        let d = resolved(s)?;
+        let how = if o == d {
+            "is"
+        } else if d.starts_with(&o) {
+            "holds"
+        } else if o.starts_with(&d) {
+            "is inside"
+        } else {
+            continue;
+        };
+        bail!(
+            "--out {} {how} the shard folder {}: the merge would overwrite its records; give an \
+             output folder apart from the shards",
+            out.display(),
+            s.display()
+        );
+    }
+    Ok(())
+}
+
+/// `p` absolute, each existing prefix resolved as the file system does (symlinks, then `..`
+/// from where they lead), the rest taken as written.
+fn resolved(p: &Path) -> Result<PathBuf> {
+    use std::path::Component;
+    let abs = std::path::absolute(p).with_context(|| format!("cannot resolve {}", p.display()))?;
+    let mut r = PathBuf::new();
+    for part in abs.components() {
+        match part {
+            Component::ParentDir => {
+                r.pop();
+            }
+            Component::CurDir => {}
+            other => r.push(other),
+        }
+        if let Ok(real) = r.canonicalize() {
+            r = real;
+        }
+    }
+    Ok(r)
 }
 
 /// `campaign plan`.

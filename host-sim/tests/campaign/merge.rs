@@ -109,3 +109,38 @@ fn merge_names_missing_and_duplicate_shards_and_foreign_ones() {
     // The three shards merge.
     ok(merge(&s, &dir.join("m")));
 }
+
+#[test]
+fn the_merge_refuses_an_output_folder_that_is_contains_or_is_inside_a_shard() {
+    let dir = tempdir("merge-out");
+    let file = write_campaign(&dir, &campaign_text(4, 2));
+    let shards = dir.join("shards");
+    let s: Vec<PathBuf> = (0..2)
+        .map(|i| {
+            let out = shards.join(format!("s{i}"));
+            ok(run_shard(&file, &format!("{i}/2"), &out));
+            out
+        })
+        .collect();
+    let before: Vec<Vec<u8>> = s
+        .iter()
+        .map(|d| std::fs::read(d.join("records.csv")).unwrap())
+        .collect();
+    // The shard itself (also spelt another way), the folder holding it, a folder inside it.
+    for out in [
+        s[1].clone(),
+        shards.join("s0/../s1"),
+        shards.clone(),
+        s[0].join("report"),
+    ] {
+        let (code, err) = refused(&merge(&s, &out));
+        assert_eq!(code, Some(2), "{}: {err}", out.display());
+        assert!(err.contains("--out"), "{}: {err}", out.display());
+    }
+    for (d, b) in s.iter().zip(&before) {
+        assert!(std::fs::read(d.join("records.csv")).unwrap() == *b);
+        assert!(d.join("shard.json").exists());
+    }
+    assert!(!s[0].join("report").exists());
+    ok(merge(&s, &dir.join("report")));
+}
