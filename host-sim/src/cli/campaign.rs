@@ -14,7 +14,7 @@
 //! array whose indices are not evenly spaced. `{shard}` in `--out` is replaced by the shard's
 //! index. A shard exits 0 when it has recorded all its runs, whatever they did (the verdict is
 //! the merge's); 130 if interrupted (rerun it: it skips the runs recorded). `merge` exits 2 when
-//! the shards do not make the campaign exactly (each problem named), 4 when
+//! the shards do not make the campaign exactly (each problem named), 1 when no run flew, 4 when
 //! fewer runs than `bound.fraction` are within bound, else 0.
 
 use std::io::Write;
@@ -355,10 +355,26 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
     for e in &merged.incomplete {
         eprintln!("host-sim: error: {e}");
     }
+    // No run flew (every draw invalid): the report says nothing of the controller (Choice 245).
+    let none_flew = merged.invalid == merged.runs;
+    if none_flew {
+        eprintln!(
+            "host-sim: error: no run flew: each of the {} draws made a scenario that does not \
+             validate (each reason is on its shard's stderr); the report says nothing of the \
+             controller",
+            merged.runs
+        );
+    }
     let missed = merged
         .required
         .is_some_and(|f| (merged.within as f64) < f * merged.runs as f64);
-    let exit = Exit::of(!merged.incomplete.is_empty(), false, false, false, missed);
+    let exit = Exit::of(
+        !merged.incomplete.is_empty(),
+        false,
+        none_flew,
+        false,
+        missed,
+    );
     if a.json {
         let text = std::fs::read_to_string(a.out.join(out::SUMMARY))
             .with_context(|| format!("reading {}", a.out.join(out::SUMMARY).display()))?;
@@ -367,13 +383,17 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
     }
     writeln!(
         stdout,
-        "campaign {}: {} runs from {} shard(s); within bound {} ({:.4} %), diverged {}",
+        "campaign {}: {} runs from {} shard(s); within bound {} ({:.4} %), diverged {}{}",
         c.spec.name(),
         merged.runs,
         shards.len(),
         merged.within,
         100.0 * merged.within as f64 / merged.runs.max(1) as f64,
-        merged.diverged
+        merged.diverged,
+        match merged.invalid {
+            0 => String::new(),
+            k => format!(", invalid {k} (not flown)"),
+        }
     )?;
     for s in &merged.stats {
         writeln!(

@@ -205,6 +205,8 @@ pub struct Merged {
     pub within: usize,
     pub runs: usize,
     pub diverged: usize,
+    /// Runs not flown: their draw made a scenario that does not validate.
+    pub invalid: usize,
     /// The campaign's required fraction within bound, when it sets one.
     pub required: Option<f64>,
     /// Outputs that could not be written (plots).
@@ -251,6 +253,7 @@ pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result
         within,
         runs: records.len(),
         diverged: count(records, Outcome::Diverged),
+        invalid: count(records, Outcome::Invalid),
         required: c.spec.required_fraction(),
         incomplete,
     };

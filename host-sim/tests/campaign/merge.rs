@@ -144,3 +144,24 @@ fn the_merge_refuses_an_output_folder_that_is_contains_or_is_inside_a_shard() {
     assert!(!s[0].join("report").exists());
     ok(merge(&s, &dir.join("report")));
 }
+
+#[test]
+fn a_campaign_in_which_no_run_flew_fails_and_says_so() {
+    let dir = tempdir("none-flew");
+    // Start offsets of up to ±1000 km: beyond the divergence limit, every draw is invalid.
+    let text = campaign_text(3, 2).replace(
+        "initial_offset = [0.02, 0.02, 0.02, 0.0, 0.0, 0.02]",
+        "initial_offset = [1e6, 1e6, 1e6, 0.0, 0.0, 0.0]",
+    );
+    let file = write_campaign(&dir, &text);
+    ok(run_shard(&file, "0/1", &dir.join("s")));
+    let r = records(&dir.join("s/records.csv"));
+    assert!(r.iter().all(|r| r.outcome.as_str() == "invalid"));
+    let out = merge(&[dir.join("s")], &dir.join("m"));
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    assert_eq!(out.status.code(), Some(1), "{stdout}");
+    assert!(stdout.contains("invalid 3"), "{stdout}");
+    assert!(String::from_utf8_lossy(&out.stderr).contains("no run flew"));
+    // The report is written all the same.
+    assert!(dir.join("m/report.md").exists());
+}
