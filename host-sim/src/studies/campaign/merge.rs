@@ -166,30 +166,7 @@ pub fn check(c: &Campaign, shards: &mut [ShardInput]) -> Result<Vec<Record>, Str
     let runs = c.runs();
     let mut problems = Vec::new();
     shard_problems(c, shards, &mut problems);
-    let mut bad: Vec<String> = Vec::new();
-    let mut bad_count = 0usize;
-    for s in shards.iter() {
-        for r in &s.records {
-            if let Some(p) = record_problem(c, s, r) {
-                bad_count += 1;
-                if bad.len() < LISTED {
-                    bad.push(format!("  {p}"));
-                }
-            }
-        }
-    }
-    if bad_count > 0 {
-        problems.push(format!(
-            "{bad_count} record(s) that the campaign did not make (edited, moved, or written by \
-             another program){}:\n{}",
-            if bad_count > LISTED {
-                ", the first"
-            } else {
-                ""
-            },
-            bad.join("\n")
-        ));
-    }
+    problems.extend(records_problem(c, shards));
     // Every record with its shard, sorted by index: duplicates are neighbours, gaps are missing
     // runs. The records are moved, not copied (a merge of 10⁶ runs holds them once).
     let mut order: Vec<(u64, usize, Record)> = shards
@@ -242,6 +219,29 @@ pub fn check(c: &Campaign, shards: &mut [ShardInput]) -> Result<Vec<Record>, Str
         return Err(problems.join("\n"));
     }
     Ok(order.into_iter().map(|o| o.2).collect())
+}
+
+/// The records of `shards` that campaign `c` did not make ([`record_problem`]): how many, and
+/// the first [`LISTED`].
+fn records_problem(c: &Campaign, shards: &[ShardInput]) -> Option<String> {
+    let mut bad: Vec<String> = Vec::new();
+    let mut count = 0usize;
+    for s in shards {
+        for p in s.records.iter().filter_map(|r| record_problem(c, s, r)) {
+            count += 1;
+            if bad.len() < LISTED {
+                bad.push(format!("  {p}"));
+            }
+        }
+    }
+    (count > 0).then(|| {
+        format!(
+            "{count} record(s) that the campaign did not make (edited, moved, or written by \
+             another program){}:\n{}",
+            if count > LISTED { ", the first" } else { "" },
+            bad.join("\n")
+        )
+    })
 }
 
 /// Why record `r` of shard `s` is not one campaign `c` made, if it is not: an index outside
