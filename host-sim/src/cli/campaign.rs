@@ -6,16 +6,17 @@
 //! host-sim campaign merge SHARD_DIR… --out DIR [--json]
 //! ```
 //!
-//! `run` without `--shard` takes the shard from the engine (**Choice 137**): Slurm's
-//! `SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN` of `SLURM_ARRAY_TASK_COUNT`, or Kubernetes'
-//! `JOB_COMPLETION_INDEX` of `--shards N` (or `HOST_SIM_SHARDS`); with none of them it is the
-//! whole campaign, 0/1. `{shard}` in `--out` is replaced by the shard's index. A shard exits 0
-//! when it has recorded all its runs, whatever they did (the verdict is the merge's); 130 if
-//! interrupted (rerun it: it skips the runs recorded). `merge` exits 2 when the shards do not
-//! make the campaign exactly (each problem named), 4 when fewer runs than `bound.fraction` are
-//! within bound, else 0.
+//! `run` without `--shard` takes the shard from the engine (**Choice 137**, **Choice 246**):
+//! Slurm's (`SLURM_ARRAY_TASK_ID` − `SLURM_ARRAY_TASK_MIN`) / `SLURM_ARRAY_TASK_STEP` of
+//! `SLURM_ARRAY_TASK_COUNT`, or Kubernetes' `JOB_COMPLETION_INDEX` of `--shards N` (or
+//! `HOST_SIM_SHARDS`); with none of them it is the whole campaign, 0/1. What is ambiguous is
+//! refused with the reason: a count without an index, counts that disagree, both engines, an
+//! array whose indices are not evenly spaced. `{shard}` in `--out` is replaced by the shard's
+//! index. A shard exits 0 when it has recorded all its runs, whatever they did (the verdict is
+//! the merge's); 130 if interrupted (rerun it: it skips the runs recorded). `merge` exits 2 when
+//! the shards do not make the campaign exactly (each problem named), 1 when no run flew, 4 when
+//! fewer runs than `bound.fraction` are within bound, else 0.
 
-use std::collections::HashSet;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -30,7 +31,7 @@ use crate::output::campaign::{self as out, RecordLog};
 use crate::output::OutputDir;
 use crate::sim::progress::duration_text;
 use crate::studies::campaign::merge::{self, Manifest};
-use crate::studies::campaign::{shard_indices, Campaign};
+use crate::studies::campaign::{Campaign, Done, Shard};
 
 /// `campaign`: plan, run a shard, merge.
 #[derive(Args, Clone, Debug, PartialEq)]
@@ -63,7 +64,8 @@ pub struct ShardArgs {
     /// This shard, I/N (0 ≤ I < N); default from the engine's environment.
     #[arg(long)]
     pub shard: Option<String>,
-    /// The shard count with JOB_COMPLETION_INDEX (else HOST_SIM_SHARDS).
+    /// The shard count with JOB_COMPLETION_INDEX (else HOST_SIM_SHARDS); with Slurm or
+    /// --shard it must agree with theirs.
     #[arg(long)]
     pub shards: Option<u64>,
     /// The shard's folder (`{shard}` is replaced by I). Rerun into the same folder to resume.
@@ -96,52 +98,122 @@ fn load(path: &Path) -> Result<Campaign> {
     Campaign::load(path).map_err(anyhow::Error::new)
 }
 
-/// The shard I/N from `--shard`, else the engine's environment (`env`), else 0/1.
+/// The shard I/N from `--shard`, else the engine's environment (`env`), else 0/1
+/// (**Choice 137**); what is ambiguous is refused with the reason (**Choice 246**).
 pub fn resolve_shard(
     flag: Option<&str>,
     count: Option<u64>,
     env: impl Fn(&str) -> Option<String>,
 ) -> Result<(u64, u64)> {
-    let num = |what: &str, s: &str| -> Result<u64> {
-        s.trim()
-            .parse()
-            .with_context(|| format!("{what} must be a whole number ≥ 0, got {s:?}"))
-    };
-    let (i, n) = if let Some(s) = flag {
-        let (a, b) = s
-            .split_once('/')
-            .with_context(|| format!("--shard must be I/N, got {s:?}"))?;
-        (num("--shard's I", a)?, num("--shard's N", b)?)
-    } else if let Some(id) = env("SLURM_ARRAY_TASK_ID") {
-        let min = match env("SLURM_ARRAY_TASK_MIN") {
-            Some(m) => num("SLURM_ARRAY_TASK_MIN", &m)?,
-            None => 0,
-        };
-        let n = env("SLURM_ARRAY_TASK_COUNT").context(
-            "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; give --shard I/N",
-        )?;
-        let id = num("SLURM_ARRAY_TASK_ID", &id)?;
-        let i = id
-            .checked_sub(min)
-            .context("SLURM_ARRAY_TASK_ID < SLURM_ARRAY_TASK_MIN")?;
-        (i, num("SLURM_ARRAY_TASK_COUNT", &n)?)
-    } else if let Some(idx) = env("JOB_COMPLETION_INDEX") {
-        let n = match (count, env("HOST_SIM_SHARDS")) {
-            (Some(n), _) => n,
-            (None, Some(s)) => num("HOST_SIM_SHARDS", &s)?,
-            (None, None) => bail!(
-                "JOB_COMPLETION_INDEX is set but not the shard count: give --shards N (the \
-                 Job's completions) or HOST_SIM_SHARDS"
+    let (i, n) = match (
+        flag,
+        env("SLURM_ARRAY_TASK_ID"),
+        env("JOB_COMPLETION_INDEX"),
+    ) {
+        (Some(s), _, _) => {
+            let (a, b) = s
+                .split_once('/')
+                .with_context(|| format!("--shard must be I/N, got {s:?}"))?;
+            let (i, n) = (number("--shard's I", a)?, number("--shard's N", b)?);
+            if count.is_some_and(|c| c != n) {
+                bail!(
+                    "--shard {s} and --shards {} disagree on the shard count; give one of them",
+                    count.unwrap_or_default()
+                );
+            }
+            (i, n)
+        }
+        (None, Some(_), Some(_)) => bail!(
+            "both SLURM_ARRAY_TASK_ID and JOB_COMPLETION_INDEX are set: which engine's index \
+             this shard is, is not known; give --shard I/N"
+        ),
+        (None, Some(id), None) => slurm_shard(&id, count, &env)?,
+        (None, None, Some(idx)) => {
+            let n = match (count, env("HOST_SIM_SHARDS")) {
+                (Some(n), None) => n,
+                (Some(n), Some(s)) if number("HOST_SIM_SHARDS", &s)? == n => n,
+                (Some(n), Some(s)) => bail!(
+                    "--shards {n} and HOST_SIM_SHARDS={s} disagree on the shard count; give one \
+                     of them"
+                ),
+                (None, Some(s)) => number("HOST_SIM_SHARDS", &s)?,
+                (None, None) => bail!(
+                    "JOB_COMPLETION_INDEX is set but not the shard count: give --shards N (the \
+                     Job's completions) or HOST_SIM_SHARDS"
+                ),
+            };
+            (number("JOB_COMPLETION_INDEX", &idx)?, n)
+        }
+        (None, None, None) => match count {
+            None | Some(1) => (0, 1),
+            Some(n) => bail!(
+                "--shards {n} without this shard's index: give --shard I/{n} (or run it as a \
+                 Slurm array task or a Kubernetes Indexed Job, which give the index)"
             ),
-        };
-        (num("JOB_COMPLETION_INDEX", &idx)?, n)
-    } else {
-        (0, count.unwrap_or(1))
+        },
     };
     if n == 0 || i >= n {
         bail!("shard {i}/{n}: need 0 ≤ I < N");
     }
     Ok((i, n))
+}
+
+fn number(what: &str, s: &str) -> Result<u64> {
+    s.trim()
+        .parse()
+        .with_context(|| format!("{what} must be a whole number ≥ 0, got {s:?}"))
+}
+
+/// The shard of Slurm array task `id`: (id − MIN) / STEP of COUNT, for an array of evenly
+/// spaced indices (`--array=A-B`, `--array=A-B:S`); a list that is not (`--array=0,2,3`: MAX is
+/// not MIN + (COUNT − 1)·STEP) has no shard numbering to read, and is refused.
+fn slurm_shard(
+    id: &str,
+    count: Option<u64>,
+    env: &impl Fn(&str) -> Option<String>,
+) -> Result<(u64, u64)> {
+    let var = |k: &str, default: Option<u64>| -> Result<Option<u64>> {
+        env(k)
+            .map(|v| number(k, &v))
+            .transpose()
+            .map(|v| v.or(default))
+    };
+    let id = number("SLURM_ARRAY_TASK_ID", id)?;
+    let min = var("SLURM_ARRAY_TASK_MIN", Some(0))?.unwrap_or_default();
+    let step = var("SLURM_ARRAY_TASK_STEP", Some(1))?.unwrap_or(1);
+    let n = var("SLURM_ARRAY_TASK_COUNT", None)?.context(
+        "SLURM_ARRAY_TASK_ID is set but SLURM_ARRAY_TASK_COUNT is not; give --shard I/N",
+    )?;
+    if step == 0 {
+        bail!("SLURM_ARRAY_TASK_STEP is 0; give --shard I/N");
+    }
+    let spaced = n
+        .checked_sub(1)
+        .and_then(|k| k.checked_mul(step))
+        .and_then(|k| k.checked_add(min));
+    if let Some(max) = var("SLURM_ARRAY_TASK_MAX", None)? {
+        if spaced != Some(max) {
+            bail!(
+                "the array's task indices are not evenly spaced (MIN {min}, MAX {max}, STEP \
+                 {step}, COUNT {n}: a list such as --array=0,2,3), so they do not number the \
+                 shards; submit --array=0-{} or give --shard I/N",
+                n.saturating_sub(1)
+            );
+        }
+    }
+    let offset = id
+        .checked_sub(min)
+        .context("SLURM_ARRAY_TASK_ID < SLURM_ARRAY_TASK_MIN")?;
+    if offset % step != 0 {
+        bail!("SLURM_ARRAY_TASK_ID {id} is not MIN {min} plus a multiple of STEP {step}");
+    }
+    if let Some(c) = count.filter(|c| *c != n) {
+        bail!(
+            "SLURM_ARRAY_TASK_COUNT is {n} but --shards {c}: the array has {n} tasks, one a \
+             shard; drop --shards, or submit the array with {c} tasks"
+        );
+    }
+    Ok((offset / step, n))
 }
 
 /// `campaign run`.
@@ -152,26 +224,24 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
         bail!("{shards} shards for {} runs: some would be empty", c.runs());
     }
     let out = PathBuf::from(a.out.replace("{shard}", &shard.to_string()));
-    let (dir, done) = resume_shard(&c, shard, shards, &out)?;
-    let todo: Vec<u64> = shard_indices(c.runs(), shard, shards)
-        .filter(|i| !done.contains(i))
-        .collect();
-    out::write_manifest(&dir, &Manifest::of(&c, shard, shards, done.len() as u64))?;
+    let part = c.shard(shard, shards);
+    let (dir, done) = resume_shard(&c, part, &out)?;
+    out::write_manifest(&dir, &Manifest::of(&c, shard, shards, done.len()))?;
+    let todo = part.len() - done.len();
     eprintln!(
-        "host-sim: campaign {} shard {shard}/{shards}: {} runs to do ({} recorded before), \
+        "host-sim: campaign {} shard {shard}/{shards}: {todo} runs to do ({} recorded before), \
          {} thread(s)",
         c.spec.name(),
-        todo.len(),
         done.len(),
         rayon::current_num_threads()
     );
     let log = RecordLog::open(&dir)?;
     let (t0, cpu0) = (Instant::now(), cpu_seconds());
-    let new = fly_logged(&c, &todo, &log, &format!("{shard}/{shards}"));
+    let new = fly_logged(&c, part, &done, todo, &log);
     let wall = t0.elapsed().as_secs_f64();
     let cpu = cpu_seconds() - cpu0;
     log.finish()?;
-    let m = Manifest::of(&c, shard, shards, done.len() as u64 + new);
+    let m = Manifest::of(&c, shard, shards, done.len() + new);
     out::write_manifest(&dir, &m)?;
     writeln!(
         stdout,
@@ -198,14 +268,11 @@ fn run_shard(a: &ShardArgs, stdout: &mut dyn Write) -> Result<Exit> {
 }
 
 /// The shard folder `out`, locked and kept (Choice 135): it must hold nothing or this shard of
-/// this campaign; its records read (a torn last line cut, Choice 136) and checked to be this
-/// shard's. Returns the folder and the indices recorded.
-fn resume_shard(
-    c: &Campaign,
-    shard: u64,
-    shards: u64,
-    out: &Path,
-) -> Result<(OutputDir, HashSet<u64>)> {
+/// this campaign (a manifest host-sim wrote whole, Choice 241); its records read one by one (a
+/// torn last line cut, Choice 136) and checked to be this shard's. Returns the folder and the
+/// runs recorded, a bit each (Choice 244).
+fn resume_shard(c: &Campaign, part: Shard, out: &Path) -> Result<(OutputDir, Done)> {
+    let (shard, shards) = (part.index, part.count);
     let dir = OutputDir::resume(out)?;
     if let Some(m) = out::read_manifest(out)? {
         if (m.campaign_hash.as_str(), m.shard, m.shards) != (c.hash.as_str(), shard, shards) {
@@ -220,31 +287,37 @@ fn resume_shard(
             );
         }
     }
-    let done = out::read_records(&out.join(out::RECORDS), true)?;
-    if let Some(r) = done.iter().find(|r| r.index % shards != shard) {
-        bail!(
-            "{} records run {}, which is not shard {shard}/{shards}'s",
-            out.display(),
-            r.index
-        );
-    }
-    Ok((dir, done.iter().map(|r| r.index).collect()))
+    let mut done = Done::new(part);
+    out::for_each_record(&out.join(out::RECORDS), true, |r| {
+        if !part.owns(r.index) {
+            bail!(
+                "{} records run {}, which is not shard {shard}/{shards}'s",
+                out.display(),
+                r.index
+            );
+        }
+        done.insert(r.index);
+        Ok(())
+    })?;
+    Ok((dir, done))
 }
 
-/// Flies `todo` in parallel into `log`, with a progress line on stderr every 5 % (a batch
-/// job's log has no terminal for a bar); returns how many runs were recorded.
-fn fly_logged(c: &Campaign, todo: &[u64], log: &RecordLog, shard: &str) -> u64 {
+/// Flies the `todo` runs of `part` not `done` in parallel into `log`, with a progress line on
+/// stderr every 5 % (a batch job's log has no terminal for a bar); returns how many runs were
+/// recorded.
+fn fly_logged(c: &Campaign, part: Shard, done: &Done, todo: u64, log: &RecordLog) -> u64 {
     let new = AtomicU64::new(0);
     let t0 = Instant::now();
-    let every = (todo.len() as u64).div_ceil(20).max(1);
-    c.run_indices(todo, |r| {
+    let every = todo.div_ceil(20).max(1);
+    c.run_shard(part, done, |r| {
         log.push(&r);
         let k = new.fetch_add(1, Ordering::Relaxed) + 1;
-        if k.is_multiple_of(every) && k < todo.len() as u64 {
+        if k.is_multiple_of(every) && k < todo {
             let s = t0.elapsed().as_secs_f64();
             eprintln!(
-                "host-sim: shard {shard}: {k} of {} runs, {} ({:.1} runs/s)",
-                todo.len(),
+                "host-sim: shard {}/{}: {k} of {todo} runs, {} ({:.1} runs/s)",
+                part.index,
+                part.count,
                 duration_text(s),
                 k as f64 / s.max(1e-9)
             );
@@ -267,32 +340,41 @@ fn cpu_seconds() -> f64 {
 
 /// `campaign merge`.
 fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
+    out_apart(&a.out, &a.shards)?;
     let mut shards = a
         .shards
         .iter()
         .map(|d| out::read_shard(d))
         .collect::<Result<Vec<_>>>()?;
-    let records = merge::check(&mut shards).map_err(|e| anyhow::anyhow!("cannot merge:\n{e}"))?;
-    let m = &shards[0].manifest;
-    let c = Campaign::from_manifest(m)
-        .with_context(|| format!("the campaign kept in {}", shards[0].label))?;
-    if c.hash != m.campaign_hash {
-        bail!(
-            "the shards were made by {} and this is {}: a different program flies the runs \
-             differently; merge with the host-sim that made them",
-            m.program_version,
-            crate::studies::campaign::PROGRAM_VERSION
-        );
-    }
+    let cannot = |e: String| anyhow::anyhow!("cannot merge:\n{e}");
+    merge::same_campaign(&shards).map_err(cannot)?;
+    let c = kept_campaign(&shards[0])?;
+    let records = merge::check(&c, &mut shards).map_err(cannot)?;
     let dir = OutputDir::prepare(&a.out)?;
     let merged = out::write_report(&dir, &c, &records)?;
     for e in &merged.incomplete {
         eprintln!("host-sim: error: {e}");
     }
+    // No run flew (every draw invalid): the report says nothing of the controller (Choice 245).
+    let none_flew = merged.invalid == merged.runs;
+    if none_flew {
+        eprintln!(
+            "host-sim: error: no run flew: each of the {} draws made a scenario that does not \
+             validate (each reason is on its shard's stderr); the report says nothing of the \
+             controller",
+            merged.runs
+        );
+    }
     let missed = merged
         .required
         .is_some_and(|f| (merged.within as f64) < f * merged.runs as f64);
-    let exit = Exit::of(!merged.incomplete.is_empty(), false, false, false, missed);
+    let exit = Exit::of(
+        !merged.incomplete.is_empty(),
+        false,
+        none_flew,
+        false,
+        missed,
+    );
     if a.json {
         let text = std::fs::read_to_string(a.out.join(out::SUMMARY))
             .with_context(|| format!("reading {}", a.out.join(out::SUMMARY).display()))?;
@@ -301,13 +383,17 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
     }
     writeln!(
         stdout,
-        "campaign {}: {} runs from {} shard(s); within bound {} ({:.4} %), diverged {}",
+        "campaign {}: {} runs from {} shard(s); within bound {} ({:.4} %), diverged {}{}",
         c.spec.name(),
         merged.runs,
         shards.len(),
         merged.within,
         100.0 * merged.within as f64 / merged.runs.max(1) as f64,
-        merged.diverged
+        merged.diverged,
+        match merged.invalid {
+            0 => String::new(),
+            k => format!(", invalid {k} (not flown)"),
+        }
     )?;
     for s in &merged.stats {
         writeln!(
@@ -322,6 +408,79 @@ fn merge_shards(a: &MergeArgs, stdout: &mut dyn Write) -> Result<Exit> {
     }
     writeln!(stdout, "report: {}", merged.report.display())?;
     Ok(exit)
+}
+
+/// The campaign shard `s` keeps, rebuilt from its texts: it must hash to the manifest's
+/// campaign hash. When it does not, the manifest of this program's version was edited (its
+/// hash recomputed: Choice 241 catches the rest), or another version made it.
+fn kept_campaign(s: &merge::ShardInput) -> Result<Campaign> {
+    let m = &s.manifest;
+    let c =
+        Campaign::from_manifest(m).with_context(|| format!("the campaign kept in {}", s.label))?;
+    if c.hash == m.campaign_hash {
+        return Ok(c);
+    }
+    let ours = crate::studies::campaign::PROGRAM_VERSION;
+    if m.program_version == ours {
+        bail!(
+            "the campaign kept in {}/{} does not give its campaign_hash: the manifest was \
+             edited; run the shard again into a new folder",
+            s.label,
+            out::SHARD_MANIFEST
+        );
+    }
+    bail!(
+        "the shards were made by {} and this is {ours}: a different program flies the runs \
+         differently; merge with the host-sim that made them",
+        m.program_version
+    )
+}
+
+/// The merge's `--out` must be apart from every shard folder (**Choice 243**): not one of them,
+/// not inside one, not holding one (the merge clears its output folder first). Compared as the
+/// file system resolves them (symlinks, `..`), the part of `--out` not yet made as written.
+fn out_apart(out: &Path, shards: &[PathBuf]) -> Result<()> {
+    let o = resolved(out)?;
+    for s in shards {
+        let d = resolved(s)?;
+        let how = if o == d {
+            "is"
+        } else if d.starts_with(&o) {
+            "holds"
+        } else if o.starts_with(&d) {
+            "is inside"
+        } else {
+            continue;
+        };
+        bail!(
+            "--out {} {how} the shard folder {}: the merge would overwrite its records; give an \
+             output folder apart from the shards",
+            out.display(),
+            s.display()
+        );
+    }
+    Ok(())
+}
+
+/// `p` absolute, each existing prefix resolved as the file system does (symlinks, then `..`
+/// from where they lead), the rest taken as written.
+fn resolved(p: &Path) -> Result<PathBuf> {
+    use std::path::Component;
+    let abs = std::path::absolute(p).with_context(|| format!("cannot resolve {}", p.display()))?;
+    let mut r = PathBuf::new();
+    for part in abs.components() {
+        match part {
+            Component::ParentDir => {
+                r.pop();
+            }
+            Component::CurDir => {}
+            other => r.push(other),
+        }
+        if let Ok(real) = r.canonicalize() {
+            r = real;
+        }
+    }
+    Ok(r)
 }
 
 /// `campaign plan`.

@@ -30,35 +30,52 @@ pub fn write_manifest(dir: &OutputDir, m: &Manifest) -> Result<()> {
     Ok(())
 }
 
-/// Reads a manifest (`dir`/[`SHARD_MANIFEST`]); `None` if there is none.
+/// Reads a manifest (`dir`/[`SHARD_MANIFEST`]); `None` if there is none. A manifest whose
+/// fields do not give its hash, or without one (an earlier host-sim's), is an error naming it
+/// (**Choice 241**).
 pub fn read_manifest(dir: &Path) -> Result<Option<Manifest>> {
     let path = dir.join(SHARD_MANIFEST);
-    match fs::read_to_string(&path) {
+    let m: Manifest = match fs::read_to_string(&path) {
         Ok(text) => serde_json::from_str(&text)
-            .map(Some)
-            .with_context(|| format!("{} is not a shard manifest", path.display())),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(None),
-        Err(e) => Err(e).with_context(|| format!("cannot read {}", path.display())),
-    }
+            .with_context(|| format!("{} is not a shard manifest", path.display()))?,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+        Err(e) => return Err(e).with_context(|| format!("cannot read {}", path.display())),
+    };
+    m.verify()
+        .map_err(|e| anyhow::anyhow!("{} {e}", path.display()))?;
+    Ok(Some(m))
 }
 
-/// Reads the records of `path` (**Choice 136**). A last line without its newline, or one that
-/// does not parse, is what a killed writer left half-written: with `repair` the file is cut
-/// back to the line before it (the run is redone), else it is left out. A bad line before the
-/// last is an error naming it (the file was edited, or is not a records file).
+/// Reads the records of `path` ([`for_each_record`]), all of them.
 pub fn read_records(path: &Path, repair: bool) -> Result<Vec<Record>> {
+    let mut records = Vec::new();
+    for_each_record(path, repair, |r| {
+        records.push(r);
+        Ok(())
+    })?;
+    Ok(records)
+}
+
+/// Hands each record of `path` to `f`, line by line (**Choice 136**, **Choice 242**): a shard
+/// of 10⁹ runs resumes without holding its records. A last line without its newline is what a
+/// killed writer left half-written: with `repair` the file is cut back to the line before it
+/// (the run is done again), else it is left out. A complete line that is not a record, last or
+/// not, is an error naming it (the file was edited, or is not a records file): a writer writes
+/// the newline last, so only a line without it can be torn.
+pub fn for_each_record(
+    path: &Path,
+    repair: bool,
+    mut f: impl FnMut(Record) -> Result<()>,
+) -> Result<()> {
     use std::io::BufRead;
     let shown = path.display();
     let file = match File::open(path) {
         Ok(f) => f,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(()),
         Err(e) => return Err(e).with_context(|| format!("cannot read {shown}")),
     };
-    let total = file.metadata().map(|m| m.len()).unwrap_or(0);
-    // Line by line: a merge of 10⁶ runs holds the records, not their text as well.
     let mut reader = std::io::BufReader::new(file);
     let header = record::header();
-    let mut records = Vec::new();
     let (mut good, mut line_no, mut line) = (0u64, 0usize, String::new());
     loop {
         line.clear();
@@ -69,31 +86,31 @@ pub fn read_records(path: &Path, repair: bool) -> Result<Vec<Record>> {
             break;
         }
         line_no += 1;
-        let complete = line.ends_with('\n');
-        let text = line.trim_end_matches('\n');
-        let parsed = match (line_no, complete) {
-            (_, false) => None,
-            (1, true) => (text == header).then_some(None),
-            (_, true) => Record::parse(text).map(Some),
-        };
-        match parsed {
-            Some(Some(r)) => records.push(r),
-            Some(None) => {}
-            None if good + n as u64 == total && (!complete || line_no > 1) => {
-                // The last line, torn (see the doc).
-                if repair {
-                    cut(path, good)?;
-                }
-                break;
+        let Some(text) = line.strip_suffix('\n') else {
+            // Without its newline: the last line (read_line stops only at one or at the end),
+            // torn (see the doc).
+            if repair {
+                cut(path, good)?;
             }
-            None => bail!(
-                "{shown} line {line_no} is not a campaign record (the file was edited, or is \
-                 not host-sim's); move it away to rerun the shard"
+            break;
+        };
+        match line_no {
+            1 if text == header => {}
+            1 => bail!(
+                "{shown} line 1 is not the records' header (the file was edited, or is not \
+                 host-sim's); move it away to rerun the shard"
             ),
+            _ => match Record::parse(text) {
+                Some(r) => f(r)?,
+                None => bail!(
+                    "{shown} line {line_no} is not a campaign record (the file was edited, or is \
+                     not host-sim's); move it away to rerun the shard"
+                ),
+            },
         }
         good += n as u64;
     }
-    Ok(records)
+    Ok(())
 }
 
 /// Cuts the records file `path` back to its first `len` bytes (a torn last line removed).
@@ -188,6 +205,8 @@ pub struct Merged {
     pub within: usize,
     pub runs: usize,
     pub diverged: usize,
+    /// Runs not flown: their draw made a scenario that does not validate.
+    pub invalid: usize,
     /// The campaign's required fraction within bound, when it sets one.
     pub required: Option<f64>,
     /// Outputs that could not be written (plots).
@@ -234,6 +253,7 @@ pub fn write_report(dir: &OutputDir, c: &Campaign, records: &[Record]) -> Result
         within,
         runs: records.len(),
         diverged: count(records, Outcome::Diverged),
+        invalid: count(records, Outcome::Invalid),
         required: c.spec.required_fraction(),
         incomplete,
     };

@@ -242,7 +242,8 @@ fn base_from_text(name: &str, text: &str, spec: &CampaignSpec) -> Result<Base, C
         path: PathBuf::from(name),
         source,
     };
-    let scenario = crate::scenario::parse_scenario(text).map_err(err)?;
+    let scenario =
+        crate::scenario::parse_scenario(text).map_err(|e| err(without_quoted_lines(e)))?;
     let cfg = scenario.config();
     if spec.draw.parameters != ParameterDraw::None && cfg.variation != VariationProfile::None {
         return Err(invalid(
@@ -270,6 +271,30 @@ fn base_from_text(name: &str, text: &str, spec: &CampaignSpec) -> Result<Base, C
         text: text.to_string(),
         scenario,
     })
+}
+
+/// A base's TOML error without the lines of the file it quotes: a campaign may name any file as
+/// a base (`/etc/…`), and the error says where (line, column) and what, not what the file holds
+/// (**Choice 247**).
+fn without_quoted_lines(e: ScenarioError) -> ScenarioError {
+    match e {
+        ScenarioError::Toml(m) => ScenarioError::Toml(
+            m.lines()
+                .filter(|l| !is_quoted_line(l))
+                .collect::<Vec<_>>()
+                .join("\n"),
+        ),
+        other => other,
+    }
+}
+
+/// A line of the `toml` crate's excerpt: `  |`, `12 | text`, `   |     ^`: a gutter (spaces and
+/// a line number) and a bar.
+fn is_quoted_line(l: &str) -> bool {
+    l.trim_start()
+        .trim_start_matches(|c: char| c.is_ascii_digit())
+        .trim_start()
+        .starts_with('|')
 }
 
 /// Every value's range.
@@ -308,6 +333,12 @@ fn check(spec: &CampaignSpec) -> Result<(), CampaignError> {
             return Err(invalid(
                 "metrics",
                 format!("unknown metric {bad:?}, expected one of {METRIC_NAMES:?}"),
+            ));
+        }
+        if let Some((k, twice)) = m.iter().enumerate().find(|(k, x)| m[..*k].contains(x)) {
+            return Err(invalid(
+                "metrics",
+                format!("{twice:?} is listed twice (again at position {k}); list each once"),
             ));
         }
     }

@@ -28,9 +28,11 @@ use crate::sim::{self, LocalController, Metrics, Recording};
 pub mod file;
 pub mod merge;
 pub mod record;
+pub mod shard;
 
 pub use file::{Base, CampaignError, CampaignSpec, ParameterDraw};
 pub use record::{Outcome, Record};
+pub use shard::{Done, Shard};
 
 /// The metrics a campaign can report, in the order of the records' columns (the one name
 /// table, [`Metrics::NAMES`]).
@@ -243,15 +245,15 @@ fn hash(spec: &CampaignSpec, bases: &[Base]) -> String {
         h.update(format!(" {}\n", b.text.len()).as_bytes());
         h.update(b.text.as_bytes());
     }
+    hex(h)
+}
+
+/// A sha256's digest in lower-case hex.
+pub(crate) fn hex(h: Sha256) -> String {
     h.finalize()
         .iter()
         .map(|b| format!("{b:02x}"))
         .collect::<String>()
-}
-
-/// The indices of shard `index` of `count`: i ≡ index (mod count), i < runs.
-pub fn shard_indices(runs: u64, index: u64, count: u64) -> impl Iterator<Item = u64> + Clone {
-    (index..runs).step_by(count.max(1) as usize)
 }
 
 impl Campaign {
@@ -310,19 +312,43 @@ impl Campaign {
             .map_err(|e| e.to_string())
     }
 
-    /// Runs the indices `todo` in parallel (rayon), handing each record to `sink` as it is
-    /// made (in completion order; the merge sorts). Runs not started when a stop is requested
-    /// are not run.
-    pub fn run_indices(&self, todo: &[u64], sink: impl Fn(Record) + Sync) {
+    /// Runs the runs of `shard` not in `done` in parallel (rayon), handing each record to
+    /// `sink` as it is made (in completion order; the merge sorts). The indices are iterated,
+    /// not listed (Choice 244). Runs not started when a stop is requested are not run.
+    pub fn run_shard(&self, shard: Shard, done: &Done, sink: impl Fn(Record) + Sync) {
         use rayon::prelude::*;
-        todo.par_iter().for_each(|&i| {
-            if crate::interrupt::requested() {
-                return;
-            }
-            if let Some(r) = self.fly(i) {
-                sink(r);
-            }
-        });
+        // An error stops rayon from starting more: an interrupted shard of 10⁹ runs does not
+        // walk the rest of its indices.
+        let _ = (0..shard.len())
+            .into_par_iter()
+            .map(|k| shard.run(k))
+            .filter(|i| !done.contains(*i))
+            .try_for_each(|i| {
+                if crate::interrupt::requested() {
+                    return Err(());
+                }
+                if let Some(r) = self.fly(i) {
+                    sink(r);
+                }
+                Ok(())
+            });
+    }
+
+    /// The shard `index`/`count` of this campaign.
+    pub fn shard(&self, index: u64, count: u64) -> Shard {
+        Shard {
+            runs: self.runs(),
+            index,
+            count,
+        }
+    }
+
+    /// The bound run `i` is held to: the campaign's, else its base's ([`Campaign::scenario`]
+    /// sets the campaign's on the base).
+    pub fn bound_of(&self, i: u64) -> Option<crate::scenario::Bound> {
+        self.spec
+            .bound()
+            .or_else(|| self.bases[self.base_of(i)].scenario.config().bound())
     }
 
     /// Seconds of CPU per run, from one calibration run of each base

@@ -201,6 +201,65 @@ impl Record {
     }
 }
 
+/// One drawn value as a record writes it.
+#[derive(Clone, Copy, Debug)]
+enum Drawn {
+    F64(f64),
+    F32(f32),
+    Int(u64),
+}
+
+impl Drawn {
+    /// The same bits (a NaN equals nothing but itself, -0 is not 0).
+    fn same(self, other: Drawn) -> bool {
+        match (self, other) {
+            (Drawn::F64(a), Drawn::F64(b)) => a.to_bits() == b.to_bits(),
+            (Drawn::F32(a), Drawn::F32(b)) => a.to_bits() == b.to_bits(),
+            (Drawn::Int(a), Drawn::Int(b)) => a == b,
+            _ => false,
+        }
+    }
+}
+
+impl std::fmt::Display for Drawn {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Drawn::F64(x) => write!(f, "{x}"),
+            Drawn::F32(x) => write!(f, "{x}"),
+            Drawn::Int(x) => write!(f, "{x}"),
+        }
+    }
+}
+
+impl Draw {
+    /// The values a record writes, in the order of its columns ([`DRAWN_COLUMNS`], the time
+    /// scale, the mounting), each with its column's name.
+    fn columns(&self) -> [(&'static str, Drawn); 20] {
+        let mut v = [("", Drawn::Int(0)); 20];
+        let floats = self.variation.iter().chain(&self.current[..2]);
+        for (k, x) in floats.enumerate() {
+            v[k] = (DRAWN_COLUMNS[k], Drawn::F64(*x));
+        }
+        v[11] = (DRAWN_COLUMNS[11], Drawn::Int(self.noise_seed));
+        for (j, x) in self.initial_offset.iter().enumerate() {
+            v[12 + j] = (DRAWN_COLUMNS[12 + j], Drawn::F64(*x));
+        }
+        v[18] = (TIME_SCALE_COLUMN, Drawn::F32(self.time_scale));
+        v[19] = (MOUNTING_COLUMN, Drawn::Int(u64::from(self.mounting)));
+        v
+    }
+
+    /// The first column in which `self` and `other` differ, bit for bit: its name and the two
+    /// values as a record writes them (the vertical current, never drawn, is not compared).
+    pub fn first_difference(&self, other: &Draw) -> Option<(&'static str, String, String)> {
+        self.columns()
+            .into_iter()
+            .zip(other.columns())
+            .find(|(a, b)| !a.1.same(b.1))
+            .map(|(a, b)| (a.0, a.1.to_string(), b.1.to_string()))
+    }
+}
+
 fn array<const N: usize>(mut f: impl FnMut(usize) -> Option<f64>) -> Option<[f64; N]> {
     let mut a = [0.0; N];
     for (j, x) in a.iter_mut().enumerate() {
