@@ -1,4 +1,4 @@
-//! Integration tests of `controller_core::trajectory` (docs/design.md §6, §8).
+//! Integration tests of `controller_core::trajectory` (docs/missions.md#closed-form-paths, docs/law.md#the-sampled-f32-loop).
 //!
 //! Every assertion checks a fact that does not come from the module's own arithmetic: finite
 //! differences of the sampled η_d, closed-form values of the paper's missions, the exact triangle

@@ -49,7 +49,7 @@ pub const BUDGETS: [StepBudget; 3] = [
         update: 4_000,
         // kinematics, trajectory, law, allocation, voltage maps. The trajectory stage's 720:
         // a waypoint path's sample (two fixed binary searches, the time law's piece and the
-        // segment's sextic, docs/design.md §27) measured 642 on the survey's golden vectors,
+        // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 642 on the survey's golden vectors,
         // against 468 for the closed forms.
         stages: [560, 720, 760, 1_000, 1_250],
     },
@@ -63,7 +63,7 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "micromath",
         update: 4_200,
-        // The waypoint path's trajectory stage: 600 measured (docs/design.md §27).
+        // The waypoint path's trajectory stage: 600 measured (docs/board.md#the-self-test-and-its-budgets).
         stages: [500, 680, 780, 1_000, 1_250],
     },
 ];

@@ -8,7 +8,7 @@ use crate::trajectory::{SpeedList, WaypointList};
 #[cfg(doc)]
 use crate::trajectory::{DEFAULT_SPEED_CHANGE, TURN_ACCEL};
 
-/// Shape and parameters of a mission (the paper's "Simulation Results"; docs/design.md §6).
+/// Shape and parameters of a mission (the paper's "Simulation Results"; docs/missions.md#closed-form-paths).
 ///
 /// All frequencies ω are in rad/s and must be positive; sizes in metres; z is positive down (NED).
 ///
@@ -83,7 +83,7 @@ pub enum TrajectoryKind {
         depth_rate: f32,
     },
     /// Straight legs through the waypoints, each corner turned on a septic blend, flown at
-    /// `speed` along the path (not in the paper; docs/design.md §27).
+    /// `speed` along the path (not in the paper; docs/missions.md#waypoint-paths).
     Waypoints {
         /// The points in the mission frame (m, z positive down): `points = [[x, y, z], …]`.
         points: WaypointList,

@@ -77,7 +77,7 @@ impl BoardInTheLoop {
 
     /// The next telemetry frame, or `None` once `until` has passed without one. No valid
     /// telemetry for the reply timeout is an error ([`BoardInTheLoop::silence`]), whatever
-    /// `until` says (**Choice 64**, docs/design.md §21: every wait bounded, silence told from
+    /// `until` says (**Choice 64**, docs/board.md#hardware-in-the-loop: every wait bounded, silence told from
     /// noise).
     fn poll_telemetry(&mut self, until: Option<Instant>) -> Result<Option<Telemetry>, String> {
         let mut chunk = [0u8; 512];

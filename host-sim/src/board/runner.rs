@@ -257,7 +257,7 @@ impl BoardInTheLoop {
     /// Numbers this end's frames after the board's last, disarms, configures and arms;
     /// returns the `Arm`'s sequence number and the board's refusals before the set-up.
     ///
-    /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
+    /// **Choice 65** (docs/board.md#hardware-in-the-loop): disarm first (a bench board may still be armed
     /// from a run before, and refuses a configuration while armed).
     fn configure(
         &mut self,

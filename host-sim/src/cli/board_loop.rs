@@ -127,7 +127,7 @@ pub(super) struct Started {
 /// compared; the report, and how the command ended. A run that loses its board keeps what it
 /// recorded (its CSV, its row in the report, marked diverged with the reason) and is named on
 /// stderr (**Choice 72**); a real-time run is compared with SIL but need not agree with it
-/// (**Choice 69**; docs/design.md §21).
+/// (**Choice 69**; docs/board.md#pacing).
 pub(super) fn fly(
     args: &LoopArgs,
     scenarios: &[Scenario],

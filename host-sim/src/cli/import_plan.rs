@@ -1,4 +1,4 @@
-//! `host-sim import-plan`: a QGroundControl `.plan` as a waypoint scenario (docs/design.md §27).
+//! `host-sim import-plan`: a QGroundControl `.plan` as a waypoint scenario (docs/missions.md#plans-from-qgroundcontrol).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -35,7 +35,7 @@ pub fn import_plan(args: &ImportPlanArgs, stdout: &mut dyn Write) -> Result<Exit
         .collect();
     writeln!(
         stdout,
-        "# Imported from {} (docs/design.md §27): NED in the tangent plane at the plan's home\n\
+        "# Imported from {} (docs/missions.md#plans-from-qgroundcontrol): NED in the tangent plane at the plan's home\n\
          # position lat {}, lon {}, alt {} m (WGS-84 flat earth; error under 1 cm within 250 m).\n\
          name = \"{}\"\n\n[trajectory]\nkind = \"waypoints\"\npoints = [\n{}\n]\nspeed = {}\n\
          heading = \"tangent\"\norigin = [{}, {}, {}]",

@@ -51,14 +51,14 @@
 //! omega = 0.1                 # rad/s; default 0.1, lawn-mower 0.05
 //! depth = 5.0                 # m, positive down; default 5
 //! points = [[0.0, 0.0, 5.0], [50.0, 0.0, 5.0]]  # waypoints (required): 2 to 32 points
-//!                             # as [x, y, z] in the mission frame (m, z down; design §27)
+//!                             # as [x, y, z] in the mission frame (m, z down; docs/missions.md#waypoint-paths)
 //! speed = 0.5                 # waypoints (required): m/s along the legs, (0, 10]
 //! turn_radius = 2.5           # waypoints, m: the corners' smallest radius; default speed²/0.1
 //! speeds = [2.11, 0.7, 1.5]   # waypoints: the flown speed profile, one per part (leg 0, turn
 //!                             # at 1, leg 1, …; 2n − 3), m/s; `check` proposes it; default none
 //! speed_change = 0.05         # waypoints: the speed changes' peak |σ̈|, m/s²; default 0.05
 //! speed_limits = [1.5, 0.8]   # waypoints: a cap per leg (n − 1 values), m/s in (0, 10]: check's
-//!                             # profile proposes no leg faster (design §27); default none
+//!                             # profile proposes no leg faster (docs/missions.md#the-speed-profile); default none
 //! heading = "paper"           # "paper" | "tangent" (ψ_d along the course); default "paper",
 //!                             # "tangent" for waypoints (their only heading)
 //! time_scale = 1.0            # k in [1, 100]: the reference is η_d(t/k); default 1

@@ -1,5 +1,5 @@
 //! The workspace's source rules, read from the files themselves (`cargo test -p xtask` checks
-//! them, `xtask/tests/source_rules.rs`; docs/design.md §22):
+//! them, `xtask/tests/source_rules.rs`; docs/ci.md#the-source-rules):
 //!
 //! - **Long functions** ([`long_functions`]): a function outside test code longer than
 //!   [`LONG_FN_LINES`] lines says why, in a line comment starting with [`LONG_MARKER`] among

@@ -1,6 +1,6 @@
 //! The path kinds, one file each: its parameter checks, the path and its derivatives at a
 //! sample, its smallest horizontal speed and its acceleration bound, in closed form
-//! (docs/design.md §6). The functions here answer each question for any [`TrajectoryKind`]
+//! (docs/missions.md#closed-form-paths). The functions here answer each question for any [`TrajectoryKind`]
 //! with one `match`: a new path kind is its file, its variant of [`TrajectoryKind`] and one
 //! arm in each of them.
 
