@@ -32,7 +32,7 @@ fn bench_update(c: &mut Criterion) {
         })
     });
     // A waypoint path of 32 points (61 segments, a time law of 61 parts): the sample's two
-    // fixed binary searches at their largest, and building it in place (docs/design.md §27).
+    // fixed binary searches at their largest, and building it in place (docs/missions.md#built-in-place).
     let survey = survey32();
     let wp = Trajectory::new(survey).expect("a valid 32-point survey");
     let t = 4000;

@@ -1,8 +1,8 @@
 //! The six degrees of freedom by index: one order for every 6-vector of the crate,
-//! η = [x y z φ θ ψ], ν = [u v w p q r], τ = [X Y Z K M N] (docs/design.md §1).
+//! η = [x y z φ θ ψ], ν = [u v w p q r], τ = [X Y Z K M N] (docs/model.md#frames-and-state).
 //!
-//! Roll is neither actuated nor controlled: no thruster gives a roll moment K (docs/design.md
-//! §5), so the law controls the other five axes (K₁₄ = K₂₄ = 0 in the paper: roll is left out
+//! Roll is neither actuated nor controlled: no thruster gives a roll moment K
+//! (docs/thrusters.md#geometry-and-the-effectiveness-matrix), so the law controls the other five axes (K₁₄ = K₂₄ = 0 in the paper: roll is left out
 //! of ‖e‖, w and Δu) and the allocation inverts B over the same five rows (B₅).
 
 /// Index of roll (φ, p, K).

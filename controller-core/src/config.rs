@@ -2,7 +2,7 @@
 //! [`Controller`](crate::controller::Controller).
 //!
 //! Validation is where every configuration-time number is computed (P, ‖K‖, the bounds over the
-//! Table-3 box, the allocation inverse) and every check of the paper and of docs/design.md §4 and §8
+//! Table-3 box, the allocation inverse) and every check of the paper and of docs/law.md#configuration-checks
 //! is made. A failed check is a [`ConfigError`] that names the check and its numbers; a
 //! configuration is never run silently out of its assumptions.
 
@@ -17,7 +17,7 @@ use crate::readable::Readable;
 use crate::thruster::ThrustUnit;
 use crate::uncertainty::{BoundsError, ParamBox};
 
-/// Which bound on ‖b‖ = ‖M̄⁻¹‖ enters δ(e,t) (docs/design.md §4 **Choice**).
+/// Which bound on ‖b‖ = ‖M̄⁻¹‖ enters δ(e,t) (docs/law.md#the-uncertainty-bound-eq-29 **Choice**).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum BBound {
     /// c_b · max(1, 1/|cos θ|) with c_b = sup‖S₀ M(p)⁻¹‖₂ over the controlled rows u, v, w, q, r.
@@ -26,7 +26,7 @@ pub enum BBound {
     ControlledRows,
     /// The literal ‖M̄⁻¹‖ ≤ sup‖M(p)⁻¹‖₂ · max(1, 1/cos²θ): dominated by the unactuated roll
     /// inertia (17.1 kg m²), it gives δ ≈ 200, far more thrust demand and chattering, and needs a
-    /// loop of ≈ 150 Hz or a δ clamp (§8). Offered for comparison with the paper's derivation.
+    /// loop of ≈ 150 Hz or a δ clamp (docs/law.md#the-δ-clamp). Offered for comparison with the paper's derivation.
     Literal,
 }
 
@@ -49,13 +49,13 @@ pub struct ControllerConfig {
     pub robust: bool,
     /// Which ‖b‖ bound enters δ.
     pub b_bound: BBound,
-    /// Clamp on δ (docs/design.md §8): δ grows with ‖e‖, so an off-path start would ask for tens of
+    /// Clamp on δ (docs/law.md#the-δ-clamp): δ grows with ‖e‖, so an off-path start would ask for tens of
     /// kN. The output reports when the clamp is active. Default 25.
     pub delta_max: f32,
     /// Control-loop rate (Hz). Time is `ticks / rate_hz`. Default 100.
     pub rate_hz: u32,
     /// |θ| beyond which the law faults instead of computing through the singularity of J
-    /// (docs/design.md §8), radians. Default 80°.
+    /// (docs/law.md#the-sampled-f32-loop), radians. Default 80°.
     pub pitch_limit: f32,
     /// Thruster supply limit: voltages are clamped to ±`voltage_limit` (V). Default
     /// [`DEFAULT_V_LIMIT`](crate::DEFAULT_V_LIMIT), the board's 24 V supply.
@@ -65,12 +65,12 @@ pub struct ControllerConfig {
     /// Parameter box the bounds are taken over (Table 3).
     pub uncertainty: ParamBox<f32>,
     /// Thruster positions and directions, the direction carrying each thruster's mounting
-    /// sign (docs/design.md §5, §9 **Choice 105**: the real AUV-150's, the vertical pair's
+    /// sign (docs/thrusters.md#geometry-and-the-effectiveness-matrix, docs/real-vehicle.md#the-default-mounting **Choice 105**: the real AUV-150's, the vertical pair's
     /// strong sides pushing up fore and down aft, the horizontal pair's to port).
     pub geometry: ThrusterGeometry,
-    /// The thrust unit of Eqs 31–32 (docs/design.md §9 **Choice**: kgf by default).
+    /// The thrust unit of Eqs 31–32 (docs/thrusters.md#the-thrust-unit **Choice**: kgf by default).
     pub thrust_unit: ThrustUnit,
-    /// Which forces the saturation-aware allocator gives up first (docs/design.md §9
+    /// Which forces the saturation-aware allocator gives up first (docs/thrusters.md#allocation-blocks-and-the-axis-priority
     /// **Choice**: pitch, depth, yaw, sway, surge, highest first).
     pub priority: AxisPriority,
 }
@@ -140,7 +140,7 @@ pub enum ConfigError {
     Assumption2 { beta_hat: f32, beta: f32 },
     /// Theorem 2 (Eq 25) as printed: λmaxλmin/(λmin − λmax) < λmin + λmin(ΔM).
     Theorem2 { lhs: f32, rhs: f32 },
-    /// docs/design.md §8: inside the boundary layer Δu is a gain δ/μ; the sampled loop needs
+    /// docs/law.md#the-loop-rate-rule: inside the boundary layer Δu is a gain δ/μ; the sampled loop needs
     /// T·(k₂ + p₂₂ δ_max/μ) < 2 on every controlled axis.
     LoopRate {
         axis: usize,
@@ -270,7 +270,7 @@ impl fmt::Display for ConfigError {
                 mu,
             } => write!(
                 f,
-                "loop period {} s is too long for axis {axis}: with δ_max = {} and μ = {} the boundary-layer gain needs T < {} s (docs/design.md §8)",
+                "loop period {} s is too long for axis {axis}: with δ_max = {} and μ = {} the boundary-layer gain needs T < {} s (docs/law.md#the-loop-rate-rule)",
                 Readable(period),
                 Readable(delta_max),
                 Readable(mu),

@@ -20,7 +20,7 @@ use crate::trajectory::{Desired, Trajectory};
 use crate::uncertainty::UncertaintyBounds;
 
 /// Largest |position| accepted (m). Positions are relative to a mission origin near the
-/// vehicle (docs/design.md §8): f32 keeps ≈ 1 mm at 10 km.
+/// vehicle (docs/numerics.md#positions): f32 keeps ≈ 1 mm at 10 km.
 pub const MAX_POSITION: f32 = 10_000.0;
 /// Largest |Euler angle| accepted (rad). Angles are wrapped internally; this only rejects
 /// absurd values.
@@ -42,7 +42,7 @@ pub enum Fault {
     NonFiniteInput = 1,
     /// η or ν is finite but outside the plausible range (see the `MAX_*` constants).
     InputOutOfRange = 2,
-    /// |θ| beyond the configured pitch limit (J is singular at ±90°, docs/design.md §8).
+    /// |θ| beyond the configured pitch limit (J is singular at ±90°, docs/law.md#the-sampled-f32-loop).
     PitchLimit = 3,
     /// An intermediate result was not finite (overflow on extreme but accepted inputs).
     NonFiniteResult = 4,
@@ -131,7 +131,7 @@ pub struct Output {
     pub tau_achieved: [f32; 6],
     /// The part of τ the saturation-aware allocator could not give inside the thrusters'
     /// envelopes (τ − B·T over the axes of each block that was not met; zero when every block
-    /// was met, and on the unactuated roll row). docs/design.md §9, §15.
+    /// was met, and on the unactuated roll row). docs/thrusters.md#allocation-blocks-and-the-axis-priority, docs/thrusters.md#the-chain-end-to-end.
     pub tau_unallocated: [f32; 6],
     /// Achieved thrust per thruster (N), order [main, vert fore, vert aft, horz fore, horz aft].
     pub thrust: [f32; THRUSTERS],
@@ -142,7 +142,7 @@ pub struct Output {
     pub saturated: u8,
     /// δ(e,t) after the clamp, Eq (29). Computed (and reported) also when Δu is off.
     pub delta: f32,
-    /// True when the δ clamp (docs/design.md §8) limited Δu this step (never when Δu is off).
+    /// True when the δ clamp (docs/law.md#the-δ-clamp) limited Δu this step (never when Δu is off).
     pub delta_clamped: bool,
     /// ‖w‖ = ‖BᵀPe‖.
     pub w_norm: f32,
@@ -201,8 +201,8 @@ pub struct Controller {
 }
 
 impl Controller {
-    /// Validates `config` and precomputes the law's constants. Every check of docs/design.md §4
-    /// and §8 is made here; see [`ConfigError`] for the list.
+    /// Validates `config` and precomputes the law's constants. Every check of docs/law.md#configuration-checks
+    /// is made here; see [`ConfigError`] for the list.
     pub fn new(config: ControllerConfig) -> Result<Self, ConfigError> {
         Self::build(config, None)
     }
@@ -250,7 +250,7 @@ impl Controller {
             k_norm = k_norm.max(libm::sqrtf(k1 * k1 + k2 * k2));
         }
 
-        // docs/design.md §8: Δu inside the boundary layer is the gain δ/μ on w, a closed-loop pole
+        // docs/law.md#the-loop-rate-rule: Δu inside the boundary layer is the gain δ/μ on w, a closed-loop pole
         // near −(k₂ + p₂₂ δ/μ); forward-Euler sampling of it is stable for T·(…) < 2. The
         // discontinuous law has no such pole (it chatters, bounded by δ), so only the
         // nominal gain is checked for it.
@@ -324,7 +324,7 @@ impl Controller {
         self.allocator.pseudo_inverse()
     }
 
-    /// The saturation-aware allocator `update` flies (docs/design.md §9).
+    /// The saturation-aware allocator `update` flies (docs/thrusters.md#allocation-blocks-and-the-axis-priority).
     pub fn allocator(&self) -> &Allocator {
         &self.allocator
     }
@@ -351,7 +351,7 @@ impl Controller {
     ///
     /// Never inlined, so that the linked firmware has an `update` symbol: the firmware CI
     /// builds the call graph of the flying image from it (no soft-float f64 routine may be
-    /// reachable, docs/design.md §16).
+    /// reachable, docs/numerics.md#no-f64-on-the-control-step-from-the-elf).
     #[inline(never)]
     pub fn update(
         &self,
@@ -497,7 +497,7 @@ impl Controller {
     }
 
     /// Stage [`Stage::Allocation`]: the thrust each thruster is asked for, by the
-    /// saturation-aware allocator (B₅⁻¹τ when it fits the envelopes; docs/design.md §9).
+    /// saturation-aware allocator (B₅⁻¹τ when it fits the envelopes; docs/thrusters.md#allocation-blocks-and-the-axis-priority).
     #[doc(hidden)]
     #[inline]
     pub fn allocation_stage(&self, tau: &Vector6<f32>) -> Allocated {

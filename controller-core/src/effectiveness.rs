@@ -1,4 +1,4 @@
-//! Thruster geometry and the effectiveness matrix B (τ = B·T), docs/design.md §5.
+//! Thruster geometry and the effectiveness matrix B (τ = B·T), docs/thrusters.md#geometry-and-the-effectiveness-matrix.
 //!
 //! This module says where the five thrusters sit and which way they push, and turns that into
 //! the 6×5 matrix B whose column i is the wrench [dᵢ; rᵢ × dᵢ] of one newton on thruster i
@@ -11,7 +11,7 @@
 //! [`HORZ_AFT`]).
 //!
 //! The geometry is **not in the paper**. [`ThrusterGeometry::default`] is the **Choice** of
-//! docs/design.md §5 (positions) and §9 (mounting signs, [`AUV150_REVERSED`]); any other
+//! docs/thrusters.md#geometry-and-the-effectiveness-matrix (positions) and docs/real-vehicle.md#the-default-mounting (mounting signs, [`AUV150_REVERSED`]); any other
 //! geometry is configuration and is checked here.
 
 use core::fmt;
@@ -38,7 +38,7 @@ pub const HORZ_AFT: usize = 4;
 /// Allowed deviation of a direction's norm from 1: |‖d‖ − 1| ≤ this.
 pub const UNIT_TOLERANCE: f32 = 1.0e-3;
 
-/// Where the AUV-150's thrusters sit, body frame (m), thruster order (docs/design.md §5
+/// Where the AUV-150's thrusters sit, body frame (m), thruster order (docs/thrusters.md#geometry-and-the-effectiveness-matrix
 /// **Choice**: all on the centre line; the main thruster at the stern, the tunnels at ±1.8 m).
 pub const AUV150_POSITIONS: [[f32; 3]; THRUSTERS] = [
     [-2.43, 0.0, 0.0],
@@ -60,7 +60,7 @@ pub const AUV150_AXES: [[f32; 3]; THRUSTERS] = [
     [0.0, 1.0, 0.0],
 ];
 
-/// The real vehicle's mounting (docs/design.md §9, **Choice 105**), as a reversed-thruster
+/// The real vehicle's mounting (docs/real-vehicle.md#the-default-mounting, **Choice 105**), as a reversed-thruster
 /// mask for [`ThrusterGeometry::auv150`]: bit i set ⇔ thruster i's positive (strong) thrust
 /// pushes against its reference axis [`AUV150_AXES`]. Chosen by flying: of the 32 masks, the
 /// one under which the six real missions (the Table-1 paths, tangent heading, the Table-3
@@ -123,7 +123,7 @@ impl fmt::Display for Mounting {
 /// y starboard, z down), in thruster order. The direction carries the **mounting sign**:
 /// positive thrust pushes the vehicle along it.
 ///
-/// [`Default`] is the real AUV-150 of docs/design.md §5 and §9 (**Choice**):
+/// [`Default`] is the real AUV-150 of docs/thrusters.md#geometry-and-the-effectiveness-matrix, docs/real-vehicle.md#the-real-missions (**Choice**):
 /// [`auv150`](Self::auv150)([`AUV150_REVERSED`]) — the main thruster at x = −2.43 m along +x;
 /// the vertical tunnels at x = +1.8 m (fore, along −z: pushing up) and −1.8 m (aft, along +z:
 /// pushing down); the

@@ -1,6 +1,6 @@
 //! Kinematics of Eq (2): η̇ = J(η) ν, J = diag(R(φ,θ,ψ), T(φ,θ)), and the terms of Eq (3).
 //!
-//! Fossen's zyx convention (docs/design.md §1): R = R_z(ψ) R_y(θ) R_x(φ) and
+//! Fossen's zyx convention (docs/model.md#frames-and-state): R = R_z(ψ) R_y(θ) R_x(φ) and
 //! T = [[1, sφ tθ, cφ tθ], [0, cφ, −sφ], [0, sφ/cθ, cφ/cθ]]. J is singular at θ = ±90°: every
 //! function that divides by cos θ returns [`GimbalLock`] there instead of a non-finite number.
 //! J⁻¹ = diag(Rᵀ, T⁻¹) needs no division and is always defined.
@@ -47,7 +47,7 @@ impl<T: RealField + Copy> Attitude<T> {
     }
 
     /// |cos θ| below which T(φ, θ) is treated as singular: ≈ 0.006° from ±90°, far beyond the
-    /// controller's pitch fault (80° by default, docs/design.md §8).
+    /// controller's pitch fault (80° by default, docs/law.md#the-sampled-f32-loop).
     pub fn gimbal_threshold() -> T {
         nalgebra::convert(1e-4)
     }
@@ -205,7 +205,7 @@ pub fn jacobian_dot<T: RealField + Copy>(
     Ok(jd)
 }
 
-/// J⁻¹ J̇ ν in closed form (docs/design.md §4): [ω × v; T⁻¹ Ṫ ω]. This is the term of Eq (3)
+/// J⁻¹ J̇ ν in closed form (docs/model.md#frames-and-state): [ω × v; T⁻¹ Ṫ ω]. This is the term of Eq (3)
 /// (ν̇ = J⁻¹(η̈ − J̇ν)) that the inversion-free law needs.
 pub fn jinv_jdot_nu<T: RealField + Copy>(
     a: &Attitude<T>,
@@ -222,7 +222,7 @@ pub fn skew<T: RealField + Copy>(a: &Vector3<T>) -> Matrix3<T> {
 }
 
 /// The kinematics of one attitude, formed once per step and shared by everything that needs
-/// them (docs/design.md §4, §16): R, sec θ and tan θ, with η̇ = Jν (Eq 2), J⁻¹J̇ν (Eq 3) and
+/// them (docs/numerics.md#one-kinematics-value-per-step): R, sec θ and tan θ, with η̇ = Jν (Eq 2), J⁻¹J̇ν (Eq 3) and
 /// J⁻¹u as methods. T and T⁻¹ are applied to vectors directly (their zeros and ones cost
 /// nothing). Building it is the one place the gimbal-lock check runs.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -289,7 +289,7 @@ impl<T: RealField + Copy> Kinematics<T> {
         Vector6::new(v[0], v[1], v[2], e.x, e.y, e.z)
     }
 
-    /// J⁻¹ J̇ ν in closed form (docs/design.md §4): [ω × v; T⁻¹ Ṫ ω]. This is the term of
+    /// J⁻¹ J̇ ν in closed form (docs/model.md#frames-and-state): [ω × v; T⁻¹ Ṫ ω]. This is the term of
     /// Eq (3) (ν̇ = J⁻¹(η̈ − J̇ν)) that the inversion-free law needs.
     #[inline]
     pub fn jinv_jdot_nu(&self, nu: &Vector6<T>) -> Vector6<T> {

@@ -26,7 +26,7 @@ pub enum RobustLaw {
 }
 
 /// Per-axis solution P = [[p₁₁, p₁₂], [p₁₂, p₂₂]] of Āᵢᵀ P + P Āᵢ = −diag(q₁, q₂) with
-/// Āᵢ = [[0, 1], [−k₁, −k₂]] (Eqs 14–15 and Theorem 3, per axis: docs/design.md §4 **Choice**).
+/// Āᵢ = [[0, 1], [−k₁, −k₂]] (Eqs 14–15 and Theorem 3, per axis: docs/law.md#the-lyapunov-matrix-p-theorem-3 **Choice**).
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct AxisLyapunov<T> {
     pub p11: T,
@@ -52,7 +52,7 @@ impl<T: RealField + Copy> AxisLyapunov<T> {
 
 /// Tracking errors e₁ = η − η_d (Eq 12) and e₂ = η̇ − η̇_d (Eq 13).
 ///
-/// **Choice** (docs/design.md §4): the yaw component of e₁ is wrapped to (−π, π], so a vehicle at
+/// **Choice** (docs/law.md#structure): the yaw component of e₁ is wrapped to (−π, π], so a vehicle at
 /// ψ = 179° tracking ψ_d = −179° sees a 2° error, not 358°.
 pub fn tracking_errors(
     eta: &Vector6<f32>,
@@ -148,7 +148,7 @@ pub struct DeltaConstants {
     pub b_sec_power: u8,
 }
 
-/// γ(t) of Eq (21) (Assumption 3), docs/design.md §4 **Choice**: a bound on the body-frame model
+/// γ(t) of Eq (21) (Assumption 3), docs/law.md#the-uncertainty-bound-eq-29 **Choice**: a bound on the body-frame model
 /// mismatch ‖Δh‖ = ‖ΔC ν + Δg‖ over the parameter box:
 /// γ = √2·ΔM·‖ν‖² + ΔM·‖J⁻¹J̇ν‖ + Δg.
 pub fn gamma(c: &DeltaConstants, nu_norm: f32, jinv_jdot_nu_norm: f32) -> f32 {
@@ -157,7 +157,7 @@ pub fn gamma(c: &DeltaConstants, nu_norm: f32, jinv_jdot_nu_norm: f32) -> f32 {
         + c.delta_g
 }
 
-/// ‖b‖ bound at the current pitch: b_level · max(1, 1/|cos θ|)^power (docs/design.md §4).
+/// ‖b‖ bound at the current pitch: b_level · max(1, 1/|cos θ|)^power (docs/law.md#the-uncertainty-bound-eq-29).
 pub fn b_norm_bound(c: &DeltaConstants, cos_theta_abs: f32) -> f32 {
     let sec = if cos_theta_abs < 1.0 {
         1.0 / cos_theta_abs
@@ -178,7 +178,7 @@ pub fn uncertainty_bound(c: &DeltaConstants, x: &DeltaInputs) -> f32 {
         / (1.0 - c.beta)
 }
 
-/// Body force by the inversion-free route (docs/design.md §4):
+/// Body force by the inversion-free route (docs/law.md#the-inversion-free-route-to-τ):
 /// τ = M̂ (J⁻¹u − J⁻¹J̇ν) + Ĉ(ν)ν + D̂(ν)ν + ĝ(η).
 ///
 /// This is Eq (7), τ̄ = b̂⁻¹(u + f̂), mapped to the body by τ = Jᵀτ̄: with b̂⁻¹ = M̄̂ and

@@ -6,7 +6,7 @@
 //! * default — the core's own f32-only [`kernels`]: sin/cos within 0.82 ulp over every f32,
 //!   cbrt within 0.51 ulp, atan2 within 1.5 ulp, and the FPU's `vsqrt.f32` (exact); no f64
 //!   anywhere, so nothing on the control step is a soft-float call on the Cortex-M4F
-//!   (docs/design.md §17, the board default on evidence: accuracy, Table 1, instruction counts);
+//!   (docs/numerics.md#the-math-backends, the board default on evidence: accuracy, Table 1, instruction counts);
 //! * feature `libm-math` — [`libm`]: correctly rounded to an ulp or two; its `sinf`, `cosf` and
 //!   `cbrtf` evaluate in f64 (soft-float calls on the Cortex-M4F) and its `sqrtf` is a software
 //!   loop there (kept to measure against);
@@ -83,7 +83,7 @@ pub fn sin_cos(x: f32) -> (f32, f32) {
 }
 
 /// atan2(y, x), the angle of the point (x, y) in [−π, π] (the tangent heading's course,
-/// docs/design.md §6).
+/// docs/missions.md#heading).
 #[inline]
 pub fn atan2(y: f32, x: f32) -> f32 {
     #[cfg(feature = "micromath")]
@@ -120,7 +120,7 @@ pub fn sqrt(x: f32) -> f32 {
 /// Correctly rounded √x in every backend (libm's `sqrtf`, one `vsqrt.f32` on the M4F), for
 /// what is computed once at configuration time or reported, where micromath's ≈ 6 % error is
 /// not acceptable: the inverse thrust maps, the trajectory's K_d and minimum speed
-/// (docs/design.md §17, Choice 30).
+/// (docs/numerics.md#the-math-backends, Choice 30).
 #[inline]
 pub fn exact_sqrt(x: f32) -> f32 {
     libm::sqrtf(x)
@@ -151,7 +151,7 @@ pub fn norm<const N: usize>(v: &[f32; N]) -> f32 {
 
 /// Wraps an angle to (−π, π] with a fixed amount of work (no loop).
 ///
-/// Used for the yaw component of e₁ (docs/design.md §4, **Choice**) and for trajectory phases.
+/// Used for the yaw component of e₁ (docs/law.md#structure, **Choice**) and for trajectory phases.
 /// Non-finite input gives NaN (the caller checks finiteness). Fossen's `ssa` (smallest signed
 /// angle, which returns [−π, π) where this returns (−π, π]) and MATLAB's `wrapToPi`.
 #[doc(alias("ssa", "wrapToPi"))]

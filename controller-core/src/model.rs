@@ -6,7 +6,7 @@
 //! through precomputed sines and cosines ([`crate::kinematics::Attitude`]), so the math backend
 //! of the f32 path stays in one place.
 //!
-//! Parameter values are Table 2 of the paper plus the choices of docs/design.md §2:
+//! Parameter values are Table 2 of the paper plus the choices of docs/model.md#parameters-table-2-and-the-inertia-m:
 //! −Z_ẇ = −Y_v̇ (axisymmetric hull), −K_ṗ = 0, −M_q̇ = −N_ṙ = 1204 kg m² (inferred from the
 //! printed M), d_p = 0, and buoyancy arms fixed so that the nominal g(η) is the printed one.
 
@@ -33,7 +33,7 @@ pub struct VehicleParams<T> {
     /// Principal inertias I_x, I_y, I_z about CO (kg m²). Table 2: 17.1, 632, 630.
     pub inertia: [T; 3],
     /// Added mass [−X_u̇, −Y_v̇, −Z_ẇ, −K_ṗ, −M_q̇, −N_ṙ]. Table 2 gives −X_u̇ = 49, −Y_v̇ = 836;
-    /// **Choice** (docs/design.md §2): −Z_ẇ = −Y_v̇, −K_ṗ = 0, −M_q̇ = −N_ṙ = 1204.
+    /// **Choice** (docs/model.md#parameters-table-2-and-the-inertia-m): −Z_ẇ = −Y_v̇, −K_ṗ = 0, −M_q̇ = −N_ṙ = 1204.
     pub added_mass: [T; 6],
     /// Quadratic damping coefficients: D(ν) = diag(dᵢ |νᵢ|). Printed: 120, 1224, 1224, d_p, 2731,
     /// 2731 with **Choice** d_p = 0.
@@ -47,14 +47,14 @@ pub struct VehicleParams<T> {
     /// the printed 296.1 cθ sφ, i.e. z_G W₀ − z_B B = 296.1.
     pub z_b_roll: T,
     /// Vertical buoyancy arm seen by the pitch moment (m): nominal g₅ = 291.1 sθ. The paper
-    /// prints different roll and pitch coefficients; docs/design.md §2 keeps both.
+    /// prints different roll and pitch coefficients; docs/model.md#restoring-forces keeps both.
     pub z_b_pitch: T,
     /// Gravitational acceleration (m/s²).
     pub gravity: T,
 }
 
 impl VehicleParams<f64> {
-    /// Nominal AUV-150 parameters (Table 2 and the docs/design.md §2 choices), in f64.
+    /// Nominal AUV-150 parameters (Table 2 and the docs/model.md#parameters-table-2-and-the-inertia-m choices), in f64.
     pub fn auv150() -> Self {
         let w0 = 490.0 * GRAVITY;
         let z_g = 0.012;
@@ -74,7 +74,7 @@ impl VehicleParams<f64> {
 }
 
 impl<T: RealField + Copy> VehicleParams<T> {
-    /// The parameters with a Table-3 variation added (plant only; docs/design.md §2).
+    /// The parameters with a Table-3 variation added (plant only; docs/model.md#parameter-variation-table-3).
     ///
     /// The −Y_v̇ variation acts on −Z_ẇ as well (the hull is axisymmetric). Buoyancy and its
     /// arms do not change: a payload adds weight, not displacement.
@@ -208,7 +208,7 @@ impl<T: RealField + Copy> ParamVariation<T> {
 }
 
 impl ParamVariation<f64> {
-    /// The "max" column of Table 3 (docs/design.md §2): every Δ at its largest printed value.
+    /// The "max" column of Table 3 (docs/model.md#parameter-variation-table-3): every Δ at its largest printed value.
     pub const TABLE3_MAX: ParamVariation<f64> = ParamVariation {
         mass: 30.0,
         r_g: [0.05, 0.02, 0.02],
@@ -233,7 +233,7 @@ impl ParamVariation<f64> {
 pub use crate::kinematics::skew;
 
 /// Rigid-body inertia M_RB = [[m I₃, −m S(r_G)], [m S(r_G), diag(I_x, I_y, I_z)]]
-/// (docs/design.md §2; Eq 1's M_RB).
+/// (docs/model.md#parameters-table-2-and-the-inertia-m; Eq 1's M_RB).
 pub fn rigid_body_mass<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
     let m = p.mass;
     let s = skew(&Vector3::from(p.r_g)) * m;
@@ -258,11 +258,11 @@ pub fn mass_matrix<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
     rigid_body_mass(p) + added_mass(p)
 }
 
-/// Coriolis–centripetal matrix of a symmetric inertia `m` in Kirchhoff form (docs/design.md §2):
+/// Coriolis–centripetal matrix of a symmetric inertia `m` in Kirchhoff form (docs/model.md#the-coriolis-and-centripetal-matrix):
 /// C(ν) = [[0, −S(a)], [−S(a), −S(b)]] with [a; b] = M ν, so C(ν) ν = [ω × a; v × a + ω × b]
 /// and νᵀ C(ν) ν = 0.
 ///
-/// **Choice** (docs/design.md §2): the paper prints every entry with the opposite sign; with the
+/// **Choice** (docs/model.md#the-coriolis-and-centripetal-matrix): the paper prints every entry with the opposite sign; with the
 /// printed sign the closed loop diverges on the lawn-mower case.
 ///
 /// Linear in `m`, so C_RB(ν) = `coriolis(&M_RB, ν)` and C_A(ν_r) = `coriolis(&M_A, ν_r)` for
@@ -280,7 +280,7 @@ pub fn coriolis<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Matrix6
 }
 
 /// C(ν)ν without forming C (the force the law and the plant need): with [a; b] = Mν,
-/// C(ν)ν = [ω × a; v × a + ω × b] ([`coriolis`] times ν; docs/design.md §2).
+/// C(ν)ν = [ω × a; v × a + ω × b] ([`coriolis`] times ν; docs/model.md#the-coriolis-and-centripetal-matrix).
 pub fn coriolis_force<T: RealField + Copy>(m: &Matrix6<T>, nu: &Vector6<T>) -> Vector6<T> {
     coriolis_force_of(&(m * nu), nu)
 }
@@ -314,7 +314,7 @@ pub fn damping<T: RealField + Copy>(p: &VehicleParams<T>, nu: &Vector6<T>) -> Ma
     })
 }
 
-/// Restoring forces g(η) (Fossen's vector, docs/design.md §2), from the attitude's sines/cosines:
+/// Restoring forces g(η) (Fossen's vector, docs/model.md#restoring-forces), from the attitude's sines/cosines:
 ///
 /// g₁ = ΔW sθ, g₂ = −ΔW cθ sφ, g₃ = −ΔW cθ cφ, with ΔW = W − B;
 /// g₄ = −(y_G W − y_B B) cθ cφ + k₄ cθ sφ, g₅ = k₅ sθ + (x_G W − x_B B) cθ cφ,

@@ -1,10 +1,10 @@
-//! Mission time to phase in integer arithmetic (docs/design.md §8, "Time"; §16).
+//! Mission time to phase in integer arithmetic (docs/numerics.md#time-as-an-integer-tick-count).
 //!
 //! Mission time is the integer tick count k at the loop rate f_s, t = k / f_s. A path of
 //! frequency ω needs the phase θ = ω t modulo 2π and, for the lawn-mower and the helix, a term
 //! linear in t. Neither may be formed from an f32 t (a millisecond a tick is lost after a few
 //! hours) nor in f64 (every f64 operation is a soft-float call on the Cortex-M4F, and no f64
-//! routine may be reachable from `update`, docs/design.md §16).
+//! routine may be reachable from `update`, docs/numerics.md#no-f64-on-the-control-step-from-the-elf).
 //!
 //! So the tick count is split once per step into whole seconds and a fraction of a second,
 //! [`MissionTime`]: q = ⌊k / f_s⌋ and the fraction (k mod f_s)/f_s in 2⁻³² units, one 64-bit
@@ -170,7 +170,7 @@ impl MissionTime {
 
 impl MissionTime {
     /// rate·t − `start` where the result is small beside rate·t (the waypoint path's parameter
-    /// within its segment, docs/design.md §27): the exact products rate·q of
+    /// within its segment, docs/missions.md#lookup-and-the-local-parameter): the exact products rate·q of
     /// [`linear`](Self::linear) are summed with their rounding errors kept (Knuth's two-sum),
     /// `start` is subtracted from the rounded sum (exact by Sterbenz's lemma when the result is
     /// at most `start`), and the errors and the fraction of a second are added last. So the

@@ -1,4 +1,4 @@
-//! A number in a message, readable whatever its size (**Choice 127**, docs/design.md §25): as
+//! A number in a message, readable whatever its size (**Choice 127**, docs/simulator.md#hostile-conditions): as
 //! Rust's shortest round-trip decimal (`0.1`, `-1`, `86400`) between 10⁻³ and 10⁶, and in the
 //! same shortest digits with an exponent outside (`1e308`, `2.5e-7`, `-3e37`), never a
 //! 309-digit integer or thirty zeros after the point. NaN and the infinities read `NaN`,

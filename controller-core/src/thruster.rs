@@ -1,5 +1,5 @@
 //! The thruster characteristic: force → voltage (Eqs 31–32 of Roy et al. 2013), its closed-form
-//! inverse, the thrust envelope at a supply limit, and saturation (docs/design.md §5, §15).
+//! inverse, the thrust envelope at a supply limit, and saturation (docs/thrusters.md#saturation, docs/thrusters.md#the-chain-end-to-end).
 //!
 //! This module knows what one thruster does with a voltage; it knows nothing about where the
 //! thrusters sit (that is [`crate::effectiveness`]) or how a wrench is split among them (that
@@ -9,19 +9,19 @@
 //! * [`ThrusterMap`]: Eq 31 (tunnel) and Eq 32 (main), V(T), and the inverse T(V) in closed form;
 //! * [`ThrusterMap::thrust_range`]: the envelope [T_min, T_max] reachable within ±V_limit;
 //! * [`actuate`]: the supply clamp, the main thruster's fold, and the thrust the clamped voltage
-//!   actually gives ([`Actuation`]) — the saturation-honesty signal of docs/design.md §5.
+//!   actually gives ([`Actuation`]) — the saturation-honesty signal of docs/thrusters.md#saturation.
 //!
 //! # Units
 //!
 //! The paper does not state the thrust unit of Eqs 31–32. [`ThrusterMap::voltage`] and
 //! [`ThrusterMap::thrust`] are the polynomials as printed, in *polynomial units*; which unit
-//! that is, is configuration: [`ThrustUnit`], default [`ThrustUnit::Kgf`] (docs/design.md §9
+//! that is, is configuration: [`ThrustUnit`], default [`ThrustUnit::Kgf`] (docs/thrusters.md#the-thrust-unit
 //! **Choice**: under the paper's own damping only the kgf reading reaches the vehicle's
 //! published 2–4 kn, and a wrong kgf guess under-drives the thrusters instead of over-driving
 //! them 9.81×). Everything else in the workspace is newtons: [`ThrusterMap::voltage_of_newtons`],
 //! [`ThrusterMap::newtons_of_voltage`], [`ThrustEnvelope`] and [`actuate`] convert at this one
 //! seam.
-//! 1 kgf = [`KGF_IN_NEWTONS`] = 9.80665 N, the standard kilogram-force (docs/design.md §9
+//! 1 kgf = [`KGF_IN_NEWTONS`] = 9.80665 N, the standard kilogram-force (docs/thrusters.md#the-thrust-unit
 //! **Choice**: the paper gives no sign that its fits use its model's g = 9.81; the two differ by
 //! 0.03 %). Voltage is in volts.
 //!
@@ -43,13 +43,13 @@
 use crate::effectiveness::THRUSTERS;
 use crate::math;
 
-/// Default supply limit of the board, V (docs/design.md §5: ±24 V).
+/// Default supply limit of the board, V (docs/thrusters.md#envelopes-at-the-supply-limit: ±24 V).
 pub const DEFAULT_V_LIMIT: f32 = 24.0;
 
-/// One kilogram-force in newtons: the standard value, 9.80665 N (docs/design.md §9 **Choice**).
+/// One kilogram-force in newtons: the standard value, 9.80665 N (docs/thrusters.md#the-thrust-unit **Choice**).
 pub const KGF_IN_NEWTONS: f32 = 9.806_65;
 
-/// The thrust unit of the polynomials of Eqs 31–32 (docs/design.md §9 **Choice**: kgf by
+/// The thrust unit of the polynomials of Eqs 31–32 (docs/thrusters.md#the-thrust-unit **Choice**: kgf by
 /// default, newtons one setting away). It is part of the controller's validated configuration
 /// ([`ControllerConfig::thrust_unit`](crate::ControllerConfig::thrust_unit)), crosses the link
 /// in `SetConfig` and is reported in every telemetry frame.
@@ -142,7 +142,7 @@ pub const MAIN_V_FOLD: f32 = MAIN_V_FOLD_F64 as f32;
 
 /// Force→voltage characteristic of one thruster (thrust T in N, voltage V in V).
 ///
-/// Both maps are the paper's experimental curve fits, used as printed (docs/design.md §5).
+/// Both maps are the paper's experimental curve fits, used as printed (docs/thrusters.md#force-to-voltage).
 /// Their value at T = 0 is not 0 V (tunnel −1.354 V, main −0.1962 V): that offset is a
 /// curve-fit artefact, and 0 V means power off (see [`Actuation::OFF`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -202,7 +202,7 @@ impl ThrusterMap {
     /// In closed form: the tunnel map is increasing, so (T(−V), T(+V)); the main map is
     /// decreasing on its branch and folds, so (T_fold, T(−V)) once V ≥ V_fold = 0.719 V (the
     /// fold of Eq 32), T(+V) below that. The envelope is asymmetric: at ±24 V a tunnel thruster
-    /// gives −9.165 … +20.102, the main thruster −17.467 … +73.306 (docs/design.md §5).
+    /// gives −9.165 … +20.102, the main thruster −17.467 … +73.306 (docs/thrusters.md#envelopes-at-the-supply-limit).
     #[inline]
     pub fn thrust_range(self, v_limit: f32) -> (f32, f32) {
         match self {
@@ -227,7 +227,7 @@ impl ThrusterMap {
 }
 
 /// The per-thruster thrust envelope [T_min, T_max] in **newtons** at a supply limit
-/// (docs/design.md §5, §9): what each thruster can give with voltages in ±V_limit, in closed
+/// (docs/thrusters.md#envelopes-at-the-supply-limit, docs/thrusters.md#the-thrust-unit): what each thruster can give with voltages in ±V_limit, in closed
 /// form from the maps ([`ThrusterMap::thrust_range`]; the main thruster's lower end is the
 /// fold of Eq 32) times the unit. Computed once at configuration time
 /// ([`Controller::new`](crate::Controller::new)); the allocator keeps every thrust inside it.
@@ -258,7 +258,7 @@ impl ThrustEnvelope {
     }
 
     /// This envelope shrunk to `fraction` of itself about 0 N (each bound times `fraction`;
-    /// every default envelope contains 0 N): the preflight check's margin (docs/design.md §9).
+    /// every default envelope contains 0 N): the preflight check's margin (docs/thrusters.md#envelopes-at-the-supply-limit).
     pub fn scaled(&self, fraction: f32) -> ThrustEnvelope {
         ThrustEnvelope {
             min: self.min.map(|x| x * fraction),
@@ -357,7 +357,7 @@ impl Actuation {
 pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
 
 /// Turns thrust commands (N) into voltages (V) within ±`v_limit` and reports the thrust (N)
-/// those voltages actually give (docs/design.md §5, "Saturation"), with Eqs 31–32 read in
+/// those voltages actually give (docs/thrusters.md#saturation), with Eqs 31–32 read in
 /// `unit`.
 ///
 /// Per thruster i, with map `maps[i]` and c = cmd · [`ThrustUnit::per_newton`] (polynomial

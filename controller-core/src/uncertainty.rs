@@ -1,5 +1,5 @@
 //! Configuration-time bounds over the Table-3 parameter box: the constants of δ(e,t) (Eq 29,
-//! docs/design.md §4) and the feasibility checks of Assumption 2 (Eq 20) and Theorem 2 (Eq 25).
+//! docs/law.md#the-uncertainty-bound-eq-29) and the feasibility checks of Assumption 2 (Eq 20) and Theorem 2 (Eq 25).
 //!
 //! Everything here runs once, when a configuration is validated, never inside `update`. The
 //! suprema over the box are taken over its 2⁹ corners (every Δ at its lower or upper end). The

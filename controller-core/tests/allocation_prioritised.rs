@@ -1,5 +1,5 @@
-//! The saturation-aware allocator (`controller_core::allocation::Allocator`, docs/design.md
-//! §9): a feasible demand gives exactly B₅⁻¹τ; the thrusts are always inside the envelope; a
+//! The saturation-aware allocator (`controller_core::allocation::Allocator`,
+//! docs/thrusters.md#envelopes-at-the-supply-limit): a feasible demand gives exactly B₅⁻¹τ; the thrusts are always inside the envelope; a
 //! higher-priority axis is met exactly whenever it is feasible on its own; the weighted
 //! least-squares optimum and the lexicographic optimum are no worse than a brute-force search
 //! over a fine grid of the box; the saturation bits and the unallocated part say what was given

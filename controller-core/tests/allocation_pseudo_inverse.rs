@@ -1,4 +1,4 @@
-//! Control allocation T = B₅⁻¹τ (`controller_core::allocation`, docs/design.md §5): against
+//! Control allocation T = B₅⁻¹τ (`controller_core::allocation`, docs/thrusters.md#allocation): against
 //! the closed form of the default geometry written here in f64, the round trip B·B₅⁻¹ on a
 //! general tilted layout, and the singular and ill-conditioned layouts it must refuse.
 
@@ -23,7 +23,7 @@ fn wrench() -> impl Strategy<Value = [f32; 6]> {
     proptest::array::uniform6(-1.0e4f32..1.0e4)
 }
 
-/// docs/design.md §5 closed form, in f64, for every thruster along its reference axis
+/// docs/thrusters.md#allocation closed form, in f64, for every thruster along its reference axis
 /// (+x, +z, +z, +y, +y); a reversed thruster (bit i of `reversed`) gives the negated thrust.
 fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; THRUSTERS] {
     let [x, y, z, _k, m, n] = tau.map(|v| v as f64);
@@ -45,8 +45,8 @@ fn closed_form(tau: &[f32; 6], reversed: u8) -> [f64; THRUSTERS] {
 
 #[test]
 fn default_is_the_real_vehicle_mounting() {
-    // Vertical fore pushing up, aft down, horizontal pair pushing to port (docs/design.md
-    // §9): a pure upward force is positive (strong) thrust fore and negative (weak) aft, a
+    // Vertical fore pushing up, aft down, horizontal pair pushing to port
+    // (docs/real-vehicle.md#the-default-mounting): a pure upward force is positive (strong) thrust fore and negative (weak) aft, a
     // nose-up moment positive thrust on both vertical tunnels, a pure force to port positive
     // thrust on both horizontal ones.
     let a = PseudoInverse::new(&ThrusterGeometry::default()).expect("default geometry");

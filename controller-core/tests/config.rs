@@ -158,7 +158,7 @@ fn theorem_2_as_printed_is_evaluated() {
 
 #[test]
 fn loop_period_is_checked_against_the_boundary_layer_gain() {
-    // docs/design.md §8: with δ_max = 25, μ = 0.1, p₂₂ = 0.15625, k₂ = 4 the loop needs
+    // docs/law.md#the-loop-rate-rule: with δ_max = 25, μ = 0.1, p₂₂ = 0.15625, k₂ = 4 the loop needs
     // T < 2/(4 + 39.06) = 46 ms: 10 Hz must fail, 25 Hz pass.
     let mut c = ControllerConfig::default();
     c.rate_hz = 10;
@@ -179,7 +179,9 @@ fn loop_period_is_checked_against_the_boundary_layer_gain() {
     c.b_bound = BBound::Literal;
     c.delta_max = 250.0;
     assert!(matches!(err(c), ConfigError::LoopRate { .. }));
-    assert!(err(c).to_string().contains("docs/design.md §8"));
+    assert!(err(c)
+        .to_string()
+        .contains("docs/law.md#the-loop-rate-rule"));
     // …with the default clamp it is accepted.
     let mut c = ControllerConfig::default();
     c.b_bound = BBound::Literal;

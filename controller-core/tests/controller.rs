@@ -40,7 +40,7 @@ fn on_the_reference_the_errors_and_w_vanish_and_delta_is_the_model_bound() {
             assert_eq!(out.status, Status::Ok);
             assert!(out.w_norm < tol, "{case:?}: ‖w‖ = {}", out.w_norm);
             assert!(out.e1.iter().all(|e| e.abs() < tol));
-            // δ stays in single digits on the paper's missions with the controlled-rows bound (docs/design.md §4).
+            // δ stays in single digits on the paper's missions with the controlled-rows bound (docs/law.md#the-uncertainty-bound-eq-29).
             assert!(
                 out.delta > 1.0 && out.delta < 10.0,
                 "{case:?}: δ = {}",
@@ -123,7 +123,7 @@ fn voltages_respect_the_supply_limit_and_report_saturation() {
     let (eta, nu) = on_reference(&tr, 0);
     let out = c.update(0, &eta, &nu, &tr);
     // The paper's crabbing circle asks the horizontal pair for far more sway force than it
-    // has (docs/design.md §9): saturated, inside the envelope, within the supply.
+    // has (docs/thrusters.md#envelopes-at-the-supply-limit): saturated, inside the envelope, within the supply.
     assert!(out.saturated != 0);
     assert!(out.voltage.iter().all(|v| v.abs() <= 24.0));
     let e = c.envelope();

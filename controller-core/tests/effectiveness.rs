@@ -1,5 +1,5 @@
 //! Thruster geometry and the effectiveness matrix B (`controller_core::effectiveness`,
-//! docs/design.md §5): the default layout is the documented choice, B is checked column by
+//! docs/thrusters.md#geometry-and-the-effectiveness-matrix): the default layout is the documented choice, B is checked column by
 //! column against r × d worked out by hand, and bad geometries are rejected with their numbers.
 
 use controller_core::allocation::{AllocationError, PseudoInverse};
@@ -10,7 +10,7 @@ use controller_core::effectiveness::{
 
 #[test]
 fn default_layout_is_the_spec_choice() {
-    // Positions docs/design.md §5; mounting §9: vertical fore pushing up (−z), aft down (+z),
+    // Positions docs/thrusters.md#geometry-and-the-effectiveness-matrix; mounting docs/real-vehicle.md#the-default-mounting: vertical fore pushing up (−z), aft down (+z),
     // horizontal pair pushing to port (−y), main forward.
     let g = ThrusterGeometry::default();
     assert_eq!(g.position[MAIN], [-2.43, 0.0, 0.0]);

@@ -1,4 +1,4 @@
-//! The missions a torpedo vehicle flies (docs/design.md §6, §9): the tangent heading
+//! The missions a torpedo vehicle flies (docs/missions.md#heading): the tangent heading
 //! ψ_d = atan2(ẏ_d, ẋ_d) and the time scale η_d(t/k), on every kind of path.
 //!
 //! Every expected value is independent of `trajectory.rs`: finite differences of the sampled
@@ -168,7 +168,7 @@ fn path_f64(kind: TrajectoryKind, t: f64) -> ([[f64; 4]; 2], f64, f64) {
 }
 
 /// The tangent heading of the unscaled path, from `path_f64`: (ψ, ψ̇, ψ̈) by the formulas of
-/// docs/design.md §9, evaluated here.
+/// docs/missions.md#heading, evaluated here.
 fn course_f64(kind: TrajectoryKind, t: f64) -> (f64, f64, f64) {
     let ([[_, xd, xdd, xddd], [_, yd, ydd, yddd]], _, _) = path_f64(kind, t);
     let d = xd * xd + yd * yd;

@@ -122,7 +122,7 @@ proptest! {
         }
     }
 
-    /// C(ν)ν = [ω × a; v × a + ω × b] with [a; b] = Mν (docs/design.md §2), written out here.
+    /// C(ν)ν = [ω × a; v × a + ω × b] with [a; b] = Mν (docs/model.md#the-coriolis-and-centripetal-matrix), written out here.
     #[test]
     fn coriolis_product_is_the_cross_product_form(nu in nu_strategy()) {
         let m = model::mass_matrix(&VehicleParams::auv150());

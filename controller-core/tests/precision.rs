@@ -1,5 +1,5 @@
 //! What f32 costs: the board's τ (f32 `Controller::update`, the default math backend) against
-//! an f64 evaluation of the same equations from the same inputs (docs/design.md §16).
+//! an f64 evaluation of the same equations from the same inputs (docs/numerics.md#what-f32-costs).
 //!
 //! The reference takes the f32 inputs and the f32 desired state widened to f64 (the trajectory's
 //! own accuracy against f64 is measured in tests/trajectory.rs and tests/phase.rs), the nominal
@@ -7,7 +7,7 @@
 //! sin/cos. Δu is off: the comparison is of the law's arithmetic, not of δ's suprema (computed in
 //! f32 at configuration time from the f32 parameters).
 //!
-//! # The bound, from the computation (docs/design.md §16, Choice 90)
+//! # The bound, from the computation (docs/numerics.md#what-f32-costs, Choice 90)
 //!
 //! τ = M(J⁻¹ū − J⁻¹J̇ν) + C(ν)ν + D(ν)ν + g(η) with ū = η̈_d − K₁e₁ − K₂e₂, e₁ = η − η_d,
 //! e₂ = J(η)ν − η̇_d. The inputs (η, ν, η_d, η̇_d, η̈_d, the gains) are the same f32 numbers on

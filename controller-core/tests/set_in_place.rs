@@ -1,4 +1,4 @@
-//! Building a trajectory in place (docs/design.md §27, Choice 180): `Trajectory::set` over
+//! Building a trajectory in place (docs/missions.md#built-in-place, Choice 180): `Trajectory::set` over
 //! whatever a trajectory held gives exactly what `Trajectory::new` gives (PartialEq over every
 //! field, whole arrays included, so no segment or piece of an earlier path is left behind), the
 //! same error for a refused mission, and a trajectory that samples as `Trajectory::EMPTY` (the

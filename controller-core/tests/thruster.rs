@@ -1,5 +1,5 @@
 //! The thruster characteristic: Eqs 31–32, their inverses, the envelope at a supply limit and
-//! saturation (`controller_core::thruster`, docs/design.md §5).
+//! saturation (`controller_core::thruster`, docs/thrusters.md#saturation).
 //!
 //! Every expected value here is computed independently of `thruster.rs`: the polynomials are
 //! re-typed from the paper in f64 and inverse maps are checked against a bisection written here
@@ -363,7 +363,7 @@ fn envelope_in_newtons_in_both_readings() {
             );
         }
     }
-    // The figures docs/design.md §9 quotes (kgf): main −171.29 … +718.89 N, tunnel −89.88 …
+    // The figures docs/thrusters.md#the-thrust-unit quotes (kgf): main −171.29 … +718.89 N, tunnel −89.88 …
     // +197.13 N.
     let e = ThrustEnvelope::new(&default_maps(), ThrustUnit::Kgf, 24.0);
     assert!((e.min[MAIN] + 171.29).abs() < 0.01 && (e.max[MAIN] - 718.89).abs() < 0.01);

@@ -1,4 +1,4 @@
-//! Integration tests of `controller_core::trajectory` (docs/design.md §6, §8): derivatives
+//! Integration tests of `controller_core::trajectory` (docs/missions.md#closed-form-paths, docs/law.md#the-sampled-f32-loop): derivatives
 //! against finite differences and the closed-form values of the paper's missions (the heading
 //! series, Table 1 and K_d: `trajectory_paper.rs`; long missions: `trajectory_long.rs`;
 //! robustness and refusals: `trajectory_robust.rs`).

@@ -1,4 +1,4 @@
-//! Long missions (docs/design.md §8): the sampled x_d, y_d, ψ_d against an f64 evaluation of
+//! Long missions (docs/law.md#the-sampled-f32-loop): the sampled x_d, y_d, ψ_d against an f64 evaluation of
 //! the paper's literal formulas written here, over the paper's 70 s and after 100 hours (the
 //! phase reduction: an f32 time would be off by centimetres).
 

@@ -1,4 +1,4 @@
-//! The paper's missions as the paper states them (docs/design.md §6–7): the heading series
+//! The paper's missions as the paper states them (docs/missions.md#closed-form-paths, docs/simulator.md#table-1): the heading series
 //! against the triangle and trapezoid waves they truncate (with the truncation bound), the
 //! Table-1 names, sizes and spans, and K_d of Assumption 1 against the sampled ‖η̈_d‖.
 

@@ -1,4 +1,4 @@
-//! The waypoint path (docs/design.md §27): legs joined by septic blends, flown at a constant
+//! The waypoint path (docs/missions.md#waypoint-paths): legs joined by septic blends, flown at a constant
 //! path speed.
 //!
 //! Every expected value is independent of the module's arithmetic: finite differences of the

@@ -75,7 +75,7 @@ pub const BUDGETS: [StepBudget; 3] = [
         update: 4_000,
         // kinematics, trajectory, law, allocation, voltage maps. The trajectory stage's 720:
         // a waypoint path's sample (two fixed binary searches, the time law's piece and the
-        // segment's sextic, docs/design.md §27) measured 642 on the survey's golden vectors,
+        // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 642 on the survey's golden vectors,
         // against 468 for the closed forms.
         stages: [560, 720, 760, 1_000, 1_250],
         // Measured 22 600 (the whole patch host-sim sends; 19 600–22 080 for one law field),
@@ -103,7 +103,7 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "micromath",
         update: 4_200,
-        // The waypoint path's trajectory stage: 600 measured (docs/design.md §27).
+        // The waypoint path's trajectory stage: 600 measured (docs/board.md#the-self-test-and-its-budgets).
         stages: [500, 680, 780, 1_000, 1_250],
         // Measured as the kernels: 22 600, 1 051 200 and 1 218 200.
         work: WorkBudget {

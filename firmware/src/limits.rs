@@ -1,6 +1,6 @@
 //! The board's own limits on its configuration, once. `SetConfig` is refused with a reason
 //! ([`auv_link::Refusal`]) when the resulting configuration breaks one; the core's own checks
-//! (`controller_core::Controller::new`: the loop-rate rule of docs/design.md §12, δ_max > 0, …)
+//! (`controller_core::Controller::new`: the loop-rate rule of docs/law.md#the-loop-rate-rule, δ_max > 0, …)
 //! come after these.
 
 /// Highest loop rate (Hz) the board accepts.

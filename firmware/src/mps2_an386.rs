@@ -15,7 +15,7 @@
 //!   (`host-sim hil --pacing realtime`) read only the bytes that came while it pumped at the
 //!   start of a period — a few dozen — and fell further behind every period. Lock-step never
 //!   waits there (it polls the link itself), so PIL is unchanged. (Choice 71,
-//!   docs/design.md §21.)
+//!   docs/board.md#pacing.)
 //! - No watchdog.
 //! - Configuration at boot: QEMU's semihosting command line (`-append "…"`, see
 //!   [`crate::semihosting::command_line`]); the flying image takes its link key from it

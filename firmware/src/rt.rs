@@ -73,7 +73,7 @@ pub fn fly<B: Board>(board: &mut B, mut sup: Supervisor, mut bufs: LinkBuffers) 
     }
 }
 
-/// Logs the thrusters' mounting in words (the strong side of each: docs/design.md §9), as the
+/// Logs the thrusters' mounting in words (the strong side of each: docs/real-vehicle.md#the-default-mounting), as the
 /// telemetry's reversed-thruster mask says it, so that a team reads which mounting a board
 /// flies without decoding the mask.
 fn log_mounting(mask: u8) {

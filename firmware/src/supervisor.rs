@@ -545,7 +545,7 @@ impl Supervisor {
     /// Validates the whole patch against the board's limits and the core, then applies all of
     /// it, or nothing. Refused while armed, whatever it holds.
     ///
-    /// The thruster chain (protocol 3, docs/design.md §9): the thrust unit of Eqs 31–32, the
+    /// The thruster chain (protocol 3, docs/link.md#what-crosses-the-link): the thrust unit of Eqs 31–32, the
     /// mounting as the AUV-150's reversed-thruster mask (a bit above the fifth is refused,
     /// [`Refusal::InvalidMounting`]) and the allocator's axis priority (a weight the core
     /// refuses is [`Refusal::InvalidPriority`]). Each changes the controller's configuration,
@@ -653,7 +653,7 @@ impl Supervisor {
         let off = Control::default();
         let stale = self.periods_since_state > u32::from(self.stale_periods);
         // The mission's start tick only: the trajectory (8.6 kB with a waypoint path's route and
-        // time law, docs/design.md §27) is borrowed in `fly`, not copied every period.
+        // time law, docs/missions.md#built-in-place) is borrowed in `fly`, not copied every period.
         let mission = self.mission.map(|start| ((), start));
         match (self.armed, self.latched, mission, self.state) {
             (false, _, _, _) => (BoardStatus::Disarmed, off),

@@ -1,6 +1,6 @@
 //! The board's signed end of the link through its whole loop (`board::period` on a bench board
 //! made of queues, `common::bench`): how far ahead of the last accepted stamp a navigation
-//! computer's frames may run (Choices 95–96, docs/design.md §20). A silence the board lived through is counted, a clock
+//! computer's frames may run (Choices 95–96, docs/link.md#how-far-ahead-a-stamp-may-run). A silence the board lived through is counted, a clock
 //! that jumped ahead of that count is refused and counted, the board then fails safe on the
 //! silence and keeps signing its telemetry, and a reset takes the new clock.
 

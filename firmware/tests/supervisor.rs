@@ -171,7 +171,7 @@ fn every_refusal_is_counted_and_its_reason_reported_in_telemetry() {
         (
             patch(ConfigPatch {
                 // Inside the stale limit (2 periods = 200 ms), but too slow for the loop-rate
-                // rule of docs/design.md §12 (> 21.5 Hz at the defaults).
+                // rule of docs/law.md#the-loop-rate-rule (> 21.5 Hz at the defaults).
                 rate_hz: Some(10),
                 ..ConfigPatch::EMPTY
             }),

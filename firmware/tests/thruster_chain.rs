@@ -1,5 +1,5 @@
 //! Protocol 3 on the board: `SetConfig` carries the thruster chain (thrust unit of Eqs 31–32,
-//! mounting, axis priority) and `StartMission` the heading and time scale (docs/design.md §9).
+//! mounting, axis priority) and `StartMission` the heading and time scale (docs/link.md#what-crosses-the-link).
 //! Each is applied whole or refused with its reason, the chain only while disarmed, and every
 //! telemetry frame names the unit and mounting the board flies. What the board then flies is
 //! checked against a controller and trajectory built on the host from the same settings.

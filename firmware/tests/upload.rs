@@ -1,4 +1,4 @@
-//! The mission upload on the board (protocol 5, docs/design.md §27): a waypoint mission
+//! The mission upload on the board (protocol 5, docs/link.md#the-mission-upload): a waypoint mission
 //! uploaded over a lossy link is acknowledged chunk by chunk in telemetry, resent, verified,
 //! and flown exactly as the core flies the same mission; it survives disarming; a new upload
 //! replaces it; every part is refused while armed.

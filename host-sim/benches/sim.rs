@@ -48,7 +48,7 @@ fn bench(c: &mut Criterion) {
         b.iter(|| host_sim::sim::run(black_box(&scenario)))
     });
     group.finish();
-    // The per-run cost that sizes a cluster (docs/design.md §26): one run of the shipped
+    // The per-run cost that sizes a cluster (docs/campaigns.md): one run of the shipped
     // real-chain campaign (70 s, real thrusters, current, noise), as a shard flies it.
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("campaigns/real-circle.campaign.toml");

@@ -66,7 +66,7 @@ fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
     assert!(report.contains("circular-10R") && report.contains(".png"));
     assert!(out_dir.join("circular-10R-with.csv").exists());
     // The waypoint missions' path over the waypoints and speed over time, written and linked
-    // (docs/design.md §27); a closed-form mission has neither.
+    // (docs/simulator.md#plots-of-a-waypoint-mission); a closed-form mission has neither.
     for name in waypoint_missions {
         for plot in ["waypoints", "speed"] {
             let file = format!("{name}-{plot}.png");

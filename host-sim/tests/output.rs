@@ -427,7 +427,7 @@ fn plot_case_survives_empty_single_and_nan_runs() {
 
 #[test]
 fn paper_table1_matches_the_spec() {
-    // docs/design.md §7, [without, with] Δu.
+    // docs/simulator.md#table-1, [without, with] Δu.
     let table: [(&str, [f64; 8]); 6] = [
         (
             "circular-10R",

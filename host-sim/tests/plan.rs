@@ -1,4 +1,4 @@
-//! QGroundControl `.plan` import and export (docs/design.md §27): geodetic → NED against known
+//! QGroundControl `.plan` import and export (docs/missions.md#plans-from-qgroundcontrol): geodetic → NED against known
 //! lengths of a degree, the round trip, the errors, and the shipped example as a scenario.
 
 use host_sim::scenario::plan::{self, Origin};
@@ -155,7 +155,7 @@ fn a_run_with_an_origin_writes_the_flown_path_as_geojson() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// The shipped pipeline mission (docs/design.md §27, Choice 174) is its plan, imported:
+/// The shipped pipeline mission (docs/missions.md#the-shipped-waypoint-missions, Choice 174) is its plan, imported:
 /// `import-plan` on the shipped `.plan` gives exactly the shipped scenario's points and origin
 /// (so the two cannot drift apart), and those are the plan's geodetic points in the tangent
 /// plane to the 3 decimals the import prints.

@@ -36,7 +36,7 @@ fn kinetic_energy_is_conserved_without_damping_and_restoring() {
 }
 
 /// Pitch has restoring (291.1 sin θ) and damping (2731|q|q): a pitched vehicle returns to
-/// level. Roll has restoring but no damping (d_p = 0, docs/design.md §8): it keeps oscillating with
+/// level. Roll has restoring but no damping (d_p = 0, docs/law.md#the-sampled-f32-loop): it keeps oscillating with
 /// its amplitude, the energy of a frictionless pendulum.
 #[test]
 fn restoring_levels_pitch_and_roll_swings_undamped() {

@@ -1,4 +1,4 @@
-//! The preflight's contract (docs/design.md §9): a mission `check` calls feasible at the time
+//! The preflight's contract (docs/real-vehicle.md#the-preflights-contract): a mission `check` calls feasible at the time
 //! scale it proposes flies within the real vehicle's bound, under every thruster mounting of
 //! the AUV-150 layout and for random missions — and the verdict it replaced did not hold.
 

@@ -41,7 +41,7 @@ impl Lcg {
 
 #[test]
 fn trim_makes_gs_force_rows_vanish_and_keeps_its_moments() {
-    // Closed form (docs/design.md §9): W = B ⇒ g₁ = g₂ = g₃ = 0 for every attitude; the trim
+    // Closed form (docs/real-vehicle.md#trim): W = B ⇒ g₁ = g₂ = g₃ = 0 for every attitude; the trim
     // buoyancy acts at CO, so the moments are the untrimmed payload's.
     let mut rng = Lcg(9);
     for corner in [0u32, 1, 0b1_1111_1111, 0b0_0000_1111, 0b1_0101_0101] {
@@ -310,7 +310,7 @@ fn the_static_demand_is_the_closed_form_of_weight_and_cg_moment() {
     // Trimmed, on the real vehicle's mounting (fore up, aft down), at rest only the moment is
     // left, on the pair's strong sides: M cos φ / 3.6 on each. At speed the demand is larger
     // (the heel turns part of the turn's centripetal force into heave, the pitch offset brings
-    // a Munk moment: docs/design.md §9).
+    // a Munk moment: docs/real-vehicle.md#the-attitude-the-vehicle-holds).
     let at_rest = moment * heel.cos() / 3.6;
     let r = real("circular-10R");
     // At k = 40 the circle's 2 m/s are 0.05 m/s (the tangent heading needs 0.02): the

@@ -55,7 +55,7 @@ fn table1_profiles_are_the_papers() {
     );
     let l = paper::config(Table1Case::LawnMower20x10, true);
     assert_eq!(l.variation, paper::table3_staircase());
-    // Table 3's lawn-mower column, row by row (docs/design.md §2).
+    // Table 3's lawn-mower column, row by row (docs/model.md#parameter-variation-table-3).
     let VariationProfile::Staircase(steps) = &l.variation else {
         panic!("{:?}", l.variation)
     };

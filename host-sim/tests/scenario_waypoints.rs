@@ -1,4 +1,4 @@
-//! Waypoint missions in scenario files (docs/design.md §27): the tangent heading by default,
+//! Waypoint missions in scenario files (docs/missions.md#waypoint-paths): the tangent heading by default,
 //! the pinned speed profile, the per-leg caps, lost upload chunks, and errors that name the
 //! key and the point, leg or chunk.
 

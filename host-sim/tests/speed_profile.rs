@@ -1,4 +1,4 @@
-//! The speed profile of a waypoint mission (docs/design.md §27): `check`'s proposal beats the
+//! The speed profile of a waypoint mission (docs/missions.md#the-speed-profile): `check`'s proposal beats the
 //! uniform time scale, and flown as pinned it stays within the real vehicle's bound.
 
 use controller_core::trajectory::SpeedList;

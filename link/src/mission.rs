@@ -12,7 +12,7 @@
 //! `MissionSpec` stays its own type because its layout *is* the wire format (variant order and
 //! field order fix the postcard bytes; see [`crate::msg`]), while `TrajectoryKind` may grow
 //! without a protocol change. A kind added to the core fails to compile here until the link
-//! carries it. The waypoint path (docs/design.md §27) is up to 32 points: it travels as a
+//! carries it. The waypoint path (docs/missions.md#waypoint-paths) is up to 32 points: it travels as a
 //! mission upload ([`crate::upload`]) and `StartMission` names it by the upload's CRC
 //! ([`MissionSpec::Waypoints`]), so core → wire computes that CRC, and wire → core needs the
 //! board's [`UploadBuffer`] ([`MissionPlan::resolve`]; without it, [`Uploaded`]).

@@ -32,7 +32,7 @@
 //!   navigation computer stamping its clock across any silence the board lived through is
 //!   accepted, a clock that jumps ahead of the board's count by more than 10 minutes is not.
 //!   The first frame after a reset is bounded by the ceiling only (the board cannot know where
-//!   its peer's clock is). docs/design.md §20, Choices 95–96.
+//!   its peer's clock is). docs/link.md#how-far-ahead-a-stamp-may-run, Choices 95–96.
 //! - **MAC:** HMAC-SHA-256 (the `hmac` and `sha2` crates: no_std, no heap), truncated to 48
 //!   bits as MAVLink does, compared in constant time. A forger's chance per attempt is 2⁻⁴⁸.
 //!

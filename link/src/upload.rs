@@ -1,4 +1,4 @@
-//! The chunked mission upload (protocol 5, docs/design.md §27, Choices 163–167): a waypoint
+//! The chunked mission upload (protocol 5, docs/link.md#the-mission-upload, Choices 163–167): a waypoint
 //! path is up to [`MAX_WAYPOINTS`] points and [`MAX_PARTS`] speeds, far more than one frame,
 //! so it travels as data before the mission starts.
 //!

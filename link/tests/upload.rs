@@ -135,7 +135,7 @@ fn the_largest_mission_crosses_chunk_by_chunk_bit_for_bit() {
     let back = board.mission(up.crc()).expect("the verified upload");
     assert_eq!(bits(&back.path), bits(&kind));
     assert_eq!((back.heading, back.time_scale), (HeadingMode::Tangent, 1.5));
-    // The whole largest upload on the wire, unsigned (the figure of docs/design.md §27), at the
+    // The whole largest upload on the wire, unsigned (the figure of docs/link.md#the-mission-upload), at the
     // board's baud rate.
     let ms = firmware_images::wire_seconds(wire_bytes as u64) * 1e3;
     assert!(wire_bytes <= (MAX_CHUNKS + 1) * MAX_FRAME, "{wire_bytes} B");

@@ -1,5 +1,5 @@
 //! Closed loop across crates: the f32 controller-core around the f64 host-sim plant, on the
-//! paper's missions (docs/design.md §6–§7).
+//! paper's missions (docs/missions.md#closed-form-paths, docs/simulator.md#table-1).
 
 use controller_core::trajectory::Helix;
 use controller_core::{Table1Case, TrajectoryKind};
@@ -81,7 +81,7 @@ fn helix_mission_tracks_depth() {
     );
 }
 
-/// Starting 1 m off the path, δ is clamped at first (docs/design.md §8) and the error converges.
+/// Starting 1 m off the path, δ is clamped at first (docs/law.md#the-δ-clamp) and the error converges.
 #[test]
 fn off_path_start_clamps_delta_then_converges() {
     let mut cfg = paper::config(Table1Case::FigureEight30x30, true);

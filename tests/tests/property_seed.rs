@@ -1,4 +1,4 @@
-//! The workspace's property tests are deterministic (docs/design.md, Choice 91): every
+//! The workspace's property tests are deterministic (docs/ci.md#deterministic-tests-and-quick-rebuilds, Choice 91): every
 //! `proptest!` starts from `ProptestConfig::default()` (directly, through `with_cases`, or as
 //! `..ProptestConfig::default()`), and proptest applies the `PROPTEST_*` environment to it and
 //! again to whatever config a test sets. Cargo sets `PROPTEST_RNG_SEED` and

@@ -1,7 +1,7 @@
 //! No double-precision arithmetic on the control step, proven from the linked ELF: no
 //! soft-float f64 routine (compiler-builtins' `__aeabi_d*`, `__adddf3`, `__extendsfdf2`, …)
 //! may be reachable from `Controller::update` in the call graph of a flying image
-//! (docs/design.md §16). The Cortex-M4F's FPU is single precision only, so every f64 operation
+//! (docs/numerics.md#no-f64-on-the-control-step-from-the-elf). The Cortex-M4F's FPU is single precision only, so every f64 operation
 //! there is one of these calls; f64 bit operations (abs, negation, loads) need none and are not
 //! arithmetic.
 //!
@@ -20,7 +20,7 @@ use xtask::ci::Ci;
 
 /// Whether a soft-float f64 routine reachable from `update` fails the firmware CI: it does. The
 /// trajectory's phases are integer arithmetic and the default math backend is the core's f32
-/// kernels, so the flying images have none (docs/design.md §16).
+/// kernels, so the flying images have none (docs/numerics.md#no-f64-on-the-control-step-from-the-elf).
 pub const FATAL: bool = true;
 
 /// The demangled name of the control step, the root of the check.

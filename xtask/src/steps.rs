@@ -32,7 +32,7 @@ pub struct Step {
     pub run: Run,
 }
 
-/// The CI, in order (docs/design.md §22, Choice 85).
+/// The CI, in order (docs/ci.md#one-entry-point, Choice 85).
 pub const STEPS: &[Step] = &[
     Step {
         name: "set-up: toolchain pieces, Debian packages (fonts, QEMU 10), defmt-print",

@@ -1,4 +1,4 @@
-//! The workspace's source rules (xtask/src/source/, docs/design.md §24, Choices 86, 210, 211),
+//! The workspace's source rules (xtask/src/source/, docs/ci.md, Choices 86, 210, 211),
 //! on the repository and on small fixture packages that break them: no function outside test
 //! code over 80 lines without its reason written above it, and no set of modules of a crate
 //! that reach each other through their imports. Every crate of the repository is read
@@ -369,7 +369,7 @@ fn host_sim_layers() -> Vec<(String, u32)> {
         .collect()
 }
 
-/// host-sim is a stack of layers (docs/design.md §22, Choice 100): a module uses only modules
+/// host-sim is a stack of layers (docs/simulator.md#structure, Choice 100): a module uses only modules
 /// of the layers below its own (or its own top-level module); two top-level modules of one
 /// layer (`board`, `studies`) do not use each other. Every top-level module has a layer.
 #[test]

@@ -1,4 +1,4 @@
-//! The blocks of the allocation (docs/design.md §9): groups of thrusters that share no actuated
+//! The blocks of the allocation (docs/thrusters.md#allocation-blocks-and-the-axis-priority): groups of thrusters that share no actuated
 //! axis with any other group, each with the rule by which it shares a shortfall, found once at
 //! configuration time from B and the axis priority.
 

@@ -1,5 +1,5 @@
 //! One block's thrusts within its box [T_min, T_max], in closed form, when B₅⁻¹τ does not fit
-//! (docs/design.md §9): the clamp, the lexicographic solution on a segment, and the weighted
+//! (docs/thrusters.md#allocation-blocks-and-the-axis-priority): the clamp, the lexicographic solution on a segment, and the weighted
 //! least squares over the box's edges and corners ([`super::Allocator`] says when each applies).
 
 /// The constants of the lexicographic solution, precomputed. With `p` the thruster whose

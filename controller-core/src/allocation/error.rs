@@ -1,5 +1,5 @@
 //! Why an allocation is refused at configuration time: one variant per check, with its
-//! numbers (docs/design.md §5, §9, §11).
+//! numbers (docs/thrusters.md#allocation, docs/thrusters.md#allocation-blocks-and-the-axis-priority, docs/law.md#configuration-checks).
 
 use core::fmt;
 
@@ -25,7 +25,7 @@ pub enum AllocationError {
     },
     /// The saturation-aware allocator ([`Allocator`](super::Allocator)) solves blocks of one or two
     /// thrusters: this geometry couples `thrusters` thrusters through `axes` actuated axes
-    /// (docs/design.md §9 **Choice**: non-block geometries are refused, no fallback).
+    /// (docs/thrusters.md#allocation-blocks-and-the-axis-priority **Choice**: non-block geometries are refused, no fallback).
     NotBlockDiagonal {
         /// Thrusters in the offending block.
         thrusters: usize,
@@ -71,7 +71,7 @@ impl fmt::Display for AllocationError {
             ),
             AllocationError::NotBlockDiagonal { thrusters, axes } => write!(
                 f,
-                "allocation check failed: {thrusters} thrusters share {axes} actuated axes; the saturation-aware allocator needs a block-diagonal allocation with blocks of one or two thrusters (docs/design.md §9)"
+                "allocation check failed: {thrusters} thrusters share {axes} actuated axes; the saturation-aware allocator needs a block-diagonal allocation with blocks of one or two thrusters (docs/thrusters.md#allocation-blocks-and-the-axis-priority)"
             ),
             AllocationError::ThrustEnvelope { thruster, min, max } => write!(
                 f,

@@ -1,5 +1,5 @@
-//! Control allocation: which thrusts T give the body wrench τ the law asks for (docs/design.md
-//! §5, §9, §15). Two parts, in the manner of PX4's `ControlAllocation` (whose methods are
+//! Control allocation: which thrusts T give the body wrench τ the law asks for
+//! (docs/thrusters.md#allocation, docs/thrusters.md#allocation-blocks-and-the-axis-priority, docs/thrusters.md#the-chain-end-to-end). Two parts, in the manner of PX4's `ControlAllocation` (whose methods are
 //! `ControlAllocationPseudoInverse` and `ControlAllocationSequentialDesaturation`):
 //!
 //! - the **geometric allocation** [`PseudoInverse`] (`pseudo_inverse.rs`): B from the thruster

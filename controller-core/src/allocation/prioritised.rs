@@ -1,13 +1,13 @@
 //! The saturation-aware allocator the board flies: thrusts inside every thruster's
 //! [`ThrustEnvelope`] that give the commanded wrench where the thrusters can, and give up the
-//! least important force first where they cannot (docs/design.md §9, §15).
+//! least important force first where they cannot (docs/thrusters.md#allocation-blocks-and-the-axis-priority, docs/thrusters.md#the-chain-end-to-end).
 //!
 //! [`Allocator::new`] runs once at configuration time. It takes the geometric allocation
 //! ([`PseudoInverse`]: B and B₅⁻¹), the envelope [T_min, T_max] of each thruster at the supply
 //! limit, and the axis priority ([`AxisPriority`]), and splits the 5×5 allocation over
 //! (X, Y, Z, M, N) into its blocks (`blocks.rs`): groups of thrusters that share no actuated
 //! axis with any other group. For the AUV-150 these are X ← main; (Z, M) ← the vertical pair;
-//! (Y, N) ← the horizontal pair. **Choice** (§9): a geometry whose allocation is not block
+//! (Y, N) ← the horizontal pair. **Choice** (docs/thrusters.md#allocation-blocks-and-the-axis-priority): a geometry whose allocation is not block
 //! diagonal with blocks of one or two thrusters is refused at configuration time
 //! ([`AllocationError::NotBlockDiagonal`]); there is no general-geometry fallback.
 //!

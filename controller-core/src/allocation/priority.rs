@@ -1,12 +1,12 @@
 //! Which forces the allocator gives up first when a block cannot meet its demand
-//! (docs/design.md §9 **Choice**).
+//! (docs/thrusters.md#allocation-blocks-and-the-axis-priority **Choice**).
 
 use core::fmt;
 
 use crate::axes::{ACTUATED, NAMES};
 
 /// Which forces the allocator gives up first when a block cannot meet its demand
-/// (docs/design.md §9 **Choice**), per row of τ = [X Y Z K M N] (the roll entries are not
+/// (docs/thrusters.md#allocation-blocks-and-the-axis-priority **Choice**), per row of τ = [X Y Z K M N] (the roll entries are not
 /// used: roll is not actuated).
 ///
 /// Within a block, the axis with the higher `rank` is met first (lexicographic); axes of

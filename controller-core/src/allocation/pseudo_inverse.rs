@@ -1,5 +1,5 @@
 //! The geometric allocation: the thrusts T that produce a body wrench τ, T = B₅⁻¹·[X Y Z M N]ᵀ
-//! (docs/design.md §5, §15).
+//! (docs/thrusters.md#allocation, docs/thrusters.md#the-chain-end-to-end).
 //!
 //! [`PseudoInverse`] is built once at configuration time from a [`ThrusterGeometry`]: it takes
 //! the effectiveness matrix B of [`crate::effectiveness`], drops the roll row K (roll is not
@@ -12,8 +12,8 @@
 //! This is the exact, unconstrained allocation. The board flies the saturation-aware
 //! [`Allocator`](super::Allocator), which starts from these thrusts, keeps them where they fit
 //! the thrusters' envelopes and solves each block of B₅ within its box where they do not
-//! (docs/design.md §9, §15). The simulator's ideal actuators deliver exactly these
-//! unconstrained thrusts (the paper's experiment, §7).
+//! (docs/thrusters.md#allocation-blocks-and-the-axis-priority, docs/thrusters.md#the-chain-end-to-end). The simulator's ideal actuators deliver exactly these
+//! unconstrained thrusts (the paper's experiment, docs/simulator.md#table-1).
 
 use nalgebra::{Matrix5, Matrix6x5, Vector5, Vector6};
 
@@ -30,7 +30,7 @@ pub const MAX_CONDITION: f32 = 1.0e4;
 /// Holds B (6×5, rows X Y Z K M N, [`ThrusterGeometry::effectiveness`]) and the inverse of its
 /// 5×5 sub-matrix B₅ over the actuated rows (X, Y, Z, M, N).
 ///
-/// For the default geometry (docs/design.md §5 **Choice**) this is the closed form, N:
+/// For the default geometry (docs/thrusters.md#geometry-and-the-effectiveness-matrix **Choice**) this is the closed form, N:
 ///
 /// ```text
 /// T_main      = X

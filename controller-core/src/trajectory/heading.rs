@@ -1,7 +1,7 @@
 //! How ψ_d is formed ([`HeadingMode`]): the paper's headings (ωt on the circle and the helix,
 //! the series of `series.rs` on the figure-eight and the lawn-mower; `paths/`), or the path's
-//! course (the tangent heading, docs/design.md §9) with its sampled bound on |ψ̈_d|
-//! (docs/design.md §6 **Choice**).
+//! course (the tangent heading, docs/missions.md#heading) with its sampled bound on |ψ̈_d|
+//! (docs/missions.md#heading **Choice**).
 
 use core::fmt;
 
@@ -9,7 +9,7 @@ use crate::trajectory::paths::PathKind;
 use crate::trajectory::phases::tangent;
 use crate::trajectory::Trajectory;
 
-/// How a mission's desired heading ψ_d is formed (docs/design.md §6, §9).
+/// How a mission's desired heading ψ_d is formed (docs/missions.md#closed-form-paths, docs/missions.md#heading).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash)]
 pub enum HeadingMode {
     /// The paper's headings: ψ_d = ωt on the circle and the helix, the triangle and trapezoid
@@ -17,7 +17,7 @@ pub enum HeadingMode {
     #[default]
     Paper,
     /// ψ_d follows the path's course χ_d = atan2(ẏ_d, ẋ_d), with ψ̇_d and ψ̈_d from the
-    /// path's curvature (docs/design.md §9): ψ̇_d = N/D, ψ̈_d = (Ṅ − ψ̇_d Ḋ)/D with
+    /// path's curvature (docs/missions.md#heading): ψ̇_d = N/D, ψ̈_d = (Ṅ − ψ̇_d Ḋ)/D with
     /// N = ẋ_d ÿ_d − ẏ_d ẍ_d, D = ẋ_d² + ẏ_d², Ṅ = ẋ_d y⃛_d − ẏ_d x⃛_d,
     /// Ḋ = 2(ẋ_d ẍ_d + ẏ_d ÿ_d). Defined where the horizontal speed √D is not zero:
     /// [`Trajectory::new`] refuses a tangent mission whose minimum speed is below
@@ -51,11 +51,11 @@ impl fmt::Display for HeadingMode {
 
 /// Samples per period of the path in the sampled bound on the tangent heading's |ψ̈_d|.
 const TANGENT_BOUND_SAMPLES: u32 = 1024;
-/// Margin on the sampled maximum of the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**).
+/// Margin on the sampled maximum of the tangent heading's |ψ̈_d| (docs/missions.md#heading **Choice**).
 pub(super) const TANGENT_BOUND_MARGIN: f32 = 1.1;
 
 impl Trajectory {
-    /// An upper bound on the tangent heading's |ψ̈_d| (docs/design.md §6 **Choice**). On the
+    /// An upper bound on the tangent heading's |ψ̈_d| (docs/missions.md#heading **Choice**). On the
     /// circle and the helix ψ̈_d = 0 exactly (the course turns at the constant −ω/k). On the
     /// figure-eight and the lawn-mower ψ̈_d is periodic in the path's phase: its maximum over
     /// [`TANGENT_BOUND_SAMPLES`] phases of one period, times [`TANGENT_BOUND_MARGIN`] for

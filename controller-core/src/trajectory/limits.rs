@@ -1,4 +1,4 @@
-//! The waypoint path's limits (docs/design.md §27, Choices 151–152, 156): how many points,
+//! The waypoint path's limits (docs/missions.md#waypoint-paths, Choices 151–152, 156): how many points,
 //! legs and parts it may have, and the sanity limits on its geometry and speeds. A leaf: the
 //! path's code (`paths/waypoints.rs`, `paths/time_law.rs`) and the refusals that name them
 //! (`error.rs`) both read them here.

@@ -3,7 +3,7 @@
 //! This module owns the desired state fed to the control law (ū = η̈_d − K₁e₁ − K₂e₂, Eq 17, with
 //! e₁ = η − η_d and e₂ = η̇ − η̇_d, Eqs 12–13) and the bound K_d ≥ ‖η̈_d(t)‖ of Assumption 1
 //! (Eq 19) that enters δ (Eq 29). The missions are the paper's "Simulation Results" section, as
-//! cleaned up in docs/design.md §6; all have φ_d = θ_d = 0 (and zero roll/pitch rates):
+//! cleaned up in docs/missions.md#closed-form-paths; all have φ_d = θ_d = 0 (and zero roll/pitch rates):
 //!
 //! | kind | x_d | y_d | z_d | ψ_d |
 //! |---|---|---|---|---|
@@ -15,7 +15,7 @@
 //! The paper's values are ω = 0.1 (circle, figure-eight) and ω = 0.05 (lawn-mower, so that
 //! 2ω = 0.1 in x_d), depth 5 m. The helix is ours (a circle that changes depth).
 //!
-//! **Choices** (docs/design.md §6):
+//! **Choices** (docs/missions.md#closed-form-paths):
 //! * The circle's printed "x_d = 10 sin(0.1)t" is read as R sin(0.1t) (a misplaced parenthesis:
 //!   y_d = 10 cos(0.1t) beside it and the circular plot fix it).
 //! * Both heading series use the prefactor 8/π (it makes the triangle and the trapezoid reach
@@ -25,8 +25,8 @@
 //!   even n), so only n = 1, 3, 5, 7, 9 are evaluated.
 //! * All derivatives are analytic (term-by-term derivatives of the truncated series).
 //!
-//! **Time and precision** (docs/design.md §8): time is the integer tick count; no f32 `t` is ever
-//! formed, and no f64 arithmetic runs per sample (docs/design.md §16). The tick count is split
+//! **Time and precision** (docs/numerics.md#time-as-an-integer-tick-count): time is the integer tick count; no f32 `t` is ever
+//! formed, and no f64 arithmetic runs per sample (docs/numerics.md#no-f64-on-the-control-step-from-the-elf). The tick count is split
 //! once into whole seconds and a fraction ([`MissionTime`]); each base frequency turns it into a
 //! phase in 2⁻³² turns by integer arithmetic ([`Frequency::phase`], exact to 3·2⁻³² turns at
 //! any mission time); harmonics are n·θ as a wrapping integer product, so they are exact too.
@@ -37,13 +37,13 @@
 //! [`MissionTime::linear`], the rate split into f32 parts at configuration so that rate·t is
 //! rounded once. Positions that
 //! grow with t (lawn-mower x_d, helix z_d) are f32 in the result, so they lose resolution as
-//! they grow (≈ 8 mm at 90 km); see §8 "Position".
+//! they grow (≈ 8 mm at 90 km); see docs/numerics.md#positions.
 //!
 //! **Heading** ψ_d is returned wrapped to (−π, π]. For the circle and helix ψ_d = ωt grows
 //! without bound and wraps once per revolution. The truncated lawn-mower series overshoots π
 //! on its plateau (its maximum is ≈ 3.198 rad), so there too ψ_d jumps by 2π while the
 //! heading itself is continuous; ψ̇_d and ψ̈_d are continuous everywhere. Consumers compare
-//! headings modulo 2π (docs/design.md §4 wraps the yaw error).
+//! headings modulo 2π (docs/law.md#structure wraps the yaw error).
 //!
 //! Every [`Trajectory::sample`] does a fixed amount of work (a `match` on the kind and, for the
 //! series, a loop over a constant five harmonics), never allocates and never panics.
@@ -109,7 +109,7 @@ pub struct Trajectory {
     mission: Mission,
     /// ω/k (rad/s), for the amplitudes.
     omega: f32,
-    /// ω/k as a turn rate, for θ (docs/design.md §16).
+    /// ω/k as a turn rate, for θ (docs/numerics.md#time-as-an-integer-tick-count).
     theta: Frequency,
     /// ω/2k, the figure-eight's half phase (zero otherwise).
     half: Frequency,
@@ -132,7 +132,7 @@ pub struct Trajectory {
 }
 
 impl Trajectory {
-    /// N, the last harmonic of the heading series (docs/design.md §6 **Choice**: truncate at N = 9).
+    /// N, the last harmonic of the heading series (docs/missions.md#closed-form-paths **Choice**: truncate at N = 9).
     pub const SERIES_TERMS: u32 = 9;
     /// The paper's ω for the circle and the figure-eight (rad/s).
     pub const PAPER_OMEGA: f32 = 0.1;
@@ -152,7 +152,7 @@ impl Trajectory {
     /// Largest time scale k (a mission flown 100 times slower than its path says).
     pub const MAX_TIME_SCALE: f32 = 100.0;
     /// Smallest horizontal speed (m/s) a tangent-heading mission may reach anywhere on its
-    /// path (docs/design.md §6 **Choice**): the course atan2(ẏ_d, ẋ_d) is undefined at zero
+    /// path (docs/missions.md#heading **Choice**): the course atan2(ẏ_d, ẋ_d) is undefined at zero
     /// speed and its derivatives grow as 1/speed², so [`Trajectory::new`] refuses a tangent
     /// mission whose closed-form minimum speed is lower, instead of holding a heading (which
     /// would need state in a stateless `update`). The shipped paths never stop.
@@ -375,7 +375,7 @@ impl Trajectory {
     /// over its harmonics, then the Euclidean norm over the components. For the circle this is
     /// √2·Rω² (the true maximum is Rω²); for the paper's figure-eight it is within 1 % of the true
     /// maximum (all the bounds are reached together at ωt = π/2). The tangent heading's term is
-    /// the sampled bound of docs/design.md §6. All frequencies are over the time scale k, so
+    /// the sampled bound of docs/missions.md#heading. All frequencies are over the time scale k, so
     /// K_d falls as 1/k². The square root is the backend's followed by one Newton step, which
     /// can only round up (AM–GM), so the bound holds with micromath's ≈ 6 % `sqrt` too.
     pub fn accel_bound(&self) -> f32 {

@@ -1,4 +1,4 @@
-//! The paper's heading series (docs/design.md §6 **Choice**: prefactor 8/π, truncated at
+//! The paper's heading series (docs/missions.md#closed-form-paths **Choice**: prefactor 8/π, truncated at
 //! N = [`Trajectory::SERIES_TERMS`] = 9): the figure-eight's triangle and the lawn-mower's
 //! trapezoid, as per-harmonic coefficients computed once and summed per sample over the odd
 //! harmonics (the even ones are identically zero in both).

@@ -1,9 +1,9 @@
-//! The six missions of the paper's Table 1 (docs/design.md §6–7 **Choice**: R = 10, 20;
+//! The six missions of the paper's Table 1 (docs/missions.md#closed-form-paths, docs/simulator.md#table-1 **Choice**: R = 10, 20;
 //! A = 15, 20; s = 2/3, 1), with the paper's frequencies and depth.
 
 use crate::trajectory::{Circle, FigureEight, LawnMower, Trajectory, TrajectoryKind};
 
-/// The six missions of the paper's Table 1 (docs/design.md §6–7).
+/// The six missions of the paper's Table 1 (docs/missions.md#closed-form-paths, docs/simulator.md#table-1).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Table1Case {
     /// Circle, R = 10 m.

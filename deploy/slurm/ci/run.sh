@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The CI's test of deploy/slurm/campaign.sbatch on a real Slurm (docs/design.md §26): starts
+# The CI's test of deploy/slurm/campaign.sbatch on a real Slurm (docs/campaigns.md): starts
 # munged, slurmctld and slurmd for a one-node cluster on localhost (deploy/slurm/ci/slurm.conf.in,
 # everything in one temporary folder), submits the shipped sbatch for the campaign
 # host-sim/campaigns/ci-small.campaign.toml in 4 shards with `sbatch --wait`, waits for its

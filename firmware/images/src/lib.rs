@@ -8,7 +8,7 @@
 //! build script uses [`image`] as a build-dependency. `host-sim` depends on this crate alone:
 //! the firmware's build script (golden vectors from the host core, the STM32 link key from the
 //! environment) is not part of a host-sim build, so a change of `AUV150_LINK_KEY` or of the
-//! firmware does not rebuild and relink the simulator (docs/design.md, Choice 92).
+//! firmware does not rebuild and relink the simulator (docs/ci.md#deterministic-tests-and-quick-rebuilds, Choice 92).
 #![cfg_attr(not(test), no_std)]
 
 pub mod image;

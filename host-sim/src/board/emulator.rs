@@ -130,7 +130,7 @@ pub fn spawn_qemu(
 /// `host-sim hil --port` opens as it would a USB-serial adapter (the CI's HIL without
 /// hardware). Ends QEMU when dropped.
 ///
-/// **Choice 70** (docs/design.md §21): the runner makes the pty with `-chardev pty,path=…`
+/// **Choice 70** (docs/board.md#hardware-in-the-loop): the runner makes the pty with `-chardev pty,path=…`
 /// and names it on stderr, since QEMU prints its own `char device redirected to` line on
 /// stdout, into the defmt stream; real time runs QEMU without `-icount`.
 pub struct QemuPty {

@@ -124,7 +124,7 @@ pub enum Error {
     #[error("the board does not fly the configuration sent: {mismatch}")]
     Config { mismatch: auv_link::ConfigMismatch },
     /// The board reports another thrust unit than the plant reads its voltages in
-    /// (docs/design.md §9): at the set-up or in any period.
+    /// (docs/thrusters.md#the-thrust-unit): at the set-up or in any period.
     #[error("the board reports thrust unit {}, but the plant reads its voltages in {} (tick {tick})", unit_name(*board), unit_name(*plant))]
     ThrustUnit {
         board: ThrustUnit,

@@ -1,6 +1,6 @@
 //! The runner's end of the board link ([`Link`]): frames out, numbered and signed if the link
 //! is; telemetry in, decoded, verified and checked for sequence order; every wait bounded by
-//! the reply timeout, with silence told from noise (**Choice 64**, docs/design.md §21).
+//! the reply timeout, with silence told from noise (**Choice 64**, docs/board.md#hardware-in-the-loop).
 
 use std::collections::VecDeque;
 use std::io;

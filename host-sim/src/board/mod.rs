@@ -31,7 +31,7 @@
 //! between the `SetConfig` and the `Arm`, [`upload`]); then `StartMission` with the
 //! scenario's validated mission (path, heading, time scale) and the first state frame. Every
 //! telemetry frame must name the thrust unit the plant reads the voltages in, or the run
-//! stops (docs/design.md §9). In lock-step the board runs
+//! stops (docs/thrusters.md#the-thrust-unit). In lock-step the board runs
 //! one control period per state frame and takes the frame's `t_ticks` as mission time (on its
 //! mission clock), so the result does not depend on host speed.
 //!
@@ -50,7 +50,7 @@
 //!
 //! Hardware in the loop (`host-sim hil`) is the same runner over another byte transport
 //! ([`transport`]): a serial device instead of QEMU's socket ([`BoardInTheLoop::over_serial`]).
-//! It paces the run one of two ways ([`Pacing`], docs/design.md §21): lock-step, exactly the
+//! It paces the run one of two ways ([`Pacing`], docs/board.md#pacing): lock-step, exactly the
 //! protocol above; or real time, where the board runs on its own timer (`lockstep = false`)
 //! and the host sends each state frame at its wall-clock period and flies the plant on the
 //! newest telemetry it has when the next period is due ([`RealTimeStats`]).

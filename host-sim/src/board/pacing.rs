@@ -1,12 +1,12 @@
 //! How a board in the loop is paced ([`Pacing`]), and the timing figures of a real-time run
 //! ([`RealTimeStats`]) with the pacer that takes them ([`RealTime`], used by
-//! period.rs). docs/design.md §21.
+//! period.rs). docs/board.md#pacing.
 
 use std::time::{Duration, Instant};
 
 use serde::{Deserialize, Serialize};
 
-/// How the runner paces the board (docs/design.md §21).
+/// How the runner paces the board (docs/board.md#pacing).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
 #[serde(rename_all = "lowercase")]
 pub enum Pacing {
@@ -33,7 +33,7 @@ impl Pacing {
 /// The timing of a real-time run ([`Pacing::Realtime`]): what the board's own clock and the
 /// link did to the loop. Times in seconds of the host's monotonic clock.
 ///
-/// **Choice 67** (docs/design.md §21): latency from a state frame sent to the first
+/// **Choice 67** (docs/board.md#pacing): latency from a state frame sent to the first
 /// telemetry naming it (a reply more than 16 frames late counts as none), p99 by nearest
 /// rank; jitter as the RMS and the largest deviation of the telemetry interval from the
 /// period; board missed = gaps in the telemetry's ticks; host missed = periods begun more
@@ -97,7 +97,7 @@ pub(super) const PHASE_FRAMES: usize = 8;
 /// period, and to phases that straddle a boundary. (A frame delayed by nearly a whole period
 /// reads as one that came just before its boundary; the set-up's frames, read as they come,
 /// are not.) `None` without arrivals. **Choice 78**,
-/// docs/design.md §21.
+/// docs/board.md#where-the-hosts-periods-sit.
 pub(super) fn board_edge(arrivals: &[Instant], period: Duration) -> Option<Instant> {
     let (&first, _) = arrivals.split_first()?;
     let p = period.as_nanos().max(1);

@@ -116,7 +116,7 @@ impl Periods {
     /// period `k + 1` is due, else the newest output the board sent (a late frame: the
     /// thrusters hold what the board last commanded, as they would on the vehicle). Period 0
     /// waits for its answer, and the run's wall clock starts then.
-    /// **Choice 66**, docs/design.md §21.
+    /// **Choice 66**, docs/board.md#pacing.
     fn realtime_reply(
         &mut self,
         link: &mut Link,

@@ -225,7 +225,7 @@ impl BoardInTheLoop {
         // Lock-step: commands, then the state frame (a mission's first state frame sets its
         // clock; an earlier one is not on it). Real time: the state first, so that a mission
         // (re)started in this period has a state when the board's next period comes
-        // (Choice 68, docs/design.md §21).
+        // (Choice 68, docs/board.md#pacing).
         let state_first = self.periods.pacing() == Pacing::Realtime;
         if !f.silent {
             if state_first && !f.dropped {

@@ -86,7 +86,7 @@ impl Session {
     /// sending), arms, and waits until the board reports itself armed with the scenario's
     /// mounting and unit.
     ///
-    /// **Choice 65** (docs/design.md §21): disarm first (a bench board may still be armed
+    /// **Choice 65** (docs/board.md#hardware-in-the-loop): disarm first (a bench board may still be armed
     /// from a run before, and refuses a configuration while armed); `Armed` counts only from
     /// telemetry whose `last_rx_seq` is the `Arm`'s (an earlier frame of a board that was
     /// armed before says nothing of this set-up). Armed, the board must fly every field of

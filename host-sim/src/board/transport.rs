@@ -15,7 +15,7 @@ use super::error::Error;
 
 /// What the runner needs from a byte transport.
 ///
-/// **Choice 62** (docs/design.md §21): one runner over this seam, not a runner per transport.
+/// **Choice 62** (docs/board.md#hardware-in-the-loop): one runner over this seam, not a runner per transport.
 pub trait Transport: Send {
     /// Up to `buf.len()` bytes, waiting at most the read timeout for the first: `Ok(0)` when
     /// nothing came in that time. A closed link is `Err` ([`io::ErrorKind::UnexpectedEof`]).

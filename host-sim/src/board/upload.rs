@@ -1,5 +1,5 @@
 //! The navigation computer's side of the mission upload (protocol 5, `auv_link::upload`,
-//! docs/design.md §27): a waypoint mission goes to the disarmed board before `Arm` as a
+//! docs/link.md#the-mission-upload): a waypoint mission goes to the disarmed board before `Arm` as a
 //! `Begin` and its chunks; each telemetry frame says which chunks the board holds; the runner
 //! resends what is missing until the board says the mission matches its CRC, in a bounded
 //! number of rounds.

@@ -138,7 +138,7 @@ pub(super) fn not_started(name: &str, e: board::Error) -> Result<Option<Started>
 /// ended. A run that loses its board keeps what it recorded (its CSV, its row in the report,
 /// marked as having lost the board, with the reason) and is named on stderr (**Choice 72**);
 /// a real-time run is compared with SIL but need not agree with it (**Choice 69**;
-/// docs/design.md §21).
+/// docs/board.md#pacing).
 pub(super) fn fly(
     args: &LoopArgs,
     scenarios: &[Scenario],

@@ -1,4 +1,4 @@
-//! `host-sim campaign plan|run|merge`: Monte Carlo campaigns in shards (docs/design.md §26).
+//! `host-sim campaign plan|run|merge`: Monte Carlo campaigns in shards (docs/campaigns.md).
 //!
 //! ```text
 //! host-sim campaign plan FILE [--workers N]

@@ -55,7 +55,7 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
         writeln!(stdout, "{p}")?;
         writeln!(stdout, "{}", preflight_table(&p))?;
     }
-    // A waypoint mission: the fastest speed profile (docs/design.md §27).
+    // A waypoint mission: the fastest speed profile (docs/missions.md#the-speed-profile).
     // None at all (Choice 175): said, and the verdict above stands (infeasible: a part that
     // cannot be flown even slowly over the box cannot be flown as written either).
     let (speed_profile, no_speed_profile) = match profile::propose(&scenario, args.margin) {
@@ -95,7 +95,7 @@ pub fn check(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Exit> {
 }
 
 /// What `check --json` prints: the check's [`Preflight`] (its keys at the top level) and, for a
-/// waypoint mission, the proposed [`SpeedProfile`] under `speed_profile` (docs/design.md §27,
+/// waypoint mission, the proposed [`SpeedProfile`] under `speed_profile` (docs/missions.md#the-speed-profile,
 /// Choice 172).
 #[derive(Serialize)]
 struct CheckJson<'a> {

@@ -1,4 +1,4 @@
-//! `host-sim import-plan`: a QGroundControl `.plan` as a waypoint scenario (docs/design.md §27).
+//! `host-sim import-plan`: a QGroundControl `.plan` as a waypoint scenario (docs/missions.md#plans-from-qgroundcontrol).
 
 use std::io::Write;
 use std::path::PathBuf;
@@ -74,7 +74,7 @@ pub fn import_plan(args: &ImportPlanArgs, stdout: &mut dyn Write) -> Result<Exit
     );
     doc.set_header(&[
         format!(
-            "Imported from {} (docs/design.md §27): NED in the tangent plane at the plan's home",
+            "Imported from {} (docs/missions.md#plans-from-qgroundcontrol): NED in the tangent plane at the plan's home",
             args.plan.display()
         ),
         format!(

@@ -16,11 +16,11 @@ pub struct Cases<T> {
     pub cases: Vec<T>,
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub incomplete: Vec<String>,
-    /// The preflight checks of the missions (`run`, `table1`; docs/design.md §9).
+    /// The preflight checks of the missions (`run`, `table1`; docs/real-vehicle.md#preflight-feasibility).
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub preflight: Vec<Preflight>,
     /// Whether the preflight's verdicts held over its validation campaign (`table1`;
-    /// docs/design.md §9).
+    /// docs/real-vehicle.md#the-preflights-contract).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contract: Option<ContractSummary>,
 }

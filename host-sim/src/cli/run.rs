@@ -70,7 +70,7 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
     progress.finish();
     let rows = [ReportRow::new(&with, without.as_ref())];
     let mut incomplete = incomplete.into_inner();
-    // A waypoint mission's path over its waypoints and speed over time (docs/design.md §27).
+    // A waypoint mission's path over its waypoints and speed over time (docs/simulator.md#plots-of-a-waypoint-mission).
     let extra: Vec<(String, PathBuf)> = mission_plots(&dir, &scenario, &with, &mut incomplete)?
         .into_iter()
         .map(|f| (with.name.clone(), f))
@@ -87,7 +87,7 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         &mut incomplete,
     )?;
     if let Some([lat, lon, alt]) = cfg.origin {
-        // The flown path on a map (docs/design.md §27): the run with Δu, its plotted samples.
+        // The flown path on a map (docs/missions.md#plans-from-qgroundcontrol): the run with Δu, its plotted samples.
         let origin = crate::scenario::plan::Origin { lat, lon, alt };
         let path: Vec<[f64; 3]> = with
             .samples

@@ -38,7 +38,7 @@ pub struct Table1Args {
     #[arg(long, default_value = DEFAULT_TABLE1_OUT)]
     pub out: PathBuf,
     /// The preflight's validation campaign the report gives its two numbers from: the real
-    /// paths under every mounting and 200 random missions (`full`, docs/design.md §9), the
+    /// paths under every mounting and 200 random missions (`full`, docs/real-vehicle.md#the-preflights-contract), the
     /// eight mountings a team would build and no random missions (`team`), or none.
     #[arg(long, value_enum, default_value_t = ContractRun::Full)]
     pub contract: ContractRun,
@@ -160,7 +160,7 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
 
 /// The plots of every run (the paper's rows, then the real missions without a companion), the
 /// waypoint missions' path over the waypoints and speed over time after their own
-/// (docs/design.md §27, Choice 173), and `report.md`; returns its path.
+/// (docs/simulator.md#plots-of-a-waypoint-mission, Choice 173), and `report.md`; returns its path.
 fn write_report(
     dir: &OutputDir,
     title: &str,

@@ -229,7 +229,7 @@ pub fn table_text(rows: &[ReportRow]) -> String {
         s.push_str(&fmt_row(r));
     }
     if rows.iter().any(|r| r.case.is_some()) {
-        s.push_str("max errors as ours (paper's Table 1, docs/design.md §7)\n");
+        s.push_str("max errors as ours (paper's Table 1, docs/simulator.md#table-1)\n");
     }
     s
 }
@@ -298,7 +298,7 @@ pub fn report_markdown(
     );
     s.push_str(
         "Maximum errors over each run in metres as **ours (paper)**, the paper's numbers from \
-         its Table 1 (docs/design.md §7) where the case is one of its six; path = \
+         its Table 1 (docs/simulator.md#table-1) where the case is one of its six; path = \
          √(max|e_x|² + max|e_y|² + max|e_z|²), rms path = √mean(e_x² + e_y² + e_z²). Angles in \
          rad. Peak |V| is the largest thruster voltage commanded; saturated is the fraction of \
          control periods with at least one thruster at the supply limit; faults counts the \
@@ -447,7 +447,7 @@ fn plots_section(dir: &Path, plots: &[PathBuf]) -> String {
     s
 }
 
-/// One row of the real-vehicle table (docs/design.md §9): a run through the real actuator
+/// One row of the real-vehicle table (docs/real-vehicle.md#the-real-missions): a run through the real actuator
 /// chain and the preflight check of its scenario.
 #[derive(Clone, Copy, Debug)]
 pub struct RealRow<'a> {
@@ -509,7 +509,7 @@ fn real_cells(rows: &[RealRow]) -> Vec<Vec<String>> {
 pub fn real_table_legend() -> String {
     format!(
         "within bound: completed with max path error ≤ {} m and a thruster saturated in ≤ {} % \
-         of the control periods (docs/design.md §9)",
+         of the control periods (docs/real-vehicle.md#the-bound-and-the-start-in-trim)",
         bound::MAX_PATH_ERROR,
         100.0 * bound::MAX_SATURATED_FRACTION
     )

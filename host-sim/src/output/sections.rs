@@ -10,13 +10,13 @@ use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
 
 /// What the report says about the real-vehicle table.
 pub const REAL_NOTES: &str = "\
-## The real vehicle (docs/design.md §9)
+## The real vehicle (docs/real-vehicle.md#the-real-missions)
 
 The missions of `scenarios/real/` fly the Table-1 paths as a vehicle team would: heading along
 the course, the Table-3 payload trimmed to neutral buoyancy, Eqs 31–32 in kgf, and the real
 actuator chain (the board's voltages, clamped at ±24 V, turned back into thrust by Eqs 31–32),
 each at the time scale the preflight check proposes; then missions planned as waypoints, on
-the speed profile the check proposes (docs/design.md §27): `survey-200x100`, a 200 m × 100 m
+the speed profile the check proposes (docs/missions.md#the-speed-profile): `survey-200x100`, a 200 m × 100 m
 lawn-mower at 5 m depth, `harbour-wall`, a descending inspection, and `pipeline`, a pipeline
 route descending from 4 m to 10 m, both imported from QGroundControl plans; each with its path
 over the waypoints and its speed over time among the plots. Below them, the
@@ -31,7 +31,7 @@ pub fn preflight<'a>(
     runs: impl IntoIterator<Item = &'a RunResult>,
 ) -> String {
     let mut s = format!(
-        "## Preflight (docs/design.md §9)\n\nWhether the real thrusters can fly each mission \
+        "## Preflight (docs/real-vehicle.md#preflight-feasibility)\n\nWhether the real thrusters can fly each mission \
          (`host-sim check --scenario FILE`): the force the reference needs along the path at \
          the attitude the vehicle holds (heel, pitch offset), through the board's allocator, \
          against {:.0} % of each thruster's envelope; for the mission as written (its payload \
@@ -111,7 +111,7 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
         .filter_map(|c| c.pil.upload.as_ref().map(|u| (c, u)))
         .collect();
     if !uploads.is_empty() {
-        notes += "\n### Mission uploads (docs/design.md §27)\n\n";
+        notes += "\n### Mission uploads (docs/link.md#the-mission-upload)\n\n";
         for (c, u) in uploads {
             notes += &format!(
                 "- {}: CRC {:#010x}, {} chunks in {} frames, {} bytes on the wire ({:.1} ms at \
@@ -134,7 +134,7 @@ pub fn board_vs_sil(cases: &[BoardComparison]) -> String {
         .filter_map(|c| c.pil.realtime.as_ref().map(|r| (c, r)))
         .collect();
     if !realtime.is_empty() {
-        notes += "\n### Real-time pacing (docs/design.md §21)\n\n";
+        notes += "\n### Real-time pacing (docs/board.md#pacing)\n\n";
         for (c, r) in realtime {
             notes += &format!("- {}: {r}\n", c.run.name);
         }

@@ -1,4 +1,4 @@
-//! The speed profile of a waypoint mission over time (docs/design.md §27, **Choice 162**): the
+//! The speed profile of a waypoint mission over time (docs/simulator.md#plots-of-a-waypoint-mission, **Choice 162**): the
 //! reference speed |η̇_d| the law is given, each part's own speed (the pinned `speeds`, else the
 //! constant `speed`) and each leg's cap (`trajectory.speed_limits`) as steps.
 

@@ -1,4 +1,4 @@
-//! The path over the waypoints of a waypoint mission (docs/design.md §27, **Choice 170**): a
+//! The path over the waypoints of a waypoint mission (docs/simulator.md#plots-of-a-waypoint-mission, **Choice 170**): a
 //! plan view as on a chart (east to the right, north up, equal scales) of the waypoints'
 //! polyline, the desired path η_d that cuts its corners on the blends (Choice 150) and the
 //! path flown, each waypoint marked and numbered as `check` names them (`turn at j`); beside

@@ -1,4 +1,4 @@
-//! The ocean current (docs/design.md §2): its model, as a scenario gives it ([`CurrentModel`]),
+//! The ocean current (docs/model.md#the-ocean-current-and-the-simulated-plant): its model, as a scenario gives it ([`CurrentModel`]),
 //! and its state as a run steps it ([`OceanCurrent`]). The plant sees ν_r = ν − [Rᵀ v_c; 0] in
 //! C_A and D.
 

@@ -2,7 +2,7 @@
 //!
 //! M_RB ν̇ + C_RB(ν) ν + M_A ν̇_r + C_A(ν_r) ν_r + D(ν_r) ν_r + g(η) = τ,  η̇ = J(η) ν,
 //!
-//! with ν_r = ν − ν_c, ν_c = [Rᵀ v_c; 0] for an earth-fixed current v_c (docs/design.md §2). The
+//! with ν_r = ν − ν_c, ν_c = [Rᵀ v_c; 0] for an earth-fixed current v_c (docs/model.md#the-ocean-current-and-the-simulated-plant). The
 //! matrices come from `controller_core::model` with the plant's (varying) parameters, so the
 //! plant and the controller share one implementation of Eq (1) and differ only in parameters.
 //!
@@ -57,7 +57,7 @@ impl Default for PlantTerms {
 /// the parameters are set ([`Plant::new`], [`Plant::set_params`]) and reused by every
 /// derivative until they change.
 ///
-/// **Choice 80** (docs/design.md §2): a simulation keeps one `Plant` and hands it the parameters of
+/// **Choice 80** (docs/model.md#evaluating-the-plant-fast): a simulation keeps one `Plant` and hands it the parameters of
 /// every step; M is refactorised only when they differ from the last ones (`==` on every
 /// field), so a constant or staircase profile factorises once per value, not once per step.
 #[derive(Clone, Debug)]
@@ -132,7 +132,7 @@ fn sin_cos_small(d: f64) -> (f64, f64) {
 /// δ = the difference of the angles ([`sin_cos_small`]); an angle that moved more than
 /// [`NEAR_ANGLE`] is evaluated afresh.
 ///
-/// **Choice 81** (docs/design.md §2): an RK4 stage moves the angles by at most h/2·|rate| or
+/// **Choice 81** (docs/model.md#evaluating-the-plant-fast): an RK4 stage moves the angles by at most h/2·|rate| or
 /// h·|rate| (below 10⁻³ rad for 1 rad/s at the 1 ms step), so the stages' sines and cosines
 /// follow from the step's by two products and a sum each, within a few ulps of libm's (the
 /// plant tests bound the difference), for three libm `sin_cos` calls per stage.

@@ -1,12 +1,12 @@
-//! Trim: the payload ballasted to neutral buoyancy (docs/design.md §9, **Choice 55**).
+//! Trim: the payload ballasted to neutral buoyancy (docs/real-vehicle.md#trim, **Choice 55**).
 
 use controller_core::model::VehicleParams;
 
 /// The parameters `p` with the payload trimmed (scenario key `variation.trimmed`,
-/// docs/design.md §9): ballasted to neutral buoyancy, B = W = m g, while the mass, the inertia
+/// docs/real-vehicle.md#trim): ballasted to neutral buoyancy, B = W = m g, while the mass, the inertia
 /// and the CG shift stay as they are.
 ///
-/// **Choice** (docs/design.md §9): the trim buoyancy B − B₀ acts at the centre of origin CO, so
+/// **Choice** (docs/real-vehicle.md#trim): the trim buoyancy B − B₀ acts at the centre of origin CO, so
 /// it adds a force and no moment: the buoyancy arms are scaled by B₀/B, which keeps every
 /// buoyancy moment (x_B B, y_B B, z_B B) as it was. Then g's force rows vanish (ΔW = 0) and its
 /// moment rows are those of the untrimmed payload: the CG shift still pitches and heels the
@@ -27,7 +27,7 @@ pub fn trimmed(p: &VehicleParams<f64>) -> VehicleParams<f64> {
 /// in roll equilibrium with no roll moment applied: the restoring roll moment of Eq (1)'s g(η),
 /// g₄ = cθ (k₄ sφ − m_y cφ) with m_y = y_G W − y_B B and k₄ = z_G W − z_B,roll B, vanishes at
 /// tan φ = m_y / k₄. The AUV-150's thrusters all sit on the centre line, so none of them rolls
-/// the vehicle: this is where a lateral CG shift leaves it (docs/design.md §9, "Attitude").
+/// the vehicle: this is where a lateral CG shift leaves it (docs/real-vehicle.md#the-attitude-the-vehicle-holds).
 /// `None` when the vehicle has no roll stability (k₄ ≤ 0: no heel is an equilibrium it returns
 /// to) or when |cos θ| is 0.
 pub fn static_heel(p: &VehicleParams<f64>, theta: f64) -> Option<f64> {

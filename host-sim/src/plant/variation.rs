@@ -1,8 +1,8 @@
-//! How the plant's parameters vary with time: the Table-3 profiles (docs/design.md §2).
+//! How the plant's parameters vary with time: the Table-3 profiles (docs/model.md#parameter-variation-table-3).
 
 use controller_core::model::ParamVariation;
 
-/// How the plant's parameters vary with time (Table 3, docs/design.md §2). Δp is added to the
+/// How the plant's parameters vary with time (Table 3, docs/model.md#parameter-variation-table-3). Δp is added to the
 /// nominal parameters of the **plant only**; the controller keeps the nominal model.
 #[derive(Clone, Debug, PartialEq)]
 pub enum VariationProfile {

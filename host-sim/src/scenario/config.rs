@@ -15,7 +15,7 @@ use crate::plant::{self, CurrentModel, VariationProfile};
 pub enum InitialAttitude {
     /// Roll and pitch of the reference (0): the vehicle released level, whatever its payload.
     Level,
-    /// **Choice 102** (docs/design.md §9): at the static heel of the payload present at
+    /// **Choice 102** (docs/real-vehicle.md#the-bound-and-the-start-in-trim): at the static heel of the payload present at
     /// t = 0 ([`crate::plant::static_heel`]; roll is not actuated, so a lateral CG shift leaves
     /// the vehicle heeled), pitch as the reference (pitch is controlled).
     Trim,
@@ -31,7 +31,7 @@ impl InitialAttitude {
     }
 }
 
-/// The bound a run must fly within (scenario table `[bound]`, docs/design.md §9): a run that
+/// The bound a run must fly within (scenario table `[bound]`, docs/real-vehicle.md#the-bound-and-the-start-in-trim): a run that
 /// completes outside it has missed.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bound {
@@ -42,7 +42,7 @@ pub struct Bound {
 }
 
 impl Bound {
-    /// The real vehicle's bound (**Choice 103**, docs/design.md §9): 0.05 m, 1 % of periods.
+    /// The real vehicle's bound (**Choice 103**, docs/real-vehicle.md#the-bound-and-the-start-in-trim): 0.05 m, 1 % of periods.
     pub const REAL_VEHICLE: Bound = Bound {
         max_path: 0.05,
         saturated: 0.01,
@@ -149,14 +149,14 @@ pub struct SimConfig {
     /// The mission's path (scenario table `[trajectory]`).
     pub trajectory: TrajectoryKind,
     /// How the mission's heading ψ_d is formed (`trajectory.heading`, default the paper's;
-    /// docs/design.md §9).
+    /// docs/missions.md#heading).
     pub heading: HeadingMode,
     /// The mission's time scale k ≥ 1: the reference is η_d(t/k) (`trajectory.time_scale`,
-    /// default 1; docs/design.md §9).
+    /// default 1; docs/missions.md#time-scaling).
     pub time_scale: f32,
     /// The mission frame's origin on the earth, [latitude, longitude (degrees), altitude (m)]
     /// (`trajectory.origin`, e.g. a QGroundControl plan's home): `run` then writes the flown
-    /// path as GeoJSON (docs/design.md §27). `None`: the frame is not placed on the earth.
+    /// path as GeoJSON (docs/missions.md#plans-from-qgroundcontrol). `None`: the frame is not placed on the earth.
     pub origin: Option<[f64; 3]>,
     /// A waypoint mission's per-leg speed caps (m/s, one per leg: n − 1 for n points;
     /// `trajectory.speed_limits`, **Choice 161**): a planning input of `check`'s speed profile
@@ -172,14 +172,14 @@ pub struct SimConfig {
     pub variation: VariationProfile,
     /// The payload is ballasted to neutral buoyancy, W = B (scenario key `variation.trimmed`,
     /// default false; plant only): its mass, inertia and CG shift still act, its net weight
-    /// does not ([`crate::plant::trimmed`], docs/design.md §9).
+    /// does not ([`crate::plant::trimmed`], docs/real-vehicle.md#trim).
     pub trimmed: bool,
     pub current: CurrentModel,
     pub noise: Option<SensorNoise>,
     /// First-order thruster lag time constant (s), if any.
     pub thruster_lag: Option<f64>,
     /// Ideal actuators: the thrusters deliver the allocated thrust whatever the voltage limit
-    /// (the Table-1 reproduction; docs/design.md §5). Voltages are still computed and reported.
+    /// (the Table-1 reproduction; docs/thrusters.md#the-chain-end-to-end). Voltages are still computed and reported.
     pub ideal_actuators: bool,
     /// Added to η(0) = η_d(0) (m, rad).
     pub initial_offset: [f64; 6],
@@ -218,8 +218,8 @@ impl SimConfig {
     }
 
     /// The attitude the run starts in: as configured, else **trim** for the real actuator
-    /// chain (a real vehicle is released in the attitude its payload gives it, docs/design.md
-    /// §9) and **level** for ideal actuators (the paper's Table 1, bit for bit as before).
+    /// chain (a real vehicle is released in the attitude its payload gives it,
+    /// docs/real-vehicle.md#the-bound-and-the-start-in-trim) and **level** for ideal actuators (the paper's Table 1, bit for bit as before).
     pub fn initial_attitude(&self) -> InitialAttitude {
         self.start_attitude.unwrap_or(match self.ideal_actuators {
             true => InitialAttitude::Level,
@@ -245,7 +245,7 @@ impl SimConfig {
     }
 
     /// Defaults around a path: the paper's heading (the tangent heading for waypoints, which
-    /// have no other: docs/design.md §27) at time scale 1, 70 s, 1 ms plant step, the
+    /// have no other: docs/missions.md#waypoint-paths) at time scale 1, 70 s, 1 ms plant step, the
     /// paper's controller at 100 Hz, no variation (untrimmed), no current, no noise, ideal
     /// actuators, starting on the reference, no Table-1 case, no faults expected, the step cap
     /// in force.

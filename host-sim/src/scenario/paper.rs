@@ -1,4 +1,4 @@
-//! The paper's Table-1 runs as scenarios, keyed by [`Table1Case`] (docs/design.md §6–7): each
+//! The paper's Table-1 runs as scenarios, keyed by [`Table1Case`] (docs/missions.md#closed-form-paths, docs/simulator.md#table-1): each
 //! case's run ([`config`]: its mission, its Table-3 variation profile, the paper's controller)
 //! and the lawn-mowers' Table-3 staircase. The paper's printed numbers and the twelve runs are
 //! [`crate::studies::table1`]'s.

@@ -299,7 +299,7 @@ fn build_controller(raw: &ControllerTable) -> Res<ControllerConfig> {
 /// `controller.reversed_thrusters`: the thrusters (by [`THRUSTER_NAMES`]) mounted with their
 /// strong (positive-thrust) side against their reference axis (+x main, +z vertical, +y
 /// horizontal), each at most once: the AUV-150 layout with those mounting signs
-/// ([`ThrusterGeometry::auv150`], docs/design.md §9).
+/// ([`ThrusterGeometry::auv150`], docs/real-vehicle.md#the-default-mounting).
 /// `key` names the list in errors (`key[i]`); a campaign's `draw.mountings[k]` uses it too.
 pub fn reversed_mask(key: &str, names: &[String]) -> Res<u8> {
     let mut mask = 0u8;
@@ -328,7 +328,7 @@ pub fn reversed_mask(key: &str, names: &[String]) -> Res<u8> {
 }
 
 /// `controller.axis_priority`: the five actuated axes by name ([`AXIS_NAMES`] without roll),
-/// each once, highest first; equal weights (docs/design.md §9).
+/// each once, highest first; equal weights (docs/thrusters.md#allocation-blocks-and-the-axis-priority).
 pub(super) fn axis_priority(order: &[String]) -> Res<AxisPriority> {
     let key = "controller.axis_priority";
     let actuated: Vec<&str> = AXIS_NAMES

@@ -1,4 +1,4 @@
-//! QGroundControl `.plan` files (docs/design.md §27, Choice 159): a survey planned in the tool
+//! QGroundControl `.plan` files (docs/missions.md#plans-from-qgroundcontrol, Choice 159): a survey planned in the tool
 //! teams use, read as the waypoints of a mission, and written back.
 //!
 //! A `.plan` is JSON; its `mission.items` are MAVLink mission items. The waypoints are the

@@ -1,4 +1,4 @@
-//! The real vehicle (docs/design.md §9): the six missions of `scenarios/real/` — the Table-1
+//! The real vehicle (docs/real-vehicle.md#the-real-missions): the six missions of `scenarios/real/` — the Table-1
 //! paths with the tangent heading, the Table-3 payload trimmed, Eqs 31–32 in kgf, the real
 //! actuator chain, each at the time scale `host-sim check` proposes — and the paper's own six
 //! missions through the same real chain ([`paper_real_chain`]), which `host-sim table1` flies
@@ -28,7 +28,7 @@ pub const REAL_SCENARIOS: [(&str, &str); 6] = shipped![
     "lawn-mower-30x15.toml",
 ];
 
-/// The real vehicle's waypoint missions (docs/design.md §27), flown in the same table after
+/// The real vehicle's waypoint missions (docs/missions.md#waypoint-paths), flown in the same table after
 /// [`REAL_SCENARIOS`]: (file name, its text).
 pub const WAYPOINT_SCENARIOS: [(&str, &str); 3] =
     shipped!["survey-200x100.toml", "harbour-wall.toml", "pipeline.toml"];

@@ -1,4 +1,4 @@
-//! Where a run starts (docs/design.md §6): on the reference, plus an offset.
+//! Where a run starts (docs/missions.md#closed-form-paths): on the reference, plus an offset.
 
 use controller_core::kinematics::{self, Attitude};
 use controller_core::Trajectory;

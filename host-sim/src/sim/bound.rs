@@ -1,4 +1,4 @@
-//! A run against its bound (docs/design.md §9): the real vehicle's, or a scenario's `[bound]`.
+//! A run against its bound (docs/real-vehicle.md#the-bound-and-the-start-in-trim): the real vehicle's, or a scenario's `[bound]`.
 
 use super::record::{Metrics, Outcome, RunResult};
 use crate::scenario::Bound;

@@ -1,4 +1,4 @@
-//! The paper's Table-1 metrics (docs/design.md §7) from a run's samples, accumulated as the run
+//! The paper's Table-1 metrics (docs/simulator.md#table-1) from a run's samples, accumulated as the run
 //! goes ([`Accumulator`]: constant memory whatever the duration) or from a slice
 //! ([`compute`]).
 

@@ -62,7 +62,7 @@ pub fn run(scenario: &Scenario) -> RunResult {
 /// Flies `scenario` with the law wherever `source` runs it, showing every sample to
 /// `observer` as it is made and keeping what `recording` says. Per control period k
 /// (t = k/rate): measure, control, actuate, then hold the thrust for the period while the plant
-/// is integrated (docs/design.md §7). Memory stays bounded whatever the duration.
+/// is integrated (docs/simulator.md#table-1). Memory stays bounded whatever the duration.
 pub fn fly(
     scenario: &Scenario,
     source: &mut dyn ControlSource,

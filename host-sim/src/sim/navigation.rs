@@ -28,7 +28,7 @@ pub fn wrap_pi(x: f64) -> f64 {
 /// 10 000 s (the run then went to fail-safe and diverged). The reduction is applied only
 /// beyond 4π, which the paper's 70 s missions never reach (their ψ stays below 7.1 rad), so
 /// the Table-1 runs are bit for bit as before; the controller wraps the yaw error anyway
-/// (docs/design.md §4), so the jump by whole turns is invisible to the law.
+/// (docs/law.md#structure), so the jump by whole turns is invisible to the law.
 pub fn reported_heading(psi: f64) -> f64 {
     if psi.abs() <= HEADING_REPORT_BOUND {
         psi

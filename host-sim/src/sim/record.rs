@@ -215,7 +215,7 @@ impl fmt::Display for FaultCounts {
     }
 }
 
-/// The paper's Table-1 metrics (docs/design.md §7) and the actuator figures.
+/// The paper's Table-1 metrics (docs/simulator.md#table-1) and the actuator figures.
 ///
 /// A run that recorded no period has none (**Choice 129**): every field is NaN
 /// ([`Metrics::NONE`]; the maximum and the mean of nothing), which the JSON writes as `null`

@@ -14,7 +14,7 @@ pub enum Recording {
     /// The plot series ([`super::decimate`]) in [`super::RunResult::samples`].
     Plot,
     /// No samples: [`super::RunResult::samples`] is empty. For runs nobody plots: **Choice 82**
-    /// (docs/design.md §2), Monte Carlo records this way. The [`super::RunResult::summary`] is
+    /// (docs/model.md#evaluating-the-plant-fast), Monte Carlo records this way. The [`super::RunResult::summary`] is
     /// the same as with [`Recording::Plot`].
     MetricsOnly,
 }

@@ -1,5 +1,5 @@
 //! The simulated thrusters: what they deliver for a period's control output, their optional
-//! first-order lag, and the body force they put on the plant (docs/design.md §7, §9, §15).
+//! first-order lag, and the body force they put on the plant (docs/simulator.md#table-1, docs/real-vehicle.md#the-real-chain-in-the-simulator, docs/thrusters.md#the-chain-end-to-end).
 //!
 //! - ideal actuators (**Choice 32**): the allocated thrusts B₅⁻¹τ, whatever the voltage;
 //! - the real chain (**Choice 56**): the controller's (clamped) voltages through the inverse of

@@ -1,4 +1,4 @@
-//! The paper's Table 1 as a study (docs/design.md §7): the paper's printed numbers
+//! The paper's Table 1 as a study (docs/simulator.md#table-1): the paper's printed numbers
 //! ([`table1_row`]), the report's notes on how our runs were made ([`notes`]), and the twelve
 //! runs themselves ([`run_all`]). The runs' scenarios are [`crate::scenario::paper`]'s.
 
@@ -18,7 +18,7 @@ pub struct PaperRow {
     pub path: [f64; 2],
 }
 
-/// The paper's Table 1 (docs/design.md §7): its row for `case`.
+/// The paper's Table 1 (docs/simulator.md#table-1): its row for `case`.
 pub fn table1_row(case: Table1Case) -> PaperRow {
     let row = |x: [f64; 2], y: [f64; 2], z: [f64; 2], path: [f64; 2]| PaperRow { x, y, z, path };
     match case {
@@ -91,9 +91,9 @@ pub fn notes() -> String {
   zero-order hold; paper gains {gains}, β = {beta}, μ = {mu}, {theorem}.
 - Actuators: ideal (the allocated thrusts are delivered). The voltages in the table are what
   the controller commanded at the board's ±{volts} V supply limit: the paper's missions need far
-  more thrust than Eqs 31–32 give at {volts} V, so a real board would saturate (docs/design.md §5).
+  more thrust than Eqs 31–32 give at {volts} V, so a real board would saturate (docs/thrusters.md#saturation).
 - The paper does not state its step size, integrator or loop rate; differences in the
-  \"without Δu\" column come mostly from that and from the choices listed in docs/design.md.
+  \"without Δu\" column come mostly from that and from the choices listed in docs/decisions.md.
 ",
         step = cfg.plant_step * 1000.0,
         rate = c.rate_hz,

@@ -1,4 +1,4 @@
-//! Does the preflight's verdict hold? (docs/design.md §9 "The preflight's contract"). A
+//! Does the preflight's verdict hold? (docs/real-vehicle.md#the-preflights-contract). A
 //! campaign that checks missions and then flies them: for each mission `check`'s verdict and
 //! proposed time scale (the mission as written), the flight at that scale through the real
 //! chain, and — by flying — the smallest scale that actually stays within the bound.
@@ -53,7 +53,7 @@ pub struct Campaign {
 }
 
 impl Default for Campaign {
-    /// The contract's campaign (docs/design.md §9): every mounting, 200 random missions, seed 1.
+    /// The contract's campaign (docs/real-vehicle.md#the-preflights-contract): every mounting, 200 random missions, seed 1.
     fn default() -> Self {
         Campaign {
             masks: all_mountings(),
@@ -412,7 +412,7 @@ impl Validation {
     /// The report: the two numbers, then one row per mission.
     pub fn markdown(&self) -> String {
         let mut s = format!(
-            "## The preflight's contract (docs/design.md §9)\n\n\
+            "## The preflight's contract (docs/real-vehicle.md#the-preflights-contract)\n\n\
              {} missions{}: {} flown at the time scale `check` proposes, {} refused (no feasible \
              scale). **False feasible: {}** (called feasible, missed the bound when flown). \
              **Conservativeness: median {:.2}×** (the proposed scale over the smallest that \

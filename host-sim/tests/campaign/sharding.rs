@@ -1,4 +1,4 @@
-//! Any sharding merges to the one-machine run's bytes (docs/design.md §26, Choice 130).
+//! Any sharding merges to the one-machine run's bytes (docs/campaigns.md#runs-and-shards, Choice 130).
 
 use crate::support::*;
 

@@ -7,7 +7,7 @@
 //! mounting: [`REAL_CHAIN`]) must equal SIL bit for bit with the board reporting the
 //! scenario's thrust unit and mounting; a link-fault case must enter and leave fail-safe
 //! at its exact ticks and drop its delayed (old) state frames; and the worst case of a small
-//! campaign (docs/design.md §26), found in SIL, flown on the board from the merge's scenario
+//! campaign (docs/campaigns.md#worst-cases), found in SIL, flown on the board from the merge's scenario
 //! file, must equal the campaign's record bit for bit.
 
 use std::path::{Path, PathBuf};
@@ -25,14 +25,14 @@ use xtask::ci::{Ci, HOST_PROFILE};
 pub const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
 
 /// The real-chain mission PIL flies (workspace-relative): one of the real-vehicle missions
-/// (docs/design.md §9), chosen because its time scale is above 1, flown for
+/// (docs/ci.md#the-board-in-ci), chosen because its time scale is above 1, flown for
 /// [`REAL_CHAIN_SECONDS`] only (CI time). The check reads it with host-sim's own loader and
 /// refuses to run unless it is what the check claims to fly.
 const REAL_CHAIN: &str = "host-sim/scenarios/real/figure-eight-30x30.toml";
 /// Seconds of the real-chain mission: 300 periods, a few seconds of QEMU.
 const REAL_CHAIN_SECONDS: &str = "3";
 
-/// The waypoint mission PIL flies (workspace-relative, docs/design.md §27): uploaded in two
+/// The waypoint mission PIL flies (workspace-relative, docs/ci.md#the-board-in-ci): uploaded in two
 /// chunks, the second lost on its first sending ([`WAYPOINTS_LOST_CHUNK`]), so the board's
 /// acknowledgement and the runner's resend are on the path; flown for its whole scenario
 /// duration (a leg, a speed change, a turn and the next leg).
@@ -343,7 +343,7 @@ fn link_faults(ci: &mut Ci, pil: &Pil) {
     }
 }
 
-/// The CI's small campaign (docs/design.md §26), run and merged here.
+/// The CI's small campaign (docs/campaigns.md#worst-cases), run and merged here.
 const CAMPAIGN: &str = "host-sim/campaigns/ci-small.campaign.toml";
 
 /// Runs the CI's small campaign in one shard and merges it, in the scratch folder; the merged

@@ -11,7 +11,7 @@
 //!   the one named up to the nearest that contains both (a folder's `mod.rs` is its front
 //!   door, and its code is the folder's);
 //! - a module's own ancestors are not edges: a child may use its parent's items, and a parent
-//!   may use and re-export its children (docs/design.md §22, §24, Choice 210).
+//!   may use and re-export its children (docs/ci.md#the-source-rules, docs/ci.md, Choice 210).
 
 use std::collections::{BTreeMap, BTreeSet, VecDeque};
 use std::fmt;

@@ -1,5 +1,5 @@
 //! The workspace's source rules, read from the files themselves (`cargo test -p xtask` checks
-//! them, `xtask/tests/source_rules.rs`; docs/design.md §24, Choices 86, 210 and 211). They
+//! them, `xtask/tests/source_rules.rs`; docs/ci.md, Choices 86, 210 and 211). They
 //! read every crate of the repository ([`crates`]): each target (library, binaries, examples,
 //! benchmarks, build script) of every package. Test code is left out: `#[cfg(test)]` and
 //! `#[test]` items, integration tests (`tests/`) and fuzz targets (`fuzz/`, which include the

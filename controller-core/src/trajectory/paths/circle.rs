@@ -1,5 +1,5 @@
-//! The circle (docs/design.md §6): x_d = R sin ωt, y_d = R cos ωt, z_d = depth, ψ_d = ωt
-//! (paper: ω = 0.1). **Choice** (§6): the printed "x_d = 10 sin(0.1)t" is read as R sin(0.1t)
+//! The circle (docs/missions.md#closed-form-paths): x_d = R sin ωt, y_d = R cos ωt, z_d = depth, ψ_d = ωt
+//! (paper: ω = 0.1). **Choice** (docs/missions.md#closed-form-paths): the printed "x_d = 10 sin(0.1)t" is read as R sin(0.1t)
 //! (a misplaced parenthesis: y_d = 10 cos(0.1t) beside it and the circular plot fix it).
 
 #[cfg(feature = "serde")]

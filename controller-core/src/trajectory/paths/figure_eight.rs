@@ -1,4 +1,4 @@
-//! The figure-eight (docs/design.md §6): x_d = A sin ωt, y_d = A cos(ωt/2), z_d = depth,
+//! The figure-eight (docs/missions.md#closed-form-paths): x_d = A sin ωt, y_d = A cos(ωt/2), z_d = depth,
 //! ψ_d the triangle series of base ω (`series.rs`; paper: ω = 0.1, A = 15 or 20 for the
 //! 30×30 and 40×40 cases).
 

@@ -1,4 +1,4 @@
-//! The helix (not in the paper; docs/design.md §6 **Choice**): the circle (`circle.rs`) with a
+//! The helix (not in the paper; docs/missions.md#closed-form-paths **Choice**): the circle (`circle.rs`) with a
 //! depth that changes linearly, z_d = depth + ż_d·t; ψ_d = ωt.
 
 use super::circle::{self, Circle};

@@ -22,7 +22,7 @@ pub(super) const DEPTH: Parameter = Parameter {
     range: ParameterRange::Symmetric(Trajectory::MAX_DEPTH),
 };
 
-/// A path kind: the variant's parameters and its equations (docs/design.md §6). Each method
+/// A path kind: the variant's parameters and its equations (docs/missions.md#closed-form-paths). Each method
 /// answers one question [`Trajectory`] asks, at configuration (all but the last two) or per
 /// sample ([`planar`](Self::planar), [`paper_heading`](Self::paper_heading): fixed work, no
 /// panic, inlined into the one `match` of the dispatch, no vtable).

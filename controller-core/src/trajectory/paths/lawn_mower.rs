@@ -1,4 +1,4 @@
-//! The lawn-mower (docs/design.md §6): x_d = s(0.25 t + 2.5 sin 2ωt), y_d = 15 s cos ωt,
+//! The lawn-mower (docs/missions.md#closed-form-paths): x_d = s(0.25 t + 2.5 sin 2ωt), y_d = 15 s cos ωt,
 //! z_d = depth, ψ_d the trapezoid series of base ω (`series.rs`; paper: ω = 0.05, so 2ω = 0.1
 //! in x_d; s = 1 is the paper's 30×15 case).
 

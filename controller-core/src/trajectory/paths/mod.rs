@@ -1,6 +1,6 @@
 //! The path kinds ([`TrajectoryKind`]), one file each: its parameters and their ranges, the
 //! path and its derivatives at a sample, its smallest horizontal speed and its acceleration
-//! bound, in closed form (docs/design.md §6), as an impl of [`PathKind`] (`kind.rs`).
+//! bound, in closed form (docs/missions.md#closed-form-paths), as an impl of [`PathKind`] (`kind.rs`).
 //!
 //! **One list.** [`path_kinds!`] below is the only place the kinds are listed: it declares
 //! [`TrajectoryKind`] (one variant per kind, holding the kind's struct), its
@@ -9,7 +9,7 @@
 //! file (the struct, its docs, its [`ClosedForm`] impl) and one line in the list; the link's
 //! wire form (`auv_link::MissionSpec`) then fails to compile until it carries the kind.
 //!
-//! The waypoint path (docs/design.md §27) is the one kind with a route and a time law: its
+//! The waypoint path (docs/missions.md#the-time-law) is the one kind with a route and a time law: its
 //! fields stay in the variant (a scenario file's `points`, `speeds`, …), borrowed as a
 //! [`WaypointPath`] for the dispatch; it is listed once, in the macro.
 
@@ -39,7 +39,7 @@ macro_rules! path_kinds {
         $(pub use $module::$kind;)+
 
         /// Shape and parameters of a mission (the paper's "Simulation Results";
-        /// docs/design.md §6): one variant per path kind, each holding its parameters.
+        /// docs/missions.md#closed-form-paths): one variant per path kind, each holding its parameters.
         ///
         /// All frequencies ω are in rad/s and must be positive; sizes in metres; z is positive
         /// down (NED).
@@ -73,7 +73,7 @@ macro_rules! path_kinds {
                 $variant($kind),
             )+
             /// Straight legs through the waypoints, each corner turned on a septic blend, flown
-            /// at `speed` along the path (not in the paper; docs/design.md §27).
+            /// at `speed` along the path (not in the paper; docs/missions.md#waypoint-paths).
             #[cfg_attr(feature = "serde", serde(rename = "waypoints"))]
             Waypoints {
                 /// The points in the mission frame (m, z positive down):

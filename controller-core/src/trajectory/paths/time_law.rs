@@ -1,4 +1,4 @@
-//! The waypoint path's time law (docs/design.md §27, Choice 156): a speed per part of the path
+//! The waypoint path's time law (docs/missions.md#the-time-law, Choice 156): a speed per part of the path
 //! (each leg and each turn), flown as constant-speed runs joined by speed changes on the quintic
 //! smoothstep, so that σ̈ is continuous and σ⃛ bounded.
 //!
@@ -9,7 +9,7 @@
 //! (v_a + v_b)/2·T of path and happens inside the faster part: a slowdown ends where the slower
 //! part begins, a speed-up starts where the slower part ends, so each part is flown at most at
 //! its own speed. A part too short for the changes at its two ends is refused (the host's
-//! preflight lowers its speed until they fit, docs/design.md §27).
+//! preflight lowers its speed until they fit, docs/missions.md#the-speed-profile).
 //!
 //! The pieces (at most three per segment: speed-up, cruise, slowdown) are sorted by start time;
 //! a fixed [`PIECE_SEARCH_STEPS`]-step binary search finds the piece. Each piece keeps its

@@ -1,4 +1,4 @@
-//! The waypoint path as a [`PathKind`] (docs/design.md §27): the fields of a
+//! The waypoint path as a [`PathKind`] (docs/missions.md#waypoint-paths): the fields of a
 //! [`TrajectoryKind::Waypoints`](crate::TrajectoryKind::Waypoints), borrowed, checked and built
 //! into the trajectory's route and time law in place, and flown along them.
 

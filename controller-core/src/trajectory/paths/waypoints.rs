@@ -1,4 +1,4 @@
-//! The waypoint path (docs/design.md §27, Choices 150–156): straight legs between the
+//! The waypoint path (docs/missions.md#waypoint-paths, Choices 150–156): straight legs between the
 //! waypoints, each corner turned on a **septic Hermite blend**, flown at a constant path
 //! speed (`speed` over the time scale k).
 //!

@@ -84,7 +84,7 @@ fn golden_vectors() -> (bool, u32, u32) {
     let mut ok = true;
     let mut worst_ulps = 0u32;
     // The survey's vectors must be bit for bit (the waypoint path's evaluation is the same
-    // f32 code on both sides, docs/design.md §27).
+    // f32 code on both sides, docs/board.md#the-self-test-and-its-budgets).
     let (mut survey, mut survey_exact) = (0u32, 0u32);
     let (mut max_ticks, mut sum_ticks, mut timed) = (0u32, 0u64, 0u32);
     let mut tr = Trajectory::EMPTY;
@@ -178,7 +178,7 @@ fn circle() -> Option<&'static Trajectory> {
 }
 
 /// The state on the paper's circle (`circle`: its trajectory, built once by [`run`]: a
-/// trajectory is 8.6 kB, docs/design.md §27) at tick `k`.
+/// trajectory is 8.6 kB, docs/missions.md#built-in-place) at tick `k`.
 fn circle_state(circle: &Trajectory, k: u64) -> StateFrame {
     let d = circle.sample(k, 100);
     let nu = kinematics::jacobian_inv(&Attitude::from_eta_f32(&d.eta)) * d.eta_dot;
@@ -420,7 +420,7 @@ fn real_chain_exercise() -> bool {
     kgf_reported && applied && mask_refused && armed_refused && scale_refused && flying
 }
 
-/// The shipped survey's upload through real frames (docs/design.md §27): refused while armed;
+/// The shipped survey's upload through real frames (docs/link.md#the-mission-upload): refused while armed;
 /// disarmed, a `Begin` and its chunks with the second lost, the telemetry's acknowledgement
 /// naming it, the resend verifying the mission; then `StartMission` of it by its CRC flies.
 /// Logs the instructions each part and the start cost the board.

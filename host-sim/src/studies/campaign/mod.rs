@@ -1,4 +1,4 @@
-//! Monte Carlo campaigns beyond one machine (docs/design.md §26): a campaign file
+//! Monte Carlo campaigns beyond one machine (docs/campaigns.md): a campaign file
 //! ([`file`]) says what is drawn around which base scenarios, how many runs, the seed, the
 //! metrics and the bound; a **shard** runs the indices i ≡ I (mod N) of it
 //! (**Choice 131**), on any engine (Slurm array, Kubernetes Indexed Job, a laptop), and writes one

@@ -1,5 +1,5 @@
 //! The attitude the vehicle holds along a mission, which the preflight evaluates the thrust
-//! demand at (docs/design.md §9 "Attitude"): not the reference's level attitude, but
+//! demand at (docs/real-vehicle.md#the-attitude-the-vehicle-holds): not the reference's level attitude, but
 //!
 //! - **the heel** — roll is neither actuated nor controlled (every thruster sits on the centre
 //!   line), so the vehicle floats at the roll angle where the roll row of Eq (1) balances: the

@@ -1,4 +1,4 @@
-//! Preflight feasibility (docs/design.md §9 "Preflight"): before any simulation, can the real
+//! Preflight feasibility (docs/real-vehicle.md#preflight-feasibility): before any simulation, can the real
 //! thrusters fly this scenario's mission, and if not, why not and how slowly could they?
 //!
 //! For the mission's reference η_d, η̇_d, η̈_d (the path the scenario flies, sampled every
@@ -34,7 +34,7 @@
 //! proposed scale flies the same path: the scenario's duration D covers the path up to
 //! D/k_scenario, which at scale k takes D·k/k_scenario.
 //!
-//! **Choices** (docs/design.md §9): the box is the controller's `uncertainty` box; the margin
+//! **Choices** (docs/real-vehicle.md#preflight-feasibility): the box is the controller's `uncertainty` box; the margin
 //! is 80 %; the path is sampled at 20 Hz of its own time; Gauss–Markov currents are taken at
 //! ±3σ; the attitude model is [`attitude`]'s (**Choice 104**).
 
@@ -82,7 +82,7 @@ pub enum CheckError {
     Interrupted,
     /// A waypoint mission with no speed profile: `part` cannot be flown over the whole box
     /// even at the slowest speed the search tries, `thruster` beyond its envelope there (the
-    /// box cannot be held at rest: docs/design.md §27, **Choice 175**).
+    /// box cannot be held at rest: docs/missions.md#the-speed-profile, **Choice 175**).
     NoProfile {
         /// `leg j` or `turn at j`.
         part: String,

@@ -1,4 +1,4 @@
-//! The speed profile of a waypoint mission (docs/design.md §27, Choices 156–158): the fastest
+//! The speed profile of a waypoint mission (docs/missions.md#the-speed-profile, Choices 156–158): the fastest
 //! speed per leg and turn at which the reference stays inside every thruster's margin envelope
 //! over the whole parameter box (and the configured current), joined by the core's speed
 //! changes, checked again as flown.

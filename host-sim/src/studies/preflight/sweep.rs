@@ -283,7 +283,7 @@ impl<'a> Checker<'a> {
     }
 
     /// [`Checker::sweep`] of every `stride`-th sample of `range` only (the speed profile's
-    /// per-part search, docs/design.md §27).
+    /// per-part search, docs/missions.md#the-speed-profile).
     pub(super) fn sweep_samples(
         &self,
         scope: Scope,
