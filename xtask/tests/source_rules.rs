@@ -9,49 +9,6 @@ use std::path::{Path, PathBuf};
 
 use xtask::source::{self, LONG_FN_LINES, LONG_MARKER};
 
-/// Import circles tolerated for now, (crate, its modules sorted). Each is inside a directory
-/// being restructured on its own branch, by the engineer who owns it and breaks it there
-/// (issue 27: `controller-core/src/trajectory/` for the closed path-kind set, `host-sim/src/
-/// board/` for the board runner's parts). The lead empties this list when those branches
-/// merge; a test below fails when an entry is no longer exactly a circle of the tree, so it
-/// cannot outlive its circle.
-const KNOWN_CYCLES_BEING_FIXED: &[source::KnownCircle] = &[
-    // closed-sets: `error` takes MAX_SLOPE from `paths::waypoints`, which returns
-    // `TrajectoryError` (a leaf `trajectory/limits.rs` breaks it); `kind` takes `WaypointList`
-    // and `SpeedList` from inside `paths`, whose dispatch matches on `TrajectoryKind` (a leaf
-    // `trajectory/lists.rs` breaks it); every path file uses `error`'s range checks.
-    (
-        "controller-core",
-        &[
-            "trajectory::error",
-            "trajectory::kind",
-            "trajectory::paths",
-            "trajectory::paths::circle",
-            "trajectory::paths::figure_eight",
-            "trajectory::paths::helix",
-            "trajectory::paths::lawn_mower",
-            "trajectory::paths::time_law",
-            "trajectory::paths::waypoints",
-        ],
-    ),
-    // board-runner: runner -> stats (BoardStats) -> upload (UploadStats) -> runner
-    // (BoardInTheLoop); `UploadStats` moved into stats.rs breaks it.
-    (
-        "host-sim",
-        &["board::runner", "board::stats", "board::upload"],
-    ),
-];
-
-/// Long functions without a reason tolerated for now, (file, function), each in a file being
-/// reworked on its own branch (issue 27: `firmware/build.rs`, golden vectors keyed by a
-/// mission plan). The lead empties this list at that merge; a test below fails when an entry
-/// is no longer an offender.
-const KNOWN_LONG_FNS_BEING_FIXED: &[(&str, &str)] = &[
-    // closed-sets: 128 and 115 lines, seen since the rule reads build scripts.
-    ("firmware/build.rs", "kernel_golden"),
-    ("firmware/build.rs", "golden"),
-];
-
 fn root() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR"))
         .parent()
@@ -69,18 +26,17 @@ fn unexplained(root: &Path) -> Vec<(String, String, usize, usize)> {
         .collect()
 }
 
-/// Every long function without a reason under `root` that is not in `known`, as a message.
-fn long_offenders(root: &Path, known: &[(&str, &str)]) -> Vec<String> {
+/// Every long function without a reason under `root`, as a message.
+fn long_offenders(root: &Path) -> Vec<String> {
     unexplained(root)
         .into_iter()
-        .filter(|(file, name, _, _)| !known.contains(&(file.as_str(), name.as_str())))
         .map(|(file, name, line, lines)| format!("{file}:{line} fn {name}: {lines} lines"))
         .collect()
 }
 
 #[test]
 fn no_function_is_long_without_its_reason() {
-    let offenders = long_offenders(&root(), KNOWN_LONG_FNS_BEING_FIXED);
+    let offenders = long_offenders(&root());
     assert!(
         offenders.is_empty(),
         "functions over {LONG_FN_LINES} lines without a `{LONG_MARKER} <reason>` comment directly above them (split them into named steps, or say why they are right long):\n  {}",
@@ -88,56 +44,24 @@ fn no_function_is_long_without_its_reason() {
     );
 }
 
-#[test]
-fn every_known_long_function_is_still_long() {
-    let now = unexplained(&root());
-    let stale: Vec<String> = KNOWN_LONG_FNS_BEING_FIXED
-        .iter()
-        .filter(|(file, name)| !now.iter().any(|(f, n, _, _)| f == file && n == name))
-        .map(|(file, name)| format!("{file} fn {name}"))
-        .collect();
-    assert!(
-        stale.is_empty(),
-        "no longer long (or moved): remove from KNOWN_LONG_FNS_BEING_FIXED:\n  {}",
-        stale.join("\n  ")
-    );
-}
-
-/// Every import circle under `root` that is not in `known`, as a report.
-fn circle_offenders(root: &Path, known: &[source::KnownCircle]) -> Vec<String> {
+/// Every import circle under `root`, as a report.
+fn circle_offenders(root: &Path) -> Vec<String> {
     source::circles(root)
         .expect("the crates")
         .iter()
-        .filter(|c| !known.iter().any(|k| source::is_known(c, k)))
         .map(ToString::to_string)
         .collect()
 }
 
 #[test]
 fn no_modules_of_a_crate_import_each_other_in_a_circle() {
-    let offenders = circle_offenders(&root(), KNOWN_CYCLES_BEING_FIXED);
+    let offenders = circle_offenders(&root());
     assert!(
         offenders.is_empty(),
         "import circles (each step is a module and the line that makes it depend on the next; \
          move what the circle's modules share into a module of its own that imports none of \
          them):\n{}",
         offenders.join("\n")
-    );
-}
-
-#[test]
-fn every_known_circle_is_still_a_circle() {
-    let now = source::circles(&root()).expect("the crates");
-    let stale: Vec<String> = KNOWN_CYCLES_BEING_FIXED
-        .iter()
-        .filter(|k| !now.iter().any(|c| source::is_known(c, k)))
-        .map(|(c, ms)| format!("{c}: {}", ms.join(", ")))
-        .collect();
-    assert!(
-        stale.is_empty(),
-        "no longer exactly a circle of the tree: remove (or update) in KNOWN_CYCLES_BEING_FIXED:\n  {}\nthe tree's circles now:\n{}",
-        stale.join("\n  "),
-        now.iter().map(ToString::to_string).collect::<String>()
     );
 }
 
@@ -235,7 +159,7 @@ fn a_circle_of_three_modules_fails_the_rule() {
             ),
         ],
     );
-    let offenders = circle_offenders(&dir, &[]);
+    let offenders = circle_offenders(&dir);
     assert_eq!(offenders.len(), 1, "{offenders:?}");
     assert!(
         offenders[0].contains("three: 3 modules import each other: runner, stats, upload"),
@@ -251,12 +175,6 @@ fn a_circle_of_three_modules_fails_the_rule() {
     ] {
         assert!(offenders[0].contains(step), "{step}: {}", offenders[0]);
     }
-    // The known list tolerates exactly that circle, no other.
-    assert!(circle_offenders(&dir, &[("three", &["runner", "stats", "upload"])]).is_empty());
-    assert_eq!(
-        circle_offenders(&dir, &[("three", &["runner", "stats"])]).len(),
-        1
-    );
 }
 
 #[test]
@@ -281,7 +199,7 @@ fn a_circle_through_a_re_export_fails_the_rule() {
             ),
         ],
     );
-    let offenders = circle_offenders(&dir, &[]);
+    let offenders = circle_offenders(&dir);
     assert_eq!(offenders.len(), 1, "{offenders:?}");
     for part in [
         "trajectory::error, trajectory::waypoints",
@@ -316,17 +234,10 @@ fn a_long_function_in_a_build_script_or_an_example_fails_the_rule() {
     );
     let lines = LONG_FN_LINES + 2;
     assert_eq!(
-        long_offenders(&dir, &[]),
+        long_offenders(&dir),
         [
             format!("benches/b.rs:1 fn main: {lines} lines"),
             format!("build.rs:1 fn main: {lines} lines"),
-            format!("examples/demo.rs:1 fn main: {lines} lines"),
-        ]
-    );
-    assert_eq!(
-        long_offenders(&dir, &[("build.rs", "main")]),
-        [
-            format!("benches/b.rs:1 fn main: {lines} lines"),
             format!("examples/demo.rs:1 fn main: {lines} lines"),
         ]
     );

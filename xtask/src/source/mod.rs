@@ -95,19 +95,6 @@ pub fn circles(root: &Path) -> Result<Vec<Circle>, String> {
     Ok(out)
 }
 
-/// A circle tolerated while it is being broken: (crate, its modules, sorted).
-pub type KnownCircle<'a> = (&'a str, &'a [&'a str]);
-
-/// True if `circle` is exactly the known one.
-pub fn is_known(circle: &Circle, known: &KnownCircle) -> bool {
-    circle.krate == known.0
-        && circle
-            .modules
-            .iter()
-            .map(String::as_str)
-            .eq(known.1.iter().copied())
-}
-
 /// `.rs` files under `root` that no crate reads (as a module of any target, test modules and
 /// integration tests included): a file the rules would never see.
 pub fn unseen_rust_files(root: &Path) -> Result<Vec<PathBuf>, String> {
