@@ -318,6 +318,9 @@ enum Script {
     SilentAfter(u64),
     /// Answers `.0` state frames, then hangs up (its side of the pty closes).
     HangUpAfter(u64),
+    /// Takes the `SetConfig` but flies its defaults (as a board its watchdog reset would):
+    /// its unit and mounting are the ones sent, its configuration digest is not.
+    Defaults,
 }
 
 /// The telemetry of a fresh board that has done nothing: disarmed, no counts, no output.
@@ -383,6 +386,12 @@ fn scripted_board(mut port: TTYPort, script: Script, stop: Arc<AtomicBool>) {
                     _ => {
                         t.thrust_unit = c.thrust_unit.unwrap_or(t.thrust_unit);
                         t.reversed_thrusters = c.reversed_thrusters.unwrap_or(0);
+                        // The digest of the whole configuration flown (protocol 6): the one
+                        // sent, which is whole; a reset board reports another.
+                        t.config_digest = match script {
+                            Script::Defaults => !c.digest().unwrap_or(0),
+                            _ => c.digest().unwrap_or(0),
+                        };
                     }
                 },
                 Msg::Command(LinkCommand::Arm) => t.status = BoardStatus::Armed,
@@ -450,7 +459,8 @@ fn with_scripted_board<R>(
 }
 
 /// The set-up's failures, each its own variant: a refusal with the board's reason, another
-/// mounting, another thrust unit, and telemetry signed when this end is not (or the reverse).
+/// mounting, another thrust unit, another configuration (Choice 228), and telemetry signed when
+/// this end is not (or the reverse).
 #[test]
 fn a_set_up_the_board_does_not_take_says_why() {
     let err = |script, key| with_scripted_board(script, key, |b| b.err());
@@ -485,6 +495,16 @@ fn a_set_up_the_board_does_not_take_says_why() {
     assert!(
         matches!(u, Some(board::Error::ThrustUnit { board, plant, .. }) if board == other_unit && plant == unit),
         "{u:?}"
+    );
+    let d = err(Script::Defaults, None);
+    assert!(
+        matches!(
+            d,
+            Some(board::Error::Config {
+                mismatch: auv_link::ConfigMismatch::Digest { .. }
+            })
+        ),
+        "{d:?}"
     );
     let key = [7u8; 32];
     let signed = err(Script::Signs(key), None);
