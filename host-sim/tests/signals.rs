@@ -130,6 +130,66 @@ fn monte_carlo_bounds_its_runs_estimates_their_time_and_writes_a_partial_report_
     assert!(stderr(&o).contains("--allow-long-run"), "{}", stderr(&o));
 }
 
+/// Waits for `child` at most `limit`; kills it and panics (naming `what`) if it is still running.
+fn wait_at_most(
+    mut child: std::process::Child,
+    limit: std::time::Duration,
+    what: &str,
+) -> std::process::Output {
+    let t0 = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what}: still running after {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// `validate-preflight --random N` had no cap and made every mission before flying the first,
+/// not looking at the interrupt (`--random 20000` was still making missions 40 s after
+/// SIGINT): beyond `monte-carlo`'s cap it is refused before anything is made, and with
+/// `--allow-long-run` the missions are made as they are flown, so the first SIGINT acts within
+/// seconds and the partial report is written. The limits are generous for a loaded machine.
+#[test]
+fn validate_preflight_bounds_its_random_missions_and_acts_on_ctrl_c_while_making_them() {
+    let dir = tempdir("validate-random");
+    let spawn = |extra: &[&str], out: &str| {
+        host_sim()
+            .args([
+                "validate-preflight",
+                "--mountings",
+                "team",
+                "--random",
+                "20000",
+            ])
+            .args(extra)
+            .arg("--out")
+            .arg(dir.join(out))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let limit = std::time::Duration::from_secs(20);
+    let o = wait_at_most(spawn(&[], "capped"), limit, "--random 20000");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--random 20000") && stderr(&o).contains("--allow-long-run"),
+        "{}",
+        stderr(&o)
+    );
+    let child = spawn(&["--allow-long-run", "--json"], "long");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    signal(child.id(), libc::SIGINT);
+    let o = wait_at_most(child, limit, "--random 20000 --allow-long-run after SIGINT");
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let report = std::fs::read_to_string(dir.join("long/report.md")).unwrap();
+    assert!(report.contains("PARTIAL"), "{report}");
+}
+
 /// A day-long circle: its preflight alone is minutes of work (1.7·10⁶ samples × 2⁹ corners).
 const DAY: &str =
     "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n";

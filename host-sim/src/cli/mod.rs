@@ -11,7 +11,7 @@
 //! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
-//! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR]
+//! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR] [--allow-long-run]
 //! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! host-sim import-plan FILE.plan [--speed 0.5] [--name NAME]    # the scenario TOML on stdout
 //! ```
