@@ -71,7 +71,17 @@ fn main() -> ExitCode {
     if let Err(e) = host_sim::interrupt::install() {
         eprintln!("host-sim: warning: no Ctrl-C handler ({e}): an interrupt loses the run");
     }
-    let command = Cli::parse()
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        // `check --json` prints one JSON object on every exit, a refused command line included.
+        if e.use_stderr() {
+            let args: Vec<_> = std::env::args_os().collect();
+            if let Some(json) = cli::usage_error_json(&args, &e.to_string()) {
+                println!("{json}");
+            }
+        }
+        e.exit()
+    });
+    let command = cli
         .command
         .unwrap_or_else(|| Command::Table1(Table1Args::default()));
     let stdout = &mut std::io::stdout().lock();

@@ -190,6 +190,51 @@ fn validate_preflight_bounds_its_random_missions_and_acts_on_ctrl_c_while_making
     assert!(report.contains("PARTIAL"), "{report}");
 }
 
+/// `check --json` printed nothing when interrupted (exit 130): stdout is exactly one JSON
+/// object, `"interrupted": true` with the verdict when it was made (a waypoint mission
+/// interrupted in its speed profile's search) and without one when it was not (a day-long
+/// circle interrupted in the check itself).
+#[test]
+fn check_json_prints_the_verdict_so_far_when_interrupted() {
+    let one_object = |stdout: &str| -> serde_json::Value {
+        let mut objects =
+            serde_json::Deserializer::from_str(stdout).into_iter::<serde_json::Value>();
+        let v = objects.next().expect("an object on stdout").unwrap();
+        assert!(objects.next().is_none(), "more than one object: {stdout}");
+        v
+    };
+    let pipeline =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/real/pipeline.toml");
+    let (code, stdout, lines) = interrupt_after(
+        &["check", "--json", "--scenario", pipeline.to_str().unwrap()],
+        "searching the speed profile",
+    );
+    assert_eq!(code, Some(130), "{lines:?}");
+    let v = one_object(&stdout);
+    assert_eq!(v["interrupted"], true, "{v}");
+    assert_eq!(v["verdict"], "feasible", "{v}");
+    assert!(
+        v["thrusters"].is_array() && v["speed_profile"].is_null(),
+        "{v}"
+    );
+
+    let dir = tempdir("check-int");
+    let s = scenario(&dir, "day", DAY);
+    let child = host_sim()
+        .args(["check", "--json", "--scenario"])
+        .arg(&s)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    signal(child.id(), libc::SIGINT);
+    let o = wait_at_most(child, std::time::Duration::from_secs(20), "check of a day");
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let v = one_object(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!(v, serde_json::json!({"interrupted": true}));
+}
+
 /// A day-long circle: its preflight alone is minutes of work (1.7·10⁶ samples × 2⁹ corners).
 const DAY: &str =
     "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n";

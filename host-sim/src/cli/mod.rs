@@ -23,7 +23,8 @@
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`](crate::sim::record::RunSummary) (table1, run) or of
 //! [`BoardComparison`](crate::board::BoardComparison) (pil, hil), or the Monte Carlo [`Summary`](crate::studies::montecarlo::Summary); its
-//! keys come out sorted.
+//! keys come out sorted. `check --json` prints one object on every exit, errors and interrupts
+//! included ([`check`]).
 //!
 //! Every command, before it computes anything: validates its input (scenario, flags, the step
 //! cap), checks and prepares the output folder ([`OutputDir::prepare`](crate::output::OutputDir::prepare): a folder, not a symlink,
@@ -67,7 +68,7 @@ mod validate;
 
 pub use board_loop::LoopArgs;
 pub use campaign::{campaign, resolve_shard, CampaignArgs, CampaignCommand};
-pub use check::{check, CheckArgs};
+pub use check::{check, usage_error_json, CheckArgs};
 pub use hil::{hil, HilArgs, DEFAULT_HIL_BAUD, DEFAULT_HIL_REPLY_TIMEOUT};
 pub use import_plan::{import_plan, ImportPlanArgs};
 pub use json::Cases;
