@@ -51,40 +51,7 @@ pub fn import_plan(args: &ImportPlanArgs, stdout: &mut dyn Write) -> Result<Exit
         .with_context(|| format!("cannot read {}", args.plan.display()))?;
     let refused = |why: String| anyhow!("{}: {why}", args.plan.display());
     let (origin, points) = plan::import(&text).map_err(|e| refused(e.to_string()))?;
-    // What the scenario would refuse, said of the plan's items (Choice 300).
-    if !(2..=MAX_WAYPOINTS).contains(&points.len()) {
-        return Err(refused(count_refused(points.len())));
-    }
-    let reach = f64::from(MAX_POSITION);
-    if let Some((i, p)) = points
-        .iter()
-        .enumerate()
-        .find(|(_, p)| p.iter().any(|x| x.abs() > reach))
-    {
-        return Err(refused(format!(
-            "{} is {} m north, {} m east and {} m down of the home: beyond the ±{reach} m \
-             (along each axis) the controller accepts from the mission origin",
-            plan::item(i),
-            Readable(p[0].round()),
-            Readable(p[1].round()),
-            Readable(p[2].round())
-        )));
-    }
-    let mission: Vec<[f32; 3]> = points.iter().map(|p| p.map(|x| x as f32)).collect();
-    let points_list = WaypointList::new(&mission).map_err(|e| refused(e.to_string()))?;
-    let path = TrajectoryKind::Waypoints {
-        points: points_list,
-        speed,
-        turn_radius: None,
-        speeds: None,
-        speed_change: None,
-    };
-    Trajectory::new(Mission {
-        path,
-        heading: HeadingMode::Tangent,
-        time_scale: 1.0,
-    })
-    .map_err(|e| refused(in_plan_items(&e, args.speed)))?;
+    let path = waypoint_path(&points, speed).map_err(refused)?;
     // The flat earth's error at the farthest waypoint (Choice 302).
     let (far, d) =
         points
@@ -96,14 +63,15 @@ pub fn import_plan(args: &ImportPlanArgs, stdout: &mut dyn Write) -> Result<Exit
                 |best, (i, d)| if d > best.1 { (i, d) } else { best },
             );
     let flat_error = origin.flat_earth_error(d);
+    let at_farthest = format!(
+        "{} is {d:.0} m from the home, where the flat-earth plane misplaces a point by up to \
+         {flat_error:.3} m",
+        plan::item(far)
+    );
     if flat_error > MAX_PATH_ERROR {
         eprintln!(
-            "host-sim: import-plan: warning: {} is {:.0} m from the home, where the flat-earth \
-             plane misplaces a point by up to {:.3} m, more than the {MAX_PATH_ERROR} m a run may \
-             miss its path by (docs/missions.md#plans-from-qgroundcontrol)",
-            plan::item(far),
-            d,
-            flat_error
+            "host-sim: import-plan: warning: {at_farthest}, more than the {MAX_PATH_ERROR} m a \
+             run may miss its path by (docs/missions.md#plans-from-qgroundcontrol)"
         );
     }
     let mut file = ScenarioFile::new(path);
@@ -124,19 +92,51 @@ pub fn import_plan(args: &ImportPlanArgs, stdout: &mut dyn Write) -> Result<Exit
             "Imported from {} (docs/missions.md#plans-from-qgroundcontrol): NED in the tangent plane at the plan's home",
             args.plan.display()
         ),
-        format!(
-            "position lat {lat}, lon {lon}, alt {alt} m (WGS-84 flat earth: {} at {:.0} m from \
-             the home, misplaced by at most {:.3} m).",
-            plan::item(far),
-            d,
-            flat_error
-        ),
+        format!("position lat {lat}, lon {lon}, alt {alt} m (WGS-84 flat earth: {at_farthest})."),
     ]);
     // Whatever else the scenario refuses, refused here, not by the `run` that reads it.
     parse_scenario(&doc.to_string())
         .map_err(|e| refused(format!("the imported scenario is refused: {e}")))?;
     write!(stdout, "{doc}")?;
     Ok(Exit::Success)
+}
+
+/// The waypoint path of the plan's `points` (NED, m; point i is `mission.items[i]`) at
+/// `speed`, or what the scenario would refuse in it, said of the plan's items (Choice 300).
+fn waypoint_path(points: &[[f64; 3]], speed: f32) -> Result<TrajectoryKind, String> {
+    if !(2..=MAX_WAYPOINTS).contains(&points.len()) {
+        return Err(count_refused(points.len()));
+    }
+    let reach = f64::from(MAX_POSITION);
+    if let Some((i, p)) = points
+        .iter()
+        .enumerate()
+        .find(|(_, p)| p.iter().any(|x| x.abs() > reach))
+    {
+        return Err(format!(
+            "{} is {} m north, {} m east and {} m down of the home: beyond the ±{reach} m \
+             (along each axis) the controller accepts from the mission origin",
+            plan::item(i),
+            Readable(p[0].round()),
+            Readable(p[1].round()),
+            Readable(p[2].round())
+        ));
+    }
+    let mission: Vec<[f32; 3]> = points.iter().map(|p| p.map(|x| x as f32)).collect();
+    let path = TrajectoryKind::Waypoints {
+        points: WaypointList::new(&mission).map_err(|e| e.to_string())?,
+        speed,
+        turn_radius: None,
+        speeds: None,
+        speed_change: None,
+    };
+    Trajectory::new(Mission {
+        path,
+        heading: HeadingMode::Tangent,
+        time_scale: 1.0,
+    })
+    .map_err(|e| in_plan_items(&e, speed))?;
+    Ok(path)
 }
 
 /// A plan of `n` waypoints, refused: a mission has 2 to [`MAX_WAYPOINTS`].
@@ -147,7 +147,7 @@ fn count_refused(n: usize) -> String {
 
 /// A refusal of the core's ([`Trajectory::new`]) said of the plan's items: waypoint i is
 /// `mission.items[i]` (Choice 300).
-fn in_plan_items(e: &TrajectoryError, speed: f64) -> String {
+fn in_plan_items(e: &TrajectoryError, speed: f32) -> String {
     let item = plan::item;
     let leg = |j: usize| format!("the leg from {} to {}", item(j), item(j + 1));
     match *e {
