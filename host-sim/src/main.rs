@@ -53,9 +53,11 @@ enum Command {
     /// one report whose worst cases replay bit for bit.
     Campaign(CampaignArgs),
     /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
-    /// frame of the plan's home position. Exit 2 if the file is not a plan of waypoints, or on a
-    /// flag the scenario would refuse (`--speed` outside (0, 10] m/s, a `--name` that is not
-    /// a file name).
+    /// frame of the plan's home position, each altitude in its item's frame. Exit 2 if the file
+    /// is not a plan of waypoints, on what the scenario would refuse (named by plan item:
+    /// `mission.items[i]`), or on a flag it would refuse (`--speed` outside (0, 10] m/s, a
+    /// `--name` that is not a file name); a warning when the flat earth misplaces a waypoint by
+    /// more than the 0.05 m path bound.
     ImportPlan(ImportPlanArgs),
 }
 
@@ -69,7 +71,17 @@ fn main() -> ExitCode {
     if let Err(e) = host_sim::interrupt::install() {
         eprintln!("host-sim: warning: no Ctrl-C handler ({e}): an interrupt loses the run");
     }
-    let command = Cli::parse()
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        // `check --json` prints one JSON object on every exit, a refused command line included.
+        if e.use_stderr() {
+            let args: Vec<_> = std::env::args_os().collect();
+            if let Some(json) = cli::usage_error_json(&args, &e.to_string()) {
+                println!("{json}");
+            }
+        }
+        e.exit()
+    });
+    let command = cli
         .command
         .unwrap_or_else(|| Command::Table1(Table1Args::default()));
     let stdout = &mut std::io::stdout().lock();

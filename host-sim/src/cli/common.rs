@@ -5,7 +5,7 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 
 use super::json::{print_json, Cases};
 use super::Exit;
@@ -15,6 +15,7 @@ use crate::scenario::{load_config, Scenario};
 use crate::sim::progress::Progress;
 use crate::sim::record::RunSummary;
 use crate::sim::{self, ControlSource, LocalController, Recording, RunResult};
+use crate::studies::montecarlo::MAX_RUNS;
 use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 
 /// Reads and validates a scenario file, with the step cap lifted if `allow_long_run`.
@@ -23,6 +24,15 @@ pub(super) fn load(path: &Path, allow_long_run: bool) -> Result<Scenario> {
     let mut config = load_config(path).with_context(ctx)?;
     config.allow_long_run = allow_long_run;
     Scenario::new(config).with_context(ctx)
+}
+
+/// A command's count of runs (`--runs`, `--random`): at most [`MAX_RUNS`] unless
+/// `allow_long_run` (the one cap of `monte-carlo` and `validate-preflight`, Choice 303).
+pub(super) fn check_run_count(flag: &str, n: usize, allow_long_run: bool) -> Result<()> {
+    if n > MAX_RUNS && !allow_long_run {
+        bail!("{flag} {n} is more than {MAX_RUNS}; give --allow-long-run to run that many");
+    }
+    Ok(())
 }
 
 /// The control periods of `scenarios`, for [`Progress`].

@@ -11,7 +11,7 @@
 //! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
-//! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR]
+//! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR] [--allow-long-run]
 //! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! host-sim import-plan FILE.plan [--speed 0.5] [--name NAME]    # the scenario TOML on stdout
 //! ```
@@ -23,7 +23,8 @@
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`](crate::sim::record::RunSummary) (table1, run) or of
 //! [`BoardComparison`](crate::board::BoardComparison) (pil, hil), or the Monte Carlo [`Summary`](crate::studies::montecarlo::Summary); its
-//! keys come out sorted.
+//! keys come out sorted. `check --json` prints one object on every exit, errors and interrupts
+//! included ([`check`]).
 //!
 //! Every command, before it computes anything: validates its input (scenario, flags, the step
 //! cap), checks and prepares the output folder ([`OutputDir::prepare`](crate::output::OutputDir::prepare): a folder, not a symlink,
@@ -67,7 +68,7 @@ mod validate;
 
 pub use board_loop::LoopArgs;
 pub use campaign::{campaign, resolve_shard, CampaignArgs, CampaignCommand};
-pub use check::{check, CheckArgs};
+pub use check::{check, usage_error_json, CheckArgs};
 pub use hil::{hil, HilArgs, DEFAULT_HIL_BAUD, DEFAULT_HIL_REPLY_TIMEOUT};
 pub use import_plan::{import_plan, ImportPlanArgs};
 pub use json::Cases;

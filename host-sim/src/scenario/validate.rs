@@ -13,7 +13,7 @@ use controller_core::{Controller, Mission, Trajectory, TrajectoryKind};
 use controller_core::{Fault, Status};
 
 use super::start::start_state;
-use super::{SensorNoise, SimConfig};
+use super::{plan, SensorNoise, SimConfig};
 use crate::plant::{CurrentModel, VariationProfile};
 
 use super::ScenarioError;
@@ -338,22 +338,33 @@ fn each(key: &str, xs: &[f64], check: fn(&str, f64) -> Res<f64>) -> Res<()> {
     Ok(())
 }
 
-/// `trajectory.origin`: a latitude in [−90, 90], a longitude in [−180, 180], a finite altitude.
+/// `trajectory.origin`: a latitude in [−90, 90] and not within
+/// [`plan::pole_margin_degrees`] of a pole (**Choice 301**, [`plan::Origin::new`]), a longitude
+/// in [−180, 180], a finite altitude.
 fn check_origin(origin: Option<[f64; 3]>) -> Res<()> {
-    match origin {
-        Some([lat, lon, alt]) if !(lat.abs() <= 90.0 && lon.abs() <= 180.0 && alt.is_finite()) => {
-            Err(invalid(
-                "trajectory.origin",
-                format!(
-                    "must be [latitude in [-90, 90], longitude in [-180, 180], a finite altitude], got [{}, {}, {}]",
-                    Readable(lat),
-                    Readable(lon),
-                    Readable(alt)
-                ),
-            ))
-        }
-        _ => Ok(()),
-    }
+    let Some([lat, lon, alt]) = origin else {
+        return Ok(());
+    };
+    let range = match lon.abs() <= 180.0 {
+        true => plan::Origin::new(lat, lon, alt)
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+        false => Err(format!(
+            "longitude {} is outside [-180, 180]",
+            Readable(lon)
+        )),
+    };
+    range.map_err(|why| {
+        invalid(
+            "trajectory.origin",
+            format!(
+                "must be [latitude, longitude, altitude] off the poles, got [{}, {}, {}]: {why}",
+                Readable(lat),
+                Readable(lon),
+                Readable(alt)
+            ),
+        )
+    })
 }
 
 /// `trajectory.speed_limits` (**Choice 161**): a waypoint mission's, one per leg (n − 1 for n

@@ -35,6 +35,7 @@
 use std::path::{Path, PathBuf};
 
 use controller_core::effectiveness::THRUSTER_NAMES;
+use controller_core::readable::Readable;
 use serde::{Deserialize, Serialize};
 
 use super::METRIC_NAMES;
@@ -356,20 +357,29 @@ fn check_draw(d: &DrawSpec) -> Result<(), CampaignError> {
         if !(v.is_finite() && (0.0..=MAX_CURRENT_SPEED).contains(&v)) {
             return Err(invalid(
                 "draw.current",
-                format!("must be a speed in [0, {MAX_CURRENT_SPEED}] m/s, got {v}"),
+                format!(
+                    "must be a speed in [0, {MAX_CURRENT_SPEED}] m/s, got {}",
+                    Readable(v)
+                ),
             ));
         }
     }
     if let Some(w) = d.initial_offset {
         // Roll and yaw within ±π, pitch inside ±π/2; the sum with the base's offset is checked
-        // by each run's scenario (a run beyond it is recorded `invalid`).
+        // by each run's scenario (a run beyond it is recorded `invalid`). A position's
+        // half-width has no upper limit of its own, and none is printed (it was f64::MAX's
+        // 309 digits).
         use std::f64::consts::{FRAC_PI_2, PI};
-        let limits = [f64::MAX, f64::MAX, f64::MAX, PI, FRAC_PI_2, PI];
+        let limits = [None, None, None, Some(PI), Some(FRAC_PI_2), Some(PI)];
         for (i, (x, lim)) in w.iter().zip(limits).enumerate() {
-            if !(x.is_finite() && *x >= 0.0 && *x <= lim) {
+            if !(x.is_finite() && *x >= 0.0 && lim.is_none_or(|l| *x <= l)) {
+                let range = match lim {
+                    None => "a half-width ≥ 0 m".to_string(),
+                    Some(l) => format!("a half-width in [0, {}] rad", Readable(l)),
+                };
                 return Err(invalid(
                     &format!("draw.initial_offset[{i}]"),
-                    format!("must be a half-width ≥ 0 (and ≤ {lim} for an angle), got {x}"),
+                    format!("must be {range}, got {}", Readable(*x)),
                 ));
             }
         }
@@ -381,7 +391,11 @@ fn check_draw(d: &DrawSpec) -> Result<(), CampaignError> {
         if !(lo.is_finite() && hi.is_finite() && 1.0 <= lo && lo <= hi && hi <= 100.0) {
             return Err(invalid(
                 "draw.time_scale",
-                format!("must be [lo, hi] with 1 ≤ lo ≤ hi ≤ 100, got [{lo}, {hi}]"),
+                format!(
+                    "must be [lo, hi] with 1 ≤ lo ≤ hi ≤ 100, got [{}, {}]",
+                    Readable(lo),
+                    Readable(hi)
+                ),
             ));
         }
     }
