@@ -134,6 +134,8 @@ pub(super) fn print_runs(
             writeln!(stdout, "{c}")?;
         }
         writeln!(stdout, "{}", output::table_text(rows))?;
+        let all: Vec<&RunResult> = runs(rows).collect();
+        writeln!(stdout, "{}", output::chatter_table_text(&all))?;
         writeln!(stdout, "report: {}", report.display())?;
     }
     Ok(exit)

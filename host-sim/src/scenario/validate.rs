@@ -13,7 +13,7 @@ use controller_core::{Controller, Mission, Trajectory, TrajectoryKind};
 use controller_core::{Fault, Status};
 
 use super::start::start_state;
-use super::{plan, SensorNoise, SimConfig};
+use super::{plan, Bound, SensorNoise, SimConfig};
 use crate::plant::{CurrentModel, VariationProfile};
 
 use super::ScenarioError;
@@ -138,15 +138,8 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
         ));
     }
     each("initial_offset", &config.initial_offset, finite)?;
-    if let Some(b) = config.bound_setting {
-        positive("bound.max_path", b.max_path)?;
-        let s = non_negative("bound.saturated", b.saturated)?;
-        if s > 1.0 {
-            return Err(invalid(
-                "bound.saturated",
-                format!("is a fraction of the control periods, in [0, 1], got {s}"),
-            ));
-        }
+    if let Some(b) = &config.bound_setting {
+        bound(b)?;
     }
     let limit = at_most(
         "divergence_limit",
@@ -310,6 +303,21 @@ fn finite(key: &str, x: f64) -> Res<f64> {
             format!("must be a finite number, got {}", Readable(x)),
         ))
     }
+}
+
+/// `[bound]`: a path limit > 0, a saturated fraction in [0, 1], chatter limits ≥ 0.
+fn bound(b: &Bound) -> Res<()> {
+    positive("bound.max_path", b.max_path)?;
+    non_negative("bound.max_reversals_per_s", b.max_reversals_per_s)?;
+    non_negative("bound.max_command_tv", b.max_command_tv)?;
+    let s = non_negative("bound.saturated", b.saturated)?;
+    if s > 1.0 {
+        return Err(invalid(
+            "bound.saturated",
+            format!("is a fraction of the control periods, in [0, 1], got {s}"),
+        ));
+    }
+    Ok(())
 }
 
 fn positive(key: &str, x: f64) -> Res<f64> {

@@ -12,6 +12,7 @@
 //! | [`record`] | a run's samples, outcome, metrics and JSON summary |
 //! | [`recorder`] | what a run keeps as it goes (metrics, fault counts, plot series, observer) |
 //! | [`metrics`], [`decimate`] | the Table-1 metrics; the bounded plot series of a long run |
+//! | [`chatter`] | what the commands do between the limits: reversals, total variation, power above the thruster's corner |
 //! | [`observer`], [`progress`] | who sees each sample as it is made; progress of long commands |
 //! | [`bound`] | the bound a real-vehicle run must fly within |
 //!
@@ -21,6 +22,7 @@
 //! ([`crate::interrupt`]) stops it at the period it is in.
 
 pub mod bound;
+pub mod chatter;
 pub mod control;
 pub mod decimate;
 pub mod metrics;
@@ -43,6 +45,7 @@ pub use recorder::Recording;
 use crate::interrupt;
 use crate::plant::PlantState;
 use crate::scenario::Scenario;
+use metrics::Accumulator;
 use navigation::{wrap_pi, Navigation};
 use recorder::Recorder;
 use thrusters::{Thrusters, Thrusts};
@@ -75,7 +78,7 @@ pub fn fly(
     let mut vehicle = Vehicle::new(scenario);
     let mut navigation = Navigation::new(cfg.noise.as_ref());
     let mut thrusters = Thrusters::new(cfg, scenario.controller(), h);
-    let mut recorder = Recorder::new(observer, recording, steps + 1);
+    let mut recorder = Recorder::new(observer, recording, steps + 1, Accumulator::of(cfg));
     let mut outcome = Outcome::Completed;
     for k in 0..=steps {
         let t = k as f64 * period;

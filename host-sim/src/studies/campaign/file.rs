@@ -9,7 +9,7 @@
 //! bases = ["circle.toml"]      # one or more scenario files, relative to this file; run i
 //!                              # flies base ⌊i·B/runs⌋ (B bases: equal blocks of indices)
 //! metrics = ["max_path", "rms_path"]  # reported metrics, the first is "the error" of the
-//!                              # scatter plots; default all ten (METRIC_NAMES)
+//!                              # scatter plots; default all (METRIC_NAMES)
 //!
 //! [draw]                       # what each run draws; a key left out draws nothing
 //! parameters = "uniform"       # "uniform" in the Table-3 box | "corners" of it | "none"
@@ -24,6 +24,8 @@
 //! [bound]                      # replaces each base's bound; default: each base's own
 //! max_path = 0.05              # m, > 0
 //! saturated = 0.01             # fraction of periods, [0, 1]
+//! max_reversals_per_s = 2.0    # 1/s, ≥ 0: any thruster's sign reversals through ±0.5 V
+//! max_command_tv = 100.0       # V/s, ≥ 0: any thruster's command total variation
 //! fraction = 0.99              # `campaign merge` exits 4 when fewer runs are within bound;
 //!                              # default: no such verdict (exit 0)
 //! ```
@@ -149,6 +151,8 @@ impl Default for DrawSpec {
 pub struct BoundSpec {
     pub max_path: Option<f64>,
     pub saturated: Option<f64>,
+    pub max_reversals_per_s: Option<f64>,
+    pub max_command_tv: Option<f64>,
     pub fraction: Option<f64>,
 }
 
@@ -347,6 +351,8 @@ fn check(spec: &CampaignSpec) -> Result<(), CampaignError> {
     if let Some(b) = &spec.bound {
         positive("bound.max_path", b.max_path)?;
         unit("bound.saturated", b.saturated)?;
+        non_negative("bound.max_reversals_per_s", b.max_reversals_per_s)?;
+        non_negative("bound.max_command_tv", b.max_command_tv)?;
         unit("bound.fraction", b.fraction)?;
     }
     Ok(())
@@ -440,6 +446,16 @@ fn positive(key: &str, v: Option<f64>) -> Result<(), CampaignError> {
     }
 }
 
+fn non_negative(key: &str, v: Option<f64>) -> Result<(), CampaignError> {
+    match v {
+        Some(x) if !(x.is_finite() && x >= 0.0) => Err(invalid(
+            key,
+            format!("must be a finite number ≥ 0, got {x}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
 fn unit(key: &str, v: Option<f64>) -> Result<(), CampaignError> {
     match v {
         Some(x) if !(0.0..=1.0).contains(&x) => {
@@ -454,13 +470,19 @@ impl CampaignSpec {
     /// for a key left out.
     pub fn bound(&self) -> Option<Bound> {
         let b = self.bound.as_ref()?;
-        if b.max_path.is_none() && b.saturated.is_none() {
+        if b.max_path.is_none()
+            && b.saturated.is_none()
+            && b.max_reversals_per_s.is_none()
+            && b.max_command_tv.is_none()
+        {
             return None;
         }
-        Some(Bound {
-            max_path: b.max_path.unwrap_or(Bound::REAL_VEHICLE.max_path),
-            saturated: b.saturated.unwrap_or(Bound::REAL_VEHICLE.saturated),
-        })
+        Some(Bound::with_defaults(
+            b.max_path,
+            b.saturated,
+            b.max_reversals_per_s,
+            b.max_command_tv,
+        ))
     }
 
     /// The least fraction of runs within bound for the merge's verdict.
