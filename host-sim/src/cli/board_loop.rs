@@ -230,7 +230,15 @@ fn fly_one(
         Recording::Plot,
     );
     let Started { mut board, log } = started;
-    let board_run = run_into(dir, s, &mut board, progress, incomplete);
+    let board_run = run_into(
+        dir,
+        s,
+        &mut board,
+        mode.source(),
+        None,
+        progress,
+        incomplete,
+    );
     let stats = board.finish();
     if let Some((log, log_path)) = log {
         if let Err(e) = log.commit() {
