@@ -1,7 +1,7 @@
 //! The flight log of a run: an MCAP file (docs/logs.md) beside its CSV, from the same
 //! [`Sample`]s, with the channels of [`schema`] at their own rates, the law's inside
 //! ([`inside`]), the scenario as an attachment and the run's metadata (version, gains, bound,
-//! outcome).
+//! outcome). [`read`] reads a log (or a run's CSV) back as series, [`diff`] compares two.
 //!
 //! **Choice 354** (docs/logs.md#a-killed-run): the log is written under its final name as
 //! the run goes, zstd-compressed, one chunk per second of flight: each chunk is closed and
@@ -13,7 +13,9 @@
 //! format says itself whether a file is complete, and a log is most wanted from the run that
 //! was killed.
 
+pub mod diff;
 pub mod inside;
+pub mod read;
 pub mod schema;
 
 use std::collections::BTreeMap;
