@@ -42,6 +42,12 @@ pub fn log_name(name: &str, robust: bool) -> String {
     format!("{name}-{}.mcap", crate::sim::record::du_suffix(robust))
 }
 
+/// The log of the SIL run `pil` and `hil` fly beside the board's (`{name}-sil.mcap`; the
+/// board's is [`log_name`]'s, source `pil` or `hil`).
+pub fn sil_log_name(name: &str) -> String {
+    format!("{name}-sil.mcap")
+}
+
 /// The log of one run being written ([`Observer`]); [`McapLog::finish`] ends it.
 ///
 /// A write error stops the writing but not the run, as for the CSV: the error and the time are
