@@ -3,14 +3,14 @@
 //! maps the outcome to the exit code; the commands are [`host_sim::cli`]'s, which documents
 //! the codes (0 done, 1 a run diverged or lost its board, or PIL ≠ SIL, or `check` found the
 //! mission infeasible, 2 bad input, I/O error or an incomplete output, 3 an unexpected
-//! controller fault, 4 a run missed its bound, 130 interrupted).
+//! controller fault, 4 a run missed its bound or `diff`'s flights differ, 130 interrupted).
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
-    self, CampaignArgs, CheckArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs, RunArgs,
-    Table1Args, ValidateArgs,
+    self, CampaignArgs, CheckArgs, DiffArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs,
+    RunArgs, Table1Args, ValidateArgs,
 };
 
 #[derive(Parser)]
@@ -59,6 +59,10 @@ enum Command {
     /// `--name` that is not a file name); a warning when the flat earth misplaces a waypoint by
     /// more than the 0.05 m path bound.
     ImportPlan(ImportPlanArgs),
+    /// Two flights (MCAP logs or runs' CSVs) compared series by series: the first time they
+    /// diverge beyond the tolerance and where, the largest difference of each series, a plot
+    /// of those that differ most. Exit 0 the same, 4 they differ, 2 bad input.
+    Diff(DiffArgs),
 }
 
 fn main() -> ExitCode {
@@ -95,6 +99,7 @@ fn main() -> ExitCode {
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
         Command::Campaign(args) => cli::campaign(&args, stdout),
         Command::ImportPlan(args) => cli::import_plan(&args, stdout),
+        Command::Diff(args) => cli::diff(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

@@ -84,6 +84,7 @@ fn synthetic(name: &str, robust: bool, n: usize, gain: f64) -> RunResult {
                     23 => ControlStatus::Board(BoardStatus::Running),
                     _ => ControlStatus::Law(Status::Ok),
                 },
+                signals: Default::default(),
             }
         })
         .collect();

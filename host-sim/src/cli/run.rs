@@ -62,12 +62,14 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         !args.json,
     );
     let incomplete = Incomplete::default();
-    let with = sil_into(&dir, &scenario, &progress, &incomplete);
+    // The scenario file as written, attached to the flight logs (docs/logs.md#metadata).
+    let text = std::fs::read_to_string(&args.scenario).ok();
+    let with = sil_into(&dir, &scenario, text.as_deref(), &progress, &incomplete);
     // A run interrupted is not followed by its companion (nothing would be done of it).
     let without = companion
         .as_ref()
         .filter(|_| !interrupt::requested())
-        .map(|c| sil_into(&dir, c, &progress, &incomplete));
+        .map(|c| sil_into(&dir, c, text.as_deref(), &progress, &incomplete));
     progress.finish();
     let rows = [ReportRow::new(&with, without.as_ref())];
     let mut incomplete = incomplete.into_inner();

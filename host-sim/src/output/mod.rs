@@ -19,6 +19,7 @@ pub mod campaign;
 pub mod csv;
 pub mod dir;
 pub mod figures;
+pub mod log;
 mod plot;
 pub mod report;
 pub mod sections;

@@ -39,7 +39,7 @@ use controller_core::Desired;
 
 pub use control::{ControlOut, ControlSource, LocalController, Stop};
 pub use observer::Observer;
-pub use record::{BoardLoss, ControlStatus, Metrics, Outcome, RunResult, Sample};
+pub use record::{BoardLoss, ControlStatus, LoopSignals, Metrics, Outcome, RunResult, Sample};
 pub use recorder::Recording;
 
 use crate::interrupt;
@@ -106,6 +106,9 @@ pub fn fly(
         let target = thrusters.target(&out);
         let mut sample = sample_of(t, &vehicle.state, &reference, error, &out);
         sample.payload = cfg.variation.at(t).mass;
+        sample.signals.eta_told = eta;
+        sample.signals.nu_told = nu;
+        sample.signals.thrust_demand = target;
         // 3. Hold it for the period: thruster lag, RK4 substeps (none after the last sample).
         let (thrust, held): (Thrusts, Result<(), (f64, String)>) = if k < steps {
             thrusters.hold(&target, substeps, |j, tau| {
@@ -196,5 +199,11 @@ fn sample_of(
         w_norm: f64::from(out.w_norm),
         payload: 0.0,
         status: out.status,
+        signals: LoopSignals {
+            nu: state.nu.into(),
+            eta_d_dot: reference.eta_dot.into(),
+            eta_d_ddot: reference.eta_ddot.into(),
+            ..LoopSignals::default()
+        },
     }
 }

@@ -86,6 +86,29 @@ pub struct Sample {
     pub payload: f64,
     /// Controller status: ok, or why the thrusters are off.
     pub status: ControlStatus,
+    /// What the loop had besides the CSV's columns (the flight log has them:
+    /// docs/logs.md#channels).
+    pub signals: LoopSignals,
+}
+
+/// The rest of a control period's signals, which the flight log records and the CSV does not
+/// ([`crate::output::log`]): the plant's body velocities, the state the law was told, the
+/// reference's derivatives and the thrust each thruster was driven towards.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LoopSignals {
+    /// True body velocities ν (m/s, rad/s).
+    pub nu: [f64; 6],
+    /// η as the navigation told the law, in f32 as it crossed ([`super::navigation`]).
+    pub eta_told: [f32; 6],
+    /// ν as the navigation told the law.
+    pub nu_told: [f32; 6],
+    /// η̇_d this period.
+    pub eta_d_dot: [f32; 6],
+    /// η̈_d this period.
+    pub eta_d_ddot: [f32; 6],
+    /// The thrust each thruster was driven towards this period (N; before the lag), order of
+    /// [`Sample::thrust`].
+    pub thrust_demand: [f64; THRUSTERS],
 }
 
 /// How a run ended.
