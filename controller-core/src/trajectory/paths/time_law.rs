@@ -216,6 +216,49 @@ impl TimeLaw {
         self.duration
     }
 
+    /// The time (s, at time scale 1) at which the path parameter reaches `sigma` (m): the
+    /// inverse of σ(t), at configuration time (Choice 311). On a cruise it is exact,
+    /// t₀ + (σ − σ₀)/v; in a speed change σ(τ) is monotone (σ̇ > 0) and τ is found by a fixed
+    /// 40-step bisection; beyond the end the path goes on at the last piece's final speed.
+    /// 0 for an empty law.
+    pub fn time_at(&self, route: &Route, sigma: f32) -> f32 {
+        let count = self.count as usize;
+        if count == 0 {
+            return 0.0;
+        }
+        let (segment, start) = route.locate(sigma);
+        let Some(segment) = segment else {
+            let last = &self.pieces[count - 1];
+            return self.duration + (sigma - route.length()) / (last.v0 + last.dv);
+        };
+        let local = sigma - start;
+        let mut piece = &self.pieces[0];
+        for p in &self.pieces[..count] {
+            if p.segment as usize == segment && p.local0 <= local {
+                piece = p;
+            }
+        }
+        let along = local - piece.local0;
+        if piece.inv_dur == 0.0 {
+            return piece.t0 + along / piece.v0;
+        }
+        let (v0, dv, w) = (piece.v0, piece.dv, piece.inv_dur);
+        let covered = |tau: f32| {
+            let t2 = tau * tau;
+            (v0 * tau + dv * t2 * t2 * (2.5 + tau * (-3.0 + tau))) / w
+        };
+        let (mut lo, mut hi) = (0.0f32, 1.0f32);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if covered(mid) < along {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        piece.t0 + 0.5 * (lo + hi) / w
+    }
+
     /// The largest σ̇ on segment `i` (its own speed: changes happen in the faster part).
     pub(crate) fn segment_speed(&self, i: usize) -> f32 {
         let mut v = 0.0f32;

@@ -366,6 +366,29 @@ impl Route {
         self.turns[i]
     }
 
+    /// The number of waypoints the route was built from (0 for an empty route): the last
+    /// segment is the last leg, n − 2, whose part is 2(n − 2).
+    pub fn waypoint_count(&self) -> usize {
+        match self.count {
+            0 => 0,
+            n => self.segments[n as usize - 1].part as usize / 2 + 2,
+        }
+    }
+
+    /// The path parameter σ (m) at which the path passes waypoint `i` nearest (Choice 311): 0
+    /// at the first, the path's length at the last, the middle of the blend (its start plus
+    /// the cut a, where the waypoint is passed at [`Route::miss`]) at an inner one.
+    pub fn passing(&self, i: usize) -> f32 {
+        if i == 0 {
+            return 0.0;
+        }
+        let turn = (2 * i - 1) as u8;
+        self.segments[..self.count as usize]
+            .iter()
+            .find(|s| s.part == turn)
+            .map_or(self.length, |s| s.s0 + self.cuts[i])
+    }
+
     /// The distance at which the path passes waypoint `i` (m): (5/16)·a·sin(Δ/2), 0 at the
     /// first and the last.
     pub fn miss(&self, i: usize) -> f32 {
