@@ -237,3 +237,57 @@ fn run_exits_by_the_configured_controller_not_by_its_companion() {
     let (code, v, _) = run_json(&dir, "off", &off);
     assert_eq!(code, Some(4), "{v}");
 }
+
+/// A 90° corner of the real vehicle at 0.5 m/s whose waypoint falls between control ticks,
+/// turned on a radius `radius`.
+fn real_corner(radius: &str, last: &str) -> String {
+    format!(
+        "name = \"corner\"\nideal_actuators = false\n[trajectory]\nkind = \"waypoints\"\n\
+         points = [[0, 0, 5], [30.0013, 0, 5], {last}]\nspeed = 0.5\nturn_radius = {radius}\n"
+    )
+}
+
+/// Item 1: `turn_radius = 1e-6` on a 90° corner passed `check` (FEASIBLE) and `run` flew it
+/// with a π/2 yaw error: the blend lasts microseconds, between two control ticks and two of the
+/// preflight's samples. Under the 1 m floor it is refused by both, naming the key and the floor.
+#[test]
+fn a_corner_under_the_floor_is_refused_by_check_and_run() {
+    let dir = tempdir("floor");
+    for radius in ["1e-6", "1e-9", "1e-30", "0.5"] {
+        let s = scenario(&dir, "corner", &real_corner(radius, "[30.0013, 30, 5]"));
+        for command in ["check", "run"] {
+            let o = host_sim()
+                .args([command, "--scenario"])
+                .arg(&s)
+                .arg("--json")
+                .args(match command {
+                    "run" => vec!["--out".to_string(), dir.join("out").display().to_string()],
+                    _ => Vec::new(),
+                })
+                .output()
+                .unwrap();
+            let e = stderr(&o);
+            assert_eq!(o.status.code(), Some(2), "{command} {radius}: {e}");
+            assert!(
+                e.contains("`trajectory.turn_radius`") && e.contains("outside [1, "),
+                "{command} {radius}: {e}"
+            );
+        }
+    }
+}
+
+/// The floor is a corner the vehicle meets: a 119° corner (near the sharpest the path allows)
+/// at the 1 m floor is flown by the real vehicle as written at a time scale of at most 1.5
+/// (at least two thirds of the planned speed), the corner's extremes checked in closed form.
+#[test]
+fn the_vehicle_meets_a_corner_at_the_floor() {
+    use host_sim::studies::preflight::{check_as_written, Verdict, DEFAULT_MARGIN};
+    let s = parse_scenario(&real_corner("1", "[10.1, 34.5, 5]")).unwrap();
+    let p = check_as_written(&s, DEFAULT_MARGIN).unwrap();
+    assert!(
+        matches!(p.verdict, Verdict::Feasible | Verdict::NeedsTimeScale),
+        "{p}"
+    );
+    let k = p.smallest_time_scale.unwrap();
+    assert!(k <= 1.5, "{p}");
+}

@@ -6,7 +6,9 @@ use super::kind::PathKind;
 use super::time_law::{self, SpeedList, TimeLaw};
 use super::waypoints::{self, turn_radius, Route, WaypointList};
 use crate::trajectory::error::{positive, Parameter, TrajectoryError};
-use crate::trajectory::limits::{DEFAULT_SPEED_CHANGE, MAX_SPEED, MAX_SPEED_CHANGE};
+use crate::trajectory::limits::{
+    DEFAULT_SPEED_CHANGE, MAX_SPEED, MAX_SPEED_CHANGE, MIN_TURN_RADIUS,
+};
 use crate::trajectory::phases::{tangent, Harmonics, Phases, Planar};
 use crate::trajectory::{Trajectory, TrajectoryKind};
 
@@ -36,7 +38,8 @@ impl PathKind for WaypointPath<'_> {
 
     /// Checks the path's parameters and builds its route and time law in place (Choice 180:
     /// validation is the build, nothing is built twice or on the stack): speed in
-    /// (0, [`MAX_SPEED`]], a configured turn radius in (0, [`Trajectory::MAX_SIZE`]], then the
+    /// (0, [`MAX_SPEED`]], a configured turn radius in [[`MIN_TURN_RADIUS`],
+    /// [`Trajectory::MAX_SIZE`]] (Choice 310), then the
     /// points ([`Route::build_into`]), then the time law if there is one
     /// ([`TimeLaw::build_into`]; else [`TimeLaw::EMPTY`], with `speed_change` still checked if
     /// given). After an error the route and the law are unspecified but safe to sample.
@@ -44,6 +47,16 @@ impl PathKind for WaypointPath<'_> {
         positive("speed", self.speed, MAX_SPEED)?;
         if let Some(r) = self.turn_radius {
             positive("turn_radius", r, Trajectory::MAX_SIZE)?;
+            // The floor a corner may have (Choice 310): every blend then turns the heading at
+            // most at speed/MIN_TURN_RADIUS and lasts at least MIN_TURN_RADIUS/speed.
+            if r < MIN_TURN_RADIUS {
+                return Err(TrajectoryError::OutOfRange {
+                    parameter: "turn_radius",
+                    value: r,
+                    min: MIN_TURN_RADIUS,
+                    max: Trajectory::MAX_SIZE,
+                });
+            }
         }
         route.build_into(self.points, turn_radius(self.speed, self.turn_radius))?;
         match self.speeds {
