@@ -291,3 +291,51 @@ fn the_vehicle_meets_a_corner_at_the_floor() {
     let k = p.smallest_time_scale.unwrap();
     assert!(k <= 1.5, "{p}");
 }
+
+/// Cosmetic (issue 29): a waypoint refusal names the point or the part. `points = 1e6 is
+/// outside …` did not say which, 1e39 was "not finite", `speed = 1e-300` was reported as 0,
+/// and a bad `speeds` entry was blamed on `trajectory.heading`.
+#[test]
+fn waypoint_refusals_name_the_point_or_the_part() {
+    use common::{invalid_key, toml_error};
+    let path = |rest: &str| format!("[trajectory]\nkind = \"waypoints\"\n{rest}\n");
+    let three = "points = [[0, 0, 5], [50, 0, 5], [50, 50, 5]]\nspeed = 0.5\n";
+    let (key, message) = invalid_key(&path("points = [[0, 0, 5], [1e6, 0, 5]]\nspeed = 0.5"));
+    assert_eq!(key, "trajectory.points");
+    assert!(
+        message.contains("waypoint 1's x = 1e6 m is outside"),
+        "{message}"
+    );
+    let e = toml_error(&path("points = [[0, 0, 5], [50, 1e39, 5]]\nspeed = 0.5"));
+    assert!(e.contains("waypoint 1's y = 1e39 m is outside"), "{e}");
+    let e = toml_error(&path("points = [[0, 0, 5], [50, 0, 5]]\nspeed = 1e-300"));
+    assert!(
+        e.contains("speed = 1e-300 is below the smallest f32"),
+        "{e}"
+    );
+    let e = toml_error(&path(&format!("{three}turn_radius = 1e39")));
+    assert!(
+        e.contains("turn_radius = 1e39 is beyond the largest f32"),
+        "{e}"
+    );
+    for (speeds, says) in [
+        ("[0.5, 1e-6, 0.5]", "speeds[1] (the turn at waypoint 1)"),
+        (
+            "[0.5, 0.5, 11]",
+            "speeds[2] (leg 1) = 11 m/s is outside (0, 10]",
+        ),
+        (
+            "[0.5, -1, 0.5]",
+            "speeds[1] (the turn at waypoint 1) = -1 m/s",
+        ),
+    ] {
+        let (key, message) = invalid_key(&path(&format!("{three}speeds = {speeds}")));
+        assert_eq!(key, "trajectory.speeds", "{speeds}: {message}");
+        assert!(message.contains(says), "{speeds}: {message}");
+    }
+    let e = toml_error(&path(&format!("{three}speeds = [0.5, 1e39, 0.5]")));
+    assert!(
+        e.contains("speeds[1] (the turn at waypoint 1) = 1e39 m/s"),
+        "{e}"
+    );
+}

@@ -130,8 +130,14 @@ impl TimeLaw {
                 expected: parts,
             });
         }
-        for &v in speeds.as_slice() {
-            positive("speeds", v, MAX_SPEED)?;
+        for (part, &value) in speeds.as_slice().iter().enumerate() {
+            // The error names the part (Choice 315).
+            if !value.is_finite() {
+                return Err(TrajectoryError::SpeedNotFinite { part });
+            }
+            if positive("speeds", value, MAX_SPEED).is_err() {
+                return Err(TrajectoryError::BadSpeed { part, value });
+            }
         }
         let v = |i: usize| speeds.as_slice()[route.segment_part(i)];
         let mut t = 0.0f32;
@@ -421,13 +427,26 @@ impl<'de> serde::Deserialize<'de> for SpeedList {
                     len: 0,
                     speeds: [0.0; MAX_PARTS],
                 };
-                while let Some(v) = seq.next_element::<f32>()? {
-                    if list.len as usize == MAX_PARTS {
+                while let Some(v) = seq.next_element::<f64>()? {
+                    let part = list.len as usize;
+                    if part == MAX_PARTS {
                         return Err(serde::de::Error::custom(format_args!(
                             "more than {MAX_PARTS} speeds"
                         )));
                     }
-                    list.speeds[list.len as usize] = v;
+                    // A number an f32 cannot hold is refused as itself, naming the part
+                    // (Choice 315), not as the infinity or the 0 it would become.
+                    let narrow = v as f32;
+                    if (v.is_finite() && !narrow.is_finite()) || (v != 0.0 && narrow == 0.0) {
+                        return Err(serde::de::Error::custom(
+                            TrajectoryError::BadSpeed {
+                                part,
+                                value: narrow,
+                            }
+                            .narrowed(v),
+                        ));
+                    }
+                    list.speeds[part] = narrow;
                     list.len += 1;
                 }
                 Ok(list)

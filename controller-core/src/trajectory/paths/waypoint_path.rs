@@ -12,6 +12,57 @@ use crate::trajectory::limits::{
 use crate::trajectory::phases::{tangent, Harmonics, Phases, Planar};
 use crate::trajectory::{Trajectory, TrajectoryKind};
 
+/// `speed` as written (an f64) narrowed to the f32 it flies as, refused when an f32 cannot
+/// hold it (Choice 315): 1e39 is not "not finite", 1e-300 is not 0.
+#[cfg(feature = "serde")]
+pub(crate) fn narrow_speed<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f32, D::Error> {
+    narrow("speed", <f64 as serde::Deserialize>::deserialize(d)?)
+}
+
+/// `turn_radius` as [`narrow_speed`] reads `speed`.
+#[cfg(feature = "serde")]
+pub(crate) fn narrow_turn_radius<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<f32>, D::Error> {
+    narrow_option("turn_radius", d)
+}
+
+/// `speed_change` as [`narrow_speed`] reads `speed`.
+#[cfg(feature = "serde")]
+pub(crate) fn narrow_speed_change<'de, D: serde::Deserializer<'de>>(
+    d: D,
+) -> Result<Option<f32>, D::Error> {
+    narrow_option("speed_change", d)
+}
+
+#[cfg(feature = "serde")]
+fn narrow_option<'de, D: serde::Deserializer<'de>>(
+    key: &str,
+    d: D,
+) -> Result<Option<f32>, D::Error> {
+    match <Option<f64> as serde::Deserialize>::deserialize(d)? {
+        Some(v) => narrow(key, v).map(Some),
+        None => Ok(None),
+    }
+}
+
+#[cfg(feature = "serde")]
+fn narrow<E: serde::de::Error>(key: &str, v: f64) -> Result<f32, E> {
+    let n = v as f32;
+    let w = crate::readable::Readable(v);
+    if v.is_finite() && !n.is_finite() {
+        Err(E::custom(format_args!(
+            "{key} = {w} is beyond the largest f32 (3.4e38) the path is flown in"
+        )))
+    } else if v != 0.0 && n == 0.0 {
+        Err(E::custom(format_args!(
+            "{key} = {w} is below the smallest f32 (1.2e-38) the path is flown in: it would read as 0"
+        )))
+    } else {
+        Ok(n)
+    }
+}
+
 /// The fields of a [`TrajectoryKind::Waypoints`], borrowed (no copy of its lists).
 #[derive(Clone, Copy)]
 pub(super) struct WaypointPath<'a> {

@@ -200,22 +200,16 @@ fn length(v: [f32; 3]) -> f32 {
     math::exact_sqrt(dot(v, v))
 }
 
-/// Every coordinate finite and within ±[`MAX_COORDINATE`] (parameter `points`).
+/// Every coordinate finite and within ±[`MAX_COORDINATE`] (parameter `points`; the error
+/// names the waypoint and the coordinate, Choice 315).
 fn check_points(pts: &[[f32; 3]]) -> Result<(), TrajectoryError> {
-    for p in pts {
-        for &c in p {
-            if !c.is_finite() {
-                return Err(TrajectoryError::NonFinite {
-                    parameter: "points",
-                });
+    for (index, p) in pts.iter().enumerate() {
+        for (axis, &value) in p.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(TrajectoryError::PointNotFinite { index, axis });
             }
-            if c.abs() > MAX_COORDINATE {
-                return Err(TrajectoryError::OutOfRange {
-                    parameter: "points",
-                    value: c,
-                    min: -MAX_COORDINATE,
-                    max: MAX_COORDINATE,
-                });
+            if value.abs() > MAX_COORDINATE {
+                return Err(TrajectoryError::BadPoint { index, axis, value });
             }
         }
     }
@@ -720,13 +714,28 @@ impl<'de> serde::Deserialize<'de> for WaypointList {
                     len: 0,
                     points: [[0.0; 3]; MAX_WAYPOINTS],
                 };
-                while let Some(p) = seq.next_element::<[f32; 3]>()? {
-                    if list.len as usize == MAX_WAYPOINTS {
+                while let Some(p) = seq.next_element::<[f64; 3]>()? {
+                    let index = list.len as usize;
+                    if index == MAX_WAYPOINTS {
                         return Err(serde::de::Error::custom(format_args!(
                             "more than {MAX_WAYPOINTS} waypoints"
                         )));
                     }
-                    list.points[list.len as usize] = p;
+                    for (axis, &v) in p.iter().enumerate() {
+                        // A number beyond an f32 is refused as itself, naming the point
+                        // (Choice 315), not as the infinity it would become.
+                        if v.is_finite() && !(v as f32).is_finite() {
+                            return Err(serde::de::Error::custom(
+                                TrajectoryError::BadPoint {
+                                    index,
+                                    axis,
+                                    value: v as f32,
+                                }
+                                .narrowed(v),
+                            ));
+                        }
+                        list.points[index][axis] = v as f32;
+                    }
                     list.len += 1;
                 }
                 Ok(list)
