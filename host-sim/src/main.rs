@@ -29,6 +29,9 @@ enum Command {
     /// The paper's six Table-1 missions with and without Δu, side by side with the paper.
     Table1(Table1Args),
     /// One scenario from a TOML file (and its companion without Δu, for comparison).
+    ///
+    /// The exit code follows the run of the controller the scenario configures; the companion
+    /// without Δu is reported beside it (table, report, JSON), never as the verdict.
     Run(RunArgs),
     /// Processor in the loop: the firmware ELF in QEMU flies the simulated vehicle over a
     /// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).

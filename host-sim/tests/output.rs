@@ -118,6 +118,7 @@ fn synthetic(name: &str, robust: bool, n: usize, gain: f64) -> RunResult {
         faults: Default::default(),
         faults_expected: false,
         miss_expected: false,
+        path: None,
         samples,
         plant_factorisations: 0,
     }

@@ -347,14 +347,14 @@ fn import_plan_writes_a_name_as_data_and_refuses_one_that_is_no_file_name() {
 
 /// A plan file named `w\nduration = 1 #.plan` made `run` fly 1 s: the name went into the
 /// header comment unescaped, and its second line was a key. Now the header escapes it and the
-/// scenario has no `duration` (the default).
+/// scenario has no `duration` (the default: a waypoint mission's path time, Choice 312).
 #[test]
 fn import_plan_writes_the_plans_file_name_into_a_comment_that_cannot_end_early() {
     let wall = std::fs::read_to_string(harbour_wall()).unwrap();
     let out = import_plan_named("w\nduration = 1 #.plan", &wall);
     let text = String::from_utf8(out.stdout).unwrap();
     let s = parse_scenario(&text).unwrap();
-    let default = host_sim::scenario::SimConfig::new("x", s.config().trajectory).duration;
+    let default = host_sim::scenario::path_time::path_time(s.trajectory()).unwrap();
     assert_eq!(s.config().duration, default, "{text}");
     assert!(text.contains("w\\nduration = 1 #.plan"), "{text}");
 }

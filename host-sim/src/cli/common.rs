@@ -124,7 +124,9 @@ pub(super) fn report_incomplete(incomplete: &[String]) {
 }
 
 /// Prints the runs of `rows` (JSON, or the table and the report's path) and says how the
-/// command ended.
+/// command ended: by the runs of the controller each scenario configures (`with`), never by
+/// its companion without Δu, which is there for comparison and reported beside it
+/// (Choice 313).
 pub(super) fn print_runs(
     stdout: &mut dyn Write,
     json: bool,
@@ -134,7 +136,7 @@ pub(super) fn print_runs(
     incomplete: Vec<String>,
 ) -> Result<Exit> {
     report_incomplete(&incomplete);
-    let exit = runs_exit(runs(rows), !incomplete.is_empty(), false);
+    let exit = runs_exit(rows.iter().map(|r| r.with), !incomplete.is_empty(), false);
     if json {
         let cases: Cases<RunSummary> = Cases {
             cases: runs(rows).map(RunResult::summary).collect(),
@@ -150,9 +152,26 @@ pub(super) fn print_runs(
         writeln!(stdout, "{}", output::table_text(rows))?;
         let all: Vec<&RunResult> = runs(rows).collect();
         writeln!(stdout, "{}", output::chatter_table_text(&all))?;
+        for r in rows {
+            if let Some(c) = r.without.filter(|c| companion_differs(r.with, c)) {
+                writeln!(
+                    stdout,
+                    "{}: the comparison run without Δu {} (reported, not the verdict: the exit \
+                     code follows the run with the controller the scenario configures)",
+                    c.name, c.outcome
+                )?;
+            }
+        }
         writeln!(stdout, "report: {}", report.display())?;
     }
     Ok(exit)
+}
+
+/// True when the companion without Δu ended otherwise than the run it accompanies (another
+/// outcome, or faults where it had none): what the text output points out.
+fn companion_differs(with: &RunResult, without: &RunResult) -> bool {
+    std::mem::discriminant(&with.outcome) != std::mem::discriminant(&without.outcome)
+        || with.faulted_unexpectedly() != without.faulted_unexpectedly()
 }
 
 /// The preflight checks of `scenarios` (in parallel), at the default margin; `None` when a

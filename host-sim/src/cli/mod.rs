@@ -49,7 +49,9 @@
 //! | 4 | a run completed outside its bound (`[bound]`; the real chain's default 0.05 m, 1 % saturated) and its scenario does not say `expect_missed = true`; `diff`: the two flights differ |
 //! | 130 | interrupted (Ctrl-C, SIGTERM): what was done is written and marked partial |
 //!
-//! When several apply, the first of 2, 130, 1, 3, 4 is the exit code. In `pil`, a run with link
+//! When several apply, the first of 2, 130, 1, 3, 4 is the exit code. In `run`, the code follows
+//! the run of the controller the scenario configures: its companion without Δu is reported
+//! beside it (a line says when it ended otherwise), never as the verdict (Choice 313). In `pil`, a run with link
 //! faults injected (flags or `[link_faults]`) expects the board's fail-safe. In `table1`, the
 //! paper's missions flown through the real chain are there to show what happens when the
 //! preflight says infeasible: their divergence and faults are reported, not an exit code.

@@ -16,7 +16,9 @@ use crate::output::{self, figures, sections, OutputDir, ReportRow};
 use crate::sim::progress::Progress;
 use crate::sim::RunResult;
 
-/// `run`: one scenario from a TOML file (and its companion without Δu, for comparison).
+/// `run`: one scenario from a TOML file (and its companion without Δu, for comparison). The
+/// exit code follows the run of the controller the scenario configures; the companion is
+/// reported beside it, not as the verdict (Choice 313).
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct RunArgs {
     #[arg(long)]

@@ -143,7 +143,10 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
                     } else {
                         ""
                     };
-                    format!("{}{expected}", r.outcome)
+                    match &r.path {
+                        Some(path) => format!("{}{expected}; {path}", r.outcome),
+                        None => format!("{}{expected}", r.outcome),
+                    }
                 }),
             ]);
         }
@@ -695,6 +698,7 @@ mod tests {
             faults: FaultCounts::default(),
             faults_expected: false,
             miss_expected: false,
+            path: None,
             samples: Vec::new(),
             plant_factorisations: 0,
         }

@@ -188,7 +188,8 @@ pub struct SimConfig {
     /// ([`crate::studies::preflight::profile`]), never flown (the pinned `speeds` are). `None`:
     /// no caps.
     pub speed_limits: Option<Vec<f64>>,
-    /// Simulated time (s). Paper: 70.
+    /// Simulated time (s). Paper: 70. A waypoint mission without `duration`: its path's time
+    /// to the last waypoint ([`crate::scenario::path_time`], Choice 312).
     pub duration: f64,
     /// Plant RK4 step (s). Default 1 ms.
     pub plant_step: f64,

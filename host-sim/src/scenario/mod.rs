@@ -77,6 +77,7 @@ mod fixed_arrays;
 mod from_config;
 pub mod paper;
 mod parse;
+pub mod path_time;
 pub mod plan;
 pub mod real_vehicle;
 mod start;

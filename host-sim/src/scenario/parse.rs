@@ -92,8 +92,17 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     if let Some(raw) = raw.controller {
         config.controller = build_controller(&raw)?;
     }
-    if let Some(d) = raw.duration {
-        config.duration = d;
+    match raw.duration {
+        Some(d) => config.duration = d,
+        // A waypoint mission flies its whole path by default (Choice 312); a path that cannot
+        // be built keeps the default, and validation names its key.
+        None => {
+            if let Ok(t) = controller_core::Trajectory::new(config.mission()) {
+                if let Some(d) = super::path_time::default_duration(&t)? {
+                    config.duration = d;
+                }
+            }
+        }
     }
     if let Some(h) = raw.plant_step {
         config.plant_step = h;

@@ -44,7 +44,7 @@ pub use recorder::Recording;
 
 use crate::interrupt;
 use crate::plant::PlantState;
-use crate::scenario::Scenario;
+use crate::scenario::{path_time, Scenario};
 use metrics::Accumulator;
 use navigation::{wrap_pi, Navigation};
 use recorder::Recorder;
@@ -132,6 +132,7 @@ pub fn fly(
             outcome = Outcome::Missed { reason };
         }
     }
+    let path = path_note(scenario, &outcome);
     RunResult {
         name: cfg.name.clone(),
         case: cfg.case,
@@ -141,8 +142,20 @@ pub fn fly(
         faults,
         faults_expected: cfg.expect_faults,
         miss_expected: cfg.expect_missed,
+        path,
         samples,
         plant_factorisations: vehicle.factorisations(),
+    }
+}
+
+/// A run that flew to its end says when its waypoint path did not (Choice 312).
+fn path_note(scenario: &Scenario, outcome: &Outcome) -> Option<String> {
+    match outcome {
+        Outcome::Completed | Outcome::Missed { .. } => path_time::run_note(
+            scenario.trajectory(),
+            scenario.steps() as f64 * scenario.period(),
+        ),
+        _ => None,
     }
 }
 

@@ -372,6 +372,9 @@ pub struct RunResult {
     /// The scenario expects to miss its bound ([`crate::scenario::SimConfig::expect_missed`]):
     /// the miss is reported but does not fail the command.
     pub miss_expected: bool,
+    /// A waypoint run whose end is not its path's: the waypoints it never reached, or how long
+    /// before it the path ended ([`crate::scenario::path_time::run_note`], Choice 312).
+    pub path: Option<String>,
     /// The samples the plots draw: every sample of a run of at most
     /// [`super::decimate::PLOT_SAMPLES`] periods, else a decimated series (see
     /// [`super::decimate`]). The CSV has every period (it is written as the run goes).
@@ -414,6 +417,9 @@ pub struct RunSummary {
     /// Whether the scenario expected faults.
     #[serde(default)]
     pub faults_expected: bool,
+    /// A waypoint run whose end is not its path's ([`RunResult::path`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<String>,
 }
 
 /// When and why a run stopped early ([`Outcome::Diverged`]).
@@ -464,6 +470,7 @@ impl RunResult {
             miss_expected: self.miss_expected,
             faults: self.faults.clone(),
             faults_expected: self.faults_expected,
+            path: self.path.clone(),
         }
     }
 
@@ -552,6 +559,7 @@ mod tests {
             faults: FaultCounts::default(),
             faults_expected: false,
             miss_expected: false,
+            path: None,
             samples: Vec::new(),
             plant_factorisations: 0,
         };
