@@ -199,6 +199,8 @@ fn every_key(path: TrajectoryKind) -> ScenarioFile {
         bound: Some(BoundTable {
             max_path: Some(1.0),
             saturated: Some(1.0),
+            max_reversals_per_s: Some(3.0),
+            max_command_tv: Some(50.0),
         }),
         link_faults: Some(LinkFaultsTable {
             drop: Some(vec![]),

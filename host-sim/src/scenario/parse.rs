@@ -114,9 +114,13 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
         AttitudeName::Level => InitialAttitude::Level,
         AttitudeName::Trim => InitialAttitude::Trim,
     });
-    config.bound_setting = raw.bound.map(|b| Bound {
-        max_path: b.max_path.unwrap_or(Bound::REAL_VEHICLE.max_path),
-        saturated: b.saturated.unwrap_or(Bound::REAL_VEHICLE.saturated),
+    config.bound_setting = raw.bound.map(|b| {
+        Bound::with_defaults(
+            b.max_path,
+            b.saturated,
+            b.max_reversals_per_s,
+            b.max_command_tv,
+        )
     });
     if let Some(raw) = raw.variation {
         config.variation = build_variation(&raw)?;

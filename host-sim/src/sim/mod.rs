@@ -12,6 +12,7 @@
 //! | [`record`] | a run's samples, outcome, metrics and JSON summary |
 //! | [`recorder`] | what a run keeps as it goes (metrics, fault counts, plot series, observer) |
 //! | [`metrics`], [`decimate`] | the Table-1 metrics; the bounded plot series of a long run |
+//! | [`chatter`] | what the commands do between the limits: reversals, total variation, power above the thruster's corner |
 //! | [`observer`], [`progress`] | who sees each sample as it is made; progress of long commands |
 //! | [`bound`] | the bound a real-vehicle run must fly within |
 //!
@@ -21,6 +22,7 @@
 //! ([`crate::interrupt`]) stops it at the period it is in.
 
 pub mod bound;
+pub mod chatter;
 pub mod control;
 pub mod decimate;
 pub mod metrics;
@@ -38,12 +40,13 @@ use controller_core::Desired;
 
 pub use control::{ControlOut, ControlSource, LocalController, Stop};
 pub use observer::Observer;
-pub use record::{BoardLoss, ControlStatus, Metrics, Outcome, RunResult, Sample};
+pub use record::{BoardLoss, ControlStatus, LoopSignals, Metrics, Outcome, RunResult, Sample};
 pub use recorder::Recording;
 
 use crate::interrupt;
 use crate::plant::PlantState;
 use crate::scenario::Scenario;
+use metrics::Accumulator;
 use navigation::{wrap_pi, Navigation};
 use recorder::Recorder;
 use thrusters::{Thrusters, Thrusts};
@@ -76,7 +79,7 @@ pub fn fly(
     let mut vehicle = Vehicle::new(scenario);
     let mut navigation = Navigation::of(cfg);
     let mut thrusters = Thrusters::new(cfg, scenario.controller(), h);
-    let mut recorder = Recorder::new(observer, recording, steps + 1);
+    let mut recorder = Recorder::new(observer, recording, steps + 1, Accumulator::of(cfg));
     let mut outcome = Outcome::Completed;
     for k in 0..=steps {
         let t = k as f64 * period;
@@ -104,6 +107,9 @@ pub fn fly(
         let target = thrusters.target(&out);
         let mut sample = sample_of(t, &vehicle.state, &reference, error, &out);
         sample.payload = cfg.variation.at(t).mass;
+        sample.signals.eta_told = eta;
+        sample.signals.nu_told = nu;
+        sample.signals.thrust_demand = target;
         // 3. Hold it for the period: thruster lag, RK4 substeps (none after the last sample).
         let (thrust, held): (Thrusts, Result<(), (f64, String)>) = if k < steps {
             thrusters.hold(&target, substeps, |j, tau| {
@@ -194,5 +200,11 @@ fn sample_of(
         w_norm: f64::from(out.w_norm),
         payload: 0.0,
         status: out.status,
+        signals: LoopSignals {
+            nu: state.nu.into(),
+            eta_d_dot: reference.eta_dot.into(),
+            eta_d_ddot: reference.eta_ddot.into(),
+            ..LoopSignals::default()
+        },
     }
 }
