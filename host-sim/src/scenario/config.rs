@@ -202,6 +202,9 @@ pub struct SimConfig {
     pub trimmed: bool,
     pub current: CurrentModel,
     pub noise: Option<SensorNoise>,
+    /// The navigation solution the law is told (`[navigation]`, docs/navigation.md); `None`:
+    /// the plant's exact state (the `ideal` preset).
+    pub navigation: Option<super::navigation::NavigationModel>,
     /// First-order thruster lag time constant (s), if any.
     pub thruster_lag: Option<f64>,
     /// Ideal actuators: the thrusters deliver the allocated thrust whatever the voltage limit
@@ -294,6 +297,7 @@ impl SimConfig {
             trimmed: false,
             current: CurrentModel::None,
             noise: None,
+            navigation: None,
             thruster_lag: None,
             ideal_actuators: true,
             initial_offset: [0.0; 6],

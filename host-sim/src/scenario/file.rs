@@ -54,6 +54,8 @@ pub struct ScenarioFile {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise: Option<NoiseTable>,
     #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<super::navigation::NavigationTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub controller: Option<ControllerTable>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bound: Option<BoundTable>,
@@ -80,6 +82,7 @@ impl ScenarioFile {
             variation: None,
             current: None,
             noise: None,
+            navigation: None,
             controller: None,
             bound: None,
             link_faults: None,

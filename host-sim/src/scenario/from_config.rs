@@ -102,6 +102,7 @@ impl TryFrom<&SimConfig> for ScenarioFile {
             nu_sigma: Some(n.nu_sigma),
             seed: Some(n.seed),
         });
+        file.navigation = c.navigation.as_ref().map(super::navigation::table);
         file.controller = Some(controller(&c.controller)?);
         file.bound = c.bound_setting.map(BoundTable::from);
         let ranges =

@@ -75,6 +75,7 @@ mod config;
 pub mod file;
 mod fixed_arrays;
 mod from_config;
+pub mod navigation;
 pub mod paper;
 mod parse;
 pub mod path_time;

@@ -19,7 +19,7 @@ use super::validate::invalid;
 use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
 use crate::plant::{CurrentModel, VariationProfile};
 
-/// Default `seed` of `[noise]` and of the Gauss–Markov current.
+/// Default `seed` of `[noise]`, `[navigation]` and the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;
 /// Name given to a scenario without `name` by [`parse_scenario`](super::parse_scenario).
 pub const DEFAULT_NAME: &str = "scenario";
@@ -144,6 +144,9 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
             nu_sigma: raw.nu_sigma.unwrap_or_default(),
             seed: raw.seed.unwrap_or(DEFAULT_SEED),
         });
+    }
+    if let Some(raw) = &raw.navigation {
+        config.navigation = super::navigation::build(raw, DEFAULT_SEED)?;
     }
     if let Some(raw) = raw.link_faults {
         config.link_faults = build_link_faults(&raw)?;

@@ -159,9 +159,7 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     }
     variation(&config.variation, h)?;
     current(&config.current, h)?;
-    if let Some(n) = &config.noise {
-        noise(n, limit)?;
-    }
+    sensors(config, limit)?;
     Ok((steps as u64, substeps as usize))
 }
 
@@ -209,6 +207,17 @@ fn start_offset(offset: &[f64; 6], limit: f64) -> Res<()> {
         ));
     }
     Ok(())
+}
+
+/// `[noise]` and `[navigation]`.
+fn sensors(config: &SimConfig, limit: f64) -> Res<()> {
+    if let Some(n) = &config.noise {
+        noise(n, limit)?;
+    }
+    match &config.navigation {
+        Some(n) => super::navigation::validate(n),
+        None => Ok(()),
+    }
 }
 
 /// Measurement noise a sensor could have (Choice 124): each σ ≥ 0; a position σ at most the

@@ -6,7 +6,7 @@
 //! | module | owns |
 //! |---|---|
 //! | [`control`] | where the law runs: [`ControlSource`], [`LocalController`] (SIL), [`ControlOut`], why a source stops ([`Stop`]) |
-//! | [`navigation`] | what the law is told: measured η, ν (heading as navigation reports it, noise) |
+//! | [`navigation`], [`nav_model`] | what the law is told: the navigation solution of `[navigation]` (or the exact state), heading as navigation reports it, `[noise]` |
 //! | [`thrusters`] | what the thrusters deliver (ideal or the real chain), their lag, B·thrust |
 //! | [`vehicle`] | the plant with its parameter profile and current, stepped by RK4 |
 //! | [`record`] | a run's samples, outcome, metrics and JSON summary |
@@ -26,6 +26,7 @@ pub mod chatter;
 pub mod control;
 pub mod decimate;
 pub mod metrics;
+pub mod nav_model;
 pub mod navigation;
 pub mod observer;
 pub mod progress;
@@ -76,7 +77,7 @@ pub fn fly(
     let (steps, substeps, period) = (scenario.steps(), scenario.substeps(), scenario.period());
     let h = period / substeps as f64;
     let mut vehicle = Vehicle::new(scenario);
-    let mut navigation = Navigation::new(cfg.noise.as_ref());
+    let mut navigation = Navigation::of(cfg);
     let mut thrusters = Thrusters::new(cfg, scenario.controller(), h);
     let mut recorder = Recorder::new(observer, recording, steps + 1, Accumulator::of(cfg));
     let mut outcome = Outcome::Completed;
