@@ -92,18 +92,7 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     if let Some(raw) = raw.controller {
         config.controller = build_controller(&raw)?;
     }
-    match raw.duration {
-        Some(d) => config.duration = d,
-        // A waypoint mission flies its whole path by default (Choice 312); a path that cannot
-        // be built keeps the default, and validation names its key.
-        None => {
-            if let Ok(t) = controller_core::Trajectory::new(config.mission()) {
-                if let Some(d) = super::path_time::default_duration(&t)? {
-                    config.duration = d;
-                }
-            }
-        }
-    }
+    config.duration = duration(raw.duration, &config)?;
     if let Some(h) = raw.plant_step {
         config.plant_step = h;
     }
@@ -152,6 +141,20 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
         config.link_faults = build_link_faults(&raw)?;
     }
     Ok(config)
+}
+
+/// The file's `duration`, else a waypoint mission's whole path (Choice 312); a path that
+/// cannot be built keeps the default, and validation names its key.
+fn duration(given: Option<f64>, config: &SimConfig) -> Res<f64> {
+    if let Some(d) = given {
+        return Ok(d);
+    }
+    if let Ok(t) = controller_core::Trajectory::new(config.mission()) {
+        if let Some(d) = super::path_time::default_duration(&t)? {
+            return Ok(d);
+        }
+    }
+    Ok(config.duration)
 }
 
 fn build_link_faults(raw: &LinkFaultsTable) -> Res<LinkFaults> {

@@ -40,6 +40,7 @@ use controller_core::Desired;
 
 pub use control::{ControlOut, ControlSource, LocalController, Stop};
 pub use observer::Observer;
+use record::FaultCounts;
 pub use record::{BoardLoss, ControlStatus, LoopSignals, Metrics, Outcome, RunResult, Sample};
 pub use recorder::Recording;
 
@@ -128,6 +129,17 @@ pub fn fly(
         }
     }
     let (metrics, faults, samples) = recorder.finish();
+    let flown = (metrics, faults, samples, vehicle.factorisations());
+    result(scenario, outcome, flown)
+}
+
+/// The run's result: its outcome held against the bound, with what the flight measured.
+fn result(
+    scenario: &Scenario,
+    mut outcome: Outcome,
+    (metrics, faults, samples, plant_factorisations): (Metrics, FaultCounts, Vec<Sample>, u64),
+) -> RunResult {
+    let cfg = scenario.config();
     if outcome == Outcome::Completed {
         if let Some(reason) = cfg.bound().and_then(|b| bound::miss(&b, &metrics)) {
             outcome = Outcome::Missed { reason };
@@ -145,7 +157,7 @@ pub fn fly(
         miss_expected: cfg.expect_missed,
         path,
         samples,
-        plant_factorisations: vehicle.factorisations(),
+        plant_factorisations,
     }
 }
 
