@@ -500,19 +500,24 @@ pub fn chatter_table_markdown(runs: &[&RunResult]) -> String {
     s
 }
 
-/// The same table as [`chatter_table_markdown`] for the terminal, columns aligned.
-pub fn chatter_table_text(runs: &[&RunResult]) -> String {
-    let header = chatter_header();
-    let body = chatter_cells(runs);
-    let widths: Vec<usize> = (0..header.len())
+/// Each column's width in characters: its widest cell, header included.
+fn column_widths<R: AsRef<[String]>>(header: &[String], body: &[R]) -> Vec<usize> {
+    (0..header.len())
         .map(|i| {
-            std::iter::once(&header)
-                .chain(&body)
+            std::iter::once(header)
+                .chain(body.iter().map(AsRef::as_ref))
                 .map(|r| r[i].chars().count())
                 .max()
                 .unwrap_or(0)
         })
-        .collect();
+        .collect()
+}
+
+/// The same table as [`chatter_table_markdown`] for the terminal, columns aligned.
+pub fn chatter_table_text(runs: &[&RunResult]) -> String {
+    let header = chatter_header();
+    let body = chatter_cells(runs);
+    let widths = column_widths(&header, &body);
     let line = |r: &[String]| {
         let cells: Vec<String> = r
             .iter()
@@ -646,15 +651,7 @@ pub fn real_table_markdown(rows: &[RealRow]) -> String {
 pub fn real_table_text(rows: &[RealRow]) -> String {
     let header: Vec<String> = REAL_HEADER.iter().map(|h| h.to_string()).collect();
     let body = real_cells(rows);
-    let widths: Vec<usize> = (0..header.len())
-        .map(|i| {
-            std::iter::once(&header)
-                .chain(&body)
-                .map(|r| r[i].chars().count())
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
+    let widths = column_widths(&header, &body);
     let line = |r: &[String]| {
         let mut l = String::new();
         for (i, c) in r.iter().enumerate() {
