@@ -11,6 +11,7 @@
 use std::path::Path;
 
 use super::read::{Flight, Point, Series};
+use super::schema;
 use crate::output::plot::{self, Line, Panel, Stroke, C_WITH, C_WITHOUT};
 
 /// The tolerance of [`compare`].
@@ -57,12 +58,21 @@ impl SeriesDiff {
     }
 }
 
-/// Every series of either flight compared, in name order.
+/// Every series of either flight compared, in name order; a series of a board's own channel
+/// (the supervisor, the link, the upload: [`schema::board_only`]) that only one flight has is
+/// not (**Choice 382**: a SIL flight has no board to report them).
 pub fn compare(a: &Flight, b: &Flight, tol: Tolerance) -> Vec<SeriesDiff> {
     let names: std::collections::BTreeSet<&String> =
         a.series.keys().chain(b.series.keys()).collect();
+    let board_only = |name: &str| {
+        let topic = name.split_once(' ').map_or(name, |(topic, _)| topic);
+        schema::board_only(topic)
+    };
     names
         .into_iter()
+        .filter(|name| {
+            (a.series.contains_key(*name) && b.series.contains_key(*name)) || !board_only(name)
+        })
         .map(|name| match (a.series.get(name), b.series.get(name)) {
             (Some(sa), Some(sb)) => series_diff(name, sa, sb, tol),
             (Some(s), None) | (None, Some(s)) => SeriesDiff {
