@@ -46,21 +46,26 @@ fn out_dir(name: &str) -> PathBuf {
 /// `host-sim hil --port PORT` on a one-second mission, with `extra` flags, and its wall time.
 fn hil(port: &str, name: &str, extra: &[&str]) -> (Output, Duration) {
     let t0 = Instant::now();
-    let (output, out) = hil_kept(port, name, extra);
+    let scenario =
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/lawn-mower-20x10.toml");
+    let (output, out) = hil_kept(port, name, &scenario, extra);
     let _ = std::fs::remove_dir_all(&out);
     (output, t0.elapsed())
 }
 
-/// [`hil`], its output folder kept (the caller removes it).
-fn hil_kept(port: &str, name: &str, extra: &[&str]) -> (Output, PathBuf) {
-    let scenario =
-        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/lawn-mower-20x10.toml");
+/// [`hil`] on `scenario`, its output folder kept (the caller removes it).
+fn hil_kept(
+    port: &str,
+    name: &str,
+    scenario: &std::path::Path,
+    extra: &[&str],
+) -> (Output, PathBuf) {
     let out = out_dir(name);
     let output = Command::new(env!("CARGO_BIN_EXE_host-sim"))
         .args(["hil", "--port", port, "--reply-timeout", REPLY_TIMEOUT])
         .args(extra)
         .arg("--scenario")
-        .arg(&scenario)
+        .arg(scenario)
         .args(["--duration", "1", "--json", "--out"])
         .arg(&out)
         .output()
@@ -593,7 +598,8 @@ fn hil_reports_a_lost_board_in_its_json_and_exits_1() {
 /// Python `mcap` reader (tests/mcap_reader.py) against the run's own figures in its JSON: a
 /// `/board/link` message per answer, the last one's counters the run's; the supervisor's state
 /// at its first answer and at each change, as many as the law's status changes; the refusals
-/// as the board counted them; and an upload's rounds, if the mission had one.
+/// as the board counted them; and the upload's rounds of a waypoint mission whose first chunk
+/// is lost on its first sending (two rounds).
 #[test]
 fn the_board_channels_agree_with_the_runs_figures() {
     let ok = Command::new("python3")
@@ -610,14 +616,35 @@ fn the_board_channels_agree_with_the_runs_figures() {
         let stop = stop.clone();
         std::thread::spawn(move || one_frame_a_period_board(master, stop))
     };
-    let (output, out) = hil_kept(&path, "board-channels", &["--pacing", "realtime"]);
+    let dir = out_dir("board-channels-scenario");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/waypoints-short.toml"),
+    )
+    .unwrap();
+    let scenario = dir.join("waypoints-short.toml");
+    std::fs::write(
+        &scenario,
+        format!("{text}\n[link_faults]\nlose_upload_chunks = [0]\n"),
+    )
+    .unwrap();
+    let (output, out) = hil_kept(
+        &path,
+        "board-channels",
+        &scenario,
+        &["--pacing", "realtime"],
+    );
     stop.store(true, Ordering::Relaxed);
     let _ = board.join();
     let stderr = String::from_utf8_lossy(&output.stderr);
     let report: serde_json::Value = serde_json::from_slice(&output.stdout)
         .unwrap_or_else(|e| panic!("no JSON report ({e}); stderr:\n{stderr}"));
     let pil = &report["cases"][0]["pil"];
-    let log = out.join("lawn-mower-20x10-with.mcap");
+    let name = report["cases"][0]["case"]
+        .as_str()
+        .unwrap_or("")
+        .to_string();
+    let log = out.join(format!("{name}-with.mcap"));
     let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/mcap_reader.py");
     let read = Command::new("python3")
         .arg(script)
@@ -680,16 +707,19 @@ fn the_board_channels_agree_with_the_runs_figures() {
         .map(|r| r["refused"].as_u64().unwrap())
         .sum();
     assert_eq!(Some(refused), pil["board_refused_commands"].as_u64());
-    // The upload's rounds, as its figures say.
-    match pil["upload"].as_object() {
-        Some(up) => {
-            let rounds = all("/board/upload");
-            assert_eq!(Some(rounds.len() as u64), up["rounds"].as_u64());
-            let last = rounds.last().unwrap();
-            assert_eq!(last["verified"], true);
-            assert_eq!(last["frames"], up["frames"]);
-            assert_eq!(last["bytes"], up["bytes"]);
-        }
-        None => assert_eq!(count("/board/upload"), 0),
-    }
+    // The upload's rounds, as its figures say: the lost chunk missing after the first, sent
+    // again in the second, which the board verified.
+    let up = pil["upload"]
+        .as_object()
+        .expect("a waypoint mission is uploaded");
+    let rounds = all("/board/upload");
+    assert_eq!(up["rounds"], 2);
+    assert_eq!(rounds.len(), 2, "{rounds:?}");
+    assert_eq!(rounds[0]["missing"], 1);
+    assert_eq!(rounds[0]["verified"], false);
+    assert_eq!(rounds[1]["chunks_sent"], 1);
+    assert_eq!(rounds[1]["verified"], true);
+    assert_eq!(rounds[1]["frames"], up["frames"]);
+    assert_eq!(rounds[1]["bytes"], up["bytes"]);
+    let _ = std::fs::remove_dir_all(&dir);
 }
