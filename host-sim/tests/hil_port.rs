@@ -45,21 +45,32 @@ fn out_dir(name: &str) -> PathBuf {
 
 /// `host-sim hil --port PORT` on a one-second mission, with `extra` flags, and its wall time.
 fn hil(port: &str, name: &str, extra: &[&str]) -> (Output, Duration) {
+    let t0 = Instant::now();
     let scenario =
         PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/lawn-mower-20x10.toml");
+    let (output, out) = hil_kept(port, name, &scenario, extra);
+    let _ = std::fs::remove_dir_all(&out);
+    (output, t0.elapsed())
+}
+
+/// [`hil`] on `scenario`, its output folder kept (the caller removes it).
+fn hil_kept(
+    port: &str,
+    name: &str,
+    scenario: &std::path::Path,
+    extra: &[&str],
+) -> (Output, PathBuf) {
     let out = out_dir(name);
-    let t0 = Instant::now();
     let output = Command::new(env!("CARGO_BIN_EXE_host-sim"))
         .args(["hil", "--port", port, "--reply-timeout", REPLY_TIMEOUT])
         .args(extra)
         .arg("--scenario")
-        .arg(&scenario)
+        .arg(scenario)
         .args(["--duration", "1", "--json", "--out"])
         .arg(&out)
         .output()
         .expect("running host-sim");
-    let _ = std::fs::remove_dir_all(&out);
-    (output, t0.elapsed())
+    (output, out)
 }
 
 fn stderr(o: &Output) -> String {
@@ -581,4 +592,134 @@ fn hil_reports_a_lost_board_in_its_json_and_exits_1() {
     let lost = run.lost_board.as_ref().expect("the run lost its board");
     assert_eq!(lost.cause, BoardLoss::LinkGone, "{lost:?}");
     assert!(err.contains(&lost.reason), "{err}");
+}
+
+/// The board's own channels in the log of a board's run (Choice 382), read by the official
+/// Python `mcap` reader (tests/mcap_reader.py) against the run's own figures in its JSON: a
+/// `/board/link` message per answer, the last one's counters the run's; the supervisor's state
+/// at its first answer and at each change, as many as the law's status changes; the refusals
+/// as the board counted them; and the upload's rounds of a waypoint mission whose first chunk
+/// is lost on its first sending (two rounds).
+#[test]
+fn the_board_channels_agree_with_the_runs_figures() {
+    let ok = Command::new("python3")
+        .args(["-c", "import mcap"])
+        .status()
+        .is_ok_and(|s| s.success());
+    if !ok {
+        eprintln!("SKIPPED: python3 with the `mcap` module is absent (scripts/setup.sh)");
+        return;
+    }
+    let (master, path) = pty();
+    let stop = Arc::new(AtomicBool::new(false));
+    let board = {
+        let stop = stop.clone();
+        std::thread::spawn(move || one_frame_a_period_board(master, stop))
+    };
+    let dir = out_dir("board-channels-scenario");
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = std::fs::read_to_string(
+        PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("scenarios/waypoints-short.toml"),
+    )
+    .unwrap();
+    let scenario = dir.join("waypoints-short.toml");
+    std::fs::write(
+        &scenario,
+        format!("{text}\n[link_faults]\nlose_upload_chunks = [0]\n"),
+    )
+    .unwrap();
+    let (output, out) = hil_kept(
+        &path,
+        "board-channels",
+        &scenario,
+        &["--pacing", "realtime"],
+    );
+    stop.store(true, Ordering::Relaxed);
+    let _ = board.join();
+    let stderr = String::from_utf8_lossy(&output.stderr);
+    let report: serde_json::Value = serde_json::from_slice(&output.stdout)
+        .unwrap_or_else(|e| panic!("no JSON report ({e}); stderr:\n{stderr}"));
+    let pil = &report["cases"][0]["pil"];
+    let name = report["cases"][0]["case"]
+        .as_str()
+        .unwrap_or("")
+        .to_string();
+    let log = out.join(format!("{name}-with.mcap"));
+    let script = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/mcap_reader.py");
+    let read = Command::new("python3")
+        .arg(script)
+        .arg(&log)
+        .output()
+        .unwrap();
+    assert!(
+        read.status.success(),
+        "{}",
+        String::from_utf8_lossy(&read.stderr)
+    );
+    let found: serde_json::Value = serde_json::from_slice(&read.stdout).unwrap();
+    assert_eq!(
+        found["problems"],
+        serde_json::json!([]),
+        "{}",
+        found["problems"]
+    );
+    let count = |topic: &str| found["counts"][topic].as_u64().unwrap_or(0);
+    let all = |topic: &str| found["all"][topic].as_array().cloned().unwrap_or_default();
+    // One answer per period: as many link messages as the law's.
+    assert!(count("/law") > 10, "{}", found["counts"]);
+    assert_eq!(count("/board/link"), count("/law"));
+    let last = all("/board/link").last().cloned().expect("link messages");
+    assert_eq!(last["state_frames_sent"], pil["state_frames_sent"]);
+    assert_eq!(last["rx_errors"], pil["board_rx_errors"]);
+    assert_eq!(last["rx_stale"], pil["board_rx_stale"]);
+    assert_eq!(last["refused_commands"], pil["board_refused_commands"]);
+    assert_eq!(last["rearms"], pil["rearms"]);
+    assert!(
+        last["telemetry_frames"].as_u64().unwrap() <= pil["telemetry_frames"].as_u64().unwrap()
+    );
+    // The supervisor: its first answer, then each change; the law's status (its CSV column)
+    // changes at the same periods.
+    let states = all("/board/supervisor");
+    assert_eq!(states[0]["previous"], "");
+    for pair in states.windows(2) {
+        assert_eq!(pair[1]["previous"], pair[0]["state"]);
+        assert_ne!(pair[1]["state"], pair[0]["state"]);
+    }
+    let status_events = all("/events")
+        .iter()
+        .filter(|e| e["kind"] == "status")
+        .count();
+    assert_eq!(states.len(), status_events, "{states:?}");
+    let enters = pil["failsafe_events"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .filter(|e| e["kind"] == "enter")
+        .count();
+    let into_failsafe = states
+        .iter()
+        .filter(|s| s["state"].as_str().unwrap().starts_with("fail-safe"))
+        .count();
+    assert_eq!(into_failsafe, enters);
+    // Refusals: their growth adds up to the board's count.
+    let refused: u64 = all("/board/refusals")
+        .iter()
+        .map(|r| r["refused"].as_u64().unwrap())
+        .sum();
+    assert_eq!(Some(refused), pil["board_refused_commands"].as_u64());
+    // The upload's rounds, as its figures say: the lost chunk missing after the first, sent
+    // again in the second, which the board verified.
+    let up = pil["upload"]
+        .as_object()
+        .expect("a waypoint mission is uploaded");
+    let rounds = all("/board/upload");
+    assert_eq!(up["rounds"], 2);
+    assert_eq!(rounds.len(), 2, "{rounds:?}");
+    assert_eq!(rounds[0]["missing"], 1);
+    assert_eq!(rounds[0]["verified"], false);
+    assert_eq!(rounds[1]["chunks_sent"], 1);
+    assert_eq!(rounds[1]["verified"], true);
+    assert_eq!(rounds[1]["frames"], up["frames"]);
+    assert_eq!(rounds[1]["bytes"], up["bytes"]);
+    let _ = std::fs::remove_dir_all(&dir);
 }

@@ -6,7 +6,8 @@ independent reader of the file, and prints what it found as one JSON object on s
 The messages are read linearly (mcap.stream_reader), so that a log whose writer was killed
 (no summary, no footer, a chunk cut short) is read up to where it ends; "ended" says how the
 reading ended. The summary (indexes, statistics) is read with the seeking reader when the
-file has one. Each message's JSON is parsed and checked against its channel's JSON Schema's
+file has one. "all" holds every message of the channels not at the control rate (the truth,
+the navigation sources, the board's, the events). Each message's JSON is parsed and checked against its channel's JSON Schema's
 required keys (and each group's members) here, by this reader."""
 
 import json
@@ -51,7 +52,7 @@ def check_keys(schema, value, where):
 
 def main(path):
     schemas, channels, counts, times, problems = {}, {}, {}, {}, []
-    attachments, metadata, first = {}, {}, {}
+    attachments, metadata, first, every = {}, {}, {}, {}
     ended = "end of file"
     with open(path, "rb") as f:
         try:
@@ -76,6 +77,8 @@ def main(path):
                     times.setdefault(topic, []).append(record.log_time)
                     value = json.loads(record.data)
                     first.setdefault(topic, value)
+                    if topic != "/navigation/told" and not topic.startswith(("/reference", "/control", "/thrusters", "/law")):
+                        every.setdefault(topic, []).append(value)
                     schema = next(
                         s["schema"] for s in schemas.values() if s["name"] == channel["schema"]
                     )
@@ -112,6 +115,7 @@ def main(path):
         "counts": counts,
         "times": times,
         "first": first,
+        "all": every,
         "attachments": attachments,
         "metadata": metadata,
         "summary": summary,

@@ -22,7 +22,7 @@ use super::session::Session;
 use super::stats::BoardStats;
 use super::transport::{Serial, Transport};
 use crate::scenario::{LinkFaults, Scenario};
-use crate::sim::{ControlOut, ControlSource, ControlStatus, Stop};
+use crate::sim::{BoardReport, ControlOut, ControlSource, ControlStatus, LinkCounters, Stop};
 
 /// How long PIL waits for valid telemetry before it gives up on QEMU (an idle QEMU under
 /// `-icount` on a loaded host is slow; the board itself answers every period).
@@ -199,6 +199,26 @@ impl BoardInTheLoop {
         }
         self.stats.reported(&t);
         self.session.check_unit(&t)?;
+        let (telemetry_frames, telemetry_refused) = self.link.telemetry_counts();
+        let board = BoardReport {
+            status: t.status,
+            board_tick: t.tick,
+            last_refusal: t.last_refusal,
+            counters: LinkCounters {
+                state_frames_sent: self.stats.state_frames_sent,
+                telemetry_frames,
+                telemetry_refused,
+                rearms: self.stats.rearms,
+                rx_frames: t.rx_frames,
+                rx_errors: t.rx_errors,
+                rx_stale: t.rx_stale,
+                rx_auth_errors: t.rx_auth_errors,
+                rx_ahead: t.rx_ahead,
+                refused_commands: t.refused_commands,
+                loop_overruns: t.loop_overruns,
+                worst_update_ticks: t.worst_update_ticks,
+            },
+        };
         Ok(ControlOut {
             status: ControlStatus::Board(t.status),
             tau: t.tau,
@@ -207,6 +227,7 @@ impl BoardInTheLoop {
             delta: t.delta,
             delta_clamped: t.delta_clamped,
             w_norm: t.w_norm,
+            board: Some(board),
         })
     }
 
@@ -271,6 +292,10 @@ impl ControlSource for BoardInTheLoop {
             nu: *nu,
         };
         self.period(k, frame).map_err(Stop::from)
+    }
+
+    fn upload_rounds(&self) -> &[crate::sim::UploadRound] {
+        self.stats.upload.as_ref().map_or(&[], |u| &u.round_log)
     }
 }
 

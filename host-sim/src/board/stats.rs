@@ -109,6 +109,9 @@ pub struct UploadStats {
     pub resent: u32,
     /// Wall-clock time from the `Begin` to the board's verification (s).
     pub seconds: f64,
+    /// Each round as it went (the flight log's `/board/upload`, Choice 382).
+    #[serde(skip)]
+    pub round_log: Vec<crate::sim::UploadRound>,
 }
 
 impl BoardStats {

@@ -11,6 +11,7 @@ use auv_link::{Command as LinkCommand, MissionUpload, Msg, Telemetry, UploadPart
 use super::error::Error;
 use super::link::Link;
 use super::stats::UploadStats;
+use crate::sim::UploadRound;
 
 /// Rounds of sending (the first and each resend) before the upload is given up.
 pub const MAX_UPLOAD_ROUNDS: u32 = 8;
@@ -33,6 +34,7 @@ pub(super) fn upload(
     let mut chunks: Vec<u8> = (0..up.chunks()).collect();
     let mut last_refusal = None;
     for round in 1..=MAX_UPLOAD_ROUNDS {
+        let frames_before = stats.frames;
         if begin {
             send_part(link, UploadPart::Begin(up.header()), &mut stats)?;
         }
@@ -51,7 +53,21 @@ pub(super) fn upload(
         last_refusal = t.last_refusal;
         let held = t.upload;
         stats.rounds = round;
-        if held.crc == up.crc() && held.chunks == up.chunks() {
+        let ours = held.crc == up.crc() && held.chunks == up.chunks();
+        stats.round_log.push(UploadRound {
+            round,
+            chunks_sent: stats.frames - frames_before - u32::from(begin),
+            missing: if ours {
+                held.missing().count() as u32
+            } else {
+                u32::from(up.chunks())
+            },
+            verified: ours && held.verified,
+            frames: stats.frames,
+            bytes: stats.bytes,
+            seconds: t0.elapsed().as_secs_f64(),
+        });
+        if ours {
             if held.verified {
                 stats.seconds = t0.elapsed().as_secs_f64();
                 return Ok((stats, t));

@@ -82,6 +82,9 @@ pub(super) fn run_into(
         .and_then(|p| McapLog::create(&p, scenario, source, text).map_err(|e| e.to_string()))
         .map_err(|e| incomplete.push(format!("{log_file} was not written: {e}")))
         .ok();
+    if let Some(log) = log.as_mut() {
+        log.upload(control.upload_rounds());
+    }
     let run = sim::fly(
         scenario,
         control,

@@ -491,6 +491,24 @@ pub(super) fn panel_grid(
     })
 }
 
+/// A 1200×900 PNG at `path` of `panels` in a `grid` (rows, columns) under `title`, each with
+/// its own legend above it (the views of a layout: `output::log::views`).
+pub(super) fn panel_grid_with_legends(
+    path: &Path,
+    title: &str,
+    grid: (usize, usize),
+    panels: &[Panel],
+) -> Result<()> {
+    render(path, |root| {
+        let area = root.titled(title, (FONT, 24)).map_err(plot_err)?;
+        for (cell, p) in area.split_evenly(grid).iter().zip(panels) {
+            let cell = legend_strip(cell, &[p])?;
+            draw_panel(&cell, p)?;
+        }
+        Ok(())
+    })
+}
+
 /// A 1200×900 PNG at `path` of one `panel` under `title`, with its legend (no run subtitle: a
 /// plot of the mission, not of a run).
 pub(super) fn panel_with_legend(path: &Path, title: &str, panel: &Panel) -> Result<()> {

@@ -5,7 +5,7 @@
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::{Controller, Trajectory};
 
-use super::record::{BoardLoss, ControlStatus};
+use super::record::{BoardLoss, BoardReport, ControlStatus, UploadRound};
 use crate::scenario::Scenario;
 
 /// What one control period returns, whether the law ran here (SIL) or on the board (PIL).
@@ -21,6 +21,8 @@ pub struct ControlOut {
     pub delta: f32,
     pub delta_clamped: bool,
     pub w_norm: f32,
+    /// What a board in the loop reported besides (PIL, HIL); none in SIL.
+    pub board: Option<BoardReport>,
 }
 
 /// Why a control source has no control for a period: the run ends there, and what was
@@ -40,6 +42,12 @@ pub trait ControlSource {
     /// The control for period `k` from the measured state. An `Err` ends the run ([`Stop`]);
     /// what was recorded is kept.
     fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, Stop>;
+
+    /// The rounds of a waypoint mission's upload before the flight, if this source had one
+    /// (a board).
+    fn upload_rounds(&self) -> &[UploadRound] {
+        &[]
+    }
 }
 
 /// The f32 core on the host, as the firmware runs it (software in the loop): the scenario's
@@ -69,6 +77,7 @@ impl ControlSource for LocalController<'_> {
             delta: out.delta,
             delta_clamped: out.delta_clamped,
             w_norm: out.w_norm,
+            board: None,
         })
     }
 }

@@ -41,7 +41,10 @@ use controller_core::Desired;
 pub use control::{ControlOut, ControlSource, LocalController, Stop};
 pub use observer::Observer;
 use record::FaultCounts;
-pub use record::{BoardLoss, ControlStatus, LoopSignals, Metrics, Outcome, RunResult, Sample};
+pub use record::{
+    BoardLoss, BoardReport, ControlStatus, LinkCounters, LoopSignals, Metrics, Outcome, RunResult,
+    Sample, UploadRound,
+};
 pub use recorder::Recording;
 
 use crate::interrupt;
@@ -111,6 +114,7 @@ pub fn fly(
         sample.signals.eta_told = eta;
         sample.signals.nu_told = nu;
         sample.signals.thrust_demand = target;
+        sample.signals.navigation = navigation.solution().map(|s| s.arrived).unwrap_or_default();
         // 3. Hold it for the period: thruster lag, RK4 substeps (none after the last sample).
         let (thrust, held): (Thrusts, Result<(), (f64, String)>) = if k < steps {
             thrusters.hold(&target, substeps, |j, tau| {
@@ -229,6 +233,7 @@ fn sample_of(
             nu: state.nu.into(),
             eta_d_dot: reference.eta_dot.into(),
             eta_d_ddot: reference.eta_ddot.into(),
+            board: out.board,
             ..LoopSignals::default()
         },
     }

@@ -40,6 +40,39 @@ pub struct Solution {
     pub bottom_lock: bool,
     /// The sample tick of the last position fix applied, if any.
     pub fix_at: Option<u64>,
+    /// The measurements that reached the computer this period.
+    pub arrived: Arrivals,
+}
+
+/// The measurements that reached the navigation computer in one control period, at most one
+/// per source (none between a source's samples, in its outages, or before its latency has
+/// passed): each source at its own rate, as the flight log's navigation channels show them
+/// (**Choice 381**, docs/logs.md#channels).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct Arrivals {
+    /// Attitude (φ θ ψ rad) and rates (p q r rad/s) as the INS measured them.
+    pub ins: Option<Measured<6>>,
+    /// A DVL ping: its velocity over the bottom (u v w m/s) when it had bottom lock.
+    pub dvl: Option<Ping>,
+    /// The pressure depth (z m).
+    pub depth: Option<Measured<1>>,
+    /// A position fix (x y m).
+    pub fix: Option<Measured<2>>,
+}
+
+/// A source's measurement and the control tick it was sampled at (it arrives its latency
+/// later).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measured<const N: usize> {
+    pub sampled_at: u64,
+    pub value: [f64; N],
+}
+
+/// A DVL ping: with bottom lock, the velocity it measured; without, none.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Ping {
+    pub sampled_at: u64,
+    pub velocity: Option<[f64; 3]>,
 }
 
 /// A source's error process: its generator and its bias's current value.
@@ -241,6 +274,7 @@ impl NavComputer {
                 velocity_at: None,
                 bottom_lock: false,
                 fix_at: None,
+                arrived: Arrivals::default(),
             },
             model: model.clone(),
         }
@@ -260,6 +294,7 @@ impl NavComputer {
         let k = self.k;
         self.k += 1;
         self.truth.push((*eta, *nu));
+        self.out.arrived = Arrivals::default();
         if k > 0 {
             self.advance();
         }
@@ -316,16 +351,32 @@ impl NavComputer {
             self.rates[i] = tn[3 + i] + er[i];
         }
         self.out.held_at = j;
+        self.out.arrived.ins = Some(Measured {
+            sampled_at: j,
+            value: std::array::from_fn(|i| {
+                if i < 3 {
+                    self.att[i]
+                } else {
+                    self.rates[i - 3]
+                }
+            }),
+        });
     }
 
     /// The DVL ping of tick `j`: with bottom lock it resets the velocity error to its own.
     fn ping(&mut self, j: u64) {
-        let (te, _) = self.truth.at(j);
+        let (te, tn) = self.truth.at(j);
         self.out.bottom_lock = self.lock(te[2]);
+        let mut velocity = None;
         if self.out.bottom_lock {
             self.e_v = self.dvl.1.sample();
             self.out.velocity_at = Some(j);
+            velocity = Some(std::array::from_fn(|i| tn[i] + self.e_v[i]));
         }
+        self.out.arrived.dvl = Some(Ping {
+            sampled_at: j,
+            velocity,
+        });
     }
 
     /// Dead reckoning (trapezoid) of period `k` on the velocity `v` and the solution's
@@ -350,6 +401,10 @@ impl NavComputer {
         if let Some(j) = self.depth.0.arrival(k).filter(|&j| j > 0) {
             let z = self.truth.at(j).0[2] + self.depth.1.sample()[0];
             self.offset[2] = z - self.dr.at((j + ins_latency).min(k))[2];
+            self.out.arrived.depth = Some(Measured {
+                sampled_at: j,
+                value: [z],
+            });
         }
         if let Some((clock, stream)) = &mut self.fix {
             if let Some(j) = clock.arrival(k).filter(|&j| j > 0) {
@@ -359,6 +414,10 @@ impl NavComputer {
                 self.offset[0] = te[0] + e[0] - at[0];
                 self.offset[1] = te[1] + e[1] - at[1];
                 self.out.fix_at = Some(j);
+                self.out.arrived.fix = Some(Measured {
+                    sampled_at: j,
+                    value: [te[0] + e[0], te[1] + e[1]],
+                });
             }
         }
     }

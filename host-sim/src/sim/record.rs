@@ -3,7 +3,7 @@
 use std::collections::BTreeMap;
 use std::fmt;
 
-use auv_link::BoardStatus;
+use auv_link::{BoardStatus, Refusal};
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::{Status, Table1Case};
 use serde::{Deserialize, Serialize};
@@ -109,6 +109,59 @@ pub struct LoopSignals {
     /// The thrust each thruster was driven towards this period (N; before the lag), order of
     /// [`Sample::thrust`].
     pub thrust_demand: [f64; THRUSTERS],
+    /// The navigation sources' measurements that arrived this period (a `[navigation]` model).
+    #[serde(skip)]
+    pub navigation: super::nav_model::Arrivals,
+    /// What the board in the loop reported besides the law's outputs (PIL, HIL).
+    #[serde(skip)]
+    pub board: Option<BoardReport>,
+}
+
+/// What a board in the loop reported with a period's answer besides the law's outputs: its
+/// supervisor's state and refusals, and the link's counters at both ends. The flight log's
+/// board channels (**Choice 382**, docs/logs.md#the-board-in-the-same-channels).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BoardReport {
+    pub status: BoardStatus,
+    /// The board's own tick of the answer.
+    pub board_tick: u64,
+    /// The board's last refusal, if it refused any command yet.
+    pub last_refusal: Option<Refusal>,
+    pub counters: LinkCounters,
+}
+
+/// The link's counters after a period: this end's (frames sent and taken, re-arms) and the
+/// board's own, as its telemetry reports them.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct LinkCounters {
+    pub state_frames_sent: u64,
+    pub telemetry_frames: u64,
+    pub telemetry_refused: u64,
+    pub rearms: u32,
+    pub rx_frames: u32,
+    pub rx_errors: u32,
+    pub rx_stale: u32,
+    pub rx_auth_errors: u32,
+    pub rx_ahead: u32,
+    pub refused_commands: u32,
+    pub loop_overruns: u32,
+    pub worst_update_ticks: u32,
+}
+
+/// One round of an upload: what was sent, what the board lacked after it, the figures so far.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct UploadRound {
+    pub round: u32,
+    /// Chunks sent in the round (a chunk lost on purpose is not).
+    pub chunks_sent: u32,
+    /// Chunks the board lacked after it (all of them when it held another upload).
+    pub missing: u32,
+    pub verified: bool,
+    /// Frames and bytes sent so far.
+    pub frames: u32,
+    pub bytes: u64,
+    /// Wall-clock time since the `Begin` (s).
+    pub seconds: f64,
 }
 
 /// How a run ended.

@@ -11,6 +11,7 @@
 use std::path::Path;
 
 use super::read::{Flight, Point, Series};
+use super::schema;
 use crate::output::plot::{self, Line, Panel, Stroke, C_WITH, C_WITHOUT};
 
 /// The tolerance of [`compare`].
@@ -57,12 +58,21 @@ impl SeriesDiff {
     }
 }
 
-/// Every series of either flight compared, in name order.
+/// Every series of either flight compared, in name order; a series of a board's own channel
+/// (the supervisor, the link, the upload: [`schema::board_only`]) that only one flight has is
+/// not (**Choice 382**: a SIL flight has no board to report them).
 pub fn compare(a: &Flight, b: &Flight, tol: Tolerance) -> Vec<SeriesDiff> {
     let names: std::collections::BTreeSet<&String> =
         a.series.keys().chain(b.series.keys()).collect();
+    let board_only = |name: &str| {
+        let topic = name.split_once(' ').map_or(name, |(topic, _)| topic);
+        schema::board_only(topic)
+    };
     names
         .into_iter()
+        .filter(|name| {
+            (a.series.contains_key(*name) && b.series.contains_key(*name)) || !board_only(name)
+        })
         .map(|name| match (a.series.get(name), b.series.get(name)) {
             (Some(sa), Some(sb)) => series_diff(name, sa, sb, tol),
             (Some(s), None) | (None, Some(s)) => SeriesDiff {
@@ -249,4 +259,46 @@ pub fn plot_most_different(
         (rows, 1),
         &panels,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn flight(names: &[&str]) -> Flight {
+        let mut f = Flight::default();
+        for name in names {
+            f.series.insert(
+                (*name).to_string(),
+                Series {
+                    times: vec![0, 10],
+                    values: vec![Point::Num(1.0), Point::Num(2.0)],
+                },
+            );
+        }
+        f
+    }
+
+    /// A board's own series that only one flight has (a board's log against SIL's) is not a
+    /// difference (Choice 382); any other series only one has is, and two board logs are
+    /// compared on the board's series too.
+    #[test]
+    fn a_boards_own_series_only_one_flight_has_is_not_a_difference() {
+        let sil = flight(&["/law lyapunov"]);
+        let board = flight(&["/law lyapunov", "/board/link rx_errors"]);
+        let d = compare(&board, &sil, Tolerance::EXACT);
+        assert_eq!(d.len(), 1);
+        assert!(!d[0].differs());
+        let other = flight(&["/law lyapunov", "/law delta"]);
+        let d = compare(&other, &sil, Tolerance::EXACT);
+        assert!(d.iter().any(|s| s.name == "/law delta" && s.differs()));
+        let mut changed = board.clone();
+        if let Some(s) = changed.series.get_mut("/board/link rx_errors") {
+            s.values[1] = Point::Num(3.0);
+        }
+        let d = compare(&board, &changed, Tolerance::EXACT);
+        assert!(d
+            .iter()
+            .any(|s| s.name == "/board/link rx_errors" && s.first == Some(1e-8)));
+    }
 }

@@ -17,6 +17,7 @@ pub mod diff;
 pub mod inside;
 pub mod read;
 pub mod schema;
+pub mod views;
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -29,8 +30,19 @@ use mcap::{Attachment, Compression, WriteOptions, Writer};
 use self::inside::InsideOf;
 use self::schema::{Rate, Record, Topic};
 use crate::scenario::Scenario;
-use crate::sim::{Observer, RunResult, Sample};
+use crate::sim::{BoardReport, Observer, RunResult, Sample, UploadRound};
 use crate::studies::campaign::PROGRAM_VERSION;
+
+/// The git revision this host-sim was built from (`git describe --always --dirty`, or
+/// `unknown` outside a checkout; host-sim/build.rs, **Choice 380**): the log's `version`
+/// metadata names it beside [`PROGRAM_VERSION`].
+pub const REVISION: &str = env!("HOST_SIM_GIT");
+
+/// The `version` metadata of a log: the program and the revision it was built from
+/// (`host-sim 0.1.0 (git 72eb61f0a1b2-dirty)`).
+pub fn version() -> String {
+    format!("{PROGRAM_VERSION} (git {REVISION})")
+}
 
 /// Where a log's law ran, the channels' `source` metadata: `sil` (the core on the host), `pil`
 /// (the board in QEMU), `hil` (the board on its wire).
@@ -64,6 +76,8 @@ pub struct McapLog<'c> {
     periods: u64,
     last_t: f64,
     status: Option<String>,
+    /// The board's last answer's supervisor state and count of refused commands.
+    board: Option<(auv_link::BoardStatus, u32)>,
     buf: String,
     error: Option<String>,
 }
@@ -127,6 +141,7 @@ impl<'c> McapLog<'c> {
             periods: 0,
             last_t: 0.0,
             status: None,
+            board: None,
             buf: String::new(),
             error: None,
         })
@@ -183,6 +198,37 @@ impl<'c> McapLog<'c> {
     }
 }
 
+impl McapLog<'_> {
+    /// The rounds of the mission's upload before the flight, at time 0 (`/board/upload`).
+    pub fn upload(&mut self, rounds: &[UploadRound]) {
+        for round in rounds {
+            schema::upload_round(round, &mut self.buf);
+            self.write(Topic::Upload, 0.0);
+        }
+    }
+
+    /// The board's supervisor state at its first answer and when it changes, and the
+    /// commands it refused when its count grows (Choice 382).
+    fn board_events(&mut self, b: &BoardReport, t: f64) {
+        let refused = b.counters.refused_commands;
+        let (previous, before) = match self.board {
+            Some((status, count)) => (Some(status), count),
+            None => (None, 0),
+        };
+        if previous != Some(b.status) {
+            let previous = previous.map_or(String::new(), |p| p.as_str().to_string());
+            schema::supervisor(b.status.as_str(), &previous, b.board_tick, &mut self.buf);
+            self.write(Topic::Supervisor, t);
+        }
+        if refused > before {
+            let reason = b.last_refusal.map_or("", |r| r.as_str());
+            schema::refusals(refused - before, refused, reason, &mut self.buf);
+            self.write(Topic::Refusals, t);
+        }
+        self.board = Some((b.status, refused.max(before)));
+    }
+}
+
 impl Observer for McapLog<'_> {
     fn sample(&mut self, s: &Sample) {
         if self.writer.is_none() {
@@ -202,18 +248,23 @@ impl Observer for McapLog<'_> {
             self.write(Topic::Events, s.t);
             self.status = Some(status);
         }
+        if let Some(b) = &s.signals.board {
+            self.board_events(b, s.t);
+        }
         let inside = self.inside.at(s);
         let record = Record {
             sample: s,
             inside: &inside,
+            period: 1.0 / self.rate_hz as f64,
         };
         for topic in Topic::ALL {
             let every = self.every[topic as usize];
             if every == 0 || !k.is_multiple_of(every) {
                 continue;
             }
-            schema::encode(topic, &record, &mut self.buf);
-            self.write(topic, s.t);
+            if schema::encode(topic, &record, &mut self.buf) {
+                self.write(topic, s.t);
+            }
         }
         // A chunk per second of flight, flushed to the file (Choice 354).
         if (k + 1).is_multiple_of(self.rate_hz) {
@@ -246,7 +297,7 @@ fn declare(
             .and_then(|id| writer.add_channel(id, spec.topic, "json", &metadata))
             .map_err(|e| format!("declaring {}: {e}", spec.topic))?;
         every[topic as usize] = match spec.rate {
-            Rate::Control => 1,
+            Rate::Control | Rate::Arrival => 1,
             Rate::AtMost(hz) => rate_hz.div_ceil(u64::from(hz.max(1))),
             Rate::Events => 0,
         };
@@ -290,7 +341,7 @@ fn run_metadata(scenario: &Scenario, source: Source) -> Metadata {
         metadata: BTreeMap::from([
             ("name".to_string(), cfg.name.clone()),
             ("source".to_string(), source.to_string()),
-            ("version".to_string(), PROGRAM_VERSION.to_string()),
+            ("version".to_string(), version()),
             ("rate_hz".to_string(), c.rate_hz.to_string()),
             ("robust".to_string(), c.robust.to_string()),
             ("law".to_string(), format!("{:?}", c.law)),

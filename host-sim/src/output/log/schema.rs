@@ -68,6 +68,12 @@ const fn group(name: &'static str, members: &'static [&'static str], about: &'st
 pub const POSE: &[&str] = &["x", "y", "z", "roll", "pitch", "yaw"];
 /// ν's components (m/s, rad/s).
 pub const VELOCITY: &[&str] = &["u", "v", "w", "p", "q", "r"];
+/// The attitude's components (rad), η's last three.
+pub const ATTITUDE: &[&str] = &["roll", "pitch", "yaw"];
+/// The body rates (rad/s), ν's last three.
+pub const RATES: &[&str] = &["p", "q", "r"];
+/// The linear body velocities (m/s), ν's first three.
+pub const LINEAR: &[&str] = &["u", "v", "w"];
 /// τ's components (N, N m).
 pub const WRENCH: &[&str] = &["X", "Y", "Z", "K", "M", "N"];
 /// The thrusters, in the order of [`Sample::thrust`] (the CSV's suffixes).
@@ -80,7 +86,10 @@ pub enum Rate {
     Control,
     /// At most this many per second: every ⌈rate/hz⌉-th control period, from the first.
     AtMost(u32),
-    /// When something happens (a status change, the run's end).
+    /// When a navigation source's measurement arrives: the source's own rate, after its
+    /// latency, none in its outages (**Choice 381**).
+    Arrival,
+    /// When something happens (a status change, a refusal, an upload's round, the run's end).
     Events,
 }
 
@@ -93,6 +102,10 @@ pub struct ChannelSpec {
     pub about: &'static str,
     pub fields: &'static [Field],
     pub rate: Rate,
+    /// Only a board in the loop has it (the supervisor, the link, the upload): a SIL log
+    /// declares it and writes no message on it, and `diff` does not hold its absence from
+    /// one of two flights against them (**Choice 382**).
+    pub board_only: bool,
 }
 
 /// The channels a log has, in the order they are declared in the file.
@@ -105,10 +118,18 @@ pub enum Topic {
     Thrusters,
     Law,
     Events,
+    Ins,
+    Dvl,
+    Depth,
+    Fix,
+    Supervisor,
+    Refusals,
+    Link,
+    Upload,
 }
 
 impl Topic {
-    pub const ALL: [Topic; 7] = [
+    pub const ALL: [Topic; 15] = [
         Topic::Truth,
         Topic::Navigation,
         Topic::Reference,
@@ -116,6 +137,14 @@ impl Topic {
         Topic::Thrusters,
         Topic::Law,
         Topic::Events,
+        Topic::Ins,
+        Topic::Dvl,
+        Topic::Depth,
+        Topic::Fix,
+        Topic::Supervisor,
+        Topic::Refusals,
+        Topic::Link,
+        Topic::Upload,
     ];
 
     /// The channel's declaration.
@@ -124,12 +153,17 @@ impl Topic {
     }
 }
 
+/// Whether the channel `topic` is one only a board in the loop has ([`ChannelSpec::board_only`]).
+pub fn board_only(topic: &str) -> bool {
+    CHANNELS.iter().any(|c| c.topic == topic && c.board_only)
+}
+
 /// The plant's truth is logged at most this often (Hz): it is f64 and changes smoothly, and
 /// the log of a mission stays a few MB per minute (**Choice 352**, docs/logs.md#size).
 pub const TRUTH_HZ: u32 = 20;
 
 /// Every channel, indexed by [`Topic`].
-pub const CHANNELS: [ChannelSpec; 7] = [
+pub const CHANNELS: [ChannelSpec; 15] = [
     ChannelSpec {
         topic: "/plant/truth",
         schema: "auv150.Truth",
@@ -145,6 +179,7 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             one("payload", Kind::Number, "payload mass variation Δm (kg)"),
         ],
         rate: Rate::AtMost(TRUTH_HZ),
+        board_only: false,
     },
     ChannelSpec {
         topic: "/navigation/told",
@@ -155,6 +190,7 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             group("nu", VELOCITY, "ν told (m/s, rad/s)"),
         ],
         rate: Rate::Control,
+        board_only: false,
     },
     ChannelSpec {
         topic: "/reference",
@@ -166,6 +202,7 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             group("eta_d_ddot", POSE, "η̈_d (m/s², rad/s²)"),
         ],
         rate: Rate::Control,
+        board_only: false,
     },
     ChannelSpec {
         topic: "/control/tau",
@@ -180,6 +217,7 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             ),
         ],
         rate: Rate::Control,
+        board_only: false,
     },
     ChannelSpec {
         topic: "/thrusters",
@@ -203,6 +241,7 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             ),
         ],
         rate: Rate::Control,
+        board_only: false,
     },
     ChannelSpec {
         topic: "/law",
@@ -240,6 +279,7 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             ),
         ],
         rate: Rate::Control,
+        board_only: false,
     },
     ChannelSpec {
         topic: "/events",
@@ -255,6 +295,203 @@ pub const CHANNELS: [ChannelSpec; 7] = [
             one("text", Kind::Text, "what happened, in words"),
         ],
         rate: Rate::Events,
+        board_only: false,
+    },
+    ChannelSpec {
+        topic: "/navigation/ins",
+        schema: "auv150.InsSample",
+        about: "each INS sample as it reached the navigation computer ([navigation].ins)",
+        fields: &[
+            one(
+                "t_sampled",
+                Kind::Number,
+                "when it was sampled (s; it arrives its latency later)",
+            ),
+            group("attitude", ATTITUDE, "attitude measured (rad)"),
+            group("rates", RATES, "body rates measured (rad/s)"),
+        ],
+        rate: Rate::Arrival,
+        board_only: false,
+    },
+    ChannelSpec {
+        topic: "/navigation/dvl",
+        schema: "auv150.DvlPing",
+        about: "each DVL ping as it reached the navigation computer ([navigation].dvl)",
+        fields: &[
+            one("t_sampled", Kind::Number, "when it was sampled (s)"),
+            one(
+                "bottom_lock",
+                Kind::Boolean,
+                "the DVL had bottom lock: its velocity reset the solution's",
+            ),
+            group(
+                "velocity",
+                LINEAR,
+                "velocity over the bottom measured (m/s); null without bottom lock",
+            ),
+        ],
+        rate: Rate::Arrival,
+        board_only: false,
+    },
+    ChannelSpec {
+        topic: "/navigation/depth",
+        schema: "auv150.Depth",
+        about: "each pressure depth as it reached the navigation computer ([navigation].depth)",
+        fields: &[
+            one("t_sampled", Kind::Number, "when it was sampled (s)"),
+            one("z", Kind::Number, "depth measured (m)"),
+        ],
+        rate: Rate::Arrival,
+        board_only: false,
+    },
+    ChannelSpec {
+        topic: "/navigation/fix",
+        schema: "auv150.Fix",
+        about: "each position fix as it reached the navigation computer ([navigation].fix)",
+        fields: &[
+            one("t_sampled", Kind::Number, "when it was sampled (s)"),
+            one("x", Kind::Number, "north measured (m)"),
+            one("y", Kind::Number, "east measured (m)"),
+        ],
+        rate: Rate::Arrival,
+        board_only: false,
+    },
+    ChannelSpec {
+        topic: "/board/supervisor",
+        schema: "auv150.Supervisor",
+        about: "the board supervisor's state, from its first answer on and at each change",
+        fields: &[
+            one(
+                "state",
+                Kind::Text,
+                "disarmed, armed, running, or fail-safe and its reason (the board's words)",
+            ),
+            one(
+                "previous",
+                Kind::Text,
+                "the state before (empty at the first answer)",
+            ),
+            one("board_tick", Kind::Integer, "the board's own tick of the answer"),
+        ],
+        rate: Rate::Events,
+        board_only: true,
+    },
+    ChannelSpec {
+        topic: "/board/refusals",
+        schema: "auv150.Refusal",
+        about: "the commands the board refused, when its count of them grows",
+        fields: &[
+            one(
+                "refused",
+                Kind::Integer,
+                "commands refused since the board's previous answer",
+            ),
+            one(
+                "refused_commands",
+                Kind::Integer,
+                "the board's count of refused commands",
+            ),
+            one("reason", Kind::Text, "the board's last refusal"),
+        ],
+        rate: Rate::Events,
+        board_only: true,
+    },
+    ChannelSpec {
+        topic: "/board/link",
+        schema: "auv150.LinkCounters",
+        about: "the link's counters at each answer: this end's and the board's, as its telemetry reports them",
+        fields: &[
+            one(
+                "state_frames_sent",
+                Kind::Integer,
+                "state frames this end sent",
+            ),
+            one(
+                "telemetry_frames",
+                Kind::Integer,
+                "telemetry frames this end took",
+            ),
+            one(
+                "telemetry_refused",
+                Kind::Integer,
+                "telemetry frames this end refused (undecodable, badly signed, out of sequence)",
+            ),
+            one("rearms", Kind::Integer, "re-arms after a fail-safe"),
+            one("rx_frames", Kind::Integer, "frames the board took"),
+            one(
+                "rx_errors",
+                Kind::Integer,
+                "frames the board could not decode",
+            ),
+            one(
+                "rx_stale",
+                Kind::Integer,
+                "frames the board dropped as repeated, old or off its mission clock",
+            ),
+            one(
+                "rx_auth_errors",
+                Kind::Integer,
+                "frames the board refused for their authentication",
+            ),
+            one(
+                "rx_ahead",
+                Kind::Integer,
+                "of those, authentic frames stamped too far ahead",
+            ),
+            one(
+                "refused_commands",
+                Kind::Integer,
+                "commands the board refused",
+            ),
+            one(
+                "loop_overruns",
+                Kind::Integer,
+                "control periods the board overran",
+            ),
+            one(
+                "worst_update_ticks",
+                Kind::Integer,
+                "the board's longest update, in its timer's unit",
+            ),
+        ],
+        rate: Rate::Control,
+        board_only: true,
+    },
+    ChannelSpec {
+        topic: "/board/upload",
+        schema: "auv150.UploadRound",
+        about: "each round of a waypoint mission's upload, before the flight (time 0)",
+        fields: &[
+            one("round", Kind::Integer, "the round (1: the first sending)"),
+            one(
+                "chunks_sent",
+                Kind::Integer,
+                "chunks sent in this round (a chunk lost on purpose is not)",
+            ),
+            one(
+                "missing",
+                Kind::Integer,
+                "chunks the board lacked after it",
+            ),
+            one(
+                "verified",
+                Kind::Boolean,
+                "the board verified the mission against its CRC",
+            ),
+            one(
+                "frames",
+                Kind::Integer,
+                "upload frames sent so far (the Begin, the chunks, the resends)",
+            ),
+            one("bytes", Kind::Integer, "their bytes on the wire"),
+            one(
+                "seconds",
+                Kind::Number,
+                "wall-clock time since the Begin (s)",
+            ),
+        ],
+        rate: Rate::Events,
+        board_only: true,
     },
 ];
 
@@ -290,10 +527,12 @@ pub fn json_schema(spec: &ChannelSpec) -> Value {
     })
 }
 
-/// What one control period gives the log: the sample and the law's inside computed from it.
+/// What one control period gives the log: the sample, the law's inside computed from it, and
+/// the control period (s: a source's sample tick as a time).
 pub struct Record<'a> {
     pub sample: &'a Sample,
     pub inside: &'a LawInside,
+    pub period: f64,
 }
 
 /// A message's JSON, written field by field in the order of the channel's declaration.
@@ -392,7 +631,7 @@ impl<'o> Message<'o> {
         self
     }
 
-    fn end(self) {
+    fn end(&mut self) {
         debug_assert!(self.fields.len() == 0, "fields left: {:?}", self.fields);
         self.out.push('}');
     }
@@ -430,40 +669,72 @@ fn narrow(xs: &[f64]) -> impl Iterator<Item = f32> + '_ {
     xs.iter().map(|&x| x as f32)
 }
 
-/// The message of `topic` for one control period, into `out` (cleared first). [`Topic::Events`]
-/// is written by [`event`] instead.
-pub fn encode(topic: Topic, r: &Record, out: &mut String) {
+/// The message of `topic` for one control period into `out` (cleared first), if the channel
+/// has one this period: a navigation source only when its measurement arrived, a board's
+/// channel only with a board in the loop. The event channels ([`Rate::Events`]) are written
+/// by [`event`], [`supervisor`], [`refusals`] and [`upload_round`] instead.
+pub fn encode(topic: Topic, r: &Record, out: &mut String) -> bool {
+    match topic {
+        Topic::Truth
+        | Topic::Navigation
+        | Topic::Reference
+        | Topic::Tau
+        | Topic::Thrusters
+        | Topic::Law => {
+            loop_message(topic, r, out);
+            true
+        }
+        Topic::Ins | Topic::Dvl | Topic::Depth | Topic::Fix => source_message(topic, r, out),
+        Topic::Link => link_message(r, out),
+        Topic::Events | Topic::Supervisor | Topic::Refusals | Topic::Upload => false,
+    }
+}
+
+/// A control-rate channel's message of the loop's own signals.
+fn loop_message(topic: Topic, r: &Record, out: &mut String) {
     let s = r.sample;
     let spec = topic.spec();
-    let mut m = Message::new(spec, out);
     match topic {
         Topic::Truth => {
-            m.nums(s.eta)
+            Message::new(spec, out)
+                .nums(s.eta)
                 .nums(s.signals.nu)
                 .nums(s.error)
-                .num(s.payload);
+                .num(s.payload)
+                .end();
         }
         Topic::Navigation => {
-            m.nums(s.signals.eta_told).nums(s.signals.nu_told);
+            Message::new(spec, out)
+                .nums(s.signals.eta_told)
+                .nums(s.signals.nu_told)
+                .end();
         }
         Topic::Reference => {
-            m.nums(narrow(&s.eta_d))
+            Message::new(spec, out)
+                .nums(narrow(&s.eta_d))
                 .nums(s.signals.eta_d_dot)
-                .nums(s.signals.eta_d_ddot);
+                .nums(s.signals.eta_d_ddot)
+                .end();
         }
         Topic::Tau => {
-            m.nums(narrow(&s.tau)).nums(s.tau_applied);
+            Message::new(spec, out)
+                .nums(narrow(&s.tau))
+                .nums(s.tau_applied)
+                .end();
         }
         Topic::Thrusters => {
-            m.nums(s.signals.thrust_demand)
+            Message::new(spec, out)
+                .nums(s.signals.thrust_demand)
                 .nums(narrow(&s.voltage))
                 .nums(s.thrust)
                 .bools((0..THRUSTER_NAMES.len()).map(|i| s.saturated & (1 << i) != 0))
-                .int(i64::from(s.saturated));
+                .int(i64::from(s.saturated))
+                .end();
         }
         Topic::Law => {
             let i = r.inside;
-            m.nums(i.e.into_iter().flatten())
+            Message::new(spec, out)
+                .nums(i.e.into_iter().flatten())
                 .nums(i.e_dot.into_iter().flatten())
                 .num(i.e_norm.unwrap_or(f64::NAN))
                 .num(s.w_norm as f32)
@@ -471,20 +742,121 @@ pub fn encode(topic: Topic, r: &Record, out: &mut String) {
                 .boolean(s.delta_clamped)
                 .num(i.lyapunov.unwrap_or(f64::NAN))
                 .num(i.ball_radius.unwrap_or(f64::NAN))
-                .text(&s.status.to_string());
+                .text(&s.status.to_string())
+                .end();
         }
-        Topic::Events => {
-            m.text("").text("").text("");
-        }
+        _ => debug_assert!(false, "{topic:?} is not a loop channel"),
     }
-    m.end();
+}
+
+/// A navigation source's message, if its measurement arrived this period.
+fn source_message(topic: Topic, r: &Record, out: &mut String) -> bool {
+    let arrived = &r.sample.signals.navigation;
+    let at = |tick: u64| tick as f64 * r.period;
+    let spec = topic.spec();
+    match topic {
+        Topic::Ins => {
+            let Some(m) = arrived.ins else { return false };
+            Message::new(spec, out)
+                .num(at(m.sampled_at))
+                .nums(m.value[..3].iter().copied())
+                .nums(m.value[3..].iter().copied())
+                .end();
+        }
+        Topic::Dvl => {
+            let Some(p) = arrived.dvl else { return false };
+            Message::new(spec, out)
+                .num(at(p.sampled_at))
+                .boolean(p.velocity.is_some())
+                .nums(p.velocity.into_iter().flatten())
+                .end();
+        }
+        Topic::Depth => {
+            let Some(m) = arrived.depth else {
+                return false;
+            };
+            Message::new(spec, out)
+                .num(at(m.sampled_at))
+                .num(m.value[0])
+                .end();
+        }
+        Topic::Fix => {
+            let Some(m) = arrived.fix else { return false };
+            Message::new(spec, out)
+                .num(at(m.sampled_at))
+                .num(m.value[0])
+                .num(m.value[1])
+                .end();
+        }
+        _ => return false,
+    }
+    true
+}
+
+/// The link's counters, with a board in the loop.
+fn link_message(r: &Record, out: &mut String) -> bool {
+    let Some(b) = &r.sample.signals.board else {
+        return false;
+    };
+    let c = &b.counters;
+    let int = |x: u64| i64::try_from(x).unwrap_or(i64::MAX);
+    Message::new(Topic::Link.spec(), out)
+        .int(int(c.state_frames_sent))
+        .int(int(c.telemetry_frames))
+        .int(int(c.telemetry_refused))
+        .int(i64::from(c.rearms))
+        .int(i64::from(c.rx_frames))
+        .int(i64::from(c.rx_errors))
+        .int(i64::from(c.rx_stale))
+        .int(i64::from(c.rx_auth_errors))
+        .int(i64::from(c.rx_ahead))
+        .int(i64::from(c.refused_commands))
+        .int(i64::from(c.loop_overruns))
+        .int(i64::from(c.worst_update_ticks))
+        .end();
+    true
+}
+
+/// A [`Topic::Supervisor`] message into `out`: the board's `state` (its own words), the one
+/// before (empty at the first answer), its tick.
+pub fn supervisor(state: &str, previous: &str, board_tick: u64, out: &mut String) {
+    Message::new(Topic::Supervisor.spec(), out)
+        .text(state)
+        .text(previous)
+        .int(i64::try_from(board_tick).unwrap_or(i64::MAX))
+        .end();
+}
+
+/// A [`Topic::Refusals`] message into `out`: `refused` more commands refused, the board's
+/// count, its last reason.
+pub fn refusals(refused: u32, count: u32, reason: &str, out: &mut String) {
+    Message::new(Topic::Refusals.spec(), out)
+        .int(i64::from(refused))
+        .int(i64::from(count))
+        .text(reason)
+        .end();
+}
+
+/// A [`Topic::Upload`] message into `out`: one round of a mission's upload.
+pub fn upload_round(r: &crate::sim::UploadRound, out: &mut String) {
+    Message::new(Topic::Upload.spec(), out)
+        .int(i64::from(r.round))
+        .int(i64::from(r.chunks_sent))
+        .int(i64::from(r.missing))
+        .boolean(r.verified)
+        .int(i64::from(r.frames))
+        .int(i64::try_from(r.bytes).unwrap_or(i64::MAX))
+        .num(r.seconds)
+        .end();
 }
 
 /// An [`Topic::Events`] message into `out`.
 pub fn event(kind: &str, status: &str, text: &str, out: &mut String) {
-    let mut m = Message::new(Topic::Events.spec(), out);
-    m.text(kind).text(status).text(text);
-    m.end();
+    Message::new(Topic::Events.spec(), out)
+        .text(kind)
+        .text(status)
+        .text(text)
+        .end();
 }
 
 #[cfg(test)]
