@@ -9,8 +9,8 @@ use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
-    self, CampaignArgs, CheckArgs, DiffArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs,
-    RunArgs, Table1Args, ValidateArgs,
+    self, CampaignArgs, CheckArgs, DiffArgs, FalsifyArgs, HilArgs, ImportPlanArgs, MonteCarloArgs,
+    PilArgs, RunArgs, Table1Args, ValidateArgs,
 };
 
 #[derive(Parser)]
@@ -55,6 +55,11 @@ enum Command {
     /// (Slurm array task, Kubernetes Indexed Job, laptop; restartable), `merge` the shards into
     /// one report whose worst cases replay bit for bit.
     Campaign(CampaignArgs),
+    /// Searches for a mission the preflight calls feasible that flies outside its bound: the
+    /// cross-entropy method and random search at the same budget, in restarts (sharded as a
+    /// campaign, `--merge` keeps the worst); writes each falsifying mission as a scenario
+    /// file. Exit 1 if one was found.
+    Falsify(FalsifyArgs),
     /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
     /// frame of the plan's home position, each altitude in its item's frame. Exit 2 if the file
     /// is not a plan of waypoints, on what the scenario would refuse (named by plan item:
@@ -101,6 +106,7 @@ fn main() -> ExitCode {
         Command::Check(args) => cli::check(&args, stdout),
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
         Command::Campaign(args) => cli::campaign(&args, stdout),
+        Command::Falsify(args) => cli::falsify(&args, stdout),
         Command::ImportPlan(args) => cli::import_plan(&args, stdout),
         Command::Diff(args) => cli::diff(&args, stdout),
     };

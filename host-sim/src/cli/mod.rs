@@ -12,6 +12,7 @@
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
 //! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR] [--allow-long-run]
+//! host-sim falsify [--budget B] [--restarts R] [--seed S] [--margin M] [--duration D] [--reach contract|realities] [--shard I/N] --out DIR | --merge DIR… --out DIR
 //! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! host-sim import-plan FILE.plan [--speed 0.5] [--name NAME]    # the scenario TOML on stdout
 //! host-sim diff A B [--abs X] [--rel Y] [--out DIR]              # two flights (MCAP or CSV)
@@ -61,6 +62,7 @@ mod campaign;
 mod check;
 mod common;
 mod diff;
+mod falsify;
 mod hil;
 mod import_plan;
 mod json;
@@ -74,6 +76,7 @@ pub use board_loop::LoopArgs;
 pub use campaign::{campaign, resolve_shard, CampaignArgs, CampaignCommand};
 pub use check::{check, usage_error_json, CheckArgs};
 pub use diff::{diff, DiffArgs};
+pub use falsify::{falsify, FalsifyArgs};
 pub use hil::{hil, HilArgs, DEFAULT_HIL_BAUD, DEFAULT_HIL_REPLY_TIMEOUT};
 pub use import_plan::{import_plan, ImportPlanArgs};
 pub use json::Cases;

@@ -18,6 +18,7 @@ pub mod atomic;
 pub mod campaign;
 pub mod csv;
 pub mod dir;
+pub mod falsify;
 pub mod figures;
 pub mod log;
 mod plot;

@@ -81,6 +81,30 @@ fn chatter(
     }
 }
 
+/// The limits of a [`Bound`] a run's robustness is taken over, in [`robustness`]'s order.
+pub const LIMITS: [&str; 4] = ["path", "saturated", "reversals", "command TV"];
+
+/// How far `metrics` are inside each limit of `bound`, each normalised by its own limit:
+/// 1 − value/limit (1 at zero, 0 on the limit, negative beyond; NaN counts as −∞), in
+/// [`LIMITS`]' order. **Choice 412** (docs/search.md#robustness): one number per limit, so no
+/// unit hides another; a search minimises their minimum.
+pub fn robustness(bound: &Bound, metrics: &Metrics) -> [f64; 4] {
+    let r = |x: f64, limit: f64| {
+        let v = 1.0 - x / limit;
+        if v.is_nan() {
+            f64::NEG_INFINITY
+        } else {
+            v
+        }
+    };
+    [
+        r(metrics.max_path, bound.max_path),
+        r(metrics.saturated_fraction, bound.saturated),
+        r(metrics.reversals_per_s, bound.max_reversals_per_s),
+        r(metrics.command_tv, bound.max_command_tv),
+    ]
+}
+
 /// True when a run completed within the real vehicle's bound ([`Bound::REAL_VEHICLE`]),
 /// whatever bound its scenario set.
 pub fn within_bound(run: &RunResult) -> bool {

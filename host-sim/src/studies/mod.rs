@@ -11,7 +11,10 @@
 //! | [`validation`] | does the preflight's verdict hold: missions checked, then flown |
 
 pub mod campaign;
+pub mod falsify;
+pub mod mission_space;
 pub mod montecarlo;
 pub mod preflight;
+pub mod rate_bound;
 pub mod table1;
 pub mod validation;

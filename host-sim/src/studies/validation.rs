@@ -16,17 +16,14 @@
 //! ([`Missions`]).
 
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
-use controller_core::trajectory::{Circle, FigureEight, LawnMower};
-use controller_core::uncertainty::ParamBox;
-use controller_core::{HeadingMode, TrajectoryKind};
-use rand::{RngExt, SeedableRng};
+use rand::SeedableRng;
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
+use super::mission_space::{self, Reach};
 use super::preflight::{self, CheckError, Verdict};
 use crate::interrupt;
-use crate::plant::{CurrentModel, VariationProfile};
-use crate::scenario::{real_vehicle, Scenario, ScenarioError, SimConfig};
+use crate::scenario::{real_vehicle, Scenario, ScenarioError};
 use crate::sim::{self, bound, LocalController, Recording};
 
 /// The vertical × horizontal mountings a team would build: each vertical pair combination
@@ -39,8 +36,7 @@ pub fn all_mountings() -> Vec<u8> {
     (0..1u8 << THRUSTERS).collect()
 }
 
-/// Largest current speed of a random mission (m/s).
-pub const RANDOM_MAX_CURRENT: f64 = 0.3;
+pub use super::mission_space::RANDOM_MAX_CURRENT;
 /// Relative resolution of the smallest flying time scale, found by bisection.
 pub const FLYING_TOLERANCE: f64 = 0.02;
 
@@ -186,48 +182,14 @@ fn matrix_mission(s: &Scenario, mask: u8) -> Result<Scenario, ScenarioError> {
 }
 
 /// Random mission `i` of `seed`, on the first real mission `base` (see the module docs): it
-/// depends only on (seed, i). A draw the core refuses (a tangent heading too slow somewhere)
-/// is drawn again.
+/// depends only on (seed, i), drawn by [`mission_space::mission`] from a generator (Choice
+/// 410). A draw the core refuses (a tangent heading too slow somewhere) is drawn again.
 fn random_mission(base: &Scenario, seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
     let mut rng =
         rand::rngs::StdRng::seed_from_u64(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     loop {
-        let speed = 0.5 + 2.0 * rng.random::<f64>();
-        let kinds = random_kinds();
-        let path = kinds[rng.random_range(0..kinds.len() as u32) as usize](speed, &mut rng);
-        let mask = rng.random_range(0..1u8 << THRUSTERS);
-        let payload = ParamBox::table3().lerp(&std::array::from_fn(|_| rng.random::<f64>()));
-        let variation = match rng.random_range(0..3u32) {
-            0 => VariationProfile::Constant(payload),
-            1 => VariationProfile::AbsSin {
-                max: payload,
-                omega: 0.05 + 0.1 * rng.random::<f64>(),
-            },
-            _ => {
-                let t1 = 10.0 + 30.0 * rng.random::<f64>();
-                let t2 = t1 + 10.0 + 30.0 * rng.random::<f64>();
-                VariationProfile::Staircase(vec![
-                    (t1, payload),
-                    (t2, payload.scaled(0.6)),
-                    (f64::INFINITY, payload.scaled(0.3)),
-                ])
-            }
-        };
-        let current_speed = RANDOM_MAX_CURRENT * rng.random::<f64>();
-        let dir = std::f64::consts::TAU * rng.random::<f64>();
-        let made = base.with(|c: &mut SimConfig| {
-            c.name = format!("random-{i:03}");
-            c.trajectory = path;
-            c.heading = HeadingMode::Tangent;
-            c.time_scale = 1.0;
-            c.duration = 70.0;
-            c.controller.geometry = ThrusterGeometry::auv150(mask);
-            c.variation = variation.clone();
-            c.trimmed = true;
-            c.current =
-                CurrentModel::Constant([current_speed * dir.cos(), current_speed * dir.sin(), 0.0]);
-        });
-        match made {
+        let name = format!("random-{i:03}");
+        match mission_space::mission(base, Reach::Contract, name, CONTRACT_DURATION, &mut rng) {
             Ok(s) => return Ok(s),
             // Too slow for the tangent heading somewhere: draw again.
             Err(ScenarioError::Invalid { key, .. }) if key.starts_with("trajectory") => continue,
@@ -236,52 +198,8 @@ fn random_mission(base: &Scenario, seed: u64, i: usize) -> Result<Scenario, Scen
     }
 }
 
-/// Draws a random path of one kind for a horizontal speed (m/s): its size, and ω from the
-/// speed.
-type DrawPath = fn(f64, &mut rand::rngs::StdRng) -> TrajectoryKind;
-
-/// The kinds the random missions fly, in `TrajectoryKind::EXAMPLES`' order, each with its
-/// draw. A new kind does not compile here until it says whether they fly it (the match is
-/// exhaustive); flying one more kind draws other missions for every seed.
-fn random_kinds() -> Vec<DrawPath> {
-    TrajectoryKind::EXAMPLES
-        .iter()
-        .filter_map(|kind| -> Option<DrawPath> {
-            match kind {
-                // R ω = speed.
-                TrajectoryKind::Circle(_) => Some(|speed, rng| {
-                    let radius = 8.0 + 32.0 * rng.random::<f64>();
-                    TrajectoryKind::Circle(Circle {
-                        radius: radius as f32,
-                        omega: (speed / radius) as f32,
-                        depth: 5.0,
-                    })
-                }),
-                // A ω = speed.
-                TrajectoryKind::FigureEight(_) => Some(|speed, rng| {
-                    let amplitude = 10.0 + 30.0 * rng.random::<f64>();
-                    TrajectoryKind::FigureEight(FigureEight {
-                        amplitude: amplitude as f32,
-                        omega: (speed / amplitude) as f32,
-                        depth: 5.0,
-                    })
-                }),
-                // 15 s ω = speed on the cross-track legs, ω within the paper's range.
-                TrajectoryKind::LawnMower(_) => Some(|speed, rng| {
-                    let scale = 0.5 + rng.random::<f64>();
-                    TrajectoryKind::LawnMower(LawnMower {
-                        scale: scale as f32,
-                        omega: (speed / (15.0 * scale)).clamp(0.02, 0.08) as f32,
-                        depth: 5.0,
-                    })
-                }),
-                // Level paths only: the contract's random missions hold their depth. The
-                // waypoint missions have their own speed profiles (`host-sim check`).
-                TrajectoryKind::Helix(_) | TrajectoryKind::Waypoints { .. } => None,
-            }
-        })
-        .collect()
-}
+/// How long the contract's random missions fly (s, at time scale 1): the paper's 70 s.
+pub const CONTRACT_DURATION: f64 = 70.0;
 
 /// `base` at time scale `k`: the same path (its duration scaled).
 fn at_scale(base: &Scenario, k: f64) -> Result<Scenario, ScenarioError> {
@@ -313,17 +231,39 @@ pub enum Measure {
     Conservativeness,
 }
 
-/// Checks and flies one mission (see the module docs); `None` if a stop was requested
-/// ([`crate::interrupt`]) during its check.
-pub fn validate_one(
+/// A mission flown at the time scale the preflight proposed.
+#[derive(Clone, Debug)]
+pub struct Flown {
+    /// The mission at the proposed scale (what was flown).
+    pub scenario: Scenario,
+    pub metrics: sim::Metrics,
+    /// Completed within the real vehicle's bound ([`bound::within_bound`]).
+    pub within: bool,
+}
+
+/// Why [`check_and_fly`] has no answer.
+#[derive(Debug, thiserror::Error)]
+pub enum CheckFlyError {
+    /// The check itself failed.
+    #[error("{0}")]
+    Check(CheckError),
+    /// The core refuses the mission at the scale the preflight proposed (a tangent heading
+    /// too slow there, say).
+    #[error("at the proposed time scale {scale}: {error}")]
+    AtScale { scale: f64, error: ScenarioError },
+}
+
+/// Checks one mission as written and flies it at the proposed scale, as the contract does
+/// (see the module docs); `None` if a stop was requested ([`crate::interrupt`]) during its
+/// check. The flight is `None` when the preflight proposes no scale.
+pub fn check_and_fly(
     base: &Scenario,
     margin: f64,
-    measure: Measure,
-) -> Result<Option<MissionResult>, String> {
+) -> Result<Option<(MissionResult, Option<Flown>)>, CheckFlyError> {
     let p = match preflight::check_as_written(base, margin) {
         Ok(p) => p,
         Err(CheckError::Interrupted) => return Ok(None),
-        Err(e) => return Err(e.to_string()),
+        Err(e) => return Err(CheckFlyError::Check(e)),
     };
     let mounting = base
         .config()
@@ -346,14 +286,40 @@ pub fn validate_one(
         smallest_flying: None,
     };
     let Some(k) = proposed else {
-        return Ok(Some(out));
+        return Ok(Some((out, None)));
     };
-    let scenario = |k: f64| at_scale(base, k).map_err(|e| e.to_string());
-    let (within, m) = flies(&scenario(k)?);
-    (out.max_path, out.saturated, out.within) =
-        (Some(m.max_path), Some(m.saturated_fraction), Some(within));
-    if within && measure == Measure::Conservativeness {
-        out.smallest_flying = Some(smallest_flying(k, &mut |k| Ok(flies(&scenario(k)?).0))?);
+    let scenario = at_scale(base, k).map_err(|error| CheckFlyError::AtScale { scale: k, error })?;
+    let (within, metrics) = flies(&scenario);
+    (out.max_path, out.saturated, out.within) = (
+        Some(metrics.max_path),
+        Some(metrics.saturated_fraction),
+        Some(within),
+    );
+    Ok(Some((
+        out,
+        Some(Flown {
+            scenario,
+            metrics,
+            within,
+        }),
+    )))
+}
+
+/// Checks and flies one mission (see the module docs); `None` if a stop was requested
+/// ([`crate::interrupt`]) during its check.
+pub fn validate_one(
+    base: &Scenario,
+    margin: f64,
+    measure: Measure,
+) -> Result<Option<MissionResult>, String> {
+    let Some((mut out, flown)) = check_and_fly(base, margin).map_err(|e| e.to_string())? else {
+        return Ok(None);
+    };
+    if let (Some(k), Some(f)) = (out.proposed, flown) {
+        if f.within && measure == Measure::Conservativeness {
+            let scenario = |k: f64| at_scale(base, k).map_err(|e| e.to_string());
+            out.smallest_flying = Some(smallest_flying(k, &mut |k| Ok(flies(&scenario(k)?).0))?);
+        }
     }
     Ok(Some(out))
 }
