@@ -6,7 +6,7 @@ use std::hint::black_box;
 use controller_core::model::{ParamVariation, VehicleParams};
 use controller_core::Table1Case;
 use criterion::{criterion_group, criterion_main, Criterion};
-use host_sim::plant::{Plant, PlantState, PlantTerms};
+use host_sim::plant::{CurrentModel, Plant, PlantState, PlantTerms};
 use host_sim::scenario::paper;
 use nalgebra::{Vector3, Vector6};
 
@@ -53,18 +53,65 @@ fn bench(c: &mut Criterion) {
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("campaigns/real-circle.campaign.toml");
     let campaign = host_sim::studies::campaign::Campaign::load(&file).expect("the campaign");
+    // The shipped campaign flies study-grade (Choice 400); the same runs at each base's 1 ms
+    // step beside it.
+    let mut spec = campaign.spec.clone();
+    spec.plant_step = None;
+    let at_1ms = host_sim::studies::campaign::Campaign::new(
+        campaign.text.clone(),
+        spec,
+        campaign.bases.clone(),
+    );
     let mut group = c.benchmark_group("campaign");
     group.sample_size(20);
-    let mut i = 0;
-    group.bench_function(
-        "real-circle run (70 s, real chain, drawn Δp, current, noise)",
-        |b| {
+    for (name, campaign) in [
+        (
+            "real-circle run (70 s, real chain, drawn Δp, current, noise), study-grade step",
+            &campaign,
+        ),
+        (
+            "real-circle run (70 s, real chain, drawn Δp, current, noise), 1 ms step",
+            &at_1ms,
+        ),
+    ] {
+        let mut i = 0;
+        group.bench_function(name, |b| {
             b.iter(|| {
                 i += 1;
                 campaign.fly(black_box(i))
             })
-        },
-    );
+        });
+    }
+    group.finish();
+    // A wandering current against a constant one (Choice 401): 100 s of the shipped waypoint
+    // route, flown as `run` flies it (plot series kept), the preflight aside.
+    let route =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/waypoints-short.toml");
+    let route = host_sim::scenario::load_scenario(&route).expect("the route");
+    let constant = route
+        .with(|c| {
+            c.duration = 100.0;
+            c.current = CurrentModel::Constant([0.1, 0.05, 0.0]);
+        })
+        .expect("constant current");
+    let wandering = route
+        .with(|c| {
+            c.duration = 100.0;
+            c.current = CurrentModel::GaussMarkov {
+                mean: [0.1, 0.05, 0.0],
+                sigma: [0.03, 0.03, 0.01],
+                tau: 20.0,
+                seed: 7,
+            };
+        })
+        .expect("Gauss–Markov current");
+    let mut group = c.benchmark_group("current");
+    group.sample_size(10);
+    for (name, s) in [("constant", &constant), ("gauss-markov", &wandering)] {
+        group.bench_function(format!("waypoints-short 100 s, {name} current"), |b| {
+            b.iter(|| host_sim::sim::run(black_box(s)))
+        });
+    }
     group.finish();
 }
 

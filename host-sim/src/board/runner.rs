@@ -223,6 +223,7 @@ impl BoardInTheLoop {
             status: ControlStatus::Board(t.status),
             tau: t.tau,
             voltage: t.voltages,
+            thrust: None,
             saturated: t.saturated,
             delta: t.delta,
             delta_clamped: t.delta_clamped,

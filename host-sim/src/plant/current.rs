@@ -6,7 +6,7 @@ use nalgebra::Vector3;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
-/// An earth-fixed ocean current v_c, as a scenario's `[current]` gives it.
+/// An earth-fixed ocean current v_c, as a scenario gives it.
 #[derive(Clone, Debug, PartialEq)]
 pub enum CurrentModel {
     None,
@@ -21,12 +21,38 @@ pub enum CurrentModel {
     },
 }
 
+/// The exact transition of the Gauss–Markov process over one step h (**Choice 401**):
+/// v(t + h) − mean = a·(v(t) − mean) + b·w with a = e^(−h/τ), b = σ√(1 − a²) and w ~ N(0, 1).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Transition {
+    /// The step it was formed for (s).
+    h: f64,
+    a: f64,
+    b: [f64; 3],
+}
+
+impl Transition {
+    fn new(h: f64, sigma: &[f64; 3], tau: f64) -> Self {
+        let a = (-h / tau).exp();
+        // 1 − a² = −expm1(−2h/τ), exact for h ≪ τ where 1 − a·a would cancel.
+        let spread = (-(-2.0 * h / tau).exp_m1()).sqrt();
+        Transition {
+            h,
+            a,
+            b: sigma.map(|s| s * spread),
+        }
+    }
+}
+
 /// The ocean current as the plant meets it, step by step: a [`CurrentModel`]'s state
 /// (Gauss–Markov is a random process, stepped with the plant).
 pub struct OceanCurrent {
     model: CurrentModel,
     v: Vector3<f64>,
     rng: rand::rngs::StdRng,
+    /// The Gauss–Markov transition of the last step length (formed once per run: the loop
+    /// steps with one h).
+    transition: Option<Transition>,
 }
 
 impl OceanCurrent {
@@ -40,6 +66,7 @@ impl OceanCurrent {
             model: model.clone(),
             v,
             rng: rand::rngs::StdRng::seed_from_u64(seed),
+            transition: None,
         }
     }
 
@@ -48,16 +75,22 @@ impl OceanCurrent {
         &self.v
     }
 
-    /// Euler–Maruyama step of v̇ = −(v − mean)/τ + σ√(2/τ)·w: stationary std σ.
+    /// Advances the current by `h` s. A Gauss–Markov current takes its exact transition
+    /// (**Choice 401**): v ← mean + e^(−h/τ)(v − mean) + σ√(1 − e^(−2h/τ))·w per axis, so
+    /// its stationary variance is σ² and its autocorrelation e^(−Δt/τ) at every step length
+    /// (the plant step of a study-grade run, Choice 400, as much as the 1 ms one).
     pub fn step(&mut self, h: f64) {
         if let CurrentModel::GaussMarkov {
             mean, sigma, tau, ..
         } = &self.model
         {
+            let tr = match self.transition {
+                Some(tr) if tr.h == h => tr,
+                _ => *self.transition.insert(Transition::new(h, sigma, *tau)),
+            };
             for i in 0..3 {
                 let w: f64 = StandardNormal.sample(&mut self.rng);
-                self.v[i] +=
-                    -(self.v[i] - mean[i]) / tau * h + sigma[i] * (2.0 * h / tau).sqrt() * w;
+                self.v[i] = mean[i] + tr.a * (self.v[i] - mean[i]) + tr.b[i] * w;
             }
         }
     }

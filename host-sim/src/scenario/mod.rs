@@ -36,8 +36,8 @@
 //! - the step cap: at most [`MAX_CONTROL_PERIODS`] control periods (duration × rate_hz) and
 //!   [`MAX_PLANT_STEPS`] plant steps (one day at 100 Hz and 1 ms), unless
 //!   [`SimConfig::allow_long_run`] (the CLI's `--allow-long-run`); never beyond 2⁵³;
-//! - `current.tau` ≥ `plant_step` (Euler–Maruyama of the Gauss–Markov current is unstable
-//!   below half the step, and its variance is σ²/(1 − h/2τ));
+//! - `current.tau` ≥ `plant_step` (the plant holds the current over a step: a Gauss–Markov
+//!   current faster than the step is not resolved);
 //! - `variation.omega` · `plant_step` ≤ [`MAX_VARIATION_OMEGA_STEP`] (the plant resolves the
 //!   variation; 1e308 used to give NaN parameters);
 //! - what the vehicle can meet (**Choice 124**): the start offset (its position part within

@@ -573,16 +573,16 @@ fn current(c: &CurrentModel, plant_step: f64) -> Res<()> {
             each("current.sigma", sigma, non_negative)?;
             current_speed("current.sigma", sigma)?;
             let tau = positive("current.tau", *tau)?;
-            // Euler–Maruyama of v̇ = −(v − mean)/τ + …: v ← (1 − h/τ) v + …, unstable for
-            // h > 2τ, and its stationary variance is σ²/(1 − h/2τ) (≤ 5 % high for τ ≥ 10 h).
+            // The process is stepped by its exact transition (Choice 401), which is stable at
+            // any step; but the plant holds the current over a step, so a correlation time
+            // shorter than the step is a current the plant does not resolve.
             if tau < plant_step {
                 return Err(invalid(
                     "current.tau",
                     format!(
-                        "{} s is below the plant step {} s: the Gauss–Markov process \
-                         is stepped by Euler–Maruyama at the plant step, which is unstable for \
-                         tau < plant_step/2 and inflates the variance by 1/(1 − plant_step/(2 tau)) \
-                         (×2 at tau = plant_step); use tau ≥ plant_step, better ≥ 10 plant steps",
+                        "{} s is below the plant step {} s: the plant holds the current over \
+                         each step, so a Gauss–Markov process faster than the step is not \
+                         resolved; use tau ≥ plant_step, better ≥ 10 plant steps",
                         Readable(tau),
                         Readable(plant_step)
                     ),

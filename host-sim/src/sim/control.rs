@@ -17,6 +17,10 @@ pub struct ControlOut {
     pub tau: [f32; 6],
     /// Voltages (used by the real actuator chain).
     pub voltage: [f32; THRUSTERS],
+    /// The thrust (N) the law's own maps give for each voltage, when the law ran here: the
+    /// simulated thrusters' inverse map of the same voltage, already computed (**Choice 402**,
+    /// [`Thrusters::target`](super::thrusters::Thrusters::target)). `None` from a board.
+    pub thrust: Option<[f32; THRUSTERS]>,
     pub saturated: u8,
     pub delta: f32,
     pub delta_clamped: bool,
@@ -73,6 +77,7 @@ impl ControlSource for LocalController<'_> {
             status: ControlStatus::Law(out.status),
             tau: out.tau,
             voltage: out.voltage,
+            thrust: Some(out.thrust),
             saturated: out.saturated,
             delta: out.delta,
             delta_clamped: out.delta_clamped,

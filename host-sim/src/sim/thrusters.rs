@@ -28,6 +28,9 @@ pub struct Thrusters<'a> {
     ideal: bool,
     /// 1 − e^(−h/T) of the lag over one plant step h, if there is a lag.
     lag_alpha: Option<f64>,
+    /// (T/h)(1 − e^(−h/T)): the lag's mean over a step, for a plant step that is the whole
+    /// control period (Choice 400).
+    lag_mean: Option<f64>,
     /// The thrust at the end of the last period (the lag's state), once a period has run.
     applied: Option<Thrusts>,
 }
@@ -42,6 +45,7 @@ impl<'a> Thrusters<'a> {
             unit: config.controller.thrust_unit,
             ideal: config.ideal_actuators,
             lag_alpha: config.thruster_lag.map(|tl| 1.0 - (-h / tl).exp()),
+            lag_mean: config.thruster_lag.map(|tl| -(-h / tl).exp_m1() * tl / h),
             applied: None,
         }
     }
@@ -60,7 +64,14 @@ impl<'a> Thrusters<'a> {
         }
         let mut t = [0.0; THRUSTERS];
         for (i, t) in t.iter_mut().enumerate() {
-            *t = self.maps[i].newtons_of_voltage(self.unit, out.voltage[i]) as f64;
+            let v = out.voltage[i];
+            *t = match out.thrust {
+                // Choice 402: the law's maps are these maps in this unit, and for a voltage
+                // other than 0 V its thrust is newtons_of_voltage(v), the same f32 operations.
+                // At 0 V the law reports 0 N (power off), the map its fit's offset.
+                Some(law) if v != 0.0 => law[i],
+                _ => self.maps[i].newtons_of_voltage(self.unit, v),
+            } as f64;
         }
         t
     }
@@ -91,10 +102,22 @@ impl<'a> Thrusters<'a> {
         let mut result = Ok(());
         for j in 0..substeps {
             if let Some(alpha) = self.lag_alpha {
+                let start = applied;
                 for i in 0..THRUSTERS {
                     applied[i] += alpha * (target[i] - applied[i]);
                 }
-                tau = self.wrench(&applied);
+                tau = match self.lag_mean {
+                    // Choice 400: one step for the whole period (study-grade flight) takes the
+                    // lagged thrust's exact mean over it, T(t) = target + (start − target)e^(−t/T):
+                    // its impulse, not its end value held for 10 ms.
+                    Some(mean) if substeps == 1 => {
+                        let m: Thrusts =
+                            std::array::from_fn(|i| target[i] + mean * (start[i] - target[i]));
+                        self.wrench(&m)
+                    }
+                    // Several substeps resolve the lag: each holds its end value.
+                    _ => self.wrench(&applied),
+                };
             } else {
                 applied = *target;
             }

@@ -30,7 +30,7 @@ pub mod merge;
 pub mod record;
 pub mod shard;
 
-pub use file::{Base, CampaignError, CampaignSpec, ParameterDraw};
+pub use file::{Base, CampaignError, CampaignSpec, ParameterDraw, PlantStep, STUDY_PATH_TOLERANCE};
 pub use record::{Outcome, Record};
 pub use shard::{Done, Shard};
 
@@ -186,6 +186,10 @@ impl Campaign {
         let spec = &self.spec;
         self.bases[self.base_of(i)].scenario.with(|c| {
             c.name = self.run_name(i);
+            if let Some(step) = spec.plant_step {
+                // Choice 400: study-grade flight.
+                step.apply(c);
+            }
             if spec.draw.parameters != ParameterDraw::None {
                 c.variation = VariationProfile::Constant(ParamVariation::from_array(d.variation));
             }
