@@ -12,6 +12,7 @@ use crate::allocation::{Allocated, Allocator, PseudoInverse};
 use crate::axes::ACTUATED;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
+use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind};
 use crate::kinematics::{Attitude, Kinematics};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw};
 use crate::model::{self, VehicleParams};
@@ -198,6 +199,18 @@ pub struct Controller {
     allocator: Allocator,
     maps: [ThrusterMap; THRUSTERS],
     cos_pitch_limit: f32,
+    /// The estimator's gains (`None`: off) and M̂⁻¹ for its model (Choice 340).
+    estimator: Option<EstimatorGains>,
+    m_hat_inv: Matrix6<f32>,
+}
+
+/// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
+/// solution holds at (`t_ticks` of the link's state frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Solution {
+    pub stamp: u64,
+    pub eta: [f32; 6],
+    pub nu: [f32; 6],
 }
 
 impl Controller {
@@ -285,8 +298,21 @@ impl Controller {
             b_sec_power,
         };
 
+        let estimator = match config.estimator.kind {
+            EstimatorKind::Off => None,
+            EstimatorKind::Kalman => Some(
+                EstimatorGains::new(&config.estimator, config.rate_hz)
+                    .map_err(|axis| ConfigError::EstimatorGain { axis })?,
+            ),
+        };
+        let m_hat = model::mass_matrix(&config.params);
+        // M̂ is positive definite (checked over the box): its inverse exists.
+        let m_hat_inv = m_hat.try_inverse().ok_or(ConfigError::NonFiniteParams)?;
+
         Ok(Controller {
-            m_hat: model::mass_matrix(&config.params),
+            estimator,
+            m_hat_inv,
+            m_hat,
             k1: Vector6::from(config.k1),
             k2: Vector6::from(config.k2),
             lyapunov,
@@ -365,6 +391,117 @@ impl Controller {
             Ok(_) => Output::fail_safe(Fault::NonFiniteResult),
             Err(fault) => Output::fail_safe(fault),
         }
+    }
+
+    /// One control step on a navigation `solution` at period `ticks`, with the estimator's
+    /// memory `memory` (docs/law.md#the-state-estimator, Choice 340): with the estimator off,
+    /// exactly [`Controller::update`] on the solution's η, ν (the memory untouched); with it
+    /// on, the solution is checked as `update` checks it (a fault gives the same fail-safe and
+    /// the memory does not take the solution), converted to η̇ = J(η)ν, filtered at its stamp
+    /// and predicted to `ticks`, and the law runs on the estimate; the acceleration the applied
+    /// thrust gives under the nominal model is then recorded for the next predictions.
+    #[inline(never)]
+    pub fn update_from_solution(
+        &self,
+        memory: &mut Estimate,
+        ticks: u64,
+        solution: &Solution,
+        trajectory: &Trajectory,
+    ) -> Output {
+        let Some(gains) = &self.estimator else {
+            return self.update(ticks, &solution.eta, &solution.nu, trajectory);
+        };
+        let (out, accel) = match self.estimated_step(memory, gains, ticks, solution, trajectory) {
+            Ok((out, a)) if out.all_finite() => (out, a),
+            Ok(_) => (Output::fail_safe(Fault::NonFiniteResult), [0.0; 6]),
+            Err(fault) => (Output::fail_safe(fault), [0.0; 6]),
+        };
+        memory.applied(gains, ticks, &accel);
+        out
+    }
+
+    /// [`Controller::update_from_solution`]'s step with the estimator on: the output and the
+    /// applied acceleration to record.
+    fn estimated_step(
+        &self,
+        memory: &mut Estimate,
+        gains: &EstimatorGains,
+        ticks: u64,
+        solution: &Solution,
+        trajectory: &Trajectory,
+    ) -> Result<(Output, [f32; 6]), Fault> {
+        let measured = self.kinematics_stage(&solution.eta, &solution.nu)?;
+        // Before any solution could be taken (the first one stamped in the future or older
+        // than the horizon) the law flies on the solution as told.
+        let kin = match memory.step(
+            gains,
+            ticks,
+            solution.stamp,
+            &measured.eta.into(),
+            &measured.eta_dot.into(),
+        ) {
+            Some((eta, eta_dot)) => self.estimate_kinematics_stage(&eta, &eta_dot)?,
+            None => measured,
+        };
+        let desired = self.trajectory_stage(ticks, trajectory);
+        let law = self.law_stage(&kin, &desired, trajectory)?;
+        let alloc = self.allocation_stage(&law.tau);
+        let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
+        let accel = estimator::applied_acceleration(
+            &law.u,
+            &kin.kin,
+            &self.m_hat_inv,
+            &law.tau,
+            &tau_achieved,
+        );
+        let out = Output {
+            status: Status::Ok,
+            tau: law.tau.into(),
+            tau_achieved: tau_achieved.into(),
+            tau_unallocated: alloc.unallocated,
+            thrust: act.thrusts,
+            voltage: act.voltages,
+            saturated: alloc.saturated | act.saturated,
+            delta: law.delta,
+            delta_clamped: self.config.robust && law.delta_clamped,
+            w_norm: law.w_norm,
+            eta_d: desired.eta.into(),
+            e1: law.e1.into(),
+        };
+        Ok((out, accel.into()))
+    }
+
+    /// The kinematics of [`Controller::kinematics_stage`] at the estimate (η̂, η̂̇): the same
+    /// checks and pitch limit, ν̂ = J(η̂)⁻¹η̂̇, and η̇ taken as η̂̇ itself.
+    #[doc(hidden)]
+    #[inline]
+    pub fn estimate_kinematics_stage(
+        &self,
+        eta: &[f32; 6],
+        eta_dot: &[f32; 6],
+    ) -> Result<StepKinematics, Fault> {
+        if !eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite()) {
+            return Err(Fault::NonFiniteResult);
+        }
+        let eta = Vector6::from(*eta);
+        let eta_dot = Vector6::from(*eta_dot);
+        let att = Attitude::from_eta_f32(&eta);
+        let cos_theta_abs = att.ctheta.abs();
+        if cos_theta_abs < self.cos_pitch_limit {
+            return Err(Fault::PitchLimit);
+        }
+        let kin = Kinematics::new(att).map_err(|_| Fault::PitchLimit)?;
+        let nu = kin.jinv_mul(&eta_dot);
+        check_inputs(&eta.into(), &nu.into())?;
+        let jinv_jdot_nu = kin.jinv_jdot_nu(&nu);
+        Ok(StepKinematics {
+            eta,
+            nu,
+            kin,
+            cos_theta_abs,
+            eta_dot,
+            jinv_jdot_nu,
+        })
     }
 
     /// The stages of [`Stage::ALL`] in order, then the output.
@@ -488,6 +625,7 @@ impl Controller {
             return Err(Fault::NonFiniteResult);
         }
         Ok(StepLaw {
+            u,
             tau,
             delta,
             delta_clamped,
@@ -577,6 +715,8 @@ pub struct StepKinematics {
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepLaw {
+    /// The commanded η̈: ū + Δu.
+    pub u: Vector6<f32>,
     pub tau: Vector6<f32>,
     pub delta: f32,
     /// δ was clamped (reported only when Δu is on).
