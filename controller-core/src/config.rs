@@ -293,6 +293,17 @@ impl fmt::Display for ConfigError {
                 Readable(max_period)
             ),
             ConfigError::Allocation(e) => write!(f, "thruster allocation: {e}"),
+            ConfigError::EstimatorSigma { .. } | ConfigError::EstimatorGain { .. } => {
+                self.fmt_estimator(f)
+            }
+        }
+    }
+}
+
+impl ConfigError {
+    /// The estimator's errors, in words.
+    fn fmt_estimator(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
             ConfigError::EstimatorSigma { name, axis, value } => write!(
                 f,
                 "{name}[{axis}] must be a finite number > 0, got {}",
@@ -302,6 +313,7 @@ impl fmt::Display for ConfigError {
                 f,
                 "the estimator's Riccati equation has no steady state on axis {axis} with these noise settings"
             ),
+            _ => Ok(()),
         }
     }
 }

@@ -298,16 +298,8 @@ impl Controller {
             b_sec_power,
         };
 
-        let estimator = match config.estimator.kind {
-            EstimatorKind::Off => None,
-            EstimatorKind::Kalman => Some(
-                EstimatorGains::new(&config.estimator, config.rate_hz)
-                    .map_err(|axis| ConfigError::EstimatorGain { axis })?,
-            ),
-        };
         let m_hat = model::mass_matrix(&config.params);
-        // M̂ is positive definite (checked over the box): its inverse exists.
-        let m_hat_inv = m_hat.try_inverse().ok_or(ConfigError::NonFiniteParams)?;
+        let (estimator, m_hat_inv) = estimator_parts(&config, &m_hat)?;
 
         Ok(Controller {
             estimator,
@@ -723,6 +715,23 @@ pub struct StepLaw {
     pub delta_clamped: bool,
     pub w_norm: f32,
     pub e1: Vector6<f32>,
+}
+
+/// The estimator's gains (`None` when it is off) and M̂⁻¹ for its model (Choice 340).
+fn estimator_parts(
+    config: &ControllerConfig,
+    m_hat: &Matrix6<f32>,
+) -> Result<(Option<EstimatorGains>, Matrix6<f32>), ConfigError> {
+    let gains = match config.estimator.kind {
+        EstimatorKind::Off => None,
+        EstimatorKind::Kalman => Some(
+            EstimatorGains::new(&config.estimator, config.rate_hz)
+                .map_err(|axis| ConfigError::EstimatorGain { axis })?,
+        ),
+    };
+    // M̂ is positive definite (checked over the box): its inverse exists.
+    let m_hat_inv = m_hat.try_inverse().ok_or(ConfigError::NonFiniteParams)?;
+    Ok((gains, m_hat_inv))
 }
 
 /// Assumption 2 (Eq 20: β̂ < 1 and β̂ ≤ the configured β) and Theorem 2 (Eq 25) over the box.

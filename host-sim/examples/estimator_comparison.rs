@@ -14,7 +14,7 @@ use std::path::Path;
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::EstimatorKind;
 use host_sim::plant::CurrentModel;
-use host_sim::scenario::{load_config, Scenario, SensorNoise};
+use host_sim::scenario::{load_config, Scenario, SensorNoise, SimConfig};
 use host_sim::sim::{fly, LocalController, Recording};
 
 #[path = "../tests/common/chatter.rs"]
@@ -32,28 +32,7 @@ fn main() -> anyhow::Result<()> {
         .iter()
         .map(|a| a.parse())
         .collect::<Result<_, _>>()?;
-    let mut base = load_config(Path::new(&path))?;
-    let env = |name: &str| std::env::var(name).ok();
-    // NOISE=0: the exact state (what the estimator costs on a perfect solution).
-    let noisy = env("NOISE").is_none_or(|v| v != "0");
-    base.noise = noisy.then_some(SensorNoise {
-        eta_sigma: [0.005, 0.005, 0.005, 0.001, 0.001, 0.001],
-        nu_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],
-        seed: env("SEED").map_or(Ok(1), |s| s.parse())?,
-    });
-    // LAG=s: first-order thruster lag; CURRENT=σ: a Gauss–Markov current (m/s, τ 60 s).
-    if let Some(lag) = env("LAG") {
-        base.thruster_lag = Some(lag.parse()?);
-    }
-    if let Some(sigma) = env("CURRENT") {
-        let sigma: f64 = sigma.parse()?;
-        base.current = CurrentModel::GaussMarkov {
-            mean: [0.0; 3],
-            sigma: [sigma, sigma, sigma / 4.0],
-            tau: 60.0,
-            seed: 7,
-        };
-    }
+    let base = base_config(Path::new(&path))?;
     let mut cases: Vec<(String, f32, Option<f32>)> = vec![
         ("nothing".into(), base.controller.mu, None),
         ("mu = 0.3".into(), 0.3, None),
@@ -77,30 +56,62 @@ fn main() -> anyhow::Result<()> {
             cfg.controller.estimator.kind = EstimatorKind::Kalman;
             cfg.controller.estimator.accel_sigma = [sa, sa, sa, sa / 5.0, sa / 5.0, sa / 5.0];
         }
-        let scenario = Scenario::new(cfg)?;
-        let mut chatter = Chatter::default();
-        let r = fly(
-            &scenario,
-            &mut LocalController::new(&scenario),
-            &mut chatter,
-            Recording::MetricsOnly,
-        );
-        let per_s = |x: &[f64; THRUSTERS]| -> String {
-            let o = [1, 2, 3, 4, 0];
-            o.iter()
-                .map(|&i| format!("{:.1}", x[i]))
-                .collect::<Vec<_>>()
-                .join(" / ")
-        };
-        println!(
-            "| {name} | {:.1} | {:.1} | {:.1} | {} | {} | {:?} |",
-            r.metrics.max_path * 1e3,
-            r.metrics.saturated_fraction * 100.0,
-            r.metrics.peak_voltage,
-            per_s(&chatter.reversals_per_s()),
-            per_s(&chatter.variation_per_s()),
-            r.outcome
-        );
+        println!("| {name} | {} |", row(cfg)?);
     }
     Ok(())
+}
+
+/// The scenario at `path` with the campaign's noise and what the environment asks for.
+fn base_config(path: &Path) -> anyhow::Result<SimConfig> {
+    let mut base = load_config(path)?;
+    let env = |name: &str| std::env::var(name).ok();
+    // NOISE=0: the exact state (what the estimator costs on a perfect solution).
+    let noisy = env("NOISE").is_none_or(|v| v != "0");
+    base.noise = noisy.then_some(SensorNoise {
+        eta_sigma: [0.005, 0.005, 0.005, 0.001, 0.001, 0.001],
+        nu_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],
+        seed: env("SEED").map_or(Ok(1), |s| s.parse())?,
+    });
+    // LAG=s: first-order thruster lag; CURRENT=σ: a Gauss–Markov current (m/s, τ 60 s).
+    if let Some(lag) = env("LAG") {
+        base.thruster_lag = Some(lag.parse()?);
+    }
+    if let Some(sigma) = env("CURRENT") {
+        let sigma: f64 = sigma.parse()?;
+        base.current = CurrentModel::GaussMarkov {
+            mean: [0.0; 3],
+            sigma: [sigma, sigma, sigma / 4.0],
+            tau: 60.0,
+            seed: 7,
+        };
+    }
+    Ok(base)
+}
+
+/// One run's cells after the case's name.
+fn row(cfg: SimConfig) -> anyhow::Result<String> {
+    let scenario = Scenario::new(cfg)?;
+    let mut chatter = Chatter::default();
+    let r = fly(
+        &scenario,
+        &mut LocalController::new(&scenario),
+        &mut chatter,
+        Recording::MetricsOnly,
+    );
+    let per_s = |x: &[f64; THRUSTERS]| -> String {
+        let o = [1, 2, 3, 4, 0];
+        o.iter()
+            .map(|&i| format!("{:.1}", x[i]))
+            .collect::<Vec<_>>()
+            .join(" / ")
+    };
+    Ok(format!(
+        "{:.1} | {:.1} | {:.1} | {} | {} | {:?}",
+        r.metrics.max_path * 1e3,
+        r.metrics.saturated_fraction * 100.0,
+        r.metrics.peak_voltage,
+        per_s(&chatter.reversals_per_s()),
+        per_s(&chatter.variation_per_s()),
+        r.outcome
+    ))
 }
