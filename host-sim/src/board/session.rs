@@ -10,6 +10,7 @@ use auv_link::{
     BoardStatus, Command as LinkCommand, ConfigPatch, MissionPlan, MissionUpload, Msg, Telemetry,
     ThrustUnit, DEFAULT_STALE_PERIODS,
 };
+use controller_core::EstimatorKind;
 
 use super::error::Error;
 use super::link::Link;
@@ -51,9 +52,13 @@ pub(super) struct SetUp {
 
 impl Session {
     /// The session of `scenario`'s validated controller and mission, paced by `pacing`.
-    /// Refuses a thruster geometry the link cannot carry.
+    /// Refuses a thruster geometry the link cannot carry, and the state estimator, which the
+    /// board does not run.
     pub(super) fn new(scenario: &Scenario, pacing: Pacing) -> Result<Self, Error> {
         let c = scenario.controller().config();
+        if c.estimator.kind != EstimatorKind::Off {
+            return Err(Error::Estimator);
+        }
         // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
         let mounting = c.geometry.auv150_reversed().ok_or(Error::Geometry)?;
         let thrust_unit = ThrustUnit::from(c.thrust_unit);
