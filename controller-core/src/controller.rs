@@ -199,9 +199,9 @@ pub struct Controller {
     allocator: Allocator,
     maps: [ThrusterMap; THRUSTERS],
     cos_pitch_limit: f32,
-    /// The estimator's gains (`None`: off) and M̂⁻¹ for its model (Choice 340).
-    estimator: Option<EstimatorGains>,
-    m_hat_inv: Matrix6<f32>,
+    /// The estimator's gains and M̂⁻¹ for its model (Choice 340); `None`: off, and nothing of
+    /// it computed.
+    estimator: Option<(EstimatorGains, Matrix6<f32>)>,
 }
 
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
@@ -299,11 +299,10 @@ impl Controller {
         };
 
         let m_hat = model::mass_matrix(&config.params);
-        let (estimator, m_hat_inv) = estimator_parts(&config, &m_hat)?;
+        let estimator = estimator_parts(&config, &m_hat)?;
 
         Ok(Controller {
             estimator,
-            m_hat_inv,
             m_hat,
             k1: Vector6::from(config.k1),
             k2: Vector6::from(config.k2),
@@ -400,10 +399,11 @@ impl Controller {
         solution: &Solution,
         trajectory: &Trajectory,
     ) -> Output {
-        let Some(gains) = &self.estimator else {
+        let Some((gains, m_hat_inv)) = &self.estimator else {
             return self.update(ticks, &solution.eta, &solution.nu, trajectory);
         };
-        let (out, accel) = match self.estimated_step(memory, gains, ticks, solution, trajectory) {
+        let step = self.estimated_step(memory, gains, m_hat_inv, ticks, solution, trajectory);
+        let (out, accel) = match step {
             Ok((out, a)) if out.all_finite() => (out, a),
             Ok(_) => (Output::fail_safe(Fault::NonFiniteResult), [0.0; 6]),
             Err(fault) => (Output::fail_safe(fault), [0.0; 6]),
@@ -418,6 +418,7 @@ impl Controller {
         &self,
         memory: &mut Estimate,
         gains: &EstimatorGains,
+        m_hat_inv: &Matrix6<f32>,
         ticks: u64,
         solution: &Solution,
         trajectory: &Trajectory,
@@ -439,13 +440,8 @@ impl Controller {
         let law = self.law_stage(&kin, &desired, trajectory)?;
         let alloc = self.allocation_stage(&law.tau);
         let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
-        let accel = estimator::applied_acceleration(
-            &law.u,
-            &kin.kin,
-            &self.m_hat_inv,
-            &law.tau,
-            &tau_achieved,
-        );
+        let accel =
+            estimator::applied_acceleration(&law.u, &kin.kin, m_hat_inv, &law.tau, &tau_achieved);
         let out = Output {
             status: Status::Ok,
             tau: law.tau.into(),
@@ -717,21 +713,21 @@ pub struct StepLaw {
     pub e1: Vector6<f32>,
 }
 
-/// The estimator's gains (`None` when it is off) and M̂⁻¹ for its model (Choice 340).
+/// The estimator's gains and M̂⁻¹ for its model (Choice 340); `None` when it is off.
 fn estimator_parts(
     config: &ControllerConfig,
     m_hat: &Matrix6<f32>,
-) -> Result<(Option<EstimatorGains>, Matrix6<f32>), ConfigError> {
-    let gains = match config.estimator.kind {
-        EstimatorKind::Off => None,
-        EstimatorKind::Kalman => Some(
-            EstimatorGains::new(&config.estimator, config.rate_hz)
-                .map_err(|axis| ConfigError::EstimatorGain { axis })?,
-        ),
-    };
-    // M̂ is positive definite (checked over the box): its inverse exists.
-    let m_hat_inv = m_hat.try_inverse().ok_or(ConfigError::NonFiniteParams)?;
-    Ok((gains, m_hat_inv))
+) -> Result<Option<(EstimatorGains, Matrix6<f32>)>, ConfigError> {
+    match config.estimator.kind {
+        EstimatorKind::Off => Ok(None),
+        EstimatorKind::Kalman => {
+            let gains = EstimatorGains::new(&config.estimator, config.rate_hz)
+                .map_err(|axis| ConfigError::EstimatorGain { axis })?;
+            // M̂ is positive definite (checked over the box): its inverse exists.
+            let m_hat_inv = m_hat.try_inverse().ok_or(ConfigError::NonFiniteParams)?;
+            Ok(Some((gains, m_hat_inv)))
+        }
+    }
 }
 
 /// Assumption 2 (Eq 20: β̂ < 1 and β̂ ≤ the configured β) and Theorem 2 (Eq 25) over the box.
