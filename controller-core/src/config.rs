@@ -165,6 +165,9 @@ pub enum ConfigError {
     },
     /// The estimator's Riccati equation has no steady state on `axis` at this rate.
     EstimatorGain { axis: usize },
+    /// The estimator is on, and this build of the core has no estimator (feature `estimator`:
+    /// the firmware's does not).
+    EstimatorNotBuilt,
 }
 
 /// The [`ControllerConfig`] field a [`ConfigError`] is about: `name` is the field's name,
@@ -199,6 +202,7 @@ impl ConfigError {
             ConfigError::Allocation(_) => ("geometry", None),
             ConfigError::EstimatorSigma { name, axis, .. } => (name, Some(axis)),
             ConfigError::EstimatorGain { axis } => ("estimator_accel_sigma", Some(axis)),
+            ConfigError::EstimatorNotBuilt => ("estimator", None),
             ConfigError::Assumption2 { .. }
             | ConfigError::Theorem2 { .. }
             | ConfigError::LoopRate { .. } => return None,
@@ -293,9 +297,9 @@ impl fmt::Display for ConfigError {
                 Readable(max_period)
             ),
             ConfigError::Allocation(e) => write!(f, "thruster allocation: {e}"),
-            ConfigError::EstimatorSigma { .. } | ConfigError::EstimatorGain { .. } => {
-                self.fmt_estimator(f)
-            }
+            ConfigError::EstimatorSigma { .. }
+            | ConfigError::EstimatorGain { .. }
+            | ConfigError::EstimatorNotBuilt => self.fmt_estimator(f),
         }
     }
 }
@@ -312,6 +316,10 @@ impl ConfigError {
             ConfigError::EstimatorGain { axis } => write!(
                 f,
                 "the estimator's Riccati equation has no steady state on axis {axis} with these noise settings"
+            ),
+            ConfigError::EstimatorNotBuilt => write!(
+                f,
+                "estimator is on, and this build of the controller has no estimator (feature `estimator`)"
             ),
             _ => Ok(()),
         }

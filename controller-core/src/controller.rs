@@ -199,9 +199,9 @@ pub struct Controller {
     allocator: Allocator,
     maps: [ThrusterMap; THRUSTERS],
     cos_pitch_limit: f32,
-    /// The estimator's gains and M̂⁻¹ for its model (Choice 340); `None`: off, and nothing of
-    /// it computed.
-    estimator: Option<(EstimatorGains, Matrix6<f32>)>,
+    /// The estimator's gains and 1/M̂ᵢᵢ for its model (Choice 340); `None`: off, and nothing
+    /// of it computed.
+    estimator: Option<(EstimatorGains, [f32; 6])>,
 }
 
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
@@ -399,10 +399,10 @@ impl Controller {
         solution: &Solution,
         trajectory: &Trajectory,
     ) -> Output {
-        let Some((gains, m_hat_inv)) = &self.estimator else {
+        let Some((gains, m_diag_inv)) = &self.estimator else {
             return self.update(ticks, &solution.eta, &solution.nu, trajectory);
         };
-        let step = self.estimated_step(memory, gains, m_hat_inv, ticks, solution, trajectory);
+        let step = self.estimated_step(memory, gains, m_diag_inv, ticks, solution, trajectory);
         let (out, accel) = match step {
             Ok((out, a)) if out.all_finite() => (out, a),
             Ok(_) => (Output::fail_safe(Fault::NonFiniteResult), [0.0; 6]),
@@ -418,7 +418,7 @@ impl Controller {
         &self,
         memory: &mut Estimate,
         gains: &EstimatorGains,
-        m_hat_inv: &Matrix6<f32>,
+        m_diag_inv: &[f32; 6],
         ticks: u64,
         solution: &Solution,
         trajectory: &Trajectory,
@@ -441,7 +441,7 @@ impl Controller {
         let alloc = self.allocation_stage(&law.tau);
         let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
         let accel =
-            estimator::applied_acceleration(&law.u, &kin.kin, m_hat_inv, &law.tau, &tau_achieved);
+            estimator::applied_acceleration(&law.u, &kin.kin, m_diag_inv, &law.tau, &tau_achieved);
         let out = Output {
             status: Status::Ok,
             tau: law.tau.into(),
@@ -713,19 +713,25 @@ pub struct StepLaw {
     pub e1: Vector6<f32>,
 }
 
-/// The estimator's gains and M̂⁻¹ for its model (Choice 340); `None` when it is off.
+/// The estimator's gains and 1/M̂ᵢᵢ for its model (Choice 340); `None` when it is off.
 fn estimator_parts(
     config: &ControllerConfig,
     m_hat: &Matrix6<f32>,
-) -> Result<Option<(EstimatorGains, Matrix6<f32>)>, ConfigError> {
+) -> Result<Option<(EstimatorGains, [f32; 6])>, ConfigError> {
     match config.estimator.kind {
         EstimatorKind::Off => Ok(None),
+        #[cfg(not(feature = "estimator"))]
+        EstimatorKind::Kalman => {
+            let _ = m_hat;
+            Err(ConfigError::EstimatorNotBuilt)
+        }
+        #[cfg(feature = "estimator")]
         EstimatorKind::Kalman => {
             let gains = EstimatorGains::new(&config.estimator, config.rate_hz)
                 .map_err(|axis| ConfigError::EstimatorGain { axis })?;
-            // M̂ is positive definite (checked over the box): its inverse exists.
-            let m_hat_inv = m_hat.try_inverse().ok_or(ConfigError::NonFiniteParams)?;
-            Ok(Some((gains, m_hat_inv)))
+            // M̂ is positive definite (checked over the box): its diagonal is > 0.
+            let m_diag_inv = core::array::from_fn(|i| 1.0 / m_hat[(i, i)]);
+            Ok(Some((gains, m_diag_inv)))
         }
     }
 }

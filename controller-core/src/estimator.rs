@@ -22,7 +22,7 @@
 //! than [`HORIZON`] periods, not newer than the last one taken, stamped in the future, or not
 //! finite is refused: the state is held and predicted, never corrected by it.
 
-use nalgebra::{Matrix2, Vector2, Vector6};
+use nalgebra::{Matrix2, Vector6};
 
 use crate::axes::YAW;
 use crate::kinematics::Kinematics;
@@ -110,38 +110,100 @@ pub fn steady_state_gain(
     accel_sigma: f32,
 ) -> Result<AxisGain, NoSteadyState> {
     let t = period;
-    let g = Vector2::new(0.5 * t * t, t);
-    let q = g * g.transpose() * (accel_sigma * accel_sigma);
-    let r = Matrix2::new(
+    let (g0, g1) = (0.5 * t * t, t);
+    let qa = accel_sigma * accel_sigma;
+    let q = M2([[qa * g0 * g0, qa * g0 * g1], [qa * g1 * g0, qa * g1 * g1]]);
+    let (rp, rv) = (
         position_sigma * position_sigma,
-        0.0,
-        0.0,
         velocity_sigma * velocity_sigma,
     );
-    let r_inv = r.try_inverse().ok_or(NoSteadyState)?;
-    let mut a = Matrix2::new(1.0, 0.0, t, 1.0); // Fᵀ
-    let mut gk = r_inv;
+    let r = M2([[rp, 0.0], [0.0, rv]]);
+    let mut a = M2([[1.0, 0.0], [t, 1.0]]); // Fᵀ
+    let mut gk = r.inverse().ok_or(NoSteadyState)?;
     let mut h = q;
     for _ in 0..DOUBLING_STEPS {
-        let w_inv = (Matrix2::identity() + gk * h)
-            .try_inverse()
+        let w_inv = M2::IDENTITY
+            .add(&gk.mul(&h))
+            .inverse()
             .ok_or(NoSteadyState)?;
-        let a_w = a * w_inv;
-        let a_next = a_w * a;
-        let g_next = gk + a_w * gk * a.transpose();
-        let h_next = h + a.transpose() * h * w_inv * a;
+        let a_w = a.mul(&w_inv);
+        let a_next = a_w.mul(&a);
+        let g_next = gk.add(&a_w.mul(&gk).mul(&a.transpose()));
+        let h_next = h.add(&a.transpose().mul(&h).mul(&w_inv).mul(&a));
         a = a_next;
         gk = g_next;
         h = h_next;
     }
     // Symmetric by construction; average the rounding away.
-    let p = (h + h.transpose()) * 0.5;
-    let k = p * (p + r).try_inverse().ok_or(NoSteadyState)?;
-    let positive = p[(0, 0)] > 0.0 && p.determinant() > 0.0;
-    if positive && k.iter().chain(p.iter()).all(|x| x.is_finite()) {
-        Ok(AxisGain { k, p_prior: p })
+    let p = h.add(&h.transpose()).scale(0.5);
+    let k = p.mul(&p.add(&r).inverse().ok_or(NoSteadyState)?);
+    let positive = p.0[0][0] > 0.0 && p.det() > 0.0;
+    let finite =
+        k.0.iter()
+            .chain(p.0.iter())
+            .flatten()
+            .all(|x| x.is_finite());
+    if positive && finite {
+        Ok(AxisGain {
+            k: k.matrix(),
+            p_prior: p.matrix(),
+        })
     } else {
         Err(NoSteadyState)
+    }
+}
+
+/// A 2×2 matrix by rows, with the few operations the doubling algorithm needs (written out:
+/// the generic ones cost the board's flash more than the budget allows).
+#[derive(Clone, Copy)]
+struct M2([[f32; 2]; 2]);
+
+impl M2 {
+    const IDENTITY: M2 = M2([[1.0, 0.0], [0.0, 1.0]]);
+
+    fn mul(&self, b: &M2) -> M2 {
+        let (a, b) = (&self.0, &b.0);
+        M2(core::array::from_fn(|i| {
+            core::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j])
+        }))
+    }
+
+    fn add(&self, b: &M2) -> M2 {
+        M2(core::array::from_fn(|i| {
+            core::array::from_fn(|j| self.0[i][j] + b.0[i][j])
+        }))
+    }
+
+    fn scale(&self, s: f32) -> M2 {
+        M2(self.0.map(|row| row.map(|x| x * s)))
+    }
+
+    fn transpose(&self) -> M2 {
+        let a = &self.0;
+        M2([[a[0][0], a[1][0]], [a[0][1], a[1][1]]])
+    }
+
+    fn det(&self) -> f32 {
+        let a = &self.0;
+        a[0][0] * a[1][1] - a[0][1] * a[1][0]
+    }
+
+    /// The inverse, if the determinant is finite and not zero.
+    fn inverse(&self) -> Option<M2> {
+        let d = self.det();
+        if d == 0.0 || !d.is_finite() {
+            return None;
+        }
+        let a = &self.0;
+        Some(M2([
+            [a[1][1] / d, -a[0][1] / d],
+            [-a[1][0] / d, a[0][0] / d],
+        ]))
+    }
+
+    fn matrix(&self) -> Matrix2<f32> {
+        let a = &self.0;
+        Matrix2::new(a[0][0], a[0][1], a[1][0], a[1][1])
     }
 }
 
@@ -174,14 +236,17 @@ impl EstimatorGains {
 /// The η-frame acceleration the nominal model gives for the thrust the board applied:
 /// η̈ = J ν̇ + J̇ ν with ν̇ = M̂⁻¹(τₐ − ĥ); the law chose τ so that the nominal η̈ is u, so
 /// η̈ = u − J M̂⁻¹(τ − τₐ) (τₐ the achieved wrench, B times the thrusts the voltages give).
+/// The shortfall τ − τₐ (zero unless the thrusters saturate) goes through M̂'s diagonal,
+/// `m_diag_inv` = 1/M̂ᵢᵢ: no 6×6 inverse in the flying image (Choice 340).
 pub fn applied_acceleration(
     u: &Vector6<f32>,
     kin: &Kinematics<f32>,
-    m_hat_inv: &nalgebra::Matrix6<f32>,
+    m_diag_inv: &[f32; 6],
     tau: &Vector6<f32>,
     tau_achieved: &Vector6<f32>,
 ) -> Vector6<f32> {
-    u - kin.eta_dot(&(m_hat_inv * (tau - tau_achieved)))
+    let shortfall = Vector6::from_fn(|i, _| m_diag_inv[i] * (tau[i] - tau_achieved[i]));
+    u - kin.eta_dot(&shortfall)
 }
 
 /// The board's estimator memory: the filter's state at its stamp and the accelerations
