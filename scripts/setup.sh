@@ -8,6 +8,8 @@
 #    deploy/slurm/campaign.sbatch: deploy/slurm/ci/run.sh); installed, not started (the
 #    packages' services are left stopped; run.sh starts its own daemons and stops them)
 #  - cargo: defmt-print (decodes the firmware's defmt log)
+#  - pip: mcap (the official MCAP reader the flight-log tests read host-sim's logs with:
+#    host-sim/tests/flight_log.rs, docs/logs.md)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -18,7 +20,7 @@ rustup target add thumbv7em-none-eabihf >/dev/null 2>&1
 SUDO=""
 [ "$(id -u)" -ne 0 ] && SUDO="sudo"
 need=()
-for pkg in libfontconfig1-dev fonts-dejavu-core slurm-wlm munge; do
+for pkg in libfontconfig1-dev fonts-dejavu-core slurm-wlm munge python3-pip; do
   dpkg -s "$pkg" >/dev/null 2>&1 || need+=("$pkg")
 done
 if ! command -v qemu-system-arm >/dev/null || ! qemu-system-arm -machine help | grep -q mps2-an386; then
@@ -36,4 +38,7 @@ if [ "${#need[@]}" -gt 0 ] || [ "${qemu:-0}" = 1 ]; then
   [ "${qemu:-0}" = 1 ] && DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq -t bookworm-backports qemu-system-arm
 fi
 command -v defmt-print >/dev/null || cargo install defmt-print --locked
+# Debian's python3 refuses a system-wide pip install (PEP 668) unless told to.
+python3 -c 'import mcap' 2>/dev/null || python3 -m pip install --quiet mcap 2>/dev/null \
+  || python3 -m pip install --quiet --break-system-packages mcap
 echo "setup: $(qemu-system-arm --version | head -1); $(defmt-print --version 2>/dev/null | head -1)"

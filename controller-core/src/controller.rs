@@ -30,6 +30,11 @@ pub const MAX_ANGLE: f32 = 1_000.0;
 pub const MAX_LINEAR_SPEED: f32 = 50.0;
 /// Largest |angular velocity| accepted (rad/s).
 pub const MAX_ANGULAR_RATE: f32 = 50.0;
+// Choice 310: a waypoint corner flown at any path speed turns the heading at most at
+// MAX_SPEED/MIN_TURN_RADIUS (|ψ′| ≤ 1/R, `Route::peak_heading_rate`), inside the rate accepted
+// above, so no corner can put the law in fail-safe.
+const _: () =
+    assert!(crate::trajectory::MAX_SPEED / crate::trajectory::MIN_TURN_RADIUS <= MAX_ANGULAR_RATE);
 
 /// Why the output is the fail-safe one.
 ///

@@ -229,7 +229,9 @@ const MOUNTING_BITS: u8 = (1 << THRUSTERS) - 1;
 /// heading (protocol 3) have their own reasons, any other parameter is an invalid mission.
 pub fn mission_refusal(e: &TrajectoryError) -> Refusal {
     match e {
-        TrajectoryError::TooSlowForTangent { .. } => Refusal::TangentTooSlow,
+        TrajectoryError::TooSlowForTangent { .. } | TrajectoryError::WaypointTooSlow { .. } => {
+            Refusal::TangentTooSlow
+        }
         e if e.parameter() == "time_scale" => Refusal::InvalidTimeScale,
         _ => Refusal::InvalidMission,
     }

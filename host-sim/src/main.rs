@@ -3,14 +3,14 @@
 //! maps the outcome to the exit code; the commands are [`host_sim::cli`]'s, which documents
 //! the codes (0 done, 1 a run diverged or lost its board, or PIL ≠ SIL, or `check` found the
 //! mission infeasible, 2 bad input, I/O error or an incomplete output, 3 an unexpected
-//! controller fault, 4 a run missed its bound, 130 interrupted).
+//! controller fault, 4 a run missed its bound or `diff`'s flights differ, 130 interrupted).
 
 use std::process::ExitCode;
 
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
-    self, CampaignArgs, CheckArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs, RunArgs,
-    Table1Args, ValidateArgs,
+    self, CampaignArgs, CheckArgs, DiffArgs, HilArgs, ImportPlanArgs, MonteCarloArgs, PilArgs,
+    RunArgs, Table1Args, ValidateArgs,
 };
 
 #[derive(Parser)]
@@ -29,6 +29,9 @@ enum Command {
     /// The paper's six Table-1 missions with and without Δu, side by side with the paper.
     Table1(Table1Args),
     /// One scenario from a TOML file (and its companion without Δu, for comparison).
+    ///
+    /// The exit code follows the run of the controller the scenario configures; the companion
+    /// without Δu is reported beside it (table, report, JSON), never as the verdict.
     Run(RunArgs),
     /// Processor in the loop: the firmware ELF in QEMU flies the simulated vehicle over a
     /// loopback socket, lock-stepped; compared with SIL. Link faults by tick range (A..B).
@@ -53,10 +56,16 @@ enum Command {
     /// one report whose worst cases replay bit for bit.
     Campaign(CampaignArgs),
     /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
-    /// frame of the plan's home position. Exit 2 if the file is not a plan of waypoints, or on a
-    /// flag the scenario would refuse (`--speed` outside (0, 10] m/s, a `--name` that is not
-    /// a file name).
+    /// frame of the plan's home position, each altitude in its item's frame. Exit 2 if the file
+    /// is not a plan of waypoints, on what the scenario would refuse (named by plan item:
+    /// `mission.items[i]`), or on a flag it would refuse (`--speed` outside (0, 10] m/s, a
+    /// `--name` that is not a file name); a warning when the flat earth misplaces a waypoint by
+    /// more than the 0.05 m path bound.
     ImportPlan(ImportPlanArgs),
+    /// Two flights (MCAP logs or runs' CSVs) compared series by series: the first time they
+    /// diverge beyond the tolerance and where, the largest difference of each series, a plot
+    /// of those that differ most. Exit 0 the same, 4 they differ, 2 bad input.
+    Diff(DiffArgs),
 }
 
 fn main() -> ExitCode {
@@ -69,7 +78,17 @@ fn main() -> ExitCode {
     if let Err(e) = host_sim::interrupt::install() {
         eprintln!("host-sim: warning: no Ctrl-C handler ({e}): an interrupt loses the run");
     }
-    let command = Cli::parse()
+    let cli = Cli::try_parse().unwrap_or_else(|e| {
+        // `check --json` prints one JSON object on every exit, a refused command line included.
+        if e.use_stderr() {
+            let args: Vec<_> = std::env::args_os().collect();
+            if let Some(json) = cli::usage_error_json(&args, &e.to_string()) {
+                println!("{json}");
+            }
+        }
+        e.exit()
+    });
+    let command = cli
         .command
         .unwrap_or_else(|| Command::Table1(Table1Args::default()));
     let stdout = &mut std::io::stdout().lock();
@@ -83,6 +102,7 @@ fn main() -> ExitCode {
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
         Command::Campaign(args) => cli::campaign(&args, stdout),
         Command::ImportPlan(args) => cli::import_plan(&args, stdout),
+        Command::Diff(args) => cli::diff(&args, stdout),
     };
     match result {
         Ok(exit) => ExitCode::from(exit.code()),

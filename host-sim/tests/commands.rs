@@ -193,6 +193,78 @@ fn a_run_outside_its_bound_is_missed_with_its_reason_and_exits_4_unless_expected
     assert!(v["cases"][0].get("missed").is_none(), "{v}");
 }
 
+/// The shipped campaign's white `[noise]` (5 mm, 1 mrad; 2 mm/s, 0.5 mrad/s).
+const CAMPAIGN_NOISE: &str = "[noise]\neta_sigma = [0.005, 0.005, 0.005, 0.001, 0.001, 0.001]\n\
+     nu_sigma = [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005]\n";
+
+/// Issue 28: on a noisy navigation solution the law reversed thrusters tens of times a second
+/// while the path error stayed millimetres, and the run said `completed`, exit 0. Now such a
+/// run is `missed`, naming the thruster and the figure, exit 4; its chatter is in the JSON
+/// (the worst thruster's and each one's), the printed table, the report and a plot; the same
+/// run within a looser chatter bound completes, and without noise it is within the default.
+#[test]
+fn a_noisy_mission_that_chatters_is_missed_naming_the_thruster_and_exits_4() {
+    let dir = tempdir("chatter");
+    let noisy = format!("name = \"noisy\"\n{REAL_CIRCLE}{CAMPAIGN_NOISE}");
+    let s = scenario(&dir, "noisy", &noisy);
+    let o = run(&["--json"], &s, &dir.join("out"));
+    assert_eq!(o.status.code(), Some(4), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    let with = &v["cases"][0];
+    // The path is fine: the miss is the chatter's alone.
+    assert!(with["max_path"].as_f64().unwrap() < 0.05, "{with}");
+    let reason = with["missed"].as_str().unwrap();
+    assert!(!reason.contains("max path error"), "{reason}");
+    assert!(
+        reason.contains("reverses") && reason.contains("times/s through ±0.5 V > 2 /s"),
+        "{reason}"
+    );
+    assert!(
+        reason.contains("V/s > 100 V/s (total variation)"),
+        "{reason}"
+    );
+    // Every thruster named in the reason is one whose own figure is beyond the limit, and the
+    // worst-thruster metric is the largest of the five.
+    let chatter = with["chatter"].as_object().unwrap();
+    assert_eq!(chatter.len(), 5, "{with}");
+    let mut worst = 0.0f64;
+    for (name, c) in chatter {
+        let r = c["reversals_per_s"].as_f64().unwrap();
+        worst = worst.max(r);
+        let named = reason.contains(&format!("thruster {name} reverses"));
+        assert_eq!(named, r > 2.0, "{name}: {r} /s; {reason}");
+    }
+    assert_eq!(with["reversals_per_s"].as_f64(), Some(worst));
+    assert!(worst > 10.0, "{with}");
+    // The text table, the report and the zoomed plot show it.
+    let o = run(&[], &s, &dir.join("out-text"));
+    assert_eq!(o.status.code(), Some(4));
+    let table = String::from_utf8_lossy(&o.stdout);
+    assert!(table.contains("sign reversals/s through ±0.5 V"), "{table}");
+    let report = std::fs::read_to_string(dir.join("out-text/report.md")).unwrap();
+    assert!(
+        report.contains("## Thruster commands") && report.contains("noisy-commands.png"),
+        "{report}"
+    );
+    assert!(dir.join("out-text/noisy-commands.png").is_file());
+    // A bound that allows it: completed, exit 0.
+    let loose = format!(
+        "{noisy}[bound]\nmax_reversals_per_s = 60\nmax_command_tv = 5000\nsaturated = 0.5\n"
+    );
+    let s = scenario(&dir, "loose", &loose);
+    let o = run(&["--json"], &s, &dir.join("out-loose"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    // Without noise, the real circle is within the default chatter bound.
+    let s = scenario(&dir, "quiet", &format!("name = \"quiet\"\n{REAL_CIRCLE}"));
+    let o = run(&["--json"], &s, &dir.join("out-quiet"));
+    assert_eq!(o.status.code(), Some(0), "{}", stderr(&o));
+    let v: serde_json::Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert!(
+        v["cases"][0]["reversals_per_s"].as_f64().unwrap() <= 2.0,
+        "{v}"
+    );
+}
+
 /// A saturated-fraction bound is a fraction; a path bound is a length: each refused out of
 /// range, naming its key.
 #[test]
@@ -203,6 +275,8 @@ fn a_bound_out_of_range_is_refused_naming_its_key() {
         ("max_path = -1", "bound.max_path"),
         ("saturated = 1.5", "bound.saturated"),
         ("saturated = -0.1", "bound.saturated"),
+        ("max_reversals_per_s = -1", "bound.max_reversals_per_s"),
+        ("max_command_tv = nan", "bound.max_command_tv"),
         ("within = 1", "within"),
     ] {
         let s = scenario(&dir, "b", &format!("{REAL_CIRCLE}[bound]\n{bound}\n"));

@@ -41,6 +41,7 @@ fn sample(k: u64) -> Sample {
         w_norm: 0.0,
         payload: 30.0 * w(0.1, 0.0).abs(),
         status: ControlStatus::Law(controller_core::Status::Ok),
+        signals: Default::default(),
     };
     if k % 40_009 == 17 {
         s.error[2] = 1e3; // a spike one period long

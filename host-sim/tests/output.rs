@@ -84,6 +84,7 @@ fn synthetic(name: &str, robust: bool, n: usize, gain: f64) -> RunResult {
                     23 => ControlStatus::Board(BoardStatus::Running),
                     _ => ControlStatus::Law(Status::Ok),
                 },
+                signals: Default::default(),
             }
         })
         .collect();
@@ -103,10 +104,21 @@ fn synthetic(name: &str, robust: bool, n: usize, gain: f64) -> RunResult {
             max_yaw: 0.03 * gain,
             peak_voltage: 24.0,
             saturated_fraction: 0.25,
+            reversals_per_s: 0.5,
+            command_tv: 12.0,
+            hf_share: 0.05,
+            chatter: host_sim::sim::chatter::Chatter(
+                [host_sim::sim::chatter::ThrusterChatter {
+                    reversals_per_s: 0.5,
+                    command_tv: 12.0,
+                    hf_share: 0.05,
+                }; 5],
+            ),
         },
         faults: Default::default(),
         faults_expected: false,
         miss_expected: false,
+        path: None,
         samples,
         plant_factorisations: 0,
     }

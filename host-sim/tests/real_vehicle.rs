@@ -455,6 +455,86 @@ fn check_exits_0_feasible_1_infeasible_2_bad_input() {
     assert_eq!(o.status.code(), Some(2));
 }
 
+/// `check --json` printed nothing when it exited 2: now stdout is exactly one JSON object
+/// on every exit 2 as well, `{"error": {"kind", "message", "key"?}}`, the kind from a closed
+/// set (a command line the parser refuses, a flag out of range, a scenario unreadable, not
+/// TOML, or a value out of range with its key).
+#[test]
+fn check_json_prints_one_error_object_on_exit_2() {
+    let dir = std::env::temp_dir().join(format!("host-sim-check-err-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let bad_value = dir.join("bad-value.toml");
+    std::fs::write(
+        &bad_value,
+        "name = \"x\"\n[trajectory]\nkind = \"circle\"\nradius = -1\n",
+    )
+    .unwrap();
+    let bad_toml = dir.join("bad-toml.toml");
+    std::fs::write(
+        &bad_toml,
+        "name = \"x\"\n[trajectory]\nkindd = \"circle\"\n",
+    )
+    .unwrap();
+    let feasible = real_file("circular-10R");
+    let cases: [(Vec<&str>, &str, Option<&str>); 5] = [
+        (
+            vec!["--margin", "abc", "--scenario", feasible.to_str().unwrap()],
+            "usage",
+            None,
+        ),
+        (
+            vec!["--margin", "1.5", "--scenario", feasible.to_str().unwrap()],
+            "flag",
+            None,
+        ),
+        (
+            vec!["--scenario", "/nonexistent/x.toml"],
+            "scenario-unreadable",
+            None,
+        ),
+        (
+            vec!["--scenario", bad_toml.to_str().unwrap()],
+            "scenario-syntax",
+            None,
+        ),
+        (
+            vec!["--scenario", bad_value.to_str().unwrap()],
+            "scenario-value",
+            Some("trajectory.radius"),
+        ),
+    ];
+    for (args, kind, key) in cases {
+        let o = host_sim()
+            .args(["check", "--json"])
+            .args(&args)
+            .output()
+            .unwrap();
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{args:?}: {err}");
+        let text = String::from_utf8(o.stdout).unwrap();
+        let mut objects =
+            serde_json::Deserializer::from_str(&text).into_iter::<serde_json::Value>();
+        let v = objects
+            .next()
+            .unwrap_or_else(|| panic!("{args:?}: nothing on stdout"))
+            .unwrap();
+        assert!(
+            objects.next().is_none(),
+            "{args:?}: more than one object: {text}"
+        );
+        assert_eq!(v["error"]["kind"], kind, "{args:?}: {v}");
+        assert!(
+            v["error"]["message"]
+                .as_str()
+                .is_some_and(|m| !m.is_empty()),
+            "{v}"
+        );
+        assert_eq!(v["error"]["key"].as_str(), key, "{args:?}: {v}");
+        assert!(!err.is_empty(), "{args:?}: stderr still says it");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 /// The static heel is where g(η)'s roll moment (controller-core's `model::restoring`, Eq 1)
 /// vanishes and restores: zero there, of opposite signs either side; the Table-3 corner,
 /// trimmed, heels the vehicle by atan(y_G W / k₄) = 0.2485 rad.

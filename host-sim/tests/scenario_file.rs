@@ -14,6 +14,7 @@ use host_sim::scenario::file::{
     EstimatorName, HeadingName, LawName, LinkFaultsTable, NoiseTable, ProfileName, StepTable,
     ThrustUnitName, TrajectoryTable, VariationTable,
 };
+use host_sim::scenario::navigation::{self, ErrorModel, NavigationModel, Preset, Source};
 use host_sim::scenario::{
     load_config, load_scenario, paper, parse_scenario, KeyPath, ScenarioError, ScenarioFile,
     SimConfig,
@@ -169,6 +170,15 @@ fn every_key(path: TrajectoryKind) -> ScenarioFile {
             nu_sigma: Some([0.0; 6]),
             seed: Some(1),
         }),
+        navigation: Some({
+            let mut m = NavigationModel::preset(Preset::Survey, 1).unwrap();
+            m.dvl.seabed_depth = Some(30.0);
+            m.fix = Some(m.depth.clone()).map(|d| Source {
+                timing: d.timing,
+                error: ErrorModel::EXACT,
+            });
+            navigation::table(&m)
+        }),
         controller: Some(ControllerTable {
             robust: Some(true),
             law: Some(LawName::Discontinuous),
@@ -193,6 +203,8 @@ fn every_key(path: TrajectoryKind) -> ScenarioFile {
         bound: Some(BoundTable {
             max_path: Some(1.0),
             saturated: Some(1.0),
+            max_reversals_per_s: Some(3.0),
+            max_command_tv: Some(50.0),
         }),
         link_faults: Some(LinkFaultsTable {
             drop: Some(vec![]),

@@ -130,6 +130,111 @@ fn monte_carlo_bounds_its_runs_estimates_their_time_and_writes_a_partial_report_
     assert!(stderr(&o).contains("--allow-long-run"), "{}", stderr(&o));
 }
 
+/// Waits for `child` at most `limit`; kills it and panics (naming `what`) if it is still running.
+fn wait_at_most(
+    mut child: std::process::Child,
+    limit: std::time::Duration,
+    what: &str,
+) -> std::process::Output {
+    let t0 = std::time::Instant::now();
+    while child.try_wait().unwrap().is_none() {
+        if t0.elapsed() > limit {
+            let _ = child.kill();
+            let _ = child.wait();
+            panic!("{what}: still running after {limit:?}");
+        }
+        std::thread::sleep(std::time::Duration::from_millis(50));
+    }
+    child.wait_with_output().unwrap()
+}
+
+/// `validate-preflight --random N` had no cap and made every mission before flying the first,
+/// not looking at the interrupt (`--random 20000` was still making missions 40 s after
+/// SIGINT): beyond `monte-carlo`'s cap it is refused before anything is made, and with
+/// `--allow-long-run` the missions are made as they are flown, so the first SIGINT acts within
+/// seconds and the partial report is written. The limits are generous for a loaded machine.
+#[test]
+fn validate_preflight_bounds_its_random_missions_and_acts_on_ctrl_c_while_making_them() {
+    let dir = tempdir("validate-random");
+    let spawn = |extra: &[&str], out: &str| {
+        host_sim()
+            .args([
+                "validate-preflight",
+                "--mountings",
+                "team",
+                "--random",
+                "20000",
+            ])
+            .args(extra)
+            .arg("--out")
+            .arg(dir.join(out))
+            .stdout(Stdio::piped())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    let limit = std::time::Duration::from_secs(20);
+    let o = wait_at_most(spawn(&[], "capped"), limit, "--random 20000");
+    assert_eq!(o.status.code(), Some(2), "{}", stderr(&o));
+    assert!(
+        stderr(&o).contains("--random 20000") && stderr(&o).contains("--allow-long-run"),
+        "{}",
+        stderr(&o)
+    );
+    let child = spawn(&["--allow-long-run", "--json"], "long");
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    signal(child.id(), libc::SIGINT);
+    let o = wait_at_most(child, limit, "--random 20000 --allow-long-run after SIGINT");
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let report = std::fs::read_to_string(dir.join("long/report.md")).unwrap();
+    assert!(report.contains("PARTIAL"), "{report}");
+}
+
+/// `check --json` printed nothing when interrupted (exit 130): stdout is exactly one JSON
+/// object, `"interrupted": true` with the verdict when it was made (a waypoint mission
+/// interrupted in its speed profile's search) and without one when it was not (a day-long
+/// circle interrupted in the check itself).
+#[test]
+fn check_json_prints_the_verdict_so_far_when_interrupted() {
+    let one_object = |stdout: &str| -> serde_json::Value {
+        let mut objects =
+            serde_json::Deserializer::from_str(stdout).into_iter::<serde_json::Value>();
+        let v = objects.next().expect("an object on stdout").unwrap();
+        assert!(objects.next().is_none(), "more than one object: {stdout}");
+        v
+    };
+    let pipeline =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/real/pipeline.toml");
+    let (code, stdout, lines) = interrupt_after(
+        &["check", "--json", "--scenario", pipeline.to_str().unwrap()],
+        "searching the speed profile",
+    );
+    assert_eq!(code, Some(130), "{lines:?}");
+    let v = one_object(&stdout);
+    assert_eq!(v["interrupted"], true, "{v}");
+    assert_eq!(v["verdict"], "feasible", "{v}");
+    assert!(
+        v["thrusters"].is_array() && v["speed_profile"].is_null(),
+        "{v}"
+    );
+
+    let dir = tempdir("check-int");
+    let s = scenario(&dir, "day", DAY);
+    let child = host_sim()
+        .args(["check", "--json", "--scenario"])
+        .arg(&s)
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    signal(child.id(), libc::SIGINT);
+    let o = wait_at_most(child, std::time::Duration::from_secs(20), "check of a day");
+    assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
+    let v = one_object(&String::from_utf8_lossy(&o.stdout));
+    assert_eq!(v, serde_json::json!({"interrupted": true}));
+}
+
 /// A day-long circle: its preflight alone is minutes of work (1.7·10⁶ samples × 2⁹ corners).
 const DAY: &str =
     "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n";

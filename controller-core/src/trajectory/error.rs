@@ -4,7 +4,9 @@
 use core::fmt;
 
 use crate::readable::Readable;
-use crate::trajectory::limits::{MAX_SLOPE, MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG};
+use crate::trajectory::limits::{
+    MAX_COORDINATE, MAX_SLOPE, MAX_SPEED, MAX_TURN_DEGREES, MAX_WAYPOINTS, MIN_LEG,
+};
 
 /// Why a [`TrajectoryKind`](crate::TrajectoryKind) was rejected by [`Trajectory::new`](crate::Trajectory::new).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -90,6 +92,151 @@ pub enum TrajectoryError {
         /// Its slope.
         slope: f32,
     },
+    /// A waypoint's coordinate that is NaN or infinite (Choice 315).
+    PointNotFinite {
+        /// The waypoint (0-based).
+        index: usize,
+        /// The coordinate: 0 x, 1 y, 2 z.
+        axis: usize,
+    },
+    /// A speed of the time law that is NaN or infinite (Choice 315).
+    SpeedNotFinite {
+        /// The part (2j: leg j, 2j − 1: the turn at waypoint j).
+        part: usize,
+    },
+    /// A waypoint's coordinate beyond ±[`MAX_COORDINATE`] (Choice 315).
+    BadPoint {
+        /// The waypoint (0-based).
+        index: usize,
+        /// The coordinate: 0 x, 1 y, 2 z.
+        axis: usize,
+        /// The rejected value.
+        value: f32,
+    },
+    /// A speed of the time law outside (0, [`MAX_SPEED`]] (Choice 315).
+    BadSpeed {
+        /// The part (2j: leg j, 2j − 1: the turn at waypoint j).
+        part: usize,
+        /// The rejected value.
+        value: f32,
+    },
+    /// A waypoint path whose horizontal speed falls below
+    /// [`Trajectory::MIN_TANGENT_SPEED`](crate::Trajectory::MIN_TANGENT_SPEED) somewhere: its
+    /// course (its heading, Choice 154) is undefined at zero speed (Choice 315).
+    WaypointTooSlow {
+        /// The path's minimum horizontal speed at its time scale (m/s).
+        min_speed: f32,
+        /// [`Trajectory::MIN_TANGENT_SPEED`](crate::Trajectory::MIN_TANGENT_SPEED).
+        threshold: f32,
+        /// The slowest part of its time law (`None`: flown at `speed`).
+        part: Option<usize>,
+    },
+}
+
+impl TrajectoryError {
+    /// The messages that name a waypoint or a part (Choice 315).
+    fn fmt_named(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            Self::PointNotFinite { index, axis } => write!(
+                f,
+                "waypoint {index}'s {} is not finite",
+                ["x", "y", "z"][axis.min(2)]
+            ),
+            Self::SpeedNotFinite { part } => {
+                write!(f, "speeds[{part}] ({}) is not finite", PartName(part))
+            }
+            Self::BadPoint { index, axis, value } => write!(
+                f,
+                "waypoint {index}'s {} = {} m is outside [{}, {}]",
+                ["x", "y", "z"][axis.min(2)],
+                Readable(value),
+                Readable(-MAX_COORDINATE),
+                Readable(MAX_COORDINATE)
+            ),
+            Self::BadSpeed { part, value } => write!(
+                f,
+                "speeds[{part}] ({}) = {} m/s is outside (0, {}]",
+                PartName(part),
+                Readable(value),
+                MAX_SPEED
+            ),
+            Self::WaypointTooSlow {
+                min_speed,
+                threshold,
+                part,
+            } => {
+                write!(
+                    f,
+                    "the path's course (its heading) needs a horizontal speed of at least {threshold} m/s everywhere; this path slows to {} m/s",
+                    Readable(min_speed)
+                )?;
+                match part {
+                    Some(p) => write!(f, " on speeds[{p}] ({}): raise it", PartName(p)),
+                    None => f.write_str(": raise speed or lower the time scale"),
+                }
+            }
+            _ => Ok(()),
+        }
+    }
+}
+
+impl TrajectoryError {
+    /// This refusal of a number read from a file as `written` (an f64 that an f32 cannot hold:
+    /// beyond ±3.4e38, or below 1.2e-38 and so read as 0), with the number as written
+    /// (Choice 315).
+    #[cfg(feature = "serde")]
+    pub(crate) fn narrowed(self, written: f64) -> NarrowedError {
+        NarrowedError {
+            error: self,
+            written,
+        }
+    }
+}
+
+/// A [`TrajectoryError`] about a number as written in a file ([`TrajectoryError::narrowed`]).
+#[cfg(feature = "serde")]
+pub(crate) struct NarrowedError {
+    error: TrajectoryError,
+    written: f64,
+}
+
+#[cfg(feature = "serde")]
+impl fmt::Display for NarrowedError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let w = Readable(self.written);
+        match self.error {
+            TrajectoryError::BadPoint { index, axis, .. } => write!(
+                f,
+                "waypoint {index}'s {} = {w} m is outside [{}, {}]",
+                ["x", "y", "z"][axis.min(2)],
+                Readable(-MAX_COORDINATE),
+                Readable(MAX_COORDINATE)
+            ),
+            TrajectoryError::BadSpeed { part, .. } => write!(
+                f,
+                "speeds[{part}] ({}) = {w} m/s is outside (0, {}]{}",
+                PartName(part),
+                MAX_SPEED,
+                match self.written.abs() < 1.0 {
+                    true => " (below the smallest f32, it would read as 0)",
+                    false => "",
+                }
+            ),
+            e => write!(f, "{e} (written {w})"),
+        }
+    }
+}
+
+/// `leg j` or `the turn at waypoint j` for part p (2j, 2j − 1).
+struct PartName(usize);
+
+impl fmt::Display for PartName {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.0 % 2 {
+            0 => write!(f, "leg {}", self.0 / 2),
+            _ => write!(f, "the turn at waypoint {}", self.0.div_ceil(2)),
+        }
+    }
 }
 
 impl TrajectoryError {
@@ -105,8 +252,15 @@ impl TrajectoryError {
             | Self::RepeatedWaypoint { .. }
             | Self::TurnTooSharp { .. }
             | Self::LegTooShort { .. }
-            | Self::TooSteep { .. } => "points",
-            Self::SpeedCount { .. } | Self::SpeedChangeTooLong { .. } => "speeds",
+            | Self::TooSteep { .. }
+            | Self::BadPoint { .. }
+            | Self::PointNotFinite { .. } => "points",
+            Self::SpeedCount { .. }
+            | Self::SpeedChangeTooLong { .. }
+            | Self::BadSpeed { .. }
+            | Self::SpeedNotFinite { .. } => "speeds",
+            Self::WaypointTooSlow { part: Some(_), .. } => "speeds",
+            Self::WaypointTooSlow { part: None, .. } => "speed",
         }
     }
 }
@@ -171,6 +325,11 @@ impl fmt::Display for TrajectoryError {
                 Readable(has),
                 Readable(needs)
             ),
+            Self::PointNotFinite { .. }
+            | Self::SpeedNotFinite { .. }
+            | Self::BadPoint { .. }
+            | Self::BadSpeed { .. }
+            | Self::WaypointTooSlow { .. } => self.fmt_named(f),
             Self::TooSteep { leg, slope } => write!(
                 f,
                 "leg {leg} (waypoints {leg} to {}) climbs or dives at slope {}, steeper than {} (the heading needs horizontal motion)",

@@ -26,7 +26,10 @@ pub const MAX_SPEED: f32 = 10.0;
 /// TURN_ACCEL (Choice 151): the paper's circle of 10 m at ω = 0.1 rad/s (Rω² = 0.1 m/s²), which
 /// the real vehicle flies within its bound.
 pub const TURN_ACCEL: f32 = 0.1;
-/// The smallest default turn radius (m).
+/// The smallest turn radius (m), default or configured (Choice 310, docs/missions.md#the-corner-radius):
+/// a blend is then at least 1 m long (its cut a ≥ R/2), so it lasts at least 0.1 s at the
+/// fastest path speed [`MAX_SPEED`] (10 control periods at 100 Hz), and it turns the tangent
+/// heading at most at speed/R ≤ 10 rad/s, inside the controller's input limit.
 pub const MIN_TURN_RADIUS: f32 = 1.0;
 /// `speed_change` when not given (m/s²): the largest |σ̈| of a change of speed.
 pub const DEFAULT_SPEED_CHANGE: f32 = 0.05;

@@ -242,9 +242,20 @@ impl Trajectory {
         if mission.heading == HeadingMode::Tangent
             && (self.min_speed.is_nan() || self.min_speed < Self::MIN_TANGENT_SPEED)
         {
-            return Err(TrajectoryError::TooSlowForTangent {
-                min_speed: self.min_speed,
-                threshold: Self::MIN_TANGENT_SPEED,
+            // A waypoint path's refusal names what sets its speed (Choice 315).
+            return Err(match mission.path {
+                TrajectoryKind::Waypoints { speeds, .. } => TrajectoryError::WaypointTooSlow {
+                    min_speed: self.min_speed,
+                    threshold: Self::MIN_TANGENT_SPEED,
+                    part: speeds.and_then(|s| {
+                        (0..s.as_slice().len())
+                            .min_by(|&a, &b| s.as_slice()[a].total_cmp(&s.as_slice()[b]))
+                    }),
+                },
+                _ => TrajectoryError::TooSlowForTangent {
+                    min_speed: self.min_speed,
+                    threshold: Self::MIN_TANGENT_SPEED,
+                },
             });
         }
         Ok(())

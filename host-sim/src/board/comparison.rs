@@ -28,6 +28,15 @@ impl Mode {
             Mode::Hil => "HIL",
         }
     }
+
+    /// `"pil"` or `"hil"`: the flight log's `source` of the board's run
+    /// ([`crate::output::log::Source`]).
+    pub fn source(self) -> &'static str {
+        match self {
+            Mode::Pil => "pil",
+            Mode::Hil => "hil",
+        }
+    }
 }
 
 /// One PIL run compared with SIL: an entry of `host-sim pil --json`'s `cases` (read it back

@@ -14,6 +14,7 @@ use super::json::{print_json, Cases};
 use super::Exit;
 use crate::board::{self, BoardComparison, BoardInTheLoop, Mode, Pacing};
 use crate::interrupt;
+use crate::output::log::{sil_log_name, McapLog};
 use crate::output::{self, atomic, sections, OutputDir, ReportRow};
 use crate::scenario::{paper, LinkFaults, Scenario, TickRange};
 use crate::sim::progress::Progress;
@@ -223,14 +224,34 @@ fn fly_one(
     incomplete: &Incomplete,
 ) -> (BoardComparison, RunResult, bool) {
     let cfg = s.config();
+    // SIL's flight log beside the board's (Choice 356, docs/logs.md#the-board-in-the-same-channels):
+    // the two `diff` compares.
+    let sil_name = sil_log_name(&cfg.name);
+    let mut sil_log = dir
+        .claim(&sil_name)
+        .map_err(|e| format!("{e:#}"))
+        .and_then(|p| McapLog::create(&p, s, "sil", None).map_err(|e| e.to_string()))
+        .map_err(|e| incomplete.push(format!("{sil_name} was not written: {e}")))
+        .ok();
     let sil_run = sim::fly(
         s,
         &mut LocalController::new(s),
-        &mut progress.observer(),
+        &mut (&mut sil_log, &mut progress.observer()),
         Recording::Plot,
     );
+    if let Some(Err(e)) = sil_log.map(|l| l.finish(&sil_run)) {
+        incomplete.push(e.to_string());
+    }
     let Started { mut board, log } = started;
-    let board_run = run_into(dir, s, &mut board, progress, incomplete);
+    let board_run = run_into(
+        dir,
+        s,
+        &mut board,
+        mode.source(),
+        None,
+        progress,
+        incomplete,
+    );
     let stats = board.finish();
     if let Some((log, log_path)) = log {
         if let Err(e) = log.commit() {

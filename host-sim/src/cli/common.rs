@@ -5,16 +5,18 @@ use std::io::Write;
 use std::path::Path;
 use std::sync::Mutex;
 
-use anyhow::{anyhow, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 
 use super::json::{print_json, Cases};
 use super::Exit;
 use crate::interrupt;
+use crate::output::log::{log_name, McapLog, Source};
 use crate::output::{self, atomic, CsvStream, OutputDir, ReportRow};
 use crate::scenario::{load_config, Scenario};
 use crate::sim::progress::Progress;
 use crate::sim::record::RunSummary;
 use crate::sim::{self, ControlSource, LocalController, Recording, RunResult};
+use crate::studies::montecarlo::MAX_RUNS;
 use crate::studies::preflight::{self, CheckError, Preflight, DEFAULT_MARGIN};
 
 /// Reads and validates a scenario file, with the step cap lifted if `allow_long_run`.
@@ -23,6 +25,15 @@ pub(super) fn load(path: &Path, allow_long_run: bool) -> Result<Scenario> {
     let mut config = load_config(path).with_context(ctx)?;
     config.allow_long_run = allow_long_run;
     Scenario::new(config).with_context(ctx)
+}
+
+/// A command's count of runs (`--runs`, `--random`): at most [`MAX_RUNS`] unless
+/// `allow_long_run` (the one cap of `monte-carlo` and `validate-preflight`, Choice 303).
+pub(super) fn check_run_count(flag: &str, n: usize, allow_long_run: bool) -> Result<()> {
+    if n > MAX_RUNS && !allow_long_run {
+        bail!("{flag} {n} is more than {MAX_RUNS}; give --allow-long-run to run that many");
+    }
+    Ok(())
 }
 
 /// The control periods of `scenarios`, for [`Progress`].
@@ -43,43 +54,54 @@ impl Incomplete {
     }
 }
 
-/// One run with the law from `source`, its CSV streamed into `dir` and its periods counted
-/// into `progress`; a CSV that cannot be written completely goes to `incomplete` (the run goes
-/// on: its metrics are still good).
+/// One run with the law from `control`, its CSV and its flight log (`source`: where the law
+/// runs, `text`: the scenario file, attached) streamed into `dir` and its periods counted
+/// into `progress`; an output that cannot be written completely goes to `incomplete` (the run
+/// goes on: its metrics are still good).
 pub(super) fn run_into(
     dir: &OutputDir,
     scenario: &Scenario,
-    source: &mut dyn ControlSource,
+    control: &mut dyn ControlSource,
+    source: Source,
+    text: Option<&str>,
     progress: &Progress,
     incomplete: &Incomplete,
 ) -> RunResult {
     let cfg = scenario.config();
     let name = output::csv_name(&cfg.name, cfg.controller.robust);
     let mut counter = progress.observer();
-    match dir.claim(&name).and_then(|p| CsvStream::create(&p)) {
-        Ok(mut csv) => {
-            let run = sim::fly(
-                scenario,
-                source,
-                &mut (&mut csv, &mut counter),
-                Recording::Plot,
-            );
-            if let Err(e) = csv.finish() {
-                incomplete.push(e.to_string());
-            }
-            run
-        }
-        Err(e) => {
-            incomplete.push(format!("{name} was not written: {e:#}"));
-            sim::fly(scenario, source, &mut counter, Recording::Plot)
-        }
+    let mut csv = dir
+        .claim(&name)
+        .and_then(|p| CsvStream::create(&p))
+        .map_err(|e| incomplete.push(format!("{name} was not written: {e:#}")))
+        .ok();
+    let log_file = log_name(&cfg.name, cfg.controller.robust);
+    let mut log = dir
+        .claim(&log_file)
+        .map_err(|e| format!("{e:#}"))
+        .and_then(|p| McapLog::create(&p, scenario, source, text).map_err(|e| e.to_string()))
+        .map_err(|e| incomplete.push(format!("{log_file} was not written: {e}")))
+        .ok();
+    let run = sim::fly(
+        scenario,
+        control,
+        &mut (&mut csv, (&mut log, &mut counter)),
+        Recording::Plot,
+    );
+    if let Some(Err(e)) = csv.map(CsvStream::finish) {
+        incomplete.push(e.to_string());
     }
+    if let Some(Err(e)) = log.map(|l| l.finish(&run)) {
+        incomplete.push(e.to_string());
+    }
+    run
 }
 
 /// [`run_into`] with the law on the host.
 pub(super) fn sil_into(
     dir: &OutputDir,
     scenario: &Scenario,
+    text: Option<&str>,
     progress: &Progress,
     incomplete: &Incomplete,
 ) -> RunResult {
@@ -87,6 +109,8 @@ pub(super) fn sil_into(
         dir,
         scenario,
         &mut LocalController::new(scenario),
+        "sil",
+        text,
         progress,
         incomplete,
     )
@@ -100,7 +124,9 @@ pub(super) fn report_incomplete(incomplete: &[String]) {
 }
 
 /// Prints the runs of `rows` (JSON, or the table and the report's path) and says how the
-/// command ended.
+/// command ended: by the runs of the controller each scenario configures (`with`), never by
+/// its companion without Δu, which is there for comparison and reported beside it
+/// (Choice 313).
 pub(super) fn print_runs(
     stdout: &mut dyn Write,
     json: bool,
@@ -110,7 +136,7 @@ pub(super) fn print_runs(
     incomplete: Vec<String>,
 ) -> Result<Exit> {
     report_incomplete(&incomplete);
-    let exit = runs_exit(runs(rows), !incomplete.is_empty(), false);
+    let exit = runs_exit(rows.iter().map(|r| r.with), !incomplete.is_empty(), false);
     if json {
         let cases: Cases<RunSummary> = Cases {
             cases: runs(rows).map(RunResult::summary).collect(),
@@ -124,9 +150,28 @@ pub(super) fn print_runs(
             writeln!(stdout, "{c}")?;
         }
         writeln!(stdout, "{}", output::table_text(rows))?;
+        let all: Vec<&RunResult> = runs(rows).collect();
+        writeln!(stdout, "{}", output::chatter_table_text(&all))?;
+        for r in rows {
+            if let Some(c) = r.without.filter(|c| companion_differs(r.with, c)) {
+                writeln!(
+                    stdout,
+                    "{}: the comparison run without Δu {} (reported, not the verdict: the exit \
+                     code follows the run with the controller the scenario configures)",
+                    c.name, c.outcome
+                )?;
+            }
+        }
         writeln!(stdout, "report: {}", report.display())?;
     }
     Ok(exit)
+}
+
+/// True when the companion without Δu ended otherwise than the run it accompanies (another
+/// outcome, or faults where it had none): what the text output points out.
+fn companion_differs(with: &RunResult, without: &RunResult) -> bool {
+    std::mem::discriminant(&with.outcome) != std::mem::discriminant(&without.outcome)
+        || with.faulted_unexpectedly() != without.faulted_unexpectedly()
 }
 
 /// The preflight checks of `scenarios` (in parallel), at the default margin; `None` when a

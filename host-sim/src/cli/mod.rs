@@ -11,9 +11,10 @@
 //! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
-//! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR]
+//! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR] [--allow-long-run]
 //! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! host-sim import-plan FILE.plan [--speed 0.5] [--name NAME]    # the scenario TOML on stdout
+//! host-sim diff A B [--abs X] [--rel Y] [--out DIR]              # two flights (MCAP or CSV)
 //! ```
 //!
 //! `check` is the preflight feasibility check ([`crate::studies::preflight`]): it simulates nothing, and
@@ -23,7 +24,8 @@
 //!
 //! `--json` prints one JSON object, `{"cases": [...]}` of [`RunSummary`](crate::sim::record::RunSummary) (table1, run) or of
 //! [`BoardComparison`](crate::board::BoardComparison) (pil, hil), or the Monte Carlo [`Summary`](crate::studies::montecarlo::Summary); its
-//! keys come out sorted.
+//! keys come out sorted. `check --json` prints one object on every exit, errors and interrupts
+//! included ([`check`]).
 //!
 //! Every command, before it computes anything: validates its input (scenario, flags, the step
 //! cap), checks and prepares the output folder ([`OutputDir::prepare`](crate::output::OutputDir::prepare): a folder, not a symlink,
@@ -44,10 +46,12 @@
 //! | 1 | a run diverged (or lost its board), or PIL disagreed with SIL; `check`: the mission is infeasible |
 //! | 2 | bad input (scenario, flags, output folder, firmware image) or an I/O error; or an output could not be written completely |
 //! | 3 | a run had the controller in fail-safe (thrusters off) for some periods and its scenario does not say `expect_faults = true` |
-//! | 4 | a run completed outside its bound (`[bound]`; the real chain's default 0.05 m, 1 % saturated) and its scenario does not say `expect_missed = true` |
+//! | 4 | a run completed outside its bound (`[bound]`; the real chain's default 0.05 m, 1 % saturated) and its scenario does not say `expect_missed = true`; `diff`: the two flights differ |
 //! | 130 | interrupted (Ctrl-C, SIGTERM): what was done is written and marked partial |
 //!
-//! When several apply, the first of 2, 130, 1, 3, 4 is the exit code. In `pil`, a run with link
+//! When several apply, the first of 2, 130, 1, 3, 4 is the exit code. In `run`, the code follows
+//! the run of the controller the scenario configures: its companion without Δu is reported
+//! beside it (a line says when it ended otherwise), never as the verdict (Choice 313). In `pil`, a run with link
 //! faults injected (flags or `[link_faults]`) expects the board's fail-safe. In `table1`, the
 //! paper's missions flown through the real chain are there to show what happens when the
 //! preflight says infeasible: their divergence and faults are reported, not an exit code.
@@ -56,6 +60,7 @@ mod board_loop;
 mod campaign;
 mod check;
 mod common;
+mod diff;
 mod hil;
 mod import_plan;
 mod json;
@@ -67,7 +72,8 @@ mod validate;
 
 pub use board_loop::LoopArgs;
 pub use campaign::{campaign, resolve_shard, CampaignArgs, CampaignCommand};
-pub use check::{check, CheckArgs};
+pub use check::{check, usage_error_json, CheckArgs};
+pub use diff::{diff, DiffArgs};
 pub use hil::{hil, HilArgs, DEFAULT_HIL_BAUD, DEFAULT_HIL_REPLY_TIMEOUT};
 pub use import_plan::{import_plan, ImportPlanArgs};
 pub use json::Cases;
@@ -97,6 +103,8 @@ pub enum Exit {
     Interrupted,
     /// `check`: the mission is not feasible at its time scale: exit 1.
     Infeasible,
+    /// `diff`: the two flights differ beyond the tolerance: exit 4.
+    Differ,
 }
 
 impl Exit {
@@ -107,7 +115,7 @@ impl Exit {
             Exit::RunFailed | Exit::Infeasible => 1,
             Exit::OutputIncomplete => 2,
             Exit::Faulted => 3,
-            Exit::Missed => 4,
+            Exit::Missed | Exit::Differ => 4,
             Exit::Interrupted => 130,
         }
     }

@@ -8,13 +8,13 @@ use clap::Args;
 use controller_core::readable::Readable;
 use controller_core::Table1Case;
 
-use super::common::load;
+use super::common::{check_run_count, load};
 use super::Exit;
 use crate::output::{atomic, OutputDir};
 use crate::plant::{CurrentModel, VariationProfile};
 use crate::scenario::{paper, Scenario, MAX_CURRENT_SPEED};
 use crate::sim::progress::Progress;
-use crate::studies::montecarlo::{self, MonteCarloOptions, MAX_RUNS};
+use crate::studies::montecarlo::{self, MonteCarloOptions};
 
 /// `monte-carlo`: draws the Table-3 parameters uniformly in their box, runs in parallel,
 /// reports percentiles and the worst case. Deterministic per seed.
@@ -72,12 +72,7 @@ pub fn monte_carlo(args: &MonteCarloArgs, stdout: &mut dyn Write) -> Result<Exit
     if args.runs == 0 {
         bail!("--runs must be at least 1");
     }
-    if args.runs > MAX_RUNS && !args.allow_long_run {
-        bail!(
-            "--runs {} is more than {MAX_RUNS}; give --allow-long-run to run that many",
-            args.runs
-        );
-    }
+    check_run_count("--runs", args.runs, args.allow_long_run)?;
     if let Some(c) = args.current {
         if !(c.is_finite() && (0.0..=MAX_CURRENT_SPEED).contains(&c)) {
             bail!(

@@ -12,10 +12,13 @@ use super::common::{
 use super::Exit;
 use crate::interrupt;
 use crate::output::waypoint_plot::mission_plots;
-use crate::output::{self, sections, OutputDir, ReportRow};
+use crate::output::{self, figures, sections, OutputDir, ReportRow};
 use crate::sim::progress::Progress;
+use crate::sim::RunResult;
 
-/// `run`: one scenario from a TOML file (and its companion without Δu, for comparison).
+/// `run`: one scenario from a TOML file (and its companion without Δu, for comparison). The
+/// exit code follows the run of the controller the scenario configures; the companion is
+/// reported beside it, not as the verdict (Choice 313).
 #[derive(Args, Clone, Debug, PartialEq)]
 pub struct RunArgs {
     #[arg(long)]
@@ -61,25 +64,34 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         !args.json,
     );
     let incomplete = Incomplete::default();
-    let with = sil_into(&dir, &scenario, &progress, &incomplete);
+    // The scenario file as written, attached to the flight logs (docs/logs.md#metadata).
+    let text = std::fs::read_to_string(&args.scenario).ok();
+    let with = sil_into(&dir, &scenario, text.as_deref(), &progress, &incomplete);
     // A run interrupted is not followed by its companion (nothing would be done of it).
     let without = companion
         .as_ref()
         .filter(|_| !interrupt::requested())
-        .map(|c| sil_into(&dir, c, &progress, &incomplete));
+        .map(|c| sil_into(&dir, c, text.as_deref(), &progress, &incomplete));
     progress.finish();
     let rows = [ReportRow::new(&with, without.as_ref())];
     let mut incomplete = incomplete.into_inner();
     // A waypoint mission's path over its waypoints and speed over time (docs/simulator.md#plots-of-a-waypoint-mission).
-    let extra: Vec<(String, PathBuf)> = mission_plots(&dir, &scenario, &with, &mut incomplete)?
+    let mut extra: Vec<(String, PathBuf)> = mission_plots(&dir, &scenario, &with, &mut incomplete)?
         .into_iter()
         .map(|f| (with.name.clone(), f))
         .collect();
+    extra.extend(commands_plot(&dir, &with, &mut incomplete)?);
+    let runs: Vec<&RunResult> = std::iter::once(&with).chain(&without).collect();
+    let sections = format!(
+        "{}\n{}",
+        output::chatter_section(&runs),
+        sections::preflight(&checks, runs.iter().copied())
+    );
     let report = output::write_plots_and_report_with(
         &dir,
         &title,
         &rows,
-        &sections::preflight(&checks, std::iter::once(&with).chain(&without)),
+        &sections,
         &[],
         &extra,
         "",
@@ -102,4 +114,21 @@ pub fn run(args: &RunArgs, stdout: &mut dyn Write) -> Result<Exit> {
         .with_context(|| format!("cannot write {}", file.display()))?;
     }
     print_runs(stdout, args.json, &rows, &checks, &report, incomplete)
+}
+
+/// The run's commands zoomed in, where a person sees the chatter (docs/real-vehicle.md#chatter):
+/// the file for the report's list of the run's plots, or nothing and why in `incomplete`.
+fn commands_plot(
+    dir: &OutputDir,
+    with: &RunResult,
+    incomplete: &mut Vec<String>,
+) -> Result<Option<(String, PathBuf)>> {
+    dir.claim(&figures::commands_plot_name(&with.name))?;
+    Ok(match figures::plot_commands(dir.path(), with) {
+        Ok(file) => Some((with.name.clone(), file)),
+        Err(e) => {
+            incomplete.push(format!("commands plot of {}: {e:#}", with.name));
+            None
+        }
+    })
 }

@@ -218,7 +218,7 @@ fn fly_all(
     let progress = Progress::start("Table 1", periods(all.iter().copied()), !json);
     let results = all
         .par_iter()
-        .map(|s| sil_into(dir, s, &progress, incomplete))
+        .map(|s| sil_into(dir, s, None, &progress, incomplete))
         .collect();
     progress.finish();
     results

@@ -7,6 +7,7 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, ValueEnum};
 
+use super::common::check_run_count;
 use super::json::print_json;
 use super::Exit;
 use crate::output::{atomic, OutputDir};
@@ -29,7 +30,8 @@ pub enum Mountings {
 pub struct ValidateArgs {
     #[arg(long, value_enum, default_value_t = Mountings::All)]
     pub mountings: Mountings,
-    /// Random missions besides the matrix.
+    /// Random missions besides the matrix (at most host_sim::studies::montecarlo::MAX_RUNS
+    /// without --allow-long-run).
     #[arg(long, default_value_t = DEFAULT_RANDOM)]
     pub random: usize,
     #[arg(long, default_value_t = 1)]
@@ -40,6 +42,9 @@ pub struct ValidateArgs {
     pub json: bool,
     #[arg(long, default_value = "runs/validate-preflight")]
     pub out: PathBuf,
+    /// Allow more than host_sim::studies::montecarlo::MAX_RUNS random missions.
+    #[arg(long)]
+    pub allow_long_run: bool,
 }
 
 /// `validate-preflight`: exit 0 when no mission was falsely feasible, 1 otherwise.
@@ -50,6 +55,7 @@ pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result
             args.margin
         );
     }
+    check_run_count("--random", args.random, args.allow_long_run)?;
     let campaign = Campaign {
         masks: match args.mountings {
             Mountings::Team => TEAM_MOUNTINGS.to_vec(),

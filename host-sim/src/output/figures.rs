@@ -15,6 +15,7 @@ use super::plot::{
 };
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 
+use crate::sim::chatter::DEAD_BAND;
 use crate::sim::{RunResult, Sample};
 
 const C_THRUSTERS: [RGBColor; THRUSTERS] = [
@@ -354,4 +355,69 @@ pub(super) fn write_plot(dest: &Path, draw: impl FnOnce(&Path) -> Result<()>) ->
     drop(file);
     draw(pending.tmp_path()).with_context(ctx)?;
     pending.commit().with_context(ctx)
+}
+
+/// Length of the zoomed command trace (s): long enough for a few reversals of a thruster that
+/// follows (≤ 2 a second), short enough to see each control period of one that does not.
+pub const COMMANDS_WINDOW: f64 = 2.0;
+
+/// The file name of [`plot_commands`]' figure of a run called `name`.
+pub fn commands_plot_name(name: &str) -> String {
+    format!("{}-commands.png", file_stem(name))
+}
+
+/// `{name}-commands.png`: the five thrusters' voltage commands over [`COMMANDS_WINDOW`] s in
+/// the middle of `run` (after the start's transient), one point per control period kept for
+/// the plots (every period of a run of up to [`crate::sim::decimate::PLOT_SAMPLES`]), with the
+/// ±[`DEAD_BAND`] V band a sign reversal must cross dashed (docs/real-vehicle.md#chatter): where
+/// a person sees the chatter the report's figures count.
+pub fn plot_commands(dir: &Path, run: &RunResult) -> Result<PathBuf> {
+    let (t0, t1) = match min_max(run.samples.iter().map(|s| s.t)) {
+        Some((a, b)) => {
+            let mid = 0.5 * (a + b);
+            let half = (0.5 * COMMANDS_WINDOW).min(0.5 * (b - a));
+            (mid - half, mid + half)
+        }
+        None => (0.0, COMMANDS_WINDOW),
+    };
+    let inside: Vec<&Sample> = run
+        .samples
+        .iter()
+        .filter(|s| s.t >= t0 && s.t <= t1)
+        .collect();
+    let mut p = Panel::new(
+        format!(
+            "thruster commands, {}, t = {t0:.2}–{t1:.2} s (one point per control period)",
+            run.du_label()
+        ),
+        "t (s)",
+        "voltage (V)",
+    );
+    p.x_range = Some((t0, t1));
+    for (k, (name, color)) in THRUSTER_NAMES.iter().zip(C_THRUSTERS).enumerate() {
+        let c = run.metrics.chatter.0[k];
+        p.lines.push(Line::new(
+            format!(
+                "{name}: {:.1} reversals/s, {:.0} V/s",
+                c.reversals_per_s, c.command_tv
+            ),
+            color,
+            Stroke::Solid,
+            inside.iter().map(|s| (s.t, s.voltage[k])).collect(),
+        ));
+    }
+    if !inside.is_empty() {
+        for v in [DEAD_BAND, -DEAD_BAND] {
+            p.lines.push(Line::new(
+                format!("dead band ±{DEAD_BAND} V"),
+                C_LIMIT,
+                Stroke::Dashed,
+                vec![(t0, v), (t1, v)],
+            ));
+        }
+    }
+    let title = format!("{}: thruster commands (chatter)", run.name);
+    write_plot(&dir.join(commands_plot_name(&run.name)), |path| {
+        render(path, |root| figure(root, &title, run, None, (1, 1), &[p]))
+    })
 }

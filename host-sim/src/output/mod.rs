@@ -19,6 +19,7 @@ pub mod campaign;
 pub mod csv;
 pub mod dir;
 pub mod figures;
+pub mod log;
 mod plot;
 pub mod report;
 pub mod sections;
@@ -29,8 +30,8 @@ pub use self::csv::{partial_name, write_csv, CsvStream, CSV_COLUMNS};
 pub use self::dir::OutputDir;
 pub use self::figures::{plot_case, plot_case_with_limit, plot_names};
 pub use self::report::{
-    real_table_markdown, real_table_text, report_markdown, table_markdown, table_text,
-    write_report, RealRow, ReportRow,
+    chatter_section, chatter_table_markdown, chatter_table_text, real_table_markdown,
+    real_table_text, report_markdown, table_markdown, table_text, write_report, RealRow, ReportRow,
 };
 
 /// The CSV file name of a run called `name`, with (`robust`) or without Δu:

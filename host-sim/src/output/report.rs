@@ -10,9 +10,11 @@ use controller_core::Table1Case;
 
 use super::atomic;
 use crate::sim::bound;
+use crate::sim::chatter::{ThrusterChatter, DEAD_BAND, NOMINAL_THRUSTER_LAG};
 use crate::sim::{Metrics, RunResult};
 use crate::studies::preflight::{Preflight, Verdict};
 use crate::studies::table1 as paper_table1;
+use controller_core::effectiveness::THRUSTER_NAMES;
 
 /// One row of a report table: a case, its run with Δu, optionally its run without Δu, and
 /// the paper's Table-1 case it reproduces, if any (its numbers are printed beside ours).
@@ -141,7 +143,10 @@ fn table_cells(rows: &[ReportRow]) -> Vec<Vec<String>> {
                     } else {
                         ""
                     };
-                    format!("{}{expected}", r.outcome)
+                    match &r.path {
+                        Some(path) => format!("{}{expected}; {path}", r.outcome),
+                        None => format!("{}{expected}", r.outcome),
+                    }
                 }),
             ]);
         }
@@ -447,6 +452,105 @@ fn plots_section(dir: &Path, plots: &[PathBuf]) -> String {
     s
 }
 
+/// The chatter table's header: per run, each figure for the five thrusters in
+/// [`THRUSTER_NAMES`] order.
+fn chatter_header() -> [String; 5] {
+    let order = THRUSTER_NAMES.join(" / ");
+    [
+        "case".to_string(),
+        "Δu".to_string(),
+        format!("sign reversals/s through ±{DEAD_BAND} V ({order})"),
+        format!("command total variation V/s ({order})"),
+        format!("power above the thruster's corner ({order})"),
+    ]
+}
+
+fn chatter_cells(runs: &[&RunResult]) -> Vec<[String; 5]> {
+    runs.iter()
+        .map(|r| {
+            let m = Some(r.metrics).filter(Metrics::recorded);
+            let per = |f: fn(&ThrusterChatter) -> String| {
+                m.as_ref().map_or("—".to_string(), |m| {
+                    m.chatter.0.iter().map(f).collect::<Vec<_>>().join(" / ")
+                })
+            };
+            [
+                r.name.clone(),
+                if r.robust { "with" } else { "without" }.to_string(),
+                per(|c| fmt_fixed(c.reversals_per_s, 1)),
+                per(|c| fmt_fixed(c.command_tv, 0)),
+                per(|c| format!("{} %", fmt_fixed(100.0 * c.hf_share, 0))),
+            ]
+        })
+        .collect()
+}
+
+/// The chatter of `runs`' thruster commands (docs/real-vehicle.md#chatter) as Markdown: per
+/// run, for each thruster, its sign reversals per second through the dead band, its command's
+/// total variation per second and its share of command power above the thruster's corner.
+pub fn chatter_table_markdown(runs: &[&RunResult]) -> String {
+    let header = chatter_header();
+    let mut s = format!(
+        "| {} |\n|---|---|---:|---:|---:|\n",
+        header.map(|h| md_escape(&h)).join(" | ")
+    );
+    for r in chatter_cells(runs) {
+        s.push_str(&format!("| {} |\n", r.map(|c| md_escape(&c)).join(" | ")));
+    }
+    s
+}
+
+/// Each column's width in characters: its widest cell, header included.
+fn column_widths<R: AsRef<[String]>>(header: &[String], body: &[R]) -> Vec<usize> {
+    (0..header.len())
+        .map(|i| {
+            std::iter::once(header)
+                .chain(body.iter().map(AsRef::as_ref))
+                .map(|r| r[i].chars().count())
+                .max()
+                .unwrap_or(0)
+        })
+        .collect()
+}
+
+/// The same table as [`chatter_table_markdown`] for the terminal, columns aligned.
+pub fn chatter_table_text(runs: &[&RunResult]) -> String {
+    let header = chatter_header();
+    let body = chatter_cells(runs);
+    let widths = column_widths(&header, &body);
+    let line = |r: &[String]| {
+        let cells: Vec<String> = r
+            .iter()
+            .zip(&widths)
+            .map(|(c, w)| format!("{c}{}", " ".repeat(w - c.chars().count())))
+            .collect();
+        format!("{}\n", cells.join("  ").trim_end())
+    };
+    let mut s = line(&header);
+    s.push_str(&line(
+        &widths.iter().map(|w| "-".repeat(*w)).collect::<Vec<_>>(),
+    ));
+    for r in &body {
+        s.push_str(&line(r));
+    }
+    s
+}
+
+/// The report section of the chatter table, with what its columns mean.
+pub fn chatter_section(runs: &[&RunResult]) -> String {
+    format!(
+        "## Thruster commands (docs/real-vehicle.md#chatter)\n\nWhat the commands do between the \
+         limits: a reversal counts when a command crosses from above +{DEAD_BAND} V to below \
+         −{DEAD_BAND} V or back; the power share is above f_c = 1/(2π T) of the thruster's lag T \
+         (the nominal {NOMINAL_THRUSTER_LAG} s when the scenario sets none). A run's bound allows \
+         at most {} reversals/s and {} V/s per thruster (the real vehicle's; a scenario's \
+         `[bound]` may set others).\n\n{}\n",
+        bound::MAX_REVERSALS_PER_S,
+        bound::MAX_COMMAND_TV,
+        chatter_table_markdown(runs)
+    )
+}
+
 /// One row of the real-vehicle table (docs/real-vehicle.md#the-real-missions): a run through the real actuator
 /// chain and the preflight check of its scenario.
 #[derive(Clone, Copy, Debug)]
@@ -455,7 +559,7 @@ pub struct RealRow<'a> {
     pub preflight: &'a Preflight,
 }
 
-const REAL_HEADER: [&str; 10] = [
+const REAL_HEADER: [&str; 12] = [
     "mission",
     "heading",
     "time scale",
@@ -463,6 +567,8 @@ const REAL_HEADER: [&str; 10] = [
     "rms path (m)",
     "peak |V| (V)",
     "saturated",
+    "reversals/s",
+    "TV (V/s)",
     "within bound",
     "preflight",
     "outcome",
@@ -492,6 +598,8 @@ fn real_cells(rows: &[RealRow]) -> Vec<Vec<String>> {
                 cell(&|m| fmt_err(m.rms_path)),
                 cell(&|m| fmt_fixed(m.peak_voltage, 1)),
                 cell(&|m| format!("{} %", fmt_fixed(100.0 * m.saturated_fraction, 1))),
+                cell(&|m| fmt_fixed(m.reversals_per_s, 1)),
+                cell(&|m| fmt_fixed(m.command_tv, 0)),
                 if bound::within_bound(r.run) {
                     "yes"
                 } else {
@@ -508,20 +616,24 @@ fn real_cells(rows: &[RealRow]) -> Vec<Vec<String>> {
 /// What the real-vehicle table's "within bound" column means.
 pub fn real_table_legend() -> String {
     format!(
-        "within bound: completed with max path error ≤ {} m and a thruster saturated in ≤ {} % \
-         of the control periods (docs/real-vehicle.md#the-bound-and-the-start-in-trim)",
+        "within bound: completed with max path error ≤ {} m, a thruster saturated in ≤ {} % \
+         of the control periods (docs/real-vehicle.md#the-bound-and-the-start-in-trim), and no \
+         thruster's command reversing more than {} times/s through ±{DEAD_BAND} V or varying by \
+         more than {} V/s (reversals/s, TV: the worst thruster's; docs/real-vehicle.md#chatter)",
         bound::MAX_PATH_ERROR,
-        100.0 * bound::MAX_SATURATED_FRACTION
+        100.0 * bound::MAX_SATURATED_FRACTION,
+        bound::MAX_REVERSALS_PER_S,
+        bound::MAX_COMMAND_TV
     )
 }
 
 /// The real-vehicle table as Markdown: per run its mission, heading, time scale, max and rms
-/// path error, peak |V|, saturated fraction, whether it is within the bound, the preflight
-/// verdict and the outcome.
+/// path error, peak |V|, saturated fraction, the worst thruster's reversals/s and command TV,
+/// whether it is within the bound, the preflight verdict and the outcome.
 pub fn real_table_markdown(rows: &[RealRow]) -> String {
     let mut s = format!("| {} |\n|", REAL_HEADER.map(md_escape).join(" | "));
     for i in 0..REAL_HEADER.len() {
-        s.push_str(if (2..8).contains(&i) {
+        s.push_str(if (2..10).contains(&i) {
             " ---: |"
         } else {
             " --- |"
@@ -539,15 +651,7 @@ pub fn real_table_markdown(rows: &[RealRow]) -> String {
 pub fn real_table_text(rows: &[RealRow]) -> String {
     let header: Vec<String> = REAL_HEADER.iter().map(|h| h.to_string()).collect();
     let body = real_cells(rows);
-    let widths: Vec<usize> = (0..header.len())
-        .map(|i| {
-            std::iter::once(&header)
-                .chain(&body)
-                .map(|r| r[i].chars().count())
-                .max()
-                .unwrap_or(0)
-        })
-        .collect();
+    let widths = column_widths(&header, &body);
     let line = |r: &[String]| {
         let mut l = String::new();
         for (i, c) in r.iter().enumerate() {
@@ -555,7 +659,7 @@ pub fn real_table_text(rows: &[RealRow]) -> String {
                 l.push_str("  ");
             }
             let pad = " ".repeat(widths[i].saturating_sub(c.chars().count()));
-            if (2..8).contains(&i) {
+            if (2..10).contains(&i) {
                 l.push_str(&pad);
                 l.push_str(c);
             } else {
@@ -591,6 +695,7 @@ mod tests {
             faults: FaultCounts::default(),
             faults_expected: false,
             miss_expected: false,
+            path: None,
             samples: Vec::new(),
             plant_factorisations: 0,
         }

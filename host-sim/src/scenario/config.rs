@@ -39,14 +39,39 @@ pub struct Bound {
     pub max_path: f64,
     /// Largest fraction of control periods with a thruster saturated.
     pub saturated: f64,
+    /// Most sign reversals per second of any thruster's command through ±0.5 V (1/s;
+    /// [`crate::sim::chatter`]).
+    pub max_reversals_per_s: f64,
+    /// Largest total variation per second of any thruster's command (V/s).
+    pub max_command_tv: f64,
 }
 
 impl Bound {
-    /// The real vehicle's bound (**Choice 103**, docs/real-vehicle.md#the-bound-and-the-start-in-trim): 0.05 m, 1 % of periods.
+    /// The real vehicle's bound (**Choice 103**, docs/real-vehicle.md#the-bound-and-the-start-in-trim): 0.05 m, 1 % of periods;
+    /// and its chatter (**Choice 322**, docs/real-vehicle.md#chatter): at most 2 reversals a
+    /// second per thruster through ±0.5 V and 100 V/s of command total variation.
     pub const REAL_VEHICLE: Bound = Bound {
         max_path: 0.05,
         saturated: 0.01,
+        max_reversals_per_s: 2.0,
+        max_command_tv: 100.0,
     };
+
+    /// `table`'s limits, the real vehicle's for a key left out.
+    pub fn with_defaults(
+        max_path: Option<f64>,
+        saturated: Option<f64>,
+        max_reversals_per_s: Option<f64>,
+        max_command_tv: Option<f64>,
+    ) -> Bound {
+        let d = Bound::REAL_VEHICLE;
+        Bound {
+            max_path: max_path.unwrap_or(d.max_path),
+            saturated: saturated.unwrap_or(d.saturated),
+            max_reversals_per_s: max_reversals_per_s.unwrap_or(d.max_reversals_per_s),
+            max_command_tv: max_command_tv.unwrap_or(d.max_command_tv),
+        }
+    }
 }
 
 /// Gaussian noise added to the measured η and ν the controller sees (seeded).
@@ -163,7 +188,8 @@ pub struct SimConfig {
     /// ([`crate::studies::preflight::profile`]), never flown (the pinned `speeds` are). `None`:
     /// no caps.
     pub speed_limits: Option<Vec<f64>>,
-    /// Simulated time (s). Paper: 70.
+    /// Simulated time (s). Paper: 70. A waypoint mission without `duration`: its path's time
+    /// to the last waypoint ([`crate::scenario::path_time`], Choice 312).
     pub duration: f64,
     /// Plant RK4 step (s). Default 1 ms.
     pub plant_step: f64,
@@ -176,6 +202,9 @@ pub struct SimConfig {
     pub trimmed: bool,
     pub current: CurrentModel,
     pub noise: Option<SensorNoise>,
+    /// The navigation solution the law is told (`[navigation]`, docs/navigation.md); `None`:
+    /// the plant's exact state (the `ideal` preset).
+    pub navigation: Option<super::navigation::NavigationModel>,
     /// First-order thruster lag time constant (s), if any.
     pub thruster_lag: Option<f64>,
     /// Ideal actuators: the thrusters deliver the allocated thrust whatever the voltage limit
@@ -268,6 +297,7 @@ impl SimConfig {
             trimmed: false,
             current: CurrentModel::None,
             noise: None,
+            navigation: None,
             thruster_lag: None,
             ideal_actuators: true,
             initial_offset: [0.0; 6],

@@ -13,7 +13,7 @@ use serde::de::{self, MapAccess, Visitor};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 use super::fixed_arrays;
-use super::ScenarioError;
+use super::{Bound, ScenarioError};
 
 /// A scenario file: the top-level keys and the tables. Only `[trajectory]` is required.
 #[derive(Clone, Debug, PartialEq, Deserialize, Serialize)]
@@ -54,6 +54,8 @@ pub struct ScenarioFile {
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise: Option<NoiseTable>,
     #[serde(skip_serializing_if = "Option::is_none")]
+    pub navigation: Option<super::navigation::NavigationTable>,
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub controller: Option<ControllerTable>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub bound: Option<BoundTable>,
@@ -80,6 +82,7 @@ impl ScenarioFile {
             variation: None,
             current: None,
             noise: None,
+            navigation: None,
             controller: None,
             bound: None,
             link_faults: None,
@@ -187,6 +190,18 @@ pub enum AttitudeName {
     Trim,
 }
 
+impl From<Bound> for BoundTable {
+    /// Every limit of `b`, written out.
+    fn from(b: Bound) -> Self {
+        BoundTable {
+            max_path: Some(b.max_path),
+            saturated: Some(b.saturated),
+            max_reversals_per_s: Some(b.max_reversals_per_s),
+            max_command_tv: Some(b.max_command_tv),
+        }
+    }
+}
+
 /// `[bound]`: the bound a run must fly within; a key left out takes the real vehicle's.
 #[derive(Clone, Debug, Default, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
@@ -195,6 +210,12 @@ pub struct BoundTable {
     pub max_path: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub saturated: Option<f64>,
+    /// Most sign reversals per second of any thruster's command through ±0.5 V.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_reversals_per_s: Option<f64>,
+    /// Largest total variation per second of any thruster's command (V/s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_command_tv: Option<f64>,
 }
 
 /// `controller.thrust_unit`: [`ThrustUnit`](controller_core::ThrustUnit) by name.

@@ -104,11 +104,9 @@ impl TryFrom<&SimConfig> for ScenarioFile {
             nu_sigma: Some(n.nu_sigma),
             seed: Some(n.seed),
         });
+        file.navigation = c.navigation.as_ref().map(super::navigation::table);
         file.controller = Some(controller(&c.controller)?);
-        file.bound = c.bound_setting.map(|b| BoundTable {
-            max_path: Some(b.max_path),
-            saturated: Some(b.saturated),
-        });
+        file.bound = c.bound_setting.map(BoundTable::from);
         let ranges =
             |v: &[TickRange]| Some(v.iter().map(|r| format!("{}..{}", r.from, r.to)).collect());
         let f = &c.link_faults;

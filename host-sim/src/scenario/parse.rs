@@ -21,7 +21,7 @@ use super::validate::invalid;
 use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
 use crate::plant::{CurrentModel, VariationProfile};
 
-/// Default `seed` of `[noise]` and of the Gauss–Markov current.
+/// Default `seed` of `[noise]`, `[navigation]` and the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;
 /// Name given to a scenario without `name` by [`parse_scenario`](super::parse_scenario).
 pub const DEFAULT_NAME: &str = "scenario";
@@ -94,9 +94,7 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     if let Some(raw) = raw.controller {
         config.controller = build_controller(&raw)?;
     }
-    if let Some(d) = raw.duration {
-        config.duration = d;
-    }
+    config.duration = duration(raw.duration, &config)?;
     if let Some(h) = raw.plant_step {
         config.plant_step = h;
     }
@@ -116,9 +114,13 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
         AttitudeName::Level => InitialAttitude::Level,
         AttitudeName::Trim => InitialAttitude::Trim,
     });
-    config.bound_setting = raw.bound.map(|b| Bound {
-        max_path: b.max_path.unwrap_or(Bound::REAL_VEHICLE.max_path),
-        saturated: b.saturated.unwrap_or(Bound::REAL_VEHICLE.saturated),
+    config.bound_setting = raw.bound.map(|b| {
+        Bound::with_defaults(
+            b.max_path,
+            b.saturated,
+            b.max_reversals_per_s,
+            b.max_command_tv,
+        )
     });
     if let Some(raw) = raw.variation {
         config.variation = build_variation(&raw)?;
@@ -134,10 +136,27 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
             seed: raw.seed.unwrap_or(DEFAULT_SEED),
         });
     }
+    if let Some(raw) = &raw.navigation {
+        config.navigation = super::navigation::build(raw, DEFAULT_SEED)?;
+    }
     if let Some(raw) = raw.link_faults {
         config.link_faults = build_link_faults(&raw)?;
     }
     Ok(config)
+}
+
+/// The file's `duration`, else a waypoint mission's whole path (Choice 312); a path that
+/// cannot be built keeps the default, and validation names its key.
+fn duration(given: Option<f64>, config: &SimConfig) -> Res<f64> {
+    if let Some(d) = given {
+        return Ok(d);
+    }
+    if let Ok(t) = controller_core::Trajectory::new(config.mission()) {
+        if let Some(d) = super::path_time::default_duration(&t)? {
+            return Ok(d);
+        }
+    }
+    Ok(config.duration)
 }
 
 fn build_link_faults(raw: &LinkFaultsTable) -> Res<LinkFaults> {

@@ -13,7 +13,7 @@ use controller_core::{Controller, Mission, Trajectory, TrajectoryKind};
 use controller_core::{Fault, Status};
 
 use super::start::start_state;
-use super::{SensorNoise, SimConfig};
+use super::{plan, Bound, SensorNoise, SimConfig};
 use crate::plant::{CurrentModel, VariationProfile};
 
 use super::ScenarioError;
@@ -138,15 +138,8 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
         ));
     }
     each("initial_offset", &config.initial_offset, finite)?;
-    if let Some(b) = config.bound_setting {
-        positive("bound.max_path", b.max_path)?;
-        let s = non_negative("bound.saturated", b.saturated)?;
-        if s > 1.0 {
-            return Err(invalid(
-                "bound.saturated",
-                format!("is a fraction of the control periods, in [0, 1], got {s}"),
-            ));
-        }
+    if let Some(b) = &config.bound_setting {
+        bound(b)?;
     }
     let limit = at_most(
         "divergence_limit",
@@ -166,9 +159,7 @@ pub(super) fn run(config: &SimConfig) -> Res<(u64, usize)> {
     }
     variation(&config.variation, h)?;
     current(&config.current, h)?;
-    if let Some(n) = &config.noise {
-        noise(n, limit)?;
-    }
+    sensors(config, limit)?;
     Ok((steps as u64, substeps as usize))
 }
 
@@ -216,6 +207,17 @@ fn start_offset(offset: &[f64; 6], limit: f64) -> Res<()> {
         ));
     }
     Ok(())
+}
+
+/// `[noise]` and `[navigation]`.
+fn sensors(config: &SimConfig, limit: f64) -> Res<()> {
+    if let Some(n) = &config.noise {
+        noise(n, limit)?;
+    }
+    match &config.navigation {
+        Some(n) => super::navigation::validate(n),
+        None => Ok(()),
+    }
 }
 
 /// Measurement noise a sensor could have (Choice 124): each σ ≥ 0; a position σ at most the
@@ -312,6 +314,21 @@ fn finite(key: &str, x: f64) -> Res<f64> {
     }
 }
 
+/// `[bound]`: a path limit > 0, a saturated fraction in [0, 1], chatter limits ≥ 0.
+fn bound(b: &Bound) -> Res<()> {
+    positive("bound.max_path", b.max_path)?;
+    non_negative("bound.max_reversals_per_s", b.max_reversals_per_s)?;
+    non_negative("bound.max_command_tv", b.max_command_tv)?;
+    let s = non_negative("bound.saturated", b.saturated)?;
+    if s > 1.0 {
+        return Err(invalid(
+            "bound.saturated",
+            format!("is a fraction of the control periods, in [0, 1], got {s}"),
+        ));
+    }
+    Ok(())
+}
+
 fn positive(key: &str, x: f64) -> Res<f64> {
     finite(key, x)?;
     if x > 0.0 {
@@ -338,22 +355,33 @@ fn each(key: &str, xs: &[f64], check: fn(&str, f64) -> Res<f64>) -> Res<()> {
     Ok(())
 }
 
-/// `trajectory.origin`: a latitude in [−90, 90], a longitude in [−180, 180], a finite altitude.
+/// `trajectory.origin`: a latitude in [−90, 90] and not within
+/// [`plan::pole_margin_degrees`] of a pole (**Choice 301**, [`plan::Origin::new`]), a longitude
+/// in [−180, 180], a finite altitude.
 fn check_origin(origin: Option<[f64; 3]>) -> Res<()> {
-    match origin {
-        Some([lat, lon, alt]) if !(lat.abs() <= 90.0 && lon.abs() <= 180.0 && alt.is_finite()) => {
-            Err(invalid(
-                "trajectory.origin",
-                format!(
-                    "must be [latitude in [-90, 90], longitude in [-180, 180], a finite altitude], got [{}, {}, {}]",
-                    Readable(lat),
-                    Readable(lon),
-                    Readable(alt)
-                ),
-            ))
-        }
-        _ => Ok(()),
-    }
+    let Some([lat, lon, alt]) = origin else {
+        return Ok(());
+    };
+    let range = match lon.abs() <= 180.0 {
+        true => plan::Origin::new(lat, lon, alt)
+            .map(|_| ())
+            .map_err(|e| e.to_string()),
+        false => Err(format!(
+            "longitude {} is outside [-180, 180]",
+            Readable(lon)
+        )),
+    };
+    range.map_err(|why| {
+        invalid(
+            "trajectory.origin",
+            format!(
+                "must be [latitude, longitude, altitude] off the poles, got [{}, {}, {}]: {why}",
+                Readable(lat),
+                Readable(lon),
+                Readable(alt)
+            ),
+        )
+    })
 }
 
 /// `trajectory.speed_limits` (**Choice 161**): a waypoint mission's, one per leg (n − 1 for n

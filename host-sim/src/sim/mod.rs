@@ -6,12 +6,13 @@
 //! | module | owns |
 //! |---|---|
 //! | [`control`] | where the law runs: [`ControlSource`], [`LocalController`] (SIL), [`ControlOut`], why a source stops ([`Stop`]) |
-//! | [`navigation`] | what the law is told: measured η, ν (heading as navigation reports it, noise) |
+//! | [`navigation`], [`nav_model`] | what the law is told: the navigation solution of `[navigation]` (or the exact state), heading as navigation reports it, `[noise]` |
 //! | [`thrusters`] | what the thrusters deliver (ideal or the real chain), their lag, B·thrust |
 //! | [`vehicle`] | the plant with its parameter profile and current, stepped by RK4 |
 //! | [`record`] | a run's samples, outcome, metrics and JSON summary |
 //! | [`recorder`] | what a run keeps as it goes (metrics, fault counts, plot series, observer) |
 //! | [`metrics`], [`decimate`] | the Table-1 metrics; the bounded plot series of a long run |
+//! | [`chatter`] | what the commands do between the limits: reversals, total variation, power above the thruster's corner |
 //! | [`observer`], [`progress`] | who sees each sample as it is made; progress of long commands |
 //! | [`bound`] | the bound a real-vehicle run must fly within |
 //!
@@ -21,9 +22,11 @@
 //! ([`crate::interrupt`]) stops it at the period it is in.
 
 pub mod bound;
+pub mod chatter;
 pub mod control;
 pub mod decimate;
 pub mod metrics;
+pub mod nav_model;
 pub mod navigation;
 pub mod observer;
 pub mod progress;
@@ -37,12 +40,14 @@ use controller_core::Desired;
 
 pub use control::{ControlOut, ControlSource, LocalController, Stop};
 pub use observer::Observer;
-pub use record::{BoardLoss, ControlStatus, Metrics, Outcome, RunResult, Sample};
+use record::FaultCounts;
+pub use record::{BoardLoss, ControlStatus, LoopSignals, Metrics, Outcome, RunResult, Sample};
 pub use recorder::Recording;
 
 use crate::interrupt;
 use crate::plant::PlantState;
-use crate::scenario::Scenario;
+use crate::scenario::{path_time, Scenario};
+use metrics::Accumulator;
 use navigation::{wrap_pi, Navigation};
 use recorder::Recorder;
 use thrusters::{Thrusters, Thrusts};
@@ -73,9 +78,9 @@ pub fn fly(
     let (steps, substeps, period) = (scenario.steps(), scenario.substeps(), scenario.period());
     let h = period / substeps as f64;
     let mut vehicle = Vehicle::new(scenario);
-    let mut navigation = Navigation::new(cfg.noise.as_ref());
+    let mut navigation = Navigation::of(cfg);
     let mut thrusters = Thrusters::new(cfg, scenario.controller(), h);
-    let mut recorder = Recorder::new(observer, recording, steps + 1);
+    let mut recorder = Recorder::new(observer, recording, steps + 1, Accumulator::of(cfg));
     let mut outcome = Outcome::Completed;
     for k in 0..=steps {
         let t = k as f64 * period;
@@ -103,6 +108,9 @@ pub fn fly(
         let target = thrusters.target(&out);
         let mut sample = sample_of(t, &vehicle.state, &reference, error, &out);
         sample.payload = cfg.variation.at(t).mass;
+        sample.signals.eta_told = eta;
+        sample.signals.nu_told = nu;
+        sample.signals.thrust_demand = target;
         // 3. Hold it for the period: thruster lag, RK4 substeps (none after the last sample).
         let (thrust, held): (Thrusts, Result<(), (f64, String)>) = if k < steps {
             thrusters.hold(&target, substeps, |j, tau| {
@@ -121,11 +129,23 @@ pub fn fly(
         }
     }
     let (metrics, faults, samples) = recorder.finish();
+    let flown = (metrics, faults, samples, vehicle.factorisations());
+    result(scenario, outcome, flown)
+}
+
+/// The run's result: its outcome held against the bound, with what the flight measured.
+fn result(
+    scenario: &Scenario,
+    mut outcome: Outcome,
+    (metrics, faults, samples, plant_factorisations): (Metrics, FaultCounts, Vec<Sample>, u64),
+) -> RunResult {
+    let cfg = scenario.config();
     if outcome == Outcome::Completed {
         if let Some(reason) = cfg.bound().and_then(|b| bound::miss(&b, &metrics)) {
             outcome = Outcome::Missed { reason };
         }
     }
+    let path = path_note(scenario, &outcome);
     RunResult {
         name: cfg.name.clone(),
         case: cfg.case,
@@ -135,8 +155,20 @@ pub fn fly(
         faults,
         faults_expected: cfg.expect_faults,
         miss_expected: cfg.expect_missed,
+        path,
         samples,
-        plant_factorisations: vehicle.factorisations(),
+        plant_factorisations,
+    }
+}
+
+/// A run that flew to its end says when its waypoint path did not (Choice 312).
+fn path_note(scenario: &Scenario, outcome: &Outcome) -> Option<String> {
+    match outcome {
+        Outcome::Completed | Outcome::Missed { .. } => path_time::run_note(
+            scenario.trajectory(),
+            scenario.steps() as f64 * scenario.period(),
+        ),
+        _ => None,
     }
 }
 
@@ -193,5 +225,11 @@ fn sample_of(
         w_norm: f64::from(out.w_norm),
         payload: 0.0,
         status: out.status,
+        signals: LoopSignals {
+            nu: state.nu.into(),
+            eta_d_dot: reference.eta_dot.into(),
+            eta_d_ddot: reference.eta_ddot.into(),
+            ..LoopSignals::default()
+        },
     }
 }

@@ -1,12 +1,15 @@
 //! The simulated navigation computer: what the law is told of the vehicle's state each period
-//! (the plant's η, ν with the heading as a navigation solution reports it, plus seeded sensor
-//! noise), rounded to f32 as it crosses to the controller.
+//! (the plant's η, ν, or the solution of a `[navigation]` model ([`super::nav_model`]), with
+//! the heading as a navigation solution reports it, plus `[noise]`'s seeded white noise),
+//! rounded to f32 as it crosses to the controller. The same values go to the law wherever it
+//! runs (SIL, PIL, HIL: [`super::ControlSource`]), so PIL = SIL holds with navigation on.
 
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
 
+use super::nav_model::{NavComputer, Solution};
 use crate::plant::PlantState;
-use crate::scenario::SensorNoise;
+use crate::scenario::{SensorNoise, SimConfig};
 
 /// x reduced into (−π, π].
 pub fn wrap_pi(x: f64) -> f64 {
@@ -41,24 +44,56 @@ pub fn reported_heading(psi: f64) -> f64 {
 /// ([`reported_heading`]).
 pub const HEADING_REPORT_BOUND: f64 = 4.0 * std::f64::consts::PI;
 
-/// The navigation computer of one run: its noise and the noise's generator.
+/// The navigation computer of one run: its model's computer (none: the exact state), its
+/// white noise and the noise's generator.
+///
+/// **Choice 330:** `[noise]` stays what it was, white noise added to what the law is told, now
+/// on top of the `[navigation]` solution; with the `ideal` preset (the default, no sources)
+/// the run is today's bit for bit: the exact state, then the same draws in the same order from
+/// the same seed (docs/navigation.md#noise-and-navigation).
 pub struct Navigation {
+    computer: Option<NavComputer>,
+    last: Option<Solution>,
     noise: Option<SensorNoise>,
     rng: rand::rngs::StdRng,
 }
 
 impl Navigation {
-    /// A navigation with `noise` (seeded from it), or exact.
+    /// A navigation with `noise` (seeded from it) over the exact state.
     pub fn new(noise: Option<&SensorNoise>) -> Self {
         Navigation {
+            computer: None,
+            last: None,
             noise: noise.cloned(),
             rng: rand::rngs::StdRng::seed_from_u64(noise.map_or(0, |n| n.seed)),
         }
     }
 
-    /// The measured η, ν the controller is given, in f32.
+    /// The navigation of a run of `cfg`: its `[navigation]` model and its `[noise]`.
+    pub fn of(cfg: &SimConfig) -> Self {
+        let mut n = Navigation::new(cfg.noise.as_ref());
+        n.computer = cfg
+            .navigation
+            .as_ref()
+            .map(|m| NavComputer::new(m, f64::from(cfg.controller.rate_hz)));
+        n
+    }
+
+    /// The model's solution of the last period measured (`None` without a model).
+    pub fn solution(&self) -> Option<&Solution> {
+        self.last.as_ref()
+    }
+
+    /// The measured η, ν the controller is given, in f32 (one call per control period, in
+    /// order).
     pub fn measure(&mut self, state: &PlantState) -> ([f32; 6], [f32; 6]) {
         let (mut eta, mut nu) = (state.eta, state.nu);
+        if let Some(c) = &mut self.computer {
+            let s = c.step(&eta.into(), &nu.into());
+            self.last = Some(s);
+            eta = s.eta.into();
+            nu = s.nu.into();
+        }
         eta[5] = reported_heading(eta[5]);
         if let Some(n) = &self.noise {
             for i in 0..6 {

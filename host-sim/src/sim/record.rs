@@ -8,6 +8,8 @@ use controller_core::effectiveness::THRUSTERS;
 use controller_core::{Status, Table1Case};
 use serde::{Deserialize, Serialize};
 
+use super::chatter::Chatter;
+
 /// What produced a control period's output, and its state: the core's own [`Status`] when the
 /// law runs on the host (SIL), the board's [`BoardStatus`] when it runs on the board (PIL).
 ///
@@ -84,6 +86,29 @@ pub struct Sample {
     pub payload: f64,
     /// Controller status: ok, or why the thrusters are off.
     pub status: ControlStatus,
+    /// What the loop had besides the CSV's columns (the flight log has them:
+    /// docs/logs.md#channels).
+    pub signals: LoopSignals,
+}
+
+/// The rest of a control period's signals, which the flight log records and the CSV does not
+/// ([`crate::output::log`]): the plant's body velocities, the state the law was told, the
+/// reference's derivatives and the thrust each thruster was driven towards.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize)]
+pub struct LoopSignals {
+    /// True body velocities ν (m/s, rad/s).
+    pub nu: [f64; 6],
+    /// η as the navigation told the law, in f32 as it crossed ([`super::navigation`]).
+    pub eta_told: [f32; 6],
+    /// ν as the navigation told the law.
+    pub nu_told: [f32; 6],
+    /// η̇_d this period.
+    pub eta_d_dot: [f32; 6],
+    /// η̈_d this period.
+    pub eta_d_ddot: [f32; 6],
+    /// The thrust each thruster was driven towards this period (N; before the lag), order of
+    /// [`Sample::thrust`].
+    pub thrust_demand: [f64; THRUSTERS],
 }
 
 /// How a run ended.
@@ -246,6 +271,18 @@ pub struct Metrics {
     /// Fraction of control periods with at least one thruster saturated.
     #[serde(deserialize_with = "nan_if_null")]
     pub saturated_fraction: f64,
+    /// Sign reversals per second through ±0.5 V of the thruster that reverses most (1/s;
+    /// [`super::chatter`], Choice 320).
+    #[serde(deserialize_with = "nan_if_null")]
+    pub reversals_per_s: f64,
+    /// Total variation per second of the command that varies most (V/s).
+    #[serde(deserialize_with = "nan_if_null")]
+    pub command_tv: f64,
+    /// The largest share of a thruster's command power above its corner frequency (Choice 321).
+    #[serde(deserialize_with = "nan_if_null")]
+    pub hf_share: f64,
+    /// The three chatter figures of each thruster (the three above are their worst).
+    pub chatter: Chatter,
 }
 
 impl Metrics {
@@ -261,11 +298,16 @@ impl Metrics {
         max_yaw: f64::NAN,
         peak_voltage: f64::NAN,
         saturated_fraction: f64::NAN,
+        reversals_per_s: f64::NAN,
+        command_tv: f64::NAN,
+        hf_share: f64::NAN,
+        chatter: Chatter::NONE,
     };
 
     /// The metrics' names, as the JSON, the CSVs and the campaign files write them, in the
     /// order of [`Metrics::values`] (the field order; a test ties the two to serde's names).
-    pub const NAMES: [&'static str; 10] = [
+    /// The per-thruster [`Metrics::chatter`] is not among them (it is not one number).
+    pub const NAMES: [&'static str; 13] = [
         "max_x",
         "max_y",
         "max_z",
@@ -276,10 +318,13 @@ impl Metrics {
         "max_yaw",
         "peak_voltage",
         "saturated_fraction",
+        "reversals_per_s",
+        "command_tv",
+        "hf_share",
     ];
 
     /// The metrics in the order of [`Metrics::NAMES`].
-    pub fn values(&self) -> [f64; 10] {
+    pub fn values(&self) -> [f64; 13] {
         [
             self.max_x,
             self.max_y,
@@ -291,6 +336,9 @@ impl Metrics {
             self.max_yaw,
             self.peak_voltage,
             self.saturated_fraction,
+            self.reversals_per_s,
+            self.command_tv,
+            self.hf_share,
         ]
     }
 
@@ -301,7 +349,7 @@ impl Metrics {
 }
 
 /// A metric as JSON has it: a number, or `null` for none (NaN).
-fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
+pub(crate) fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> Result<f64, D::Error> {
     Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
 }
 
@@ -324,6 +372,9 @@ pub struct RunResult {
     /// The scenario expects to miss its bound ([`crate::scenario::SimConfig::expect_missed`]):
     /// the miss is reported but does not fail the command.
     pub miss_expected: bool,
+    /// A waypoint run whose end is not its path's: the waypoints it never reached, or how long
+    /// before it the path ended ([`crate::scenario::path_time::run_note`], Choice 312).
+    pub path: Option<String>,
     /// The samples the plots draw: every sample of a run of at most
     /// [`super::decimate::PLOT_SAMPLES`] periods, else a decimated series (see
     /// [`super::decimate`]). The CSV has every period (it is written as the run goes).
@@ -366,6 +417,9 @@ pub struct RunSummary {
     /// Whether the scenario expected faults.
     #[serde(default)]
     pub faults_expected: bool,
+    /// A waypoint run whose end is not its path's ([`RunResult::path`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<String>,
 }
 
 /// When and why a run stopped early ([`Outcome::Diverged`]).
@@ -416,6 +470,7 @@ impl RunResult {
             miss_expected: self.miss_expected,
             faults: self.faults.clone(),
             faults_expected: self.faults_expected,
+            path: self.path.clone(),
         }
     }
 
@@ -504,6 +559,7 @@ mod tests {
             faults: FaultCounts::default(),
             faults_expected: false,
             miss_expected: false,
+            path: None,
             samples: Vec::new(),
             plant_factorisations: 0,
         };
@@ -524,7 +580,8 @@ mod tests {
     }
 
     /// The name table is the struct's: each name is the key serde writes for the value at the
-    /// same index (ten distinct values, so a swapped or misspelt name cannot pass).
+    /// same index (distinct values, so a swapped or misspelt name cannot pass); the only other
+    /// key is the per-thruster `chatter`.
     #[test]
     fn metric_names_are_the_json_keys_in_the_order_of_values() {
         let m = Metrics {
@@ -538,10 +595,15 @@ mod tests {
             max_yaw: 8.0,
             peak_voltage: 9.0,
             saturated_fraction: 10.0,
+            reversals_per_s: 11.0,
+            command_tv: 12.0,
+            hf_share: 13.0,
+            chatter: Chatter::NONE,
         };
         let json = serde_json::to_value(m).expect("metrics serialise");
         let object = json.as_object().expect("an object");
-        assert_eq!(object.len(), Metrics::NAMES.len());
+        assert_eq!(object.len(), Metrics::NAMES.len() + 1);
+        assert!(object["chatter"].is_object());
         for (name, value) in Metrics::NAMES.iter().zip(m.values()) {
             assert_eq!(object[*name].as_f64(), Some(value), "{name}");
         }

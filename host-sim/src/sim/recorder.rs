@@ -28,12 +28,17 @@ pub struct Recorder<'o> {
 }
 
 impl<'o> Recorder<'o> {
-    /// A recorder for a run of `periods` control periods.
-    pub fn new(observer: &'o mut dyn Observer, recording: Recording, periods: u64) -> Self {
+    /// A recorder for a run of `periods` control periods whose metrics `metrics` accumulates.
+    pub fn new(
+        observer: &'o mut dyn Observer,
+        recording: Recording,
+        periods: u64,
+        metrics: metrics::Accumulator,
+    ) -> Self {
         Recorder {
             observer,
             plot: (recording == Recording::Plot).then(|| Decimator::new(periods)),
-            metrics: metrics::Accumulator::default(),
+            metrics,
             faults: FaultCounts::default(),
         }
     }

@@ -27,7 +27,8 @@ use crate::scenario::{Scenario, ScenarioError};
 use crate::sim::progress::duration_text;
 use crate::sim::{self, LocalController, Metrics, Observer, Recording};
 
-/// Most runs of one Monte Carlo without the explicit override (`--allow-long-run`).
+/// Most runs of one Monte Carlo, and most random missions of `validate-preflight` (Choice
+/// 303), without the explicit override (`--allow-long-run`).
 pub const MAX_RUNS: usize = 10_000;
 
 /// Simulated time of the calibration run of [`estimate`] (s), or the base's duration if

@@ -10,9 +10,10 @@
 //! makes a team fly).
 //!
 //! The missions: the Table-1 paths of `scenarios/real/` under each thruster mounting of a
-//! list ([`matrix`]: the AUV-150 layout's reversed-thruster masks), and random missions
-//! ([`random`]: path kind, size, speed, mounting, a payload inside the box with a constant,
-//! abs-sin or staircase profile, a constant current), each deterministic from (seed, index).
+//! list (the AUV-150 layout's reversed-thruster masks), and random missions (path kind, size,
+//! speed, mounting, a payload inside the box with a constant, abs-sin or staircase profile, a
+//! constant current), each deterministic from (seed, index) and made when it is flown
+//! ([`Missions`]).
 
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
 use controller_core::trajectory::{Circle, FigureEight, LawnMower};
@@ -64,11 +65,50 @@ impl Default for Campaign {
 }
 
 impl Campaign {
-    /// Its missions: the matrix, then the random ones.
-    pub fn missions(&self) -> Result<Vec<Scenario>, ScenarioError> {
-        let mut out = matrix(&self.masks)?;
-        out.extend(random(self.random, self.seed)?);
-        Ok(out)
+    /// Its missions, made one at a time as they are flown ([`Missions::get`]): the matrix,
+    /// then the random ones. Only the six real scenarios are read here, so the memory does not
+    /// grow with [`Campaign::random`] (**Choice 303**).
+    pub fn missions(&self) -> Result<Missions<'_>, ScenarioError> {
+        Ok(Missions {
+            campaign: self,
+            real: real_vehicle::real_scenarios()?,
+        })
+    }
+}
+
+/// A campaign's missions, by index: mission i is made when it is asked for (the matrix's
+/// real path i mod 6 under mounting i / 6, then random mission i − matrix), deterministic
+/// from the campaign alone.
+#[derive(Clone, Debug)]
+pub struct Missions<'a> {
+    campaign: &'a Campaign,
+    real: Vec<Scenario>,
+}
+
+impl Missions<'_> {
+    /// How many: the real paths under each mounting, and the random ones.
+    pub fn len(&self) -> usize {
+        self.matrix_len() + self.campaign.random
+    }
+
+    /// Whether there are none.
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    fn matrix_len(&self) -> usize {
+        self.campaign.masks.len() * self.real.len()
+    }
+
+    /// Mission `i` (< [`Missions::len`]).
+    pub fn get(&self, i: usize) -> Result<Scenario, ScenarioError> {
+        match i.checked_sub(self.matrix_len()) {
+            None => matrix_mission(
+                &self.real[i % self.real.len()],
+                self.campaign.masks[i / self.real.len()],
+            ),
+            Some(r) => random_mission(&self.real[0], self.campaign.seed, r),
+        }
     }
 }
 
@@ -134,34 +174,23 @@ pub struct Validation {
     pub partial: bool,
 }
 
-/// The six real missions of `scenarios/real/` under each mounting of `masks`.
-pub fn matrix(masks: &[u8]) -> Result<Vec<Scenario>, ScenarioError> {
-    let real = real_vehicle::real_scenarios()?;
-    let mut out = Vec::with_capacity(masks.len() * real.len());
-    for &mask in masks {
-        for s in &real {
-            out.push(s.with(|c| {
-                c.name = format!("{}-m{mask:02}", c.name);
-                c.controller.geometry = ThrusterGeometry::auv150(mask);
-                // The file's time scale is its own mounting's; the campaign asks anew.
-                c.duration /= f64::from(c.time_scale);
-                c.time_scale = 1.0;
-            })?);
-        }
-    }
-    Ok(out)
+/// The real mission `s` under the mounting `mask`, at time scale 1.
+fn matrix_mission(s: &Scenario, mask: u8) -> Result<Scenario, ScenarioError> {
+    s.with(|c| {
+        c.name = format!("{}-m{mask:02}", c.name);
+        c.controller.geometry = ThrusterGeometry::auv150(mask);
+        // The file's time scale is its own mounting's; the campaign asks anew.
+        c.duration /= f64::from(c.time_scale);
+        c.time_scale = 1.0;
+    })
 }
 
-/// `n` random missions from `seed` (see the module docs); mission i depends only on
-/// (seed, i). A draw the core refuses (a tangent heading too slow somewhere) is drawn again.
-pub fn random(n: usize, seed: u64) -> Result<Vec<Scenario>, ScenarioError> {
-    (0..n).map(|i| random_mission(seed, i)).collect()
-}
-
-fn random_mission(seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
+/// Random mission `i` of `seed`, on the first real mission `base` (see the module docs): it
+/// depends only on (seed, i). A draw the core refuses (a tangent heading too slow somewhere)
+/// is drawn again.
+fn random_mission(base: &Scenario, seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
     let mut rng =
         rand::rngs::StdRng::seed_from_u64(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
-    let base = real_vehicle::real_scenarios()?.remove(0);
     loop {
         let speed = 0.5 + 2.0 * rng.random::<f64>();
         let kinds = random_kinds();
@@ -350,20 +379,23 @@ fn smallest_flying(
     Ok(hi)
 }
 
-/// The campaign over `missions`, in parallel; `on_done` is called after each mission.
+/// The campaign over `missions`, in parallel, each mission made when its turn comes (a stop
+/// requested, [`crate::interrupt`], is seen before each is made: Choice 303); `on_done` is
+/// called after each mission.
 pub fn validate(
-    missions: &[Scenario],
+    missions: &Missions<'_>,
     margin: f64,
     measure: Measure,
     on_done: impl Fn() + Sync,
 ) -> Result<Validation, String> {
-    let results: Result<Vec<Option<MissionResult>>, String> = missions
-        .par_iter()
-        .map(|m| {
+    let results: Result<Vec<Option<MissionResult>>, String> = (0..missions.len())
+        .into_par_iter()
+        .map(|i| {
             if interrupt::requested() {
                 return Ok(None);
             }
-            let r = validate_one(m, margin, measure);
+            let m = missions.get(i).map_err(|e| e.to_string())?;
+            let r = validate_one(&m, margin, measure);
             on_done();
             r
         })

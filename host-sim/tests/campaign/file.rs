@@ -95,6 +95,31 @@ fn a_bad_campaign_file_is_refused_naming_the_key() {
     assert!(err.contains("base.toml") && err.contains("radios"), "{err}");
 }
 
+/// A bad `draw.initial_offset` used to be refused with f64::MAX written out (309 digits) as
+/// the positions' limit, and the value as given (`-1e308`: 309 digits more): the message names
+/// the entry, its range and the value, readable.
+#[test]
+fn a_bad_initial_offset_is_refused_in_a_readable_line() {
+    let dir = tempdir("offset-digits");
+    for (offset, key) in [
+        (
+            "[-1e308, 0.02, 0.02, 0.0, 0.0, 0.02]",
+            "`draw.initial_offset[0]`",
+        ),
+        (
+            "[0.02, 0.02, 0.02, 0.0, 4.0, 0.02]",
+            "`draw.initial_offset[4]`",
+        ),
+    ] {
+        let text = campaign_text(5, 1).replace("[0.02, 0.02, 0.02, 0.0, 0.0, 0.02]", offset);
+        let file = write_campaign(&dir, &text);
+        let (code, err) = refused(&run_shard(&file, "0/1", &dir.join("out")));
+        assert_eq!(code, Some(2), "{err}");
+        assert!(err.contains(key), "{err}");
+        assert!(err.lines().all(|l| l.len() < 200), "{err}");
+    }
+}
+
 #[test]
 fn a_metric_listed_twice_is_refused() {
     let dir = tempdir("metric-twice");

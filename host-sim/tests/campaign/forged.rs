@@ -108,6 +108,15 @@ fn an_outcome_that_its_metrics_contradict_is_refused() {
     let (code, err) = shards.merge_edited("beyond", |s| edit_record(&s[k], run, "max_path", "0.5"));
     assert_eq!(code, Some(2), "{err}");
     assert!(err.contains(&format!("run {run} ")), "{err}");
+    // … or beyond its chatter limit (100 reversals/s), by the worst thruster's figure.
+    let (code, err) = shards.merge_edited("chatter", |s| {
+        edit_record(&s[k], run, "reversals_per_s", "150")
+    });
+    assert_eq!(code, Some(2), "{err}");
+    assert!(
+        err.contains(&format!("run {run} ")) && err.contains("reverses 150.0 times/s"),
+        "{err}"
+    );
     let (code, err) =
         shards.merge_edited("missed", |s| edit_record(&s[k], run, "outcome", "missed"));
     assert_eq!(code, Some(2), "{err}");

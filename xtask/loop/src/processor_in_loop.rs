@@ -19,6 +19,7 @@ use controller_core::HeadingMode;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 use host_sim::board::{BoardComparison, FailSafeEventKind};
 use host_sim::cli::Cases;
+use host_sim::output::log;
 use xtask::ci::{Ci, HOST_PROFILE};
 
 /// The key the signed runs use (workspace-relative): public, for tests only.
@@ -183,6 +184,7 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
         );
         whole_counts(ci, name, &c);
         bit_for_bit(ci, name, ok, &c);
+        whole_flight(ci, pil, name, &c);
         if let Some((unit, mounting)) = want_chain {
             chain_taken(ci, name, unit, *mounting, &c);
         }
@@ -190,6 +192,32 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
         if name == "waypoints" {
             upload_resent(ci, name, &c);
         }
+    }
+}
+
+/// PIL = SIL on the whole flight, not only its metrics: `host-sim diff` finds the board's
+/// flight log (its telemetry in the log's channels, source `pil`) the same as SIL's, every
+/// series at every period (docs/logs.md#the-board-in-the-same-channels).
+fn whole_flight(ci: &mut Ci, pil: &Pil, name: &str, c: &BoardComparison) {
+    let out = ci.scratch().join(format!("pil-{name}"));
+    let sil = out.join(log::sil_log_name(&c.run.name));
+    let board = out.join(log::log_name(&c.run.name, c.run.robust));
+    let output = Command::new(pil.host_sim)
+        .arg("diff")
+        .arg(&sil)
+        .arg(&board)
+        .arg("--out")
+        .arg(ci.scratch().join(format!("pil-{name}-diff")))
+        .output();
+    match output {
+        Ok(o) if o.status.success() => println!("{name}: diff of the flight logs: the same"),
+        Ok(o) => ci.fail(format!(
+            "PIL {name}: the board's flight log differs from SIL's (host-sim diff exited {}):\n{}{}",
+            o.status,
+            String::from_utf8_lossy(&o.stdout),
+            String::from_utf8_lossy(&o.stderr)
+        )),
+        Err(e) => ci.fail(format!("PIL {name}: running host-sim diff: {e}")),
     }
 }
 

@@ -80,12 +80,19 @@ macro_rules! path_kinds {
                 /// `points = [[x, y, z], …]`.
                 points: WaypointList,
                 /// σ̇, the path speed on the legs (m/s; slower in the turns).
+                #[cfg_attr(
+                    feature = "serde",
+                    serde(deserialize_with = "waypoint_path::narrow_speed")
+                )]
                 speed: f32,
                 /// The smallest radius of a turn (m); `None`: speed²/[`TURN_ACCEL`]
                 /// (Choice 151).
                 ///
                 /// [`TURN_ACCEL`]: crate::trajectory::TURN_ACCEL
-                #[cfg_attr(feature = "serde", serde(default))]
+                #[cfg_attr(
+                    feature = "serde",
+                    serde(default, deserialize_with = "waypoint_path::narrow_turn_radius")
+                )]
                 turn_radius: Option<f32>,
                 /// The time law: a speed per leg and turn in path order (m/s; Choice 156), the
                 /// profile `host-sim check` proposes; `None`: `speed` everywhere.
@@ -95,7 +102,10 @@ macro_rules! path_kinds {
                 /// [`DEFAULT_SPEED_CHANGE`].
                 ///
                 /// [`DEFAULT_SPEED_CHANGE`]: crate::trajectory::DEFAULT_SPEED_CHANGE
-                #[cfg_attr(feature = "serde", serde(default))]
+                #[cfg_attr(
+                    feature = "serde",
+                    serde(default, deserialize_with = "waypoint_path::narrow_speed_change")
+                )]
                 speed_change: Option<f32>,
             },
         }

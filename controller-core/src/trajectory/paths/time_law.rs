@@ -130,8 +130,14 @@ impl TimeLaw {
                 expected: parts,
             });
         }
-        for &v in speeds.as_slice() {
-            positive("speeds", v, MAX_SPEED)?;
+        for (part, &value) in speeds.as_slice().iter().enumerate() {
+            // The error names the part (Choice 315).
+            if !value.is_finite() {
+                return Err(TrajectoryError::SpeedNotFinite { part });
+            }
+            if positive("speeds", value, MAX_SPEED).is_err() {
+                return Err(TrajectoryError::BadSpeed { part, value });
+            }
         }
         let v = |i: usize| speeds.as_slice()[route.segment_part(i)];
         let mut t = 0.0f32;
@@ -214,6 +220,49 @@ impl TimeLaw {
             }
         }
         self.duration
+    }
+
+    /// The time (s, at time scale 1) at which the path parameter reaches `sigma` (m): the
+    /// inverse of σ(t), at configuration time (Choice 311). On a cruise it is exact,
+    /// t₀ + (σ − σ₀)/v; in a speed change σ(τ) is monotone (σ̇ > 0) and τ is found by a fixed
+    /// 40-step bisection; beyond the end the path goes on at the last piece's final speed.
+    /// 0 for an empty law.
+    pub fn time_at(&self, route: &Route, sigma: f32) -> f32 {
+        let count = self.count as usize;
+        if count == 0 {
+            return 0.0;
+        }
+        let (segment, start) = route.locate(sigma);
+        let Some(segment) = segment else {
+            let last = &self.pieces[count - 1];
+            return self.duration + (sigma - route.length()) / (last.v0 + last.dv);
+        };
+        let local = sigma - start;
+        let mut piece = &self.pieces[0];
+        for p in &self.pieces[..count] {
+            if p.segment as usize == segment && p.local0 <= local {
+                piece = p;
+            }
+        }
+        let along = local - piece.local0;
+        if piece.inv_dur == 0.0 {
+            return piece.t0 + along / piece.v0;
+        }
+        let (v0, dv, w) = (piece.v0, piece.dv, piece.inv_dur);
+        let covered = |tau: f32| {
+            let t2 = tau * tau;
+            (v0 * tau + dv * t2 * t2 * (2.5 + tau * (-3.0 + tau))) / w
+        };
+        let (mut lo, mut hi) = (0.0f32, 1.0f32);
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if covered(mid) < along {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        piece.t0 + 0.5 * (lo + hi) / w
     }
 
     /// The largest σ̇ on segment `i` (its own speed: changes happen in the faster part).
@@ -378,13 +427,26 @@ impl<'de> serde::Deserialize<'de> for SpeedList {
                     len: 0,
                     speeds: [0.0; MAX_PARTS],
                 };
-                while let Some(v) = seq.next_element::<f32>()? {
-                    if list.len as usize == MAX_PARTS {
+                while let Some(v) = seq.next_element::<f64>()? {
+                    let part = list.len as usize;
+                    if part == MAX_PARTS {
                         return Err(serde::de::Error::custom(format_args!(
                             "more than {MAX_PARTS} speeds"
                         )));
                     }
-                    list.speeds[list.len as usize] = v;
+                    // A number an f32 cannot hold is refused as itself, naming the part
+                    // (Choice 315), not as the infinity or the 0 it would become.
+                    let narrow = v as f32;
+                    if (v.is_finite() && !narrow.is_finite()) || (v != 0.0 && narrow == 0.0) {
+                        return Err(serde::de::Error::custom(
+                            TrajectoryError::BadSpeed {
+                                part,
+                                value: narrow,
+                            }
+                            .narrowed(v),
+                        ));
+                    }
+                    list.speeds[part] = narrow;
                     list.len += 1;
                 }
                 Ok(list)

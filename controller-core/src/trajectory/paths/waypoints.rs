@@ -120,6 +120,35 @@ pub(crate) struct Segment {
     e: [f32; 3],
 }
 
+/// Points of the scan in [`Route::heading_accel_peaks`].
+const PEAK_SCAN: u32 = 256;
+
+/// A blend's horizontal tangent h(s) = h_in + s·Δh (Choice 314): 1/L, |h_in|², h_in·Δh,
+/// |Δh|² and C = h_in × Δh.
+struct BlendGeometry {
+    inv_len: f32,
+    h2: f32,
+    dot: f32,
+    dh2: f32,
+    c: f32,
+}
+
+impl BlendGeometry {
+    /// D(s) = |h_in + s·Δh|².
+    fn d(&self, s: f32) -> f32 {
+        self.h2 + s * (2.0 * self.dot + s * self.dh2)
+    }
+
+    /// The smallest D on s ∈ [0, 1] (a quadratic: at s* = −h_in·Δh/|Δh|², clamped).
+    fn d_min(&self) -> f32 {
+        let s = match self.dh2 > 0.0 {
+            true => (-self.dot / self.dh2).clamp(0.0, 1.0),
+            false => 0.0,
+        };
+        self.d(s)
+    }
+}
+
 /// An unused segment (all zeros).
 const NO_SEGMENT: Segment = Segment {
     s0: 0.0,
@@ -171,22 +200,16 @@ fn length(v: [f32; 3]) -> f32 {
     math::exact_sqrt(dot(v, v))
 }
 
-/// Every coordinate finite and within ±[`MAX_COORDINATE`] (parameter `points`).
+/// Every coordinate finite and within ±[`MAX_COORDINATE`] (parameter `points`; the error
+/// names the waypoint and the coordinate, Choice 315).
 fn check_points(pts: &[[f32; 3]]) -> Result<(), TrajectoryError> {
-    for p in pts {
-        for &c in p {
-            if !c.is_finite() {
-                return Err(TrajectoryError::NonFinite {
-                    parameter: "points",
-                });
+    for (index, p) in pts.iter().enumerate() {
+        for (axis, &value) in p.iter().enumerate() {
+            if !value.is_finite() {
+                return Err(TrajectoryError::PointNotFinite { index, axis });
             }
-            if c.abs() > MAX_COORDINATE {
-                return Err(TrajectoryError::OutOfRange {
-                    parameter: "points",
-                    value: c,
-                    min: -MAX_COORDINATE,
-                    max: MAX_COORDINATE,
-                });
+            if value.abs() > MAX_COORDINATE {
+                return Err(TrajectoryError::BadPoint { index, axis, value });
             }
         }
     }
@@ -366,6 +389,29 @@ impl Route {
         self.turns[i]
     }
 
+    /// The number of waypoints the route was built from (0 for an empty route): the last
+    /// segment is the last leg, n − 2, whose part is 2(n − 2).
+    pub fn waypoint_count(&self) -> usize {
+        match self.count {
+            0 => 0,
+            n => self.segments[n as usize - 1].part as usize / 2 + 2,
+        }
+    }
+
+    /// The path parameter σ (m) at which the path passes waypoint `i` nearest (Choice 311): 0
+    /// at the first, the path's length at the last, the middle of the blend (its start plus
+    /// the cut a, where the waypoint is passed at [`Route::miss`]) at an inner one.
+    pub fn passing(&self, i: usize) -> f32 {
+        if i == 0 {
+            return 0.0;
+        }
+        let turn = (2 * i - 1) as u8;
+        self.segments[..self.count as usize]
+            .iter()
+            .find(|s| s.part == turn)
+            .map_or(self.length, |s| s.s0 + self.cuts[i])
+    }
+
     /// The distance at which the path passes waypoint `i` (m): (5/16)·a·sin(Δ/2), 0 at the
     /// first and the last.
     pub fn miss(&self, i: usize) -> f32 {
@@ -384,6 +430,106 @@ impl Route {
             libm::cosf(0.5 * self.turns[i]),
         );
         15.0 / 8.0 * s / (a * c * c)
+    }
+
+    /// The tangent heading on segment `i` in closed form (Choice 314): its first two
+    /// derivatives with respect to σ, (ψ′, ψ″), at `local` = σ − the segment's start (0 on a
+    /// leg; at σ̇ = v, σ̈ = 0 the heading's rate is ψ′v and its acceleration ψ″v²). On a blend
+    /// the horizontal tangent is h(s) = h_in + s·Δh with s = q′(u)/2 ∈ [0, 1] (u = local/L,
+    /// Δh = h_out − h_in), so with C = h_in × Δh, D(s) = |h(s)|², s′ = q″(u)/(2L) and
+    /// s″ = q‴(u)/(2L²):
+    ///
+    /// ψ′ = C·s′/D,  ψ″ = C·s″/D − C·D′(s)·s′²/D²,  D′(s) = 2 h_in·Δh + 2s|Δh|².
+    pub fn heading_derivatives(&self, i: usize, local: f32) -> (f32, f32) {
+        let Some(b) = self.blend(i) else {
+            return (0.0, 0.0);
+        };
+        let u = local * b.inv_len;
+        let w = u * (1.0 - u);
+        let s = 0.5 * u * u * u * (20.0 + u * (-30.0 + 12.0 * u));
+        let s1 = 30.0 * w * w * b.inv_len;
+        let s2 = 60.0 * w * (1.0 - 2.0 * u) * b.inv_len * b.inv_len;
+        let d = b.d(s);
+        let dd = 2.0 * (b.dot + s * b.dh2);
+        (b.c * s1 / d, b.c * s2 / d - b.c * dd * s1 * s1 / (d * d))
+    }
+
+    /// A bound on |ψ′| over blend `i` in closed form (Choice 314; 0 on a leg):
+    /// |C|/D_min · 15/(8L), the largest s′ (q″(½)/(2L)) over the smallest |h|². Exact for a
+    /// level corner, where both are at the middle: (15/8)·tan(Δ/2)/a, ≤ cos(Δ/2)/R by the
+    /// corner rule (Choice 151), so a blend flown at speed v turns the heading at most at v/R.
+    pub fn peak_heading_rate(&self, i: usize) -> f32 {
+        match self.blend(i) {
+            Some(b) => libm::fabsf(b.c) / b.d_min() * (15.0 / 8.0) * b.inv_len,
+            None => 0.0,
+        }
+    }
+
+    /// The largest |ψ″| over blend `i` (Choice 314; 0 on a leg): the closed form
+    /// ([`Route::heading_derivatives`]) at the peaks [`Route::heading_accel_peaks`] finds.
+    /// (Each factor at its own largest would bound it too, but 3× high at 90°: at a level
+    /// 90° corner the peak is 0.451/R², the bound 1.41/R².)
+    pub fn peak_heading_accel(&self, i: usize) -> f32 {
+        let [up, down] = self.heading_accel_peaks(i);
+        libm::fabsf(self.heading_derivatives(i, up).1)
+            .max(libm::fabsf(self.heading_derivatives(i, down).1))
+    }
+
+    /// Where on blend `i` the heading's acceleration is largest (Choice 314): the local σ of
+    /// the largest and of the smallest ψ″ ([`Route::heading_derivatives`]), found on the closed
+    /// form by a scan of [`PEAK_SCAN`] points and a golden-section refinement around each;
+    /// `[0, 0]` on a leg. Configuration-time work, for the host's preflight.
+    pub fn heading_accel_peaks(&self, i: usize) -> [f32; 2] {
+        let Some(b) = self.blend(i) else {
+            return [0.0; 2];
+        };
+        let len = 1.0 / b.inv_len;
+        let at = |u: f32| self.heading_derivatives(i, u * len).1;
+        let mut best = [(0.0f32, f32::NEG_INFINITY), (0.0f32, f32::NEG_INFINITY)];
+        for j in 0..=PEAK_SCAN {
+            let u = j as f32 / PEAK_SCAN as f32;
+            let v = at(u);
+            if v > best[0].1 {
+                best[0] = (u, v);
+            }
+            if -v > best[1].1 {
+                best[1] = (u, -v);
+            }
+        }
+        let step = 1.0 / PEAK_SCAN as f32;
+        let refine = |u0: f32, sign: f32| {
+            let (mut lo, mut hi) = ((u0 - step).max(0.0), (u0 + step).min(1.0));
+            const G: f32 = 0.618_034;
+            for _ in 0..30 {
+                let (m1, m2) = (hi - G * (hi - lo), lo + G * (hi - lo));
+                if sign * at(m1) >= sign * at(m2) {
+                    hi = m2;
+                } else {
+                    lo = m1;
+                }
+            }
+            0.5 * (lo + hi) * len
+        };
+        [refine(best[0].0, 1.0), refine(best[1].0, -1.0)]
+    }
+
+    /// The horizontal geometry of blend `i`, `None` for a leg or an index past the end.
+    fn blend(&self, i: usize) -> Option<BlendGeometry> {
+        let seg = self.segments[..self.count as usize].get(i)?;
+        if seg.part % 2 == 0 {
+            return None;
+        }
+        // u_out − u_in = e/a = 2e/L.
+        let k = 2.0 * seg.inv_len;
+        let (hx, hy) = (seg.dir[0], seg.dir[1]);
+        let (dx, dy) = (seg.e[0] * k, seg.e[1] * k);
+        Some(BlendGeometry {
+            inv_len: seg.inv_len,
+            h2: hx * hx + hy * hy,
+            dot: hx * dx + hy * dy,
+            dh2: dx * dx + dy * dy,
+            c: hx * dy - hy * dx,
+        })
     }
 
     /// The index of the segment holding σ: the last whose start is ≤ σ, by a binary search of
@@ -568,13 +714,28 @@ impl<'de> serde::Deserialize<'de> for WaypointList {
                     len: 0,
                     points: [[0.0; 3]; MAX_WAYPOINTS],
                 };
-                while let Some(p) = seq.next_element::<[f32; 3]>()? {
-                    if list.len as usize == MAX_WAYPOINTS {
+                while let Some(p) = seq.next_element::<[f64; 3]>()? {
+                    let index = list.len as usize;
+                    if index == MAX_WAYPOINTS {
                         return Err(serde::de::Error::custom(format_args!(
                             "more than {MAX_WAYPOINTS} waypoints"
                         )));
                     }
-                    list.points[list.len as usize] = p;
+                    for (axis, &v) in p.iter().enumerate() {
+                        // A number beyond an f32 is refused as itself, naming the point
+                        // (Choice 315), not as the infinity it would become.
+                        if v.is_finite() && !(v as f32).is_finite() {
+                            return Err(serde::de::Error::custom(
+                                TrajectoryError::BadPoint {
+                                    index,
+                                    axis,
+                                    value: v as f32,
+                                }
+                                .narrowed(v),
+                            ));
+                        }
+                        list.points[index][axis] = v as f32;
+                    }
                     list.len += 1;
                 }
                 Ok(list)

@@ -9,7 +9,7 @@
 //! bases = ["circle.toml"]      # one or more scenario files, relative to this file; run i
 //!                              # flies base ⌊i·B/runs⌋ (B bases: equal blocks of indices)
 //! metrics = ["max_path", "rms_path"]  # reported metrics, the first is "the error" of the
-//!                              # scatter plots; default all ten (METRIC_NAMES)
+//!                              # scatter plots; default all (METRIC_NAMES)
 //!
 //! [draw]                       # what each run draws; a key left out draws nothing
 //! parameters = "uniform"       # "uniform" in the Table-3 box | "corners" of it | "none"
@@ -24,6 +24,8 @@
 //! [bound]                      # replaces each base's bound; default: each base's own
 //! max_path = 0.05              # m, > 0
 //! saturated = 0.01             # fraction of periods, [0, 1]
+//! max_reversals_per_s = 2.0    # 1/s, ≥ 0: any thruster's sign reversals through ±0.5 V
+//! max_command_tv = 100.0       # V/s, ≥ 0: any thruster's command total variation
 //! fraction = 0.99              # `campaign merge` exits 4 when fewer runs are within bound;
 //!                              # default: no such verdict (exit 0)
 //! ```
@@ -35,6 +37,7 @@
 use std::path::{Path, PathBuf};
 
 use controller_core::effectiveness::THRUSTER_NAMES;
+use controller_core::readable::Readable;
 use serde::{Deserialize, Serialize};
 
 use super::METRIC_NAMES;
@@ -148,6 +151,8 @@ impl Default for DrawSpec {
 pub struct BoundSpec {
     pub max_path: Option<f64>,
     pub saturated: Option<f64>,
+    pub max_reversals_per_s: Option<f64>,
+    pub max_command_tv: Option<f64>,
     pub fraction: Option<f64>,
 }
 
@@ -346,6 +351,8 @@ fn check(spec: &CampaignSpec) -> Result<(), CampaignError> {
     if let Some(b) = &spec.bound {
         positive("bound.max_path", b.max_path)?;
         unit("bound.saturated", b.saturated)?;
+        non_negative("bound.max_reversals_per_s", b.max_reversals_per_s)?;
+        non_negative("bound.max_command_tv", b.max_command_tv)?;
         unit("bound.fraction", b.fraction)?;
     }
     Ok(())
@@ -356,20 +363,29 @@ fn check_draw(d: &DrawSpec) -> Result<(), CampaignError> {
         if !(v.is_finite() && (0.0..=MAX_CURRENT_SPEED).contains(&v)) {
             return Err(invalid(
                 "draw.current",
-                format!("must be a speed in [0, {MAX_CURRENT_SPEED}] m/s, got {v}"),
+                format!(
+                    "must be a speed in [0, {MAX_CURRENT_SPEED}] m/s, got {}",
+                    Readable(v)
+                ),
             ));
         }
     }
     if let Some(w) = d.initial_offset {
         // Roll and yaw within ±π, pitch inside ±π/2; the sum with the base's offset is checked
-        // by each run's scenario (a run beyond it is recorded `invalid`).
+        // by each run's scenario (a run beyond it is recorded `invalid`). A position's
+        // half-width has no upper limit of its own, and none is printed (it was f64::MAX's
+        // 309 digits).
         use std::f64::consts::{FRAC_PI_2, PI};
-        let limits = [f64::MAX, f64::MAX, f64::MAX, PI, FRAC_PI_2, PI];
+        let limits = [None, None, None, Some(PI), Some(FRAC_PI_2), Some(PI)];
         for (i, (x, lim)) in w.iter().zip(limits).enumerate() {
-            if !(x.is_finite() && *x >= 0.0 && *x <= lim) {
+            if !(x.is_finite() && *x >= 0.0 && lim.is_none_or(|l| *x <= l)) {
+                let range = match lim {
+                    None => "a half-width ≥ 0 m".to_string(),
+                    Some(l) => format!("a half-width in [0, {}] rad", Readable(l)),
+                };
                 return Err(invalid(
                     &format!("draw.initial_offset[{i}]"),
-                    format!("must be a half-width ≥ 0 (and ≤ {lim} for an angle), got {x}"),
+                    format!("must be {range}, got {}", Readable(*x)),
                 ));
             }
         }
@@ -381,7 +397,11 @@ fn check_draw(d: &DrawSpec) -> Result<(), CampaignError> {
         if !(lo.is_finite() && hi.is_finite() && 1.0 <= lo && lo <= hi && hi <= 100.0) {
             return Err(invalid(
                 "draw.time_scale",
-                format!("must be [lo, hi] with 1 ≤ lo ≤ hi ≤ 100, got [{lo}, {hi}]"),
+                format!(
+                    "must be [lo, hi] with 1 ≤ lo ≤ hi ≤ 100, got [{}, {}]",
+                    Readable(lo),
+                    Readable(hi)
+                ),
             ));
         }
     }
@@ -426,6 +446,16 @@ fn positive(key: &str, v: Option<f64>) -> Result<(), CampaignError> {
     }
 }
 
+fn non_negative(key: &str, v: Option<f64>) -> Result<(), CampaignError> {
+    match v {
+        Some(x) if !(x.is_finite() && x >= 0.0) => Err(invalid(
+            key,
+            format!("must be a finite number ≥ 0, got {x}"),
+        )),
+        _ => Ok(()),
+    }
+}
+
 fn unit(key: &str, v: Option<f64>) -> Result<(), CampaignError> {
     match v {
         Some(x) if !(0.0..=1.0).contains(&x) => {
@@ -440,13 +470,19 @@ impl CampaignSpec {
     /// for a key left out.
     pub fn bound(&self) -> Option<Bound> {
         let b = self.bound.as_ref()?;
-        if b.max_path.is_none() && b.saturated.is_none() {
+        if b.max_path.is_none()
+            && b.saturated.is_none()
+            && b.max_reversals_per_s.is_none()
+            && b.max_command_tv.is_none()
+        {
             return None;
         }
-        Some(Bound {
-            max_path: b.max_path.unwrap_or(Bound::REAL_VEHICLE.max_path),
-            saturated: b.saturated.unwrap_or(Bound::REAL_VEHICLE.saturated),
-        })
+        Some(Bound::with_defaults(
+            b.max_path,
+            b.saturated,
+            b.max_reversals_per_s,
+            b.max_command_tv,
+        ))
     }
 
     /// The least fraction of runs within bound for the merge's verdict.

@@ -325,7 +325,7 @@ fn outcome_problem(c: &Campaign, r: &Record, d: &super::Draw) -> Option<String> 
     }
 }
 
-/// A record's metrics as the bound reads them (the two it holds a run to, by name).
+/// A record's metrics as the bound reads them (the four it holds a run to, by name).
 fn metrics_of(r: &Record) -> crate::sim::Metrics {
     let at = |name: &str| {
         METRIC_NAMES
@@ -336,6 +336,8 @@ fn metrics_of(r: &Record) -> crate::sim::Metrics {
     crate::sim::Metrics {
         max_path: at("max_path"),
         saturated_fraction: at("saturated_fraction"),
+        reversals_per_s: at("reversals_per_s"),
+        command_tv: at("command_tv"),
         ..crate::sim::Metrics::default()
     }
 }

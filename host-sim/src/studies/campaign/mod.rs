@@ -36,7 +36,7 @@ pub use shard::{Done, Shard};
 
 /// The metrics a campaign can report, in the order of the records' columns (the one name
 /// table, [`Metrics::NAMES`]).
-pub const METRIC_NAMES: [&str; 10] = Metrics::NAMES;
+pub const METRIC_NAMES: [&str; 13] = Metrics::NAMES;
 
 /// What run i drew. Everything is drawn for every run, in a fixed order (new keys draw after
 /// the old ones), whether the campaign
@@ -294,10 +294,7 @@ impl Campaign {
         }
         file.trajectory.time_scale = Some(f64::from(d.time_scale));
         if let Some(b) = self.spec.bound() {
-            file.bound = Some(BoundTable {
-                max_path: Some(b.max_path),
-                saturated: Some(b.saturated),
-            });
+            file.bound = Some(BoundTable::from(b));
         }
         let header = format!(
             "# Run {i} of campaign {} (hash {}), written by `host-sim campaign merge`:\n\

@@ -47,7 +47,7 @@ pub struct Record {
     pub base: usize,
     pub draw: Draw,
     /// In the order of [`METRIC_NAMES`].
-    pub metrics: [f64; 10],
+    pub metrics: [f64; METRIC_NAMES.len()],
     /// The controller was in fail-safe in some period.
     pub faulted: bool,
     pub outcome: Outcome,
@@ -121,7 +121,7 @@ impl Record {
             index,
             base,
             draw,
-            metrics: [f64::NAN; 10],
+            metrics: [f64::NAN; METRIC_NAMES.len()],
             faulted: false,
             outcome: Outcome::Invalid,
         }
@@ -175,9 +175,10 @@ impl Record {
         let initial_offset: [f64; 6] = array(|j| num(14 + j))?;
         let time_scale = f[20].parse::<f32>().ok()?;
         let mounting = f[21].parse().ok()?;
-        let metrics: [f64; 10] = array(|j| num(22 + j))?;
-        let faulted = f[32].parse().ok()?;
-        let outcome = *Outcome::ALL.iter().find(|o| o.as_str() == f[33])?;
+        let metrics: [f64; METRIC_NAMES.len()] = array(|j| num(22 + j))?;
+        let after = 22 + METRIC_NAMES.len();
+        let faulted = f[after].parse().ok()?;
+        let outcome = *Outcome::ALL.iter().find(|o| o.as_str() == f[after + 1])?;
         Some(Record {
             index: f[0].parse().ok()?,
             base: f[1].parse().ok()?,

@@ -41,7 +41,7 @@ use controller_core::trajectory::{Route, SpeedList, DEFAULT_SPEED_CHANGE, MAX_SP
 
 use super::sweep::Checker;
 use super::{CheckError, Scope};
-use crate::scenario::{Scenario, SimConfig};
+use crate::scenario::{path_time, Scenario, SimConfig, MAX_DURATION};
 
 /// Every this many samples of the path (0.5 s of path time at 20 Hz) in the per-part search.
 pub const PROFILE_STRIDE: usize = 10;
@@ -217,10 +217,17 @@ fn with_law(
         time_scale: 1.0,
     })
     .map_err(|e| invalid(format!("the profiled mission: {e}")))?;
-    c.duration = match t.time_law().is_set() {
-        true => f64::from(t.time_law().duration()),
-        false => f64::from(t.route().length()) / f64::from(speed),
-    } + extra;
+    // The path's time, refused under the key that sets its pace when no run could fly it:
+    // never under `duration`, which this scenario sets and the file may not have (Choice 312).
+    let path = path_time::path_time(&t).unwrap_or(0.0);
+    if path + extra > MAX_DURATION {
+        let what = match speeds {
+            Some(_) => "with the proposed speed profile",
+            None => "at the planned `speed`, at which check samples the path",
+        };
+        return Err(invalid(path_time::too_long(&t, path, what).to_string()));
+    }
+    c.duration = path + extra;
     Scenario::new(c).map_err(|e| invalid(e.to_string()))
 }
 

@@ -68,6 +68,10 @@ impl CasePlants<'_> {
 pub(super) struct Checker<'a> {
     scenario: &'a Scenario,
     samples: Vec<PathSample>,
+    /// A waypoint path's corners at their closed-form extremes (Choice 314): every blend's
+    /// middle (its largest heading rate) and the two points of its largest heading
+    /// acceleration, in time order, whatever the blend's length against the sample period.
+    corners_peaks: Vec<PathSample>,
     /// K_d of the path at k = 1.
     accel_bound: f64,
     /// Every corner of the controller's parameter box (trimmed if the scenario is).
@@ -150,6 +154,7 @@ impl<'a> Checker<'a> {
                 })
             })
             .collect::<Result<_, CheckError>>()?;
+        let corners_peaks = blend_peaks(&path, span);
         let bx = controller.config().uncertainty.cast(f64::from);
         let nominal = VehicleParams::auv150();
         let corners = (0..ParamBox::<f64>::CORNERS)
@@ -179,6 +184,7 @@ impl<'a> Checker<'a> {
         Ok(Checker {
             scenario,
             samples,
+            corners_peaks,
             accel_bound: f64::from(path.accel_bound()),
             corners,
             nominal,
@@ -190,10 +196,7 @@ impl<'a> Checker<'a> {
 
     /// The real time of each sample at 1/k = `inv_k` (at rest: at the scenario's scale).
     fn times(&self, inv_k: f64) -> Vec<f64> {
-        let k = match inv_k > 0.0 {
-            true => 1.0 / inv_k,
-            false => time_scale(self.scenario.config().time_scale),
-        };
+        let k = self.scale(inv_k);
         self.samples.iter().map(|s| s.s * k).collect()
     }
 
@@ -271,10 +274,70 @@ impl<'a> Checker<'a> {
         Ok(out)
     }
 
-    /// Every sample of every case of `scope` at 1/k = `inv_k`; stops at the first violation
-    /// unless `full` (which also collects the peaks), and at a stop request.
+    /// Every sample of every case of `scope` at 1/k = `inv_k`, then the corners' extremes
+    /// (Choice 314); stops at the first violation unless `full` (which also collects the
+    /// peaks), and at a stop request.
     pub(super) fn sweep(&self, scope: Scope, inv_k: f64, full: bool) -> Result<Sweep, CheckError> {
-        self.sweep_samples(scope, inv_k, full, 0..self.samples.len(), 1)
+        let mut out = self.sweep_samples(scope, inv_k, full, 0..self.samples.len(), 1)?;
+        if out.first.is_some() && !full {
+            return Ok(out);
+        }
+        if self.corners_peaks.is_empty() {
+            return Ok(out);
+        }
+        // The cases over the regular times and the extremes' merged in order, so that the
+        // payload and the roll swing at an extreme are those of its time.
+        let k = self.scale(inv_k);
+        let mut merged: Vec<(f64, Option<usize>)> = self
+            .times(inv_k)
+            .into_iter()
+            .map(|t| (t, None))
+            .chain(
+                self.corners_peaks
+                    .iter()
+                    .enumerate()
+                    .map(|(j, s)| (s.s * k, Some(j))),
+            )
+            .collect();
+        merged.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let times: Vec<f64> = merged.iter().map(|m| m.0).collect();
+        let owned = match scope {
+            Scope::AsWritten => self.profile_plants(&times).map_err(CheckError::Invalid)?,
+            Scope::WholeBox => Vec::new(),
+        };
+        let cases = self.cases(scope, &times, &owned);
+        for (m, &(t, peak)) in merged.iter().enumerate() {
+            let Some(j) = peak else { continue };
+            let smp = &self.corners_peaks[j];
+            poll()?;
+            let stiffness = self.pitch_stiffness(smp, inv_k);
+            for case in &cases {
+                for current in &self.currents {
+                    let at = Point {
+                        smp,
+                        t,
+                        inv_k,
+                        plant: case.plant(m),
+                        swing: case.swing(m),
+                        current,
+                        stiffness,
+                    };
+                    self.check_point(&at, full, &mut out);
+                    if out.first.is_some() && !full {
+                        return Ok(out);
+                    }
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The time scale of 1/k = `inv_k` (at rest: the scenario's).
+    fn scale(&self, inv_k: f64) -> f64 {
+        match inv_k > 0.0 {
+            true => 1.0 / inv_k,
+            false => time_scale(self.scenario.config().time_scale),
+        }
     }
 
     /// The samples (at k = 1: path time, s) the check takes, in order.
@@ -415,6 +478,49 @@ impl<'a> Checker<'a> {
             given_up: axes.iter().map(|&r| AXIS_NAMES[r].to_string()).collect(),
         }
     }
+}
+
+/// Sample rate (Hz) of the corners' extremes: their times to a microsecond.
+const PEAK_RATE_HZ: u32 = 1 << 20;
+
+/// A waypoint path's corners at their closed-form extremes, at k = 1, up to path time `span`
+/// (Choice 314): per blend, its middle and the two points of its largest heading
+/// acceleration ([`Route::heading_accel_peaks`](controller_core::trajectory::Route::heading_accel_peaks)),
+/// each sampled from the trajectory itself at its time on the path (the time law's inverse).
+/// Empty for the other kinds.
+fn blend_peaks(path: &Trajectory, span: f64) -> Vec<PathSample> {
+    let controller_core::TrajectoryKind::Waypoints { speed, .. } = path.kind() else {
+        return Vec::new();
+    };
+    let (route, law) = (path.route(), path.time_law());
+    let mut out = Vec::new();
+    for i in 0..route.segment_count() {
+        if route.segment_part(i) % 2 == 0 {
+            continue;
+        }
+        let [up, down] = route.heading_accel_peaks(i);
+        let mut locals = [0.5 * route.segment_length(i), up, down];
+        locals.sort_by(f32::total_cmp);
+        for local in locals {
+            let sigma = route.segment_start(i) + local;
+            let t = match law.is_set() {
+                true => f64::from(law.time_at(route, sigma)),
+                false => f64::from(sigma) / f64::from(speed),
+            };
+            if t > span {
+                continue;
+            }
+            let ticks = (t * f64::from(PEAK_RATE_HZ)).round() as u64;
+            let d = path.sample(ticks, PEAK_RATE_HZ);
+            out.push(PathSample {
+                s: ticks as f64 / f64::from(PEAK_RATE_HZ),
+                eta: d.eta.cast::<f64>(),
+                eta_dot: d.eta_dot.cast::<f64>(),
+                eta_ddot: d.eta_ddot.cast::<f64>(),
+            });
+        }
+    }
+    out
 }
 
 /// One point of a sweep: a sample, the case's plant and swing there, a current, and the law's

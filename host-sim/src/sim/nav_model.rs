@@ -1,0 +1,365 @@
+//! The navigation computer of a `[navigation]` model (docs/navigation.md#the-solution): its
+//! sources sample the plant's true state on the control periods at their own rates, each
+//! sample enters the solution its latency later, and the solution the law is told each period
+//! is, as a DVL-aided INS forms it (**Choice 332**):
+//!
+//! - attitude and rates: the last INS sample (truth at its time + its error); the solution
+//!   holds at that sample's time ([`Solution::held_at`]);
+//! - velocity: the truth at the same time plus the velocity error e_v, which each DVL ping with
+//!   bottom lock resets to that ping's error and which, between pings and while the bottom is
+//!   lost, integrates the INS's acceleration error (ė_v = b_a + w_a: the drift);
+//! - position: dead reckoning (the trapezoid rule on R(Θ)·v of the solution, Fossen's Eq 2.18
+//!   kinematics), shifted by each position fix (x, y) and each pressure depth (z) so that the
+//!   solution passes through the measurement at its time: smooth and drifting in between, a
+//!   jump at a fix.
+//!
+//! Everything is f64 and deterministic: each source draws from its own generator, seeded from
+//! the model's seed and the source, so changing one source does not change another's noise.
+
+use std::collections::VecDeque;
+
+use rand::rngs::StdRng;
+use rand::SeedableRng;
+use rand_distr::{Distribution, StandardNormal};
+
+use crate::scenario::navigation::{ErrorModel, NavigationModel, Timing};
+
+/// What the navigation computer reports for one control period.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Solution {
+    /// η (x y z m, φ θ ψ rad) and ν (u v w m/s, p q r rad/s), f64.
+    pub eta: [f64; 6],
+    pub nu: [f64; 6],
+    /// The control tick the solution holds at: its last INS sample's time. The state frame's
+    /// `t_ticks` stays the period it is reported at (**Choice 334**,
+    /// docs/navigation.md#stamps-and-latency).
+    pub held_at: u64,
+    /// The sample tick of the DVL ping the velocity was last reset to, if any yet.
+    pub velocity_at: Option<u64>,
+    /// The DVL had bottom lock at its last ping.
+    pub bottom_lock: bool,
+    /// The sample tick of the last position fix applied, if any.
+    pub fix_at: Option<u64>,
+}
+
+/// A source's error process: its generator and its bias's current value.
+struct Stream<const N: usize> {
+    model: ErrorModel<N>,
+    rng: StdRng,
+    gm: [f64; N],
+    walk: [f64; N],
+}
+
+impl<const N: usize> Stream<N> {
+    fn new(model: ErrorModel<N>, seed: u64, source: u64) -> Self {
+        // Distinct streams per source (a golden-ratio step between their seeds).
+        let mut rng =
+            StdRng::seed_from_u64(seed.wrapping_add(source.wrapping_mul(0x9E37_79B9_7F4A_7C15)));
+        let mut gm = [0.0; N];
+        for (g, s) in gm.iter_mut().zip(model.bias_sigma) {
+            let n: f64 = StandardNormal.sample(&mut rng);
+            *g = s * n;
+        }
+        Stream {
+            model,
+            rng,
+            gm,
+            walk: [0.0; N],
+        }
+    }
+
+    /// Advances the bias by `dt`: the Gauss–Markov part exactly (its discrete form keeps the
+    /// steady σ), the walk by σ_w·√dt.
+    fn advance(&mut self, dt: f64) {
+        let a = (-dt / self.model.bias_tau).exp();
+        let b = (1.0 - a * a).sqrt();
+        for i in 0..N {
+            let n1: f64 = StandardNormal.sample(&mut self.rng);
+            let n2: f64 = StandardNormal.sample(&mut self.rng);
+            self.gm[i] = a * self.gm[i] + self.model.bias_sigma[i] * b * n1;
+            self.walk[i] += self.model.bias_walk[i] * dt.sqrt() * n2;
+        }
+    }
+
+    /// One sample's error: the bias plus white noise.
+    fn sample(&mut self) -> [f64; N] {
+        let mut e = [0.0; N];
+        for (i, e) in e.iter_mut().enumerate() {
+            let n: f64 = StandardNormal.sample(&mut self.rng);
+            *e = self.model.bias[i] + self.gm[i] + self.walk[i] + self.model.sigma[i] * n;
+        }
+        e
+    }
+}
+
+/// When a source's samples are taken and arrive, on control ticks (**Choice 335**,
+/// docs/navigation.md#the-sources).
+struct Clock {
+    /// Samples per control period (≥ 1: every period).
+    ratio: f64,
+    latency: u64,
+    /// Outages in ticks [from, to).
+    outages: Vec<[f64; 2]>,
+    rate_hz: f64,
+}
+
+impl Clock {
+    fn new(t: &Timing, rate_hz: f64) -> Self {
+        Clock {
+            ratio: t.rate_hz / rate_hz,
+            latency: latency_ticks(t.latency, rate_hz),
+            outages: t.outages.clone(),
+            rate_hz,
+        }
+    }
+
+    /// The sample tick whose sample arrives at tick `k`, if one does (a sample is taken on the
+    /// first period and whenever ⌊j·rate/rate_c⌋ steps; none in an outage).
+    fn arrival(&self, k: u64) -> Option<u64> {
+        let j = k.checked_sub(self.latency)?;
+        let taken = self.ratio >= 1.0
+            || j == 0
+            || (j as f64 * self.ratio).floor() != ((j - 1) as f64 * self.ratio).floor();
+        let t = j as f64 / self.rate_hz;
+        let out = self.outages.iter().any(|[a, b]| *a <= t && t < *b);
+        (taken && !out).then_some(j)
+    }
+}
+
+/// A latency in whole control periods (rounded to the nearest).
+pub fn latency_ticks(latency: f64, rate_hz: f64) -> u64 {
+    (latency * rate_hz).round() as u64
+}
+
+/// A ring of the last values per tick.
+struct History<T: Copy> {
+    first: u64,
+    values: VecDeque<T>,
+    keep: usize,
+}
+
+impl<T: Copy> History<T> {
+    fn new(keep: usize) -> Self {
+        History {
+            first: 0,
+            values: VecDeque::with_capacity(keep + 1),
+            keep: keep.max(1),
+        }
+    }
+
+    fn push(&mut self, v: T) {
+        self.values.push_back(v);
+        if self.values.len() > self.keep {
+            self.values.pop_front();
+            self.first += 1;
+        }
+    }
+
+    /// The value at tick `k` (the oldest kept before it, the newest after it).
+    fn at(&self, k: u64) -> T {
+        let i = k.saturating_sub(self.first) as usize;
+        self.values[i.min(self.values.len() - 1)]
+    }
+}
+
+/// Body-to-NED rotation of (φ, θ, ψ) applied to v (Fossen's R(Θ), zyx).
+fn rotate(att: &[f64; 3], v: &[f64; 3]) -> [f64; 3] {
+    let (sf, cf) = att[0].sin_cos();
+    let (st, ct) = att[1].sin_cos();
+    let (sp, cp) = att[2].sin_cos();
+    [
+        cp * ct * v[0] + (-sp * cf + cp * st * sf) * v[1] + (sp * sf + cp * cf * st) * v[2],
+        sp * ct * v[0] + (cp * cf + sf * st * sp) * v[1] + (-cp * sf + st * sp * cf) * v[2],
+        -st * v[0] + ct * sf * v[1] + ct * cf * v[2],
+    ]
+}
+
+/// The navigation computer of one run.
+pub struct NavComputer {
+    model: NavigationModel,
+    dt: f64,
+    k: u64,
+    ins: (Clock, Stream<3>, Stream<3>),
+    accel: Stream<3>,
+    dvl: (Clock, Stream<3>),
+    depth: (Clock, Stream<1>),
+    fix: Option<(Clock, Stream<2>)>,
+    truth: History<([f64; 6], [f64; 6])>,
+    /// The dead-reckoned position per report tick.
+    dr: History<[f64; 3]>,
+    att: [f64; 3],
+    rates: [f64; 3],
+    e_v: [f64; 3],
+    offset: [f64; 3],
+    last_rv: [f64; 3],
+    out: Solution,
+}
+
+impl NavComputer {
+    /// The computer of `model` on a control loop at `rate_hz`.
+    pub fn new(model: &NavigationModel, rate_hz: f64) -> Self {
+        let seed = model.seed;
+        let ins = Clock::new(&model.ins.timing, rate_hz);
+        let dvl = Clock::new(&model.dvl.timing, rate_hz);
+        let depth = Clock::new(&model.depth.timing, rate_hz);
+        let fix = model.fix.as_ref().map(|f| {
+            (
+                Clock::new(&f.timing, rate_hz),
+                Stream::new(f.error, seed, 6),
+            )
+        });
+        let longest = [&ins, &dvl, &depth]
+            .into_iter()
+            .chain(fix.as_ref().map(|f| &f.0))
+            .map(|c| c.latency)
+            .max()
+            .unwrap_or(0);
+        let keep = (longest + ins.latency + 2) as usize;
+        NavComputer {
+            dt: 1.0 / rate_hz,
+            k: 0,
+            ins: (
+                ins,
+                Stream::new(model.ins.attitude, seed, 1),
+                Stream::new(model.ins.rates, seed, 2),
+            ),
+            accel: Stream::new(model.ins.accel, seed, 3),
+            dvl: (dvl, Stream::new(model.dvl.velocity, seed, 4)),
+            depth: (depth, Stream::new(model.depth.error, seed, 5)),
+            fix,
+            truth: History::new(keep),
+            dr: History::new(keep),
+            att: [0.0; 3],
+            rates: [0.0; 3],
+            e_v: [0.0; 3],
+            offset: [0.0; 3],
+            last_rv: [0.0; 3],
+            out: Solution {
+                eta: [0.0; 6],
+                nu: [0.0; 6],
+                held_at: 0,
+                velocity_at: None,
+                bottom_lock: false,
+                fix_at: None,
+            },
+            model: model.clone(),
+        }
+    }
+
+    /// Whether the DVL has bottom lock at the true depth `z` and sample tick `j`.
+    fn lock(&self, z: f64) -> bool {
+        let d = &self.model.dvl;
+        d.seabed_depth.is_none_or(|s| {
+            let altitude = s - z;
+            d.min_altitude <= altitude && altitude <= d.max_altitude
+        })
+    }
+
+    /// The solution of the next control period, given the plant's true η, ν at it.
+    pub fn step(&mut self, eta: &[f64; 6], nu: &[f64; 6]) -> Solution {
+        let k = self.k;
+        self.k += 1;
+        self.truth.push((*eta, *nu));
+        if k > 0 {
+            self.advance();
+        }
+        // The first period has the samples the computer took before the mission (the vehicle
+        // at its start), stamped 0; a later sample of tick 0 is that one.
+        let first = |clock: &Clock| match k {
+            0 => Some(0),
+            _ => clock.arrival(k).filter(|&j| j > 0),
+        };
+        if let Some(j) = first(&self.ins.0) {
+            self.ins_sample(j);
+        }
+        if let Some(j) = first(&self.dvl.0) {
+            self.ping(j);
+        }
+        let held = self.truth.at(self.out.held_at);
+        let v: [f64; 3] = std::array::from_fn(|i| held.1[i] + self.e_v[i]);
+        let p = self.dead_reckon(k, &held.0, &v);
+        self.anchor(k);
+        for i in 0..3 {
+            self.out.eta[i] = p[i] + self.offset[i];
+            self.out.eta[3 + i] = self.att[i];
+            self.out.nu[i] = v[i];
+            self.out.nu[3 + i] = self.rates[i];
+        }
+        self.out
+    }
+
+    /// One period on: every bias steps, and the velocity error integrates the INS's
+    /// acceleration error (reset only by a ping).
+    fn advance(&mut self) {
+        let dt = self.dt;
+        self.ins.1.advance(dt);
+        self.ins.2.advance(dt);
+        self.accel.advance(dt);
+        self.dvl.1.advance(dt);
+        self.depth.1.advance(dt);
+        if let Some(f) = &mut self.fix {
+            f.1.advance(dt);
+        }
+        let a = self.accel.sample();
+        for (e, a) in self.e_v.iter_mut().zip(a) {
+            *e += a * dt;
+        }
+    }
+
+    /// The INS sample of tick `j`: attitude and rates; the solution now holds at `j`.
+    fn ins_sample(&mut self, j: u64) {
+        let (te, tn) = self.truth.at(j);
+        let ea = self.ins.1.sample();
+        let er = self.ins.2.sample();
+        for i in 0..3 {
+            self.att[i] = te[3 + i] + ea[i];
+            self.rates[i] = tn[3 + i] + er[i];
+        }
+        self.out.held_at = j;
+    }
+
+    /// The DVL ping of tick `j`: with bottom lock it resets the velocity error to its own.
+    fn ping(&mut self, j: u64) {
+        let (te, _) = self.truth.at(j);
+        self.out.bottom_lock = self.lock(te[2]);
+        if self.out.bottom_lock {
+            self.e_v = self.dvl.1.sample();
+            self.out.velocity_at = Some(j);
+        }
+    }
+
+    /// Dead reckoning (trapezoid) of period `k` on the velocity `v` and the solution's
+    /// attitude, from the true start `start`.
+    fn dead_reckon(&mut self, k: u64, start: &[f64; 6], v: &[f64; 3]) -> [f64; 3] {
+        let rv = rotate(&self.att, v);
+        let p = if k == 0 {
+            [start[0], start[1], start[2]]
+        } else {
+            let last = self.dr.at(k - 1);
+            std::array::from_fn(|i| last[i] + 0.5 * self.dt * (self.last_rv[i] + rv[i]))
+        };
+        self.last_rv = rv;
+        self.dr.push(p);
+        p
+    }
+
+    /// The pressure depth and the fixes arriving at period `k` shift the dead reckoning so
+    /// that it passes through them at their time.
+    fn anchor(&mut self, k: u64) {
+        let ins_latency = self.ins.0.latency;
+        if let Some(j) = self.depth.0.arrival(k).filter(|&j| j > 0) {
+            let z = self.truth.at(j).0[2] + self.depth.1.sample()[0];
+            self.offset[2] = z - self.dr.at((j + ins_latency).min(k))[2];
+        }
+        if let Some((clock, stream)) = &mut self.fix {
+            if let Some(j) = clock.arrival(k).filter(|&j| j > 0) {
+                let e = stream.sample();
+                let (te, _) = self.truth.at(j);
+                let at = self.dr.at((j + ins_latency).min(k));
+                self.offset[0] = te[0] + e[0] - at[0];
+                self.offset[1] = te[1] + e[1] - at[1];
+                self.out.fix_at = Some(j);
+            }
+        }
+    }
+}
