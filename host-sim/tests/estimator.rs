@@ -66,7 +66,13 @@ fn fly_chatter(config: SimConfig) -> (f64, f64, f64, f64) {
         &mut chatter,
         Recording::MetricsOnly,
     );
-    assert_eq!(r.outcome, Outcome::Completed);
+    // The chatter bound in `[bound]` may call the run missed (the law told the raw solution
+    // is); what this comparison needs is a flight that ran to its end.
+    assert!(
+        matches!(r.outcome, Outcome::Completed | Outcome::Missed { .. }),
+        "{:?}",
+        r.outcome
+    );
     let worst = |x: [f64; 5]| x.into_iter().fold(0.0, f64::max);
     (
         r.metrics.max_path,
