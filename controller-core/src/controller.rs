@@ -316,7 +316,9 @@ impl Controller {
             bounds,
             allocator,
             maps,
-            cos_pitch_limit: libm::cosf(config.pitch_limit),
+            // Choice 360: the core's cosine kernel in every backend (libm's cosf, the one call of
+            // it on the board, was 5.4 kB of flash with its f64 reduction).
+            cos_pitch_limit: crate::math::kernels::cos(config.pitch_limit),
             config,
         })
     }
