@@ -54,6 +54,7 @@ fn main() {
     println!("cargo:rerun-if-changed={}", survey.display());
     fs::write(out.join("golden.rs"), golden(&survey)).expect("writing golden.rs");
     fs::write(out.join("kernel_golden.rs"), kernel_golden()).expect("writing kernel_golden.rs");
+    fs::write(out.join("boot_bounds.rs"), boot_bounds()).expect("writing boot_bounds.rs");
 
     println!("cargo:rerun-if-env-changed={KEY_VAR}");
     println!("cargo:rerun-if-env-changed={UNSIGNED_VAR}");
@@ -116,6 +117,33 @@ fn bits(x: f32) -> String {
 
 /// Inputs of every range of the math kernels (`controller_core::math::kernels`) and the host's
 /// results, as bit patterns: the self-test checks that the target gives the same bits.
+/// The suprema over the default configuration's parameter box, as the same f32 core computes
+/// them, for the flying images to boot on (`firmware::boot`, Choice 363): every field by its
+/// bits.
+fn boot_bounds() -> String {
+    let c = Controller::new(ControllerConfig::default()).expect("defaults");
+    let b = c.bounds();
+    let t = &b.theorem2;
+    let f = |x: f32| format!("f32::from_bits({:#010x})", x.to_bits());
+    format!(
+        "/// The bounds over the default box, computed by firmware/build.rs (Choice 363).\n\
+         pub const BOOT_BOUNDS: UncertaintyBounds<f32> = UncertaintyBounds {{\n\
+         delta_m: {}, delta_g: {}, b_controlled: {}, b_full: {}, beta_hat: {},\n\
+         theorem2: Theorem2 {{ lambda_min_m: {}, lambda_max_m: {}, lambda_min_delta_m: {}, lhs: {}, rhs: {} }},\n\
+         }};\n",
+        f(b.delta_m),
+        f(b.delta_g),
+        f(b.b_controlled),
+        f(b.b_full),
+        f(b.beta_hat),
+        f(t.lambda_min_m),
+        f(t.lambda_max_m),
+        f(t.lambda_min_delta_m),
+        f(t.lhs),
+        f(t.rhs)
+    )
+}
+
 fn kernel_golden() -> String {
     use controller_core::math::kernels;
     let mut rng = XorShift(0x2545_f491_4f6c_dd1d);

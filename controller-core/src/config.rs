@@ -165,9 +165,9 @@ pub enum ConfigError {
     },
     /// The estimator's Riccati equation has no steady state on `axis` at this rate.
     EstimatorGain { axis: usize },
-    /// The estimator is on, and this build of the core has no estimator (feature `estimator`:
-    /// the firmware's does not).
-    EstimatorNotBuilt,
+    /// The bounds given to `Controller::with_bounds` are of other vehicle parameters or
+    /// another box than the configuration's (Choice 363).
+    BoundsOfAnotherBox,
 }
 
 /// The [`ControllerConfig`] field a [`ConfigError`] is about: `name` is the field's name,
@@ -192,7 +192,9 @@ impl ConfigError {
             ConfigError::PitchLimit { .. } => ("pitch_limit", None),
             ConfigError::ZeroRate => ("rate_hz", None),
             ConfigError::NonFiniteParams => ("params", None),
-            ConfigError::InvalidBox | ConfigError::Bounds(_) => ("uncertainty", None),
+            ConfigError::InvalidBox | ConfigError::Bounds(_) | ConfigError::BoundsOfAnotherBox => {
+                ("uncertainty", None)
+            }
             ConfigError::Allocation(AllocationError::Weight { axis, .. }) => {
                 ("priority", Some(axis))
             }
@@ -202,7 +204,6 @@ impl ConfigError {
             ConfigError::Allocation(_) => ("geometry", None),
             ConfigError::EstimatorSigma { name, axis, .. } => (name, Some(axis)),
             ConfigError::EstimatorGain { axis } => ("estimator_accel_sigma", Some(axis)),
-            ConfigError::EstimatorNotBuilt => ("estimator", None),
             ConfigError::Assumption2 { .. }
             | ConfigError::Theorem2 { .. }
             | ConfigError::LoopRate { .. } => return None,
@@ -264,6 +265,10 @@ impl fmt::Display for ConfigError {
             ConfigError::InvalidBox => {
                 write!(f, "parameter box is not finite or has lower > upper")
             }
+            ConfigError::BoundsOfAnotherBox => write!(
+                f,
+                "the bounds given are of other vehicle parameters or another box than the configuration's"
+            ),
             ConfigError::Bounds(BoundsError::MassNotPositiveDefinite {
                 corner,
                 min_eigenvalue,
@@ -298,8 +303,7 @@ impl fmt::Display for ConfigError {
             ),
             ConfigError::Allocation(e) => write!(f, "thruster allocation: {e}"),
             ConfigError::EstimatorSigma { .. }
-            | ConfigError::EstimatorGain { .. }
-            | ConfigError::EstimatorNotBuilt => self.fmt_estimator(f),
+            | ConfigError::EstimatorGain { .. } => self.fmt_estimator(f),
         }
     }
 }
@@ -316,10 +320,6 @@ impl ConfigError {
             ConfigError::EstimatorGain { axis } => write!(
                 f,
                 "the estimator's Riccati equation has no steady state on axis {axis} with these noise settings"
-            ),
-            ConfigError::EstimatorNotBuilt => write!(
-                f,
-                "estimator is on, and this build of the controller has no estimator (feature `estimator`)"
             ),
             _ => Ok(()),
         }

@@ -209,6 +209,15 @@ pub struct Controller {
     estimator: Option<(EstimatorGains, [f32; 6])>,
 }
 
+/// The suprema over a parameter box ([`UncertaintyBounds`]) with the vehicle parameters and
+/// the box they are of: what [`Controller::with_bounds`] takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoxBounds {
+    pub params: VehicleParams<f32>,
+    pub uncertainty: crate::uncertainty::ParamBox<f32>,
+    pub bounds: UncertaintyBounds<f32>,
+}
+
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
 /// solution holds at (`t_ticks` of the link's state frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -241,11 +250,59 @@ impl Controller {
         Self::build(config, same_box.then_some(self.bounds))
     }
 
+    /// The controller [`Controller::new`] gives for `config`, the same in every bit, with the
+    /// suprema over the parameter box given: `bounds` must be those of `config`'s vehicle
+    /// parameters and box ([`ConfigError::BoundsOfAnotherBox`] otherwise). Never computes them.
+    ///
+    /// **Choice 363:** the flying images boot on bounds the firmware's build computed on the
+    /// host with this same f32 code (firmware/build.rs), and rebuild with
+    /// [`Controller::rebuild`], so no flying image carries the bounds' eigen-solver (≈ 12 kB
+    /// of flash) nor spends its ≈ 26 M instructions at boot; the self-test computes them on
+    /// the board and requires the very bits the build gave.
+    pub fn with_bounds(config: ControllerConfig, bounds: &BoxBounds) -> Result<Self, ConfigError> {
+        if config.params != bounds.params || config.uncertainty != bounds.uncertainty {
+            return Err(ConfigError::BoundsOfAnotherBox);
+        }
+        Self::build_on(config, bounds.bounds)
+    }
+
+    /// [`Controller::reconfigure`] that never computes the bounds: `config` must have this
+    /// controller's vehicle parameters and box ([`ConfigError::BoundsOfAnotherBox`]
+    /// otherwise), which every configuration a board's link can set has (Choice 225).
+    pub fn rebuild(&self, config: ControllerConfig) -> Result<Self, ConfigError> {
+        Self::with_bounds(config, &self.box_bounds())
+    }
+
+    /// This controller's bounds with the parameters and box they are of.
+    pub fn box_bounds(&self) -> BoxBounds {
+        BoxBounds {
+            params: self.config.params,
+            uncertainty: self.config.uncertainty,
+            bounds: self.bounds,
+        }
+    }
+
     /// `new`, with the bounds over the box given (`Some`: computed before for the same
-    /// parameters and box) or computed here.
+    /// parameters and box) or computed here (after the scalar checks).
     fn build(
         config: ControllerConfig,
         bounds: Option<UncertaintyBounds<f32>>,
+    ) -> Result<Self, ConfigError> {
+        let bounds = match bounds {
+            Some(b) => b,
+            None => {
+                config.check_scalars()?;
+                UncertaintyBounds::compute(&config.params, &config.uncertainty)?
+            }
+        };
+        Self::build_on(config, bounds)
+    }
+
+    /// `new` on the bounds over the box given: never computes them (so that a flying image
+    /// that only calls this carries no eigen-solver, Choice 363).
+    fn build_on(
+        config: ControllerConfig,
+        bounds: UncertaintyBounds<f32>,
     ) -> Result<Self, ConfigError> {
         config.check_scalars()?;
         let allocation = PseudoInverse::new(&config.geometry)?;
@@ -253,10 +310,6 @@ impl Controller {
         let envelope = ThrustEnvelope::new(&maps, config.thrust_unit, config.voltage_limit);
         let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
-        let bounds = match bounds {
-            Some(b) => b,
-            None => UncertaintyBounds::compute(&config.params, &config.uncertainty)?,
-        };
         check_feasible(&bounds, config.beta)?;
 
         let mut lyapunov = [AxisLyapunov::default(); 6];
@@ -727,12 +780,6 @@ fn estimator_parts(
 ) -> Result<Option<(EstimatorGains, [f32; 6])>, ConfigError> {
     match config.estimator.kind {
         EstimatorKind::Off => Ok(None),
-        #[cfg(not(feature = "estimator"))]
-        EstimatorKind::Kalman => {
-            let _ = m_hat;
-            Err(ConfigError::EstimatorNotBuilt)
-        }
-        #[cfg(feature = "estimator")]
         EstimatorKind::Kalman => {
             let gains = EstimatorGains::new(&config.estimator, config.rate_hz)
                 .map_err(|axis| ConfigError::EstimatorGain { axis })?;

@@ -3,7 +3,7 @@
 //! semihosting, the STM32 resets) and hands them to these functions.
 
 use auv_link::sign::LinkKey;
-use controller_core::{Controller, ControllerConfig};
+use controller_core::Controller;
 use cortex_m_rt::ExceptionFrame;
 use defmt::{error, info, warn};
 
@@ -29,7 +29,7 @@ pub fn core_peripherals(halt: Halt) -> cortex_m::Peripherals {
 /// and the math backend (`halt(1)` if the defaults were rejected, which the host tests rule
 /// out).
 pub fn controller(halt: Halt) -> Controller {
-    let controller = match Controller::new(ControllerConfig::default()) {
+    let controller = match crate::boot::controller() {
         Ok(c) => c,
         Err(_) => {
             error!("default controller configuration rejected");

@@ -101,33 +101,3 @@ fn on_a_noisy_solution_the_estimator_keeps_the_real_circle_within_the_chatter_bo
     assert!(reversals <= 2.0, "{reversals} reversals/s");
     assert!(variation <= 100.0, "{variation} V/s");
 }
-
-/// The board's `update` does not run the estimator: a board in the loop would fly another law
-/// than SIL, so the runner refuses the scenario at once, before any traffic (on a port nobody
-/// answers, which without the refusal ends as a silent board after the reply timeout).
-#[test]
-fn a_board_in_the_loop_refuses_a_scenario_that_flies_on_the_estimator() {
-    use host_sim::board::{self, BoardInTheLoop, Pacing};
-    use host_sim::scenario::LinkFaults;
-    use serialport::SerialPort;
-    use std::time::Duration;
-
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let mut c = load_config(&root.join("scenarios/lawn-mower-20x10.toml")).unwrap();
-    c.duration = 1.0;
-    c.controller.estimator.kind = EstimatorKind::Kalman;
-    let scenario = Scenario::new(c).unwrap();
-    let (_master, slave) = serialport::TTYPort::pair().expect("a pseudo-terminal pair");
-    let path = slave.name().expect("the slave's path");
-    drop(slave);
-    let b = BoardInTheLoop::over_serial(
-        &path,
-        115_200,
-        &scenario,
-        LinkFaults::default(),
-        Pacing::Lockstep,
-        Duration::from_secs_f64(0.5),
-        None,
-    );
-    assert!(matches!(b, Err(board::Error::Estimator)), "{:?}", b.err());
-}

@@ -101,11 +101,6 @@ pub enum Error {
     /// The scenario's thruster geometry is not one the link carries.
     #[error("the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly")]
     Geometry,
-    /// The scenario's controller flies on the state estimator (`controller.estimator`,
-    /// docs/law.md#the-state-estimator), which the board's `update` does not run yet: PIL
-    /// would fly another law than SIL.
-    #[error("the scenario's controller flies on the state estimator (controller.estimator = \"kalman\"), which the board does not run yet; PIL and HIL fly it with the estimator off only")]
-    Estimator,
     /// The board refused a command of the set-up, with its reason.
     #[error("the board refused the set-up: {}", reason.map_or("(no reason)", Refusal::as_str))]
     Refused { reason: Option<Refusal> },
@@ -172,8 +167,7 @@ impl From<Error> for Stop {
             | Error::Refused { .. }
             | Error::UploadNotVerified { .. }
             | Error::NotArmed { .. }
-            | Error::Geometry
-            | Error::Estimator => BoardLoss::Misconfigured,
+            | Error::Geometry => BoardLoss::Misconfigured,
             Error::LinkIo { .. }
             | Error::Encode(_)
             | Error::ElfUnreadable { .. }

@@ -10,7 +10,6 @@ use auv_link::{
     BoardStatus, Command as LinkCommand, ConfigPatch, MissionPlan, MissionUpload, Msg, Telemetry,
     ThrustUnit, DEFAULT_STALE_PERIODS,
 };
-use controller_core::EstimatorKind;
 
 use super::error::Error;
 use super::link::Link;
@@ -52,29 +51,17 @@ pub(super) struct SetUp {
 
 impl Session {
     /// The session of `scenario`'s validated controller and mission, paced by `pacing`.
-    /// Refuses a thruster geometry the link cannot carry, and the state estimator, which the
-    /// board does not run.
+    /// Refuses a thruster geometry the link cannot carry. The whole configuration is sent
+    /// (`ConfigPatch::whole`: the law's settings, the thruster chain and the state estimator's
+    /// settings, from which the board computes its gains, Choice 361).
     pub(super) fn new(scenario: &Scenario, pacing: Pacing) -> Result<Self, Error> {
         let c = scenario.controller().config();
-        if c.estimator.kind != EstimatorKind::Off {
-            return Err(Error::Estimator);
-        }
         // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
         let mounting = c.geometry.auv150_reversed().ok_or(Error::Geometry)?;
         let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let mission = scenario.trajectory().mission();
         Ok(Session {
-            config: ConfigPatch {
-                rate_hz: Some(c.rate_hz),
-                robust: Some(c.robust),
-                delta_max: Some(c.delta_max),
-                voltage_limit: Some(c.voltage_limit),
-                stale_periods: Some(DEFAULT_STALE_PERIODS),
-                lockstep: Some(pacing == Pacing::Lockstep),
-                thrust_unit: Some(thrust_unit),
-                reversed_thrusters: Some(mounting),
-                priority: Some(c.priority.into()),
-            },
+            config: ConfigPatch::whole(c, DEFAULT_STALE_PERIODS, pacing == Pacing::Lockstep),
             mission: MissionPlan::from(mission),
             upload: MissionUpload::of(&mission),
             thrust_unit,
