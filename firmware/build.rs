@@ -27,7 +27,7 @@ use firmware_images::image;
 // The golden vector's one definition, shared with the self-test that reads them.
 #[path = "src/bin/qemu_selftest/vector.rs"]
 mod vector;
-use vector::Golden;
+use vector::{estimator_steps, EstimatorGolden, Golden};
 
 // The STM32 image's link key from the environment (host-tested in tests/provision.rs).
 #[path = "src/provision.rs"]
@@ -430,7 +430,52 @@ fn golden(survey: &Path) -> String {
         writeln!(s, "    {},", rust(g)).ok();
     }
     s += "];\n";
+    let estimator = estimator_golden(&vectors);
+    writeln!(
+        s,
+        "pub const ESTIMATOR_GOLDEN: [EstimatorGolden; {}] = [",
+        estimator.len()
+    )
+    .ok();
+    for e in &estimator {
+        writeln!(s, "    {e:?},").ok();
+    }
+    s += "];\n";
     s
+}
+
+/// The estimator's golden vectors: [`estimator_steps`] on every closed-form vector with Δu on
+/// that the law flies, by the default controller with the estimator on (Kalman).
+fn estimator_golden(vectors: &[Golden]) -> Vec<EstimatorGolden> {
+    let mut cfg = ControllerConfig::default();
+    cfg.estimator.kind = controller_core::EstimatorKind::Kalman;
+    let c = Controller::new(cfg).expect("the defaults with the estimator");
+    let mut out = Vec::new();
+    for (vector, g) in vectors.iter().enumerate() {
+        let Ok(mission) = Mission::try_from(g.plan) else {
+            continue;
+        };
+        let Some(steps) = estimator_steps(g) else {
+            continue;
+        };
+        if !g.robust || g.status != 0 {
+            continue;
+        }
+        let tr = Trajectory::new(mission).expect("a golden vector's mission");
+        let mut memory = controller_core::Estimate::new();
+        let mut last = None;
+        for (ticks, solution) in steps {
+            last = Some(c.update_from_solution(&mut memory, ticks, &solution, &tr));
+        }
+        let o = last.expect("three steps");
+        assert!(o.status == Status::Ok, "the estimator's case flies: {o:?}");
+        out.push(EstimatorGolden {
+            vector,
+            voltage: o.voltage,
+            tau: o.tau,
+        });
+    }
+    out
 }
 
 /// `g` as a Rust expression: its `Debug` form, whose every finite `f32` is the shortest
