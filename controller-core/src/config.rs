@@ -265,10 +265,7 @@ impl fmt::Display for ConfigError {
             ConfigError::InvalidBox => {
                 write!(f, "parameter box is not finite or has lower > upper")
             }
-            ConfigError::BoundsOfAnotherBox => write!(
-                f,
-                "the bounds given are of other vehicle parameters or another box than the configuration's"
-            ),
+            ConfigError::BoundsOfAnotherBox => f.write_str(BOUNDS_OF_ANOTHER_BOX),
             ConfigError::Bounds(BoundsError::MassNotPositiveDefinite {
                 corner,
                 min_eigenvalue,
@@ -325,6 +322,10 @@ impl ConfigError {
         }
     }
 }
+
+/// [`ConfigError::BoundsOfAnotherBox`] in words.
+const BOUNDS_OF_ANOTHER_BOX: &str =
+    "the bounds given are of other vehicle parameters or another box than the configuration's";
 
 /// A finite value > 0.
 fn positive(name: &'static str, value: f32) -> Result<(), ConfigError> {

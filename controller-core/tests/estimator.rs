@@ -446,6 +446,61 @@ fn a_solution_too_old_repeated_or_from_the_future_is_refused_and_the_state_held(
     }
 }
 
+/// A position fix jumps the solution by 1 m (docs/board.md#the-state-estimator-on-the-board):
+/// no gate refuses it; it enters through the gain at once (the estimate moves by K·[d, 0]) and
+/// the error then decays as the closed-form recursion e⁺ = (I − K)F e, with K the gain of the
+/// Riccati recursion iterated in f64.
+#[test]
+fn a_position_fix_that_jumps_the_solution_enters_through_the_gain_and_converges() {
+    let (t, sp, sv, sa) = (0.01f64, 0.005, 0.002, 0.02);
+    let g = gains(sp as f32, sv as f32, sa as f32);
+    let k = riccati_gain(t, sp, sv, sa, 200_000);
+    let mut memory = Estimate::new();
+    let zero = [0.0f32; 6];
+    for tick in 0..300 {
+        memory.step(&g, tick, tick, &zero, &zero).unwrap();
+        memory.applied(&g, tick, &zero);
+    }
+    let d = 1.0f64;
+    let fix = [d as f32, 0.0, 0.0, 0.0, 0.0, 0.0];
+    // The error against the vehicle at x = d: before the fix's correction [−d, 0].
+    let mut e = [-d, 0.0];
+    let step = |e: [f64; 2], first: bool| {
+        let prior = if first { e } else { [e[0] + t * e[1], e[1]] };
+        let ik = sub(&I2, &k);
+        [
+            ik[0][0] * prior[0] + ik[0][1] * prior[1],
+            ik[1][0] * prior[0] + ik[1][1] * prior[1],
+        ]
+    };
+    for n in 0..400u64 {
+        let tick = 300 + n;
+        let (x, v) = memory.step(&g, tick, tick, &fix, &zero).unwrap();
+        memory.applied(&g, tick, &zero);
+        e = step(e, n == 0);
+        if n == 0 {
+            // At once: K₀₀·d of the jump, and the velocity K₁₀·d.
+            assert!(
+                (f64::from(x[0]) - k[0][0] * d).abs() < 2e-3 * k[0][0] * d,
+                "{}",
+                x[0]
+            );
+            assert!((f64::from(v[0]) - k[1][0] * d).abs() < 2e-3 * k[1][0].abs() * d + 1e-6);
+        }
+        assert!(
+            (f64::from(x[0]) - (d + e[0])).abs() < 2e-3 * d,
+            "period {n}: x̂ {} against the closed form {}",
+            x[0],
+            d + e[0]
+        );
+        // The other axes never see it.
+        assert_eq!(&x[1..], &[0.0; 5]);
+    }
+    // With the defaults' σ the model is trusted: 4 s after the fix a fifth of it remains
+    // (the closed form's 0.20 m of 1 m; docs/board.md#the-state-estimator-on-the-board).
+    assert!(e[0].abs() < 0.25 * d, "4 s after the fix: {}", e[0]);
+}
+
 fn estimating() -> Controller {
     let mut c = ControllerConfig::default();
     c.estimator.kind = EstimatorKind::Kalman;
