@@ -223,6 +223,13 @@ pub struct BoxBounds {
     pub bounds: UncertaintyBounds<f32>,
 }
 
+/// The state the law flies on with the estimator on, and J's kinematics there.
+struct Estimated {
+    eta: [f32; 6],
+    nu: [f32; 6],
+    kin: Kinematics<f32>,
+}
+
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
 /// solution holds at (`t_ticks` of the link's state frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -475,7 +482,7 @@ impl Controller {
         };
         let (out, accel) = match self.estimate(memory, gains, ticks, solution) {
             Err(fault) => (Output::fail_safe(fault), [0.0; 6]),
-            Ok((eta, nu, kin)) => {
+            Ok(Estimated { eta, nu, kin }) => {
                 let out = self.update(ticks, &eta, &nu, trajectory);
                 let accel = match out.status {
                     Status::Ok => estimator::applied_acceleration(
@@ -505,7 +512,7 @@ impl Controller {
         gains: &EstimatorGains,
         ticks: u64,
         solution: &Solution,
-    ) -> Result<([f32; 6], [f32; 6], Kinematics<f32>), Fault> {
+    ) -> Result<Estimated, Fault> {
         check_inputs(&solution.eta, &solution.nu)?;
         let kin = self.checked_kinematics(&solution.eta)?;
         let eta_dot = kin.eta_dot(&Vector6::from(solution.nu));
@@ -516,9 +523,17 @@ impl Controller {
                 }
                 let kin = self.checked_kinematics(&eta)?;
                 let nu = kin.jinv_mul(&Vector6::from(eta_dot));
-                Ok((eta, nu.into(), kin))
+                Ok(Estimated {
+                    eta,
+                    nu: nu.into(),
+                    kin,
+                })
             }
-            None => Ok((solution.eta, solution.nu, kin)),
+            None => Ok(Estimated {
+                eta: solution.eta,
+                nu: solution.nu,
+                kin,
+            }),
         }
     }
 
