@@ -149,20 +149,6 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
     let signed = [&short[..3], &["5", "--link-key-file", &key]].concat();
     let real = ["--scenario", REAL_CHAIN, "--duration", REAL_CHAIN_SECONDS];
     let real_chain = real_chain_scenario(ci);
-    let estimator = estimator_scenario(ci);
-    let estimator_args = estimator.as_deref().map(|file| {
-        [
-            "--scenario".to_string(),
-            file.to_string_lossy().into_owned(),
-            "--duration".to_string(),
-            REAL_CHAIN_SECONDS.to_string(),
-        ]
-    });
-    let estimator_args: Vec<&str> = estimator_args
-        .iter()
-        .flatten()
-        .map(String::as_str)
-        .collect();
     let waypoints = [
         "--scenario",
         WAYPOINTS,
@@ -173,12 +159,8 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
         ("short", &short[..], false),
         ("short-signed", &signed[..], true),
         ("real-chain", &real[..], false),
-        ("estimator-survey", &estimator_args[..], false),
         ("waypoints", &waypoints[..], false),
     ] {
-        if args.is_empty() {
-            continue;
-        }
         let want_chain = if name == "real-chain" {
             match &real_chain {
                 Some(c) => Some(c),
@@ -492,62 +474,6 @@ fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
             "PIL campaign worst case: the board flew run {} to a max path of {} m, SIL {} m, the campaign recorded {recorded} m: all three must be the same bits (the worst case's scenario file replays the run)",
             worst.index, c.run.metrics.max_path, c.sil_max_path
         ));
-    }
-}
-
-/// The real-chain mission flown on the state estimator (`controller.estimator = "kalman"`)
-/// and the survey-grade navigation preset (`[navigation] preset = "survey"`): PIL = SIL with
-/// the estimator on the board and the navigation model on (issue 28, Choice 361). Written
-/// into this run's scratch folder from [`REAL_CHAIN`]; `None` (and a failure) if that file
-/// is not as expected.
-fn estimator_scenario(ci: &mut Ci) -> Option<PathBuf> {
-    let path = ci.root.join(REAL_CHAIN);
-    let text = match std::fs::read_to_string(&path) {
-        Ok(t) => t,
-        Err(e) => {
-            ci.fail(format!("PIL estimator-survey: reading {REAL_CHAIN}: {e}"));
-            return None;
-        }
-    };
-    if !text.contains("\n[controller]\n") || text.contains("[navigation]") {
-        ci.fail(format!(
-            "PIL estimator-survey: {REAL_CHAIN} must have a [controller] table and no [navigation] one"
-        ));
-        return None;
-    }
-    let text = text.replacen(
-        "\n[controller]\n",
-        "\n[controller]\nestimator = \"kalman\"\n",
-        1,
-    ) + "\n[navigation]\npreset = \"survey\"\n";
-    let out = ci.scratch().join("pil-estimator-survey.toml");
-    if let Err(e) = std::fs::write(&out, text) {
-        ci.fail(format!(
-            "PIL estimator-survey: writing {}: {e}",
-            out.display()
-        ));
-        return None;
-    }
-    // host-sim's own loader must read it as the check claims: the estimator on, on the survey
-    // preset.
-    match host_sim::scenario::load_scenario(&out) {
-        Ok(s)
-            if s.controller().config().estimator.kind == controller_core::EstimatorKind::Kalman =>
-        {
-            Some(out)
-        }
-        Ok(_) => {
-            ci.fail("PIL estimator-survey: the scenario written does not fly on the estimator");
-            None
-        }
-        Err(e) => {
-            ci.fail(format!(
-                "PIL estimator-survey: {}: {:#}",
-                out.display(),
-                anyhow::Error::from(e)
-            ));
-            None
-        }
     }
 }
 
