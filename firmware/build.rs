@@ -27,7 +27,7 @@ use firmware_images::image;
 // The golden vector's one definition, shared with the self-test that reads them.
 #[path = "src/bin/qemu_selftest/vector.rs"]
 mod vector;
-use vector::Golden;
+use vector::{estimator_steps, EstimatorGolden, Golden};
 
 // The STM32 image's link key from the environment (host-tested in tests/provision.rs).
 #[path = "src/provision.rs"]
@@ -54,6 +54,7 @@ fn main() {
     println!("cargo:rerun-if-changed={}", survey.display());
     fs::write(out.join("golden.rs"), golden(&survey)).expect("writing golden.rs");
     fs::write(out.join("kernel_golden.rs"), kernel_golden()).expect("writing kernel_golden.rs");
+    fs::write(out.join("boot_bounds.rs"), boot_bounds()).expect("writing boot_bounds.rs");
 
     println!("cargo:rerun-if-env-changed={KEY_VAR}");
     println!("cargo:rerun-if-env-changed={UNSIGNED_VAR}");
@@ -116,6 +117,33 @@ fn bits(x: f32) -> String {
 
 /// Inputs of every range of the math kernels (`controller_core::math::kernels`) and the host's
 /// results, as bit patterns: the self-test checks that the target gives the same bits.
+/// The suprema over the default configuration's parameter box, as the same f32 core computes
+/// them, for the flying images to boot on (`firmware::boot`, Choice 363): every field by its
+/// bits.
+fn boot_bounds() -> String {
+    let c = Controller::new(ControllerConfig::default()).expect("defaults");
+    let b = c.bounds();
+    let t = &b.theorem2;
+    let f = |x: f32| format!("f32::from_bits({:#010x})", x.to_bits());
+    format!(
+        "/// The bounds over the default box, computed by firmware/build.rs (Choice 363).\n\
+         pub const BOOT_BOUNDS: UncertaintyBounds<f32> = UncertaintyBounds {{\n\
+         delta_m: {}, delta_g: {}, b_controlled: {}, b_full: {}, beta_hat: {},\n\
+         theorem2: Theorem2 {{ lambda_min_m: {}, lambda_max_m: {}, lambda_min_delta_m: {}, lhs: {}, rhs: {} }},\n\
+         }};\n",
+        f(b.delta_m),
+        f(b.delta_g),
+        f(b.b_controlled),
+        f(b.b_full),
+        f(b.beta_hat),
+        f(t.lambda_min_m),
+        f(t.lambda_max_m),
+        f(t.lambda_min_delta_m),
+        f(t.lhs),
+        f(t.rhs)
+    )
+}
+
 fn kernel_golden() -> String {
     use controller_core::math::kernels;
     let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
@@ -402,7 +430,52 @@ fn golden(survey: &Path) -> String {
         writeln!(s, "    {},", rust(g)).ok();
     }
     s += "];\n";
+    let estimator = estimator_golden(&vectors);
+    writeln!(
+        s,
+        "pub const ESTIMATOR_GOLDEN: [EstimatorGolden; {}] = [",
+        estimator.len()
+    )
+    .ok();
+    for e in &estimator {
+        writeln!(s, "    {e:?},").ok();
+    }
+    s += "];\n";
     s
+}
+
+/// The estimator's golden vectors: [`estimator_steps`] on every closed-form vector with Δu on
+/// that the law flies, by the default controller with the estimator on (Kalman).
+fn estimator_golden(vectors: &[Golden]) -> Vec<EstimatorGolden> {
+    let mut cfg = ControllerConfig::default();
+    cfg.estimator.kind = controller_core::EstimatorKind::Kalman;
+    let c = Controller::new(cfg).expect("the defaults with the estimator");
+    let mut out = Vec::new();
+    for (vector, g) in vectors.iter().enumerate() {
+        let Ok(mission) = Mission::try_from(g.plan) else {
+            continue;
+        };
+        let Some(steps) = estimator_steps(g) else {
+            continue;
+        };
+        if !g.robust || g.status != 0 {
+            continue;
+        }
+        let tr = Trajectory::new(mission).expect("a golden vector's mission");
+        let mut memory = controller_core::Estimate::new();
+        let mut last = None;
+        for (ticks, solution) in steps {
+            last = Some(c.update_from_solution(&mut memory, ticks, &solution, &tr));
+        }
+        let o = last.expect("three steps");
+        assert!(o.status == Status::Ok, "the estimator's case flies: {o:?}");
+        out.push(EstimatorGolden {
+            vector,
+            voltage: o.voltage,
+            tau: o.tau,
+        });
+    }
+    out
 }
 
 /// `g` as a Rust expression: its `Debug` form, whose every finite `f32` is the shortest

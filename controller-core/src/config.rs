@@ -11,6 +11,7 @@ use core::fmt;
 use crate::allocation::{AllocationError, AxisPriority};
 use crate::axes::{ACTUATED, ROLL};
 use crate::effectiveness::ThrusterGeometry;
+use crate::estimator::{EstimatorConfig, EstimatorKind};
 use crate::law::RobustLaw;
 use crate::model::VehicleParams;
 use crate::readable::Readable;
@@ -73,6 +74,9 @@ pub struct ControllerConfig {
     /// Which forces the saturation-aware allocator gives up first (docs/thrusters.md#allocation-blocks-and-the-axis-priority
     /// **Choice**: pitch, depth, yaw, sway, surge, highest first).
     pub priority: AxisPriority,
+    /// The state estimator the law flies on (docs/law.md#the-state-estimator **Choice 340**):
+    /// off by default, so the law is given the navigation solution as it arrives.
+    pub estimator: EstimatorConfig,
 }
 
 impl Default for ControllerConfig {
@@ -95,6 +99,7 @@ impl Default for ControllerConfig {
             geometry: ThrusterGeometry::default(),
             thrust_unit: ThrustUnit::Kgf,
             priority: AxisPriority::default(),
+            estimator: EstimatorConfig::default(),
         }
     }
 }
@@ -151,6 +156,18 @@ pub enum ConfigError {
     },
     /// Thruster geometry rejected.
     Allocation(AllocationError),
+    /// An estimator noise setting (`estimator_position_sigma`, `estimator_velocity_sigma`,
+    /// `estimator_accel_sigma`) of `axis` is not finite and > 0.
+    EstimatorSigma {
+        name: &'static str,
+        axis: usize,
+        value: f32,
+    },
+    /// The estimator's Riccati equation has no steady state on `axis` at this rate.
+    EstimatorGain { axis: usize },
+    /// The bounds given to `Controller::with_bounds` are of other vehicle parameters or
+    /// another box than the configuration's (Choice 363).
+    BoundsOfAnotherBox,
 }
 
 /// The [`ControllerConfig`] field a [`ConfigError`] is about: `name` is the field's name,
@@ -175,7 +192,9 @@ impl ConfigError {
             ConfigError::PitchLimit { .. } => ("pitch_limit", None),
             ConfigError::ZeroRate => ("rate_hz", None),
             ConfigError::NonFiniteParams => ("params", None),
-            ConfigError::InvalidBox | ConfigError::Bounds(_) => ("uncertainty", None),
+            ConfigError::InvalidBox | ConfigError::Bounds(_) | ConfigError::BoundsOfAnotherBox => {
+                ("uncertainty", None)
+            }
             ConfigError::Allocation(AllocationError::Weight { axis, .. }) => {
                 ("priority", Some(axis))
             }
@@ -183,6 +202,8 @@ impl ConfigError {
                 ("voltage_limit", None)
             }
             ConfigError::Allocation(_) => ("geometry", None),
+            ConfigError::EstimatorSigma { name, axis, .. } => (name, Some(axis)),
+            ConfigError::EstimatorGain { axis } => ("estimator_accel_sigma", Some(axis)),
             ConfigError::Assumption2 { .. }
             | ConfigError::Theorem2 { .. }
             | ConfigError::LoopRate { .. } => return None,
@@ -244,6 +265,7 @@ impl fmt::Display for ConfigError {
             ConfigError::InvalidBox => {
                 write!(f, "parameter box is not finite or has lower > upper")
             }
+            ConfigError::BoundsOfAnotherBox => f.write_str(BOUNDS_OF_ANOTHER_BOX),
             ConfigError::Bounds(BoundsError::MassNotPositiveDefinite {
                 corner,
                 min_eigenvalue,
@@ -277,9 +299,33 @@ impl fmt::Display for ConfigError {
                 Readable(max_period)
             ),
             ConfigError::Allocation(e) => write!(f, "thruster allocation: {e}"),
+            ConfigError::EstimatorSigma { .. }
+            | ConfigError::EstimatorGain { .. } => self.fmt_estimator(f),
         }
     }
 }
+
+impl ConfigError {
+    /// The estimator's errors, in words.
+    fn fmt_estimator(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match *self {
+            ConfigError::EstimatorSigma { name, axis, value } => write!(
+                f,
+                "{name}[{axis}] must be a finite number > 0, got {}",
+                Readable(value)
+            ),
+            ConfigError::EstimatorGain { axis } => write!(
+                f,
+                "the estimator's Riccati equation has no steady state on axis {axis} with these noise settings"
+            ),
+            _ => Ok(()),
+        }
+    }
+}
+
+/// [`ConfigError::BoundsOfAnotherBox`] in words.
+const BOUNDS_OF_ANOTHER_BOX: &str =
+    "the bounds given are of other vehicle parameters or another box than the configuration's";
 
 /// A finite value > 0.
 fn positive(name: &'static str, value: f32) -> Result<(), ConfigError> {
@@ -342,6 +388,20 @@ impl ControllerConfig {
         }
         if !self.uncertainty.is_valid() {
             return Err(ConfigError::InvalidBox);
+        }
+        if self.estimator.kind != EstimatorKind::Off {
+            let e = &self.estimator;
+            for (name, sigma) in [
+                ("estimator_position_sigma", &e.position_sigma),
+                ("estimator_velocity_sigma", &e.velocity_sigma),
+                ("estimator_accel_sigma", &e.accel_sigma),
+            ] {
+                for (axis, &value) in sigma.iter().enumerate() {
+                    if !(value.is_finite() && value > 0.0) {
+                        return Err(ConfigError::EstimatorSigma { name, axis, value });
+                    }
+                }
+            }
         }
         Ok(())
     }

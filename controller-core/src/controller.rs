@@ -12,6 +12,7 @@ use crate::allocation::{Allocated, Allocator, PseudoInverse};
 use crate::axes::ACTUATED;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
+use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind};
 use crate::kinematics::{Attitude, Kinematics};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw};
 use crate::model::{self, VehicleParams};
@@ -155,6 +156,9 @@ pub struct Output {
     pub eta_d: [f32; 6],
     /// e₁ = η − η_d (yaw wrapped).
     pub e1: [f32; 6],
+    /// The commanded η̈ = ū + Δu (m/s², rad/s²): what the state estimator's model takes as
+    /// applied (docs/law.md#the-state-estimator).
+    pub u: [f32; 6],
 }
 
 impl Output {
@@ -173,6 +177,7 @@ impl Output {
             w_norm: 0.0,
             eta_d: [0.0; 6],
             e1: [0.0; 6],
+            u: [0.0; 6],
         }
     }
 
@@ -185,6 +190,7 @@ impl Output {
             .chain(self.voltage.iter())
             .chain(self.eta_d.iter())
             .chain(self.e1.iter())
+            .chain(self.u.iter())
             .chain([self.delta, self.w_norm].iter())
             .all(|x| x.is_finite())
     }
@@ -203,6 +209,34 @@ pub struct Controller {
     allocator: Allocator,
     maps: [ThrusterMap; THRUSTERS],
     cos_pitch_limit: f32,
+    /// The estimator's gains and 1/M̂ᵢᵢ for its model (Choice 340); `None`: off, and nothing
+    /// of it computed.
+    estimator: Option<(EstimatorGains, [f32; 6])>,
+}
+
+/// The suprema over a parameter box ([`UncertaintyBounds`]) with the vehicle parameters and
+/// the box they are of: what [`Controller::with_bounds`] takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BoxBounds {
+    pub params: VehicleParams<f32>,
+    pub uncertainty: crate::uncertainty::ParamBox<f32>,
+    pub bounds: UncertaintyBounds<f32>,
+}
+
+/// The state the law flies on with the estimator on, and J's kinematics there.
+struct Estimated {
+    eta: [f32; 6],
+    nu: [f32; 6],
+    kin: Kinematics<f32>,
+}
+
+/// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
+/// solution holds at (`t_ticks` of the link's state frame).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Solution {
+    pub stamp: u64,
+    pub eta: [f32; 6],
+    pub nu: [f32; 6],
 }
 
 impl Controller {
@@ -228,11 +262,59 @@ impl Controller {
         Self::build(config, same_box.then_some(self.bounds))
     }
 
+    /// The controller [`Controller::new`] gives for `config`, the same in every bit, with the
+    /// suprema over the parameter box given: `bounds` must be those of `config`'s vehicle
+    /// parameters and box ([`ConfigError::BoundsOfAnotherBox`] otherwise). Never computes them.
+    ///
+    /// **Choice 363:** the flying images boot on bounds the firmware's build computed on the
+    /// host with this same f32 code (firmware/build.rs), and rebuild with
+    /// [`Controller::rebuild`], so no flying image carries the bounds' eigen-solver (≈ 12 kB
+    /// of flash) nor spends its ≈ 26 M instructions at boot; the self-test computes them on
+    /// the board and requires the very bits the build gave.
+    pub fn with_bounds(config: ControllerConfig, bounds: &BoxBounds) -> Result<Self, ConfigError> {
+        if config.params != bounds.params || config.uncertainty != bounds.uncertainty {
+            return Err(ConfigError::BoundsOfAnotherBox);
+        }
+        Self::build_on(config, bounds.bounds)
+    }
+
+    /// [`Controller::reconfigure`] that never computes the bounds: `config` must have this
+    /// controller's vehicle parameters and box ([`ConfigError::BoundsOfAnotherBox`]
+    /// otherwise), which every configuration a board's link can set has (Choice 225).
+    pub fn rebuild(&self, config: ControllerConfig) -> Result<Self, ConfigError> {
+        Self::with_bounds(config, &self.box_bounds())
+    }
+
+    /// This controller's bounds with the parameters and box they are of.
+    pub fn box_bounds(&self) -> BoxBounds {
+        BoxBounds {
+            params: self.config.params,
+            uncertainty: self.config.uncertainty,
+            bounds: self.bounds,
+        }
+    }
+
     /// `new`, with the bounds over the box given (`Some`: computed before for the same
-    /// parameters and box) or computed here.
+    /// parameters and box) or computed here (after the scalar checks).
     fn build(
         config: ControllerConfig,
         bounds: Option<UncertaintyBounds<f32>>,
+    ) -> Result<Self, ConfigError> {
+        let bounds = match bounds {
+            Some(b) => b,
+            None => {
+                config.check_scalars()?;
+                UncertaintyBounds::compute(&config.params, &config.uncertainty)?
+            }
+        };
+        Self::build_on(config, bounds)
+    }
+
+    /// `new` on the bounds over the box given: never computes them (so that a flying image
+    /// that only calls this carries no eigen-solver, Choice 363).
+    fn build_on(
+        config: ControllerConfig,
+        bounds: UncertaintyBounds<f32>,
     ) -> Result<Self, ConfigError> {
         config.check_scalars()?;
         let allocation = PseudoInverse::new(&config.geometry)?;
@@ -240,10 +322,6 @@ impl Controller {
         let envelope = ThrustEnvelope::new(&maps, config.thrust_unit, config.voltage_limit);
         let allocator = Allocator::new(&allocation, &envelope, &config.priority)?;
 
-        let bounds = match bounds {
-            Some(b) => b,
-            None => UncertaintyBounds::compute(&config.params, &config.uncertainty)?,
-        };
         check_feasible(&bounds, config.beta)?;
 
         let mut lyapunov = [AxisLyapunov::default(); 6];
@@ -290,8 +368,12 @@ impl Controller {
             b_sec_power,
         };
 
+        let m_hat = model::mass_matrix(&config.params);
+        let estimator = estimator_parts(&config, &m_hat)?;
+
         Ok(Controller {
-            m_hat: model::mass_matrix(&config.params),
+            estimator,
+            m_hat,
             k1: Vector6::from(config.k1),
             k2: Vector6::from(config.k2),
             lyapunov,
@@ -299,7 +381,9 @@ impl Controller {
             bounds,
             allocator,
             maps,
-            cos_pitch_limit: libm::cosf(config.pitch_limit),
+            // Choice 360: the core's cosine kernel in every backend (libm's cosf, the one call of
+            // it on the board, was 5.4 kB of flash with its f64 reduction).
+            cos_pitch_limit: crate::math::kernels::cos(config.pitch_limit),
             config,
         })
     }
@@ -372,6 +456,96 @@ impl Controller {
         }
     }
 
+    /// One control step on a navigation `solution` at period `ticks`, with the estimator's
+    /// memory `memory` (docs/law.md#the-state-estimator, Choice 340): with the estimator off,
+    /// exactly [`Controller::update`] on the solution's η, ν (the memory untouched); with it
+    /// on, the solution is checked as `update` checks it (a fault gives the same fail-safe and
+    /// the memory does not take the solution), converted to η̇ = J(η)ν, filtered at its stamp
+    /// and predicted to `ticks`, and [`Controller::update`] runs on the estimate (η̂,
+    /// ν̂ = J(η̂)⁻¹η̂̇); the acceleration the applied thrust gives under the nominal model is
+    /// then recorded for the next predictions.
+    ///
+    /// **Choice 364:** the law on the estimate is `update` itself, called, not a second copy
+    /// of its stages: on the board each stage's code then has one caller and is inlined into
+    /// `update` as before the estimator (two callers made the compiler outline them, and
+    /// `update` alone went from 3 920 to 6 160 instructions in the self-test).
+    #[inline(never)]
+    pub fn update_from_solution(
+        &self,
+        memory: &mut Estimate,
+        ticks: u64,
+        solution: &Solution,
+        trajectory: &Trajectory,
+    ) -> Output {
+        let Some((gains, m_diag_inv)) = &self.estimator else {
+            return self.update(ticks, &solution.eta, &solution.nu, trajectory);
+        };
+        let (out, accel) = match self.estimate(memory, gains, ticks, solution) {
+            Err(fault) => (Output::fail_safe(fault), [0.0; 6]),
+            Ok(Estimated { eta, nu, kin }) => {
+                let out = self.update(ticks, &eta, &nu, trajectory);
+                let accel = match out.status {
+                    Status::Ok => estimator::applied_acceleration(
+                        &Vector6::from(out.u),
+                        &kin,
+                        m_diag_inv,
+                        &Vector6::from(out.tau),
+                        &Vector6::from(out.tau_achieved),
+                    )
+                    .into(),
+                    Status::Fault(_) => [0.0; 6],
+                };
+                (out, accel)
+            }
+        };
+        memory.applied(gains, ticks, &accel);
+        out
+    }
+
+    /// The state the law flies on with the estimator on: the solution checked as
+    /// [`Controller::update`] checks it, taken into `memory` at its stamp and predicted to
+    /// `ticks` (η̂, ν̂ = J(η̂)⁻¹η̂̇, and J(η̂)'s kinematics), or the solution as told before any
+    /// could be taken.
+    fn estimate(
+        &self,
+        memory: &mut Estimate,
+        gains: &EstimatorGains,
+        ticks: u64,
+        solution: &Solution,
+    ) -> Result<Estimated, Fault> {
+        check_inputs(&solution.eta, &solution.nu)?;
+        let kin = self.checked_kinematics(&solution.eta)?;
+        let eta_dot = kin.eta_dot(&Vector6::from(solution.nu));
+        match memory.step(gains, ticks, solution.stamp, &solution.eta, &eta_dot.into()) {
+            Some((eta, eta_dot)) => {
+                if !eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite()) {
+                    return Err(Fault::NonFiniteResult);
+                }
+                let kin = self.checked_kinematics(&eta)?;
+                let nu = kin.jinv_mul(&Vector6::from(eta_dot));
+                Ok(Estimated {
+                    eta,
+                    nu: nu.into(),
+                    kin,
+                })
+            }
+            None => Ok(Estimated {
+                eta: solution.eta,
+                nu: solution.nu,
+                kin,
+            }),
+        }
+    }
+
+    /// J(η)'s kinematics, with the pitch limit (η finite).
+    fn checked_kinematics(&self, eta: &[f32; 6]) -> Result<Kinematics<f32>, Fault> {
+        let att = Attitude::from_eta_f32(&Vector6::from(*eta));
+        if att.ctheta.abs() < self.cos_pitch_limit {
+            return Err(Fault::PitchLimit);
+        }
+        Kinematics::new(att).map_err(|_| Fault::PitchLimit)
+    }
+
     /// The stages of [`Stage::ALL`] in order, then the output.
     fn step(
         &self,
@@ -398,6 +572,7 @@ impl Controller {
             w_norm: law.w_norm,
             eta_d: desired.eta.into(),
             e1: law.e1.into(),
+            u: law.u.into(),
         })
     }
 
@@ -493,6 +668,7 @@ impl Controller {
             return Err(Fault::NonFiniteResult);
         }
         Ok(StepLaw {
+            u,
             tau,
             delta,
             delta_clamped,
@@ -582,12 +758,31 @@ pub struct StepKinematics {
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepLaw {
+    /// The commanded η̈: ū + Δu.
+    pub u: Vector6<f32>,
     pub tau: Vector6<f32>,
     pub delta: f32,
     /// δ was clamped (reported only when Δu is on).
     pub delta_clamped: bool,
     pub w_norm: f32,
     pub e1: Vector6<f32>,
+}
+
+/// The estimator's gains and 1/M̂ᵢᵢ for its model (Choice 340); `None` when it is off.
+fn estimator_parts(
+    config: &ControllerConfig,
+    m_hat: &Matrix6<f32>,
+) -> Result<Option<(EstimatorGains, [f32; 6])>, ConfigError> {
+    match config.estimator.kind {
+        EstimatorKind::Off => Ok(None),
+        EstimatorKind::Kalman => {
+            let gains = EstimatorGains::new(&config.estimator, config.rate_hz)
+                .map_err(|axis| ConfigError::EstimatorGain { axis })?;
+            // M̂ is positive definite (checked over the box): its diagonal is > 0.
+            let m_diag_inv = core::array::from_fn(|i| 1.0 / m_hat[(i, i)]);
+            Ok(Some((gains, m_diag_inv)))
+        }
+    }
 }
 
 /// Assumption 2 (Eq 20: β̂ < 1 and β̂ ≤ the configured β) and Theorem 2 (Eq 25) over the box.

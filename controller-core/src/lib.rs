@@ -9,6 +9,7 @@ pub mod axes;
 pub mod config;
 pub mod controller;
 pub mod effectiveness;
+pub mod estimator;
 pub mod kinematics;
 pub mod law;
 pub mod math;
@@ -20,7 +21,8 @@ pub mod trajectory;
 pub mod uncertainty;
 
 pub use config::{BBound, ConfigError, ControllerConfig};
-pub use controller::{Controller, Fault, Output, Stage, Status};
+pub use controller::{BoxBounds, Controller, Fault, Output, Solution, Stage, Status};
+pub use estimator::{Estimate, EstimatorConfig, EstimatorKind};
 pub use law::RobustLaw;
 pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};
 pub use trajectory::{

@@ -78,10 +78,11 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 642 on the survey's golden vectors,
         // against 468 for the closed forms.
         stages: [560, 720, 760, 1_000, 1_250],
-        // Measured 22 600 (the whole patch host-sim sends; 19 600–22 080 for one law field),
-        // 1 051 160 and 1 218 200.
+        // Measured 29 160 (the whole patch host-sim sends, protocol 7: its digest covers the
+        // estimator's 73 bytes too, and the rebuild checks the box its bounds are of, Choice
+        // 363; 21 600–24 120 for one law field), 1 051 160 and 1 218 200.
         work: WorkBudget {
-            set_config: 26_000,
+            set_config: 34_000,
             build: 1_200_000,
             period: 1_400_000,
         },
@@ -94,7 +95,7 @@ pub const BUDGETS: [StepBudget; 3] = [
         // Measured 34 720, 1 281 440 and 1 448 480 (libm's cosf in the rebuild, its sin/cos in
         // the waypoint build).
         work: WorkBudget {
-            set_config: 40_000,
+            set_config: 48_000,
             build: 1_450_000,
             period: 1_650_000,
         },
@@ -105,9 +106,9 @@ pub const BUDGETS: [StepBudget; 3] = [
         update: 4_200,
         // The waypoint path's trajectory stage: 600 measured (docs/board.md#the-self-test-and-its-budgets).
         stages: [500, 680, 780, 1_000, 1_250],
-        // Measured as the kernels: 22 600, 1 051 200 and 1 218 200.
+        // Measured as the kernels: 29 160, 1 051 200 and 1 218 200.
         work: WorkBudget {
-            set_config: 26_000,
+            set_config: 34_000,
             build: 1_200_000,
             period: 1_400_000,
         },

@@ -1,6 +1,7 @@
 //! AUV-150 thruster-board firmware: a thin fixed-rate shell around `controller-core`.
 //!
-//! Hardware-free parts, tested on the host: [`supervisor`] (arming, missions, fail-safe,
+//! Hardware-free parts, tested on the host: [`boot`] (the controller a flying image boots
+//! with, on bounds computed at build time), [`supervisor`] (arming, missions, fail-safe,
 //! refusals), [`limits`] (what the board's configuration may be), [`budget`] (the
 //! instruction budgets on the target: the control step, the long jobs, a period's work),
 //! [`pwm`] (voltage → H-bridge duty), [`board`] (the board trait and one control period),
@@ -19,6 +20,7 @@
 #![cfg_attr(not(test), no_std)]
 
 pub mod board;
+pub mod boot;
 pub mod budget;
 pub mod limits;
 pub mod pwm;

@@ -32,7 +32,9 @@ use auv_link::{
 };
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
 use controller_core::trajectory::TrajectoryError;
-use controller_core::{Controller, ControllerConfig, Status, Trajectory};
+use controller_core::{
+    Controller, ControllerConfig, Estimate, EstimatorKind, Solution, Status, Trajectory,
+};
 
 use crate::limits;
 
@@ -210,6 +212,9 @@ pub struct Supervisor {
     /// The controller's thruster mounting as the link's reversed-thruster mask, computed when
     /// the controller is set ([`mounting_of`]).
     mounting: u8,
+    /// The state estimator's memory (docs/law.md#the-state-estimator): a new mission and a
+    /// new configuration start it afresh; untouched while the estimator is off.
+    memory: Estimate,
 }
 
 pub use auv_link::{mounting_of, NOT_AUV150};
@@ -271,6 +276,7 @@ impl Supervisor {
             worst_update_ticks: 0,
             last_state_seq: 0,
             state_fresh: false,
+            memory: Estimate::new(),
         }
     }
 
@@ -486,6 +492,7 @@ impl Supervisor {
         }
         self.mission = Some(self.tick);
         self.clock = MissionClock::START;
+        self.memory = Estimate::new();
         // A state frame from before the mission is not its state, in either pacing (Choice 227:
         // "a new mission counts from its start"): the mission waits for its first with the
         // `stale_periods` grace. Kept, an old frame made a free-running mission latch stale
@@ -552,7 +559,7 @@ impl Supervisor {
     /// [`Refusal::InvalidMounting`]) and the allocator's axis priority (a weight the core
     /// refuses is [`Refusal::InvalidPriority`]). Each changes the controller's configuration,
     /// so the core revalidates all of it (the envelope and the allocator's blocks are rebuilt
-    /// by `Controller::reconfigure`, which keeps the suprema over the parameter box computed
+    /// by `Controller::rebuild`, which keeps the suprema over the parameter box computed
     /// at boot: Choice 225) before anything is applied. A rebuild is the period's long job
     /// (Choice 226).
     fn configure(&mut self, p: &ConfigPatch) -> Result<(), Refusal> {
@@ -584,6 +591,9 @@ impl Supervisor {
         if let Some(q) = p.priority {
             cfg.priority = q.into();
         }
+        if let Some(e) = p.estimator {
+            cfg.estimator = e.into();
+        }
         let stale_periods = p.stale_periods.unwrap_or(self.stale_periods);
         let lockstep = p.lockstep.unwrap_or(self.lockstep);
 
@@ -602,20 +612,17 @@ impl Supervisor {
         let controller = if cfg == *self.controller.config() {
             None
         } else {
-            Some(
-                self.controller
-                    .reconfigure(cfg)
-                    .map_err(|e| match e.field() {
-                        Some(f) if f.name == "priority" => Refusal::InvalidPriority,
-                        _ => Refusal::ControllerConfig,
-                    })?,
-            )
+            Some(self.controller.rebuild(cfg).map_err(|e| match e.field() {
+                Some(f) if f.name == "priority" => Refusal::InvalidPriority,
+                _ => Refusal::ControllerConfig,
+            })?)
         };
 
         // Everything validated: apply all of it.
         if let Some(c) = controller {
             self.mounting = mounting_of(c.config());
             self.controller = c;
+            self.memory = Estimate::new();
             self.long_job = true;
         }
         self.stale_periods = stale_periods;
@@ -682,18 +689,38 @@ impl Supervisor {
         }
     }
 
-    /// `update` on the latest state frame, timed; a fault latches the fail-safe.
+    /// `update` on the latest state frame (through the state estimator when it is on), timed;
+    /// a fault latches the fail-safe.
+    ///
+    /// **Choice 362:** the solution's stamp and the period's tick. Mission time is the board's
+    /// own ticks since `StartMission`, or in lock-step the state frame's `t_ticks` (so PIL
+    /// does not depend on host speed). The solution holds at the period its frame was taken
+    /// in: in lock-step its `t_ticks`, free-running the board's tick of that period (the
+    /// board does not mix the navigation computer's clock with its own). A period without a
+    /// fresh frame (`stale_periods` allows a few) flies the last one `age` periods old: the
+    /// estimator predicts it forward over those periods with the thrust it applied; with the
+    /// estimator off the law is given the frame as it was (in lock-step at its own tick, as
+    /// before the estimator).
     fn fly(&mut self, start: u64, s: &StateFrame, now: &dyn Fn() -> u32) -> (BoardStatus, Control) {
         let traj = &self.trajectory;
-        // Mission time: the board's own ticks since StartMission; in lock-step the state
-        // frame's t_ticks, on the mission clock (so PIL does not depend on host speed).
-        let mission_ticks = if self.lockstep {
-            s.t_ticks
+        let age = u64::from(self.periods_since_state);
+        let estimating = self.controller.config().estimator.kind != EstimatorKind::Off;
+        let (ticks, stamp) = if self.lockstep {
+            let ahead = if estimating { age } else { 0 };
+            (s.t_ticks.saturating_add(ahead), s.t_ticks)
         } else {
-            self.tick.wrapping_sub(start)
+            let ticks = self.tick.wrapping_sub(start);
+            (ticks, ticks.saturating_sub(age))
+        };
+        let solution = Solution {
+            stamp,
+            eta: s.eta,
+            nu: s.nu,
         };
         let t0 = now();
-        let out = self.controller.update(mission_ticks, &s.eta, &s.nu, traj);
+        let out = self
+            .controller
+            .update_from_solution(&mut self.memory, ticks, &solution, traj);
         let dt = now().wrapping_sub(t0);
         self.worst_update_ticks = self.worst_update_ticks.max(dt);
         match out.status {

@@ -10,9 +10,9 @@ use std::path::Path;
 use controller_core::trajectory::{Circle, FigureEight, Helix, LawnMower, SpeedList, WaypointList};
 use controller_core::{Table1Case, TrajectoryKind};
 use host_sim::scenario::file::{
-    AttitudeName, BBoundName, BoundTable, ControllerTable, CurrentName, CurrentTable, HeadingName,
-    LawName, LinkFaultsTable, NoiseTable, ProfileName, StepTable, ThrustUnitName, TrajectoryTable,
-    VariationTable,
+    AttitudeName, BBoundName, BoundTable, ControllerTable, CurrentName, CurrentTable,
+    EstimatorName, HeadingName, LawName, LinkFaultsTable, NoiseTable, ProfileName, StepTable,
+    ThrustUnitName, TrajectoryTable, VariationTable,
 };
 use host_sim::scenario::navigation::{self, ErrorModel, NavigationModel, Preset, Source};
 use host_sim::scenario::{
@@ -195,6 +195,10 @@ fn every_key(path: TrajectoryKind) -> ScenarioFile {
             thrust_unit: Some(ThrustUnitName::Newton),
             axis_priority: Some(vec!["pitch".into()]),
             reversed_thrusters: Some(vec![]),
+            estimator: Some(EstimatorName::Kalman),
+            estimator_position_sigma: Some([1.0; 6]),
+            estimator_velocity_sigma: Some([1.0; 6]),
+            estimator_accel_sigma: Some([1.0; 6]),
         }),
         bound: Some(BoundTable {
             max_path: Some(1.0),

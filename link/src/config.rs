@@ -13,8 +13,9 @@
 //! little-endian), `robust` (1 byte, 0 or 1), `delta_max` and `voltage_limit` (f32, their four
 //! little-endian bytes), `stale_periods` (1 byte), `lockstep` (0 or 1), the thrust unit (its
 //! wire index: 0 kgf, 1 newton), `reversed_thrusters` (1 byte), then the priority's six ranks
-//! (1 byte each) and six weights (f32 each): 47 bytes. Written field by field, not through
-//! postcard, so that the board carries no serializer for a message it only receives.
+//! (1 byte each) and six weights (f32 each), then the estimator's (protocol 7): on (0 or 1),
+//! σₚ, σᵥ, σₐ (six f32 each): 120 bytes. Written field by field, not through postcard, so that
+//! the board carries no serializer for a message it only receives.
 
 use controller_core::ControllerConfig;
 
@@ -22,7 +23,7 @@ use crate::msg::{ConfigPatch, Telemetry, ThrustUnit, NOT_AUV150};
 use crate::upload::CRC32;
 
 /// Bytes the digest covers (module docs).
-const DIGEST_BYTES: usize = 4 + 1 + 4 + 4 + 1 + 1 + 1 + 1 + 6 + 6 * 4;
+const DIGEST_BYTES: usize = 4 + 1 + 4 + 4 + 1 + 1 + 1 + 1 + 6 + 6 * 4 + 1 + 18 * 4;
 
 /// The thruster mounting a board that flies `config` reports: the AUV-150 layout's
 /// reversed-thruster mask ([`Telemetry::reversed_thrusters`]), or [`NOT_AUV150`] for a geometry
@@ -46,6 +47,7 @@ impl ConfigPatch {
             thrust_unit: Some(config.thrust_unit.into()),
             reversed_thrusters: Some(mounting_of(config)),
             priority: Some(config.priority.into()),
+            estimator: Some(config.estimator.into()),
         }
     }
 
@@ -68,6 +70,7 @@ impl ConfigPatch {
             Some(unit),
             Some(mounting),
             Some(priority),
+            Some(estimator),
         ) = (
             self.rate_hz,
             self.robust,
@@ -78,6 +81,7 @@ impl ConfigPatch {
             self.thrust_unit,
             self.reversed_thrusters,
             self.priority,
+            self.estimator,
         )
         else {
             return None;
@@ -97,6 +101,15 @@ impl ConfigPatch {
         bytes[17..23].copy_from_slice(&priority.rank);
         for (i, w) in priority.weight.iter().enumerate() {
             bytes[23 + 4 * i..27 + 4 * i].copy_from_slice(&w.to_le_bytes());
+        }
+        bytes[47] = u8::from(estimator.kalman);
+        let sigmas = [
+            &estimator.position_sigma,
+            &estimator.velocity_sigma,
+            &estimator.accel_sigma,
+        ];
+        for (i, x) in sigmas.into_iter().flatten().enumerate() {
+            bytes[48 + 4 * i..52 + 4 * i].copy_from_slice(&x.to_le_bytes());
         }
         Some(CRC32.checksum(&bytes))
     }

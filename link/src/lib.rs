@@ -108,9 +108,9 @@ pub use frame::{
 };
 pub use heading::Heading;
 pub use msg::{
-    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason, MissionPlan,
-    MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS, NOT_AUV150,
-    PROTOCOL_VERSION,
+    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings, FailSafeReason,
+    MissionPlan, MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
+    NOT_AUV150, PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;
 pub use upload::{

@@ -20,7 +20,7 @@
 use controller_core::{trajectory, HeadingMode, Mission, TrajectoryKind};
 
 use crate::heading::Heading;
-use crate::msg::{AxisPriority, MissionPlan, MissionSpec, ThrustUnit};
+use crate::msg::{AxisPriority, EstimatorSettings, MissionPlan, MissionSpec, ThrustUnit};
 use crate::refusal::Refusal;
 use crate::upload::{MissionUpload, UploadBuffer};
 
@@ -186,5 +186,43 @@ impl From<AxisPriority> for controller_core::allocation::AxisPriority {
     fn from(p: AxisPriority) -> Self {
         let AxisPriority { rank, weight } = p;
         controller_core::allocation::AxisPriority { rank, weight }
+    }
+}
+
+impl From<controller_core::EstimatorConfig> for EstimatorSettings {
+    fn from(e: controller_core::EstimatorConfig) -> Self {
+        let controller_core::EstimatorConfig {
+            kind,
+            position_sigma,
+            velocity_sigma,
+            accel_sigma,
+        } = e;
+        EstimatorSettings {
+            kalman: kind == controller_core::EstimatorKind::Kalman,
+            position_sigma,
+            velocity_sigma,
+            accel_sigma,
+        }
+    }
+}
+
+impl From<EstimatorSettings> for controller_core::EstimatorConfig {
+    fn from(e: EstimatorSettings) -> Self {
+        let EstimatorSettings {
+            kalman,
+            position_sigma,
+            velocity_sigma,
+            accel_sigma,
+        } = e;
+        controller_core::EstimatorConfig {
+            kind: if kalman {
+                controller_core::EstimatorKind::Kalman
+            } else {
+                controller_core::EstimatorKind::Off
+            },
+            position_sigma,
+            velocity_sigma,
+            accel_sigma,
+        }
     }
 }

@@ -32,7 +32,11 @@ use crate::upload::{UploadChunk, UploadPart, UploadStatus, CHUNK_WORDS};
 /// 6: `Telemetry` carries the digest of the whole configuration the board flies
 /// ([`Telemetry::config_digest`], [`ConfigPatch::digest`]), so that the navigation computer
 /// confirms every field it set (Choice 228).
-pub const PROTOCOL_VERSION: u8 = 6;
+///
+/// 7: `SetConfig` carries the state estimator's settings ([`ConfigPatch::estimator`],
+/// [`EstimatorSettings`]), which the digest covers; the board computes the gains from them
+/// while disarmed (Choice 361).
+pub const PROTOCOL_VERSION: u8 = 7;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -333,6 +337,34 @@ pub struct ConfigPatch {
     /// Which forces the saturation-aware allocator gives up first. Refused while armed, and
     /// when the core refuses a weight ([`Refusal::InvalidPriority`]).
     pub priority: Option<AxisPriority>,
+    // Protocol 7: appended field.
+    /// The state estimator the law flies on and its noise settings (refused while armed, and
+    /// when the core refuses a setting: [`Refusal::ControllerConfig`]).
+    pub estimator: Option<EstimatorSettings>,
+}
+
+/// The wire form of `controller_core::EstimatorConfig` (docs/law.md#the-state-estimator):
+/// whether the law flies on the estimate, and σₚ, σᵥ, σₐ per axis of η. The board computes
+/// the filter's gains from them with the core's f32 code (Choice 361), so a board and the
+/// host's SIL given the same settings fly the same gains, bit for bit. Convert with `From`
+/// both ways ([`crate::mission`]).
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct EstimatorSettings {
+    /// The per-axis steady-state Kalman filter is on (false: the law flies on the solution
+    /// as told).
+    pub kalman: bool,
+    /// σₚ (m, rad).
+    pub position_sigma: [f32; 6],
+    /// σᵥ (m/s, rad/s).
+    pub velocity_sigma: [f32; 6],
+    /// σₐ (m/s², rad/s²).
+    pub accel_sigma: [f32; 6],
+}
+
+impl EstimatorSettings {
+    /// Worst-case postcard size of an `EstimatorSettings` (bytes).
+    pub const MAX_SIZE: usize = BOOL + 18 * F32;
 }
 
 /// The wire form of `controller_core::allocation::AxisPriority`: per row of τ = [X Y Z K M N],
@@ -363,7 +395,8 @@ impl ConfigPatch {
         + option(BOOL)
         + option(ThrustUnit::MAX_SIZE)
         + option(U8)
-        + option(AxisPriority::MAX_SIZE);
+        + option(AxisPriority::MAX_SIZE)
+        + option(EstimatorSettings::MAX_SIZE);
 
     /// Changes nothing.
     pub const EMPTY: ConfigPatch = ConfigPatch {
@@ -376,6 +409,7 @@ impl ConfigPatch {
         thrust_unit: None,
         reversed_thrusters: None,
         priority: None,
+        estimator: None,
     };
 }
 

@@ -3,7 +3,9 @@
 //! laid out by hand), every field moves it, and `confirm` tells a board that flies what was
 //! sent from one that does not, naming what differs where telemetry can tell.
 
-use auv_link::{AxisPriority, ConfigMismatch, ConfigPatch, Telemetry, ThrustUnit};
+use auv_link::{
+    AxisPriority, ConfigMismatch, ConfigPatch, EstimatorSettings, Telemetry, ThrustUnit,
+};
 use controller_core::ControllerConfig;
 
 #[path = "common/frames.rs"]
@@ -32,11 +34,16 @@ fn the_whole_configuration_sets_every_field_from_the_core_and_the_board() {
         Some(controller_core::effectiveness::AUV150_REVERSED)
     );
     assert_eq!(w.priority, Some(AxisPriority::from(c.priority)));
+    assert_eq!(w.estimator, Some(EstimatorSettings::from(c.estimator)));
     // Any field unset: not whole.
     for unset in [
         ConfigPatch { rate_hz: None, ..w },
         ConfigPatch {
             priority: None,
+            ..w
+        },
+        ConfigPatch {
+            estimator: None,
             ..w
         },
         ConfigPatch {
@@ -66,7 +73,16 @@ fn the_digest_is_the_crc32_of_the_documented_bytes() {
     for x in p.weight {
         bytes.extend_from_slice(&x.to_le_bytes());
     }
-    assert_eq!(bytes.len(), 47);
+    // Protocol 7: the estimator, off, then σₚ, σᵥ, σₐ.
+    bytes.push(0);
+    let e = c.estimator;
+    for x in [e.position_sigma, e.velocity_sigma, e.accel_sigma]
+        .iter()
+        .flatten()
+    {
+        bytes.extend_from_slice(&x.to_le_bytes());
+    }
+    assert_eq!(bytes.len(), 120);
     assert_eq!(w.digest(), Some(crc32_by_hand(&bytes)));
     // Newton is the unit's wire index 1.
     let newton = ConfigPatch {
@@ -92,7 +108,21 @@ fn every_field_moves_the_digest() {
     let w = defaults();
     let mut priority = w.priority.unwrap();
     priority.weight[5] = 1.5;
+    let on = EstimatorSettings {
+        kalman: true,
+        ..w.estimator.unwrap()
+    };
+    let mut sigma = w.estimator.unwrap();
+    sigma.accel_sigma[5] = 0.005;
     let changed = [
+        ConfigPatch {
+            estimator: Some(on),
+            ..w
+        },
+        ConfigPatch {
+            estimator: Some(sigma),
+            ..w
+        },
         ConfigPatch {
             rate_hz: Some(200),
             ..w

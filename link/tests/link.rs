@@ -128,6 +128,12 @@ fn max_sizes_are_exact() {
             rank: [u8::MAX; 6],
             weight: [f32::MAX; 6],
         }),
+        estimator: Some(auv_link::EstimatorSettings {
+            kalman: true,
+            position_sigma: [f32::MAX; 6],
+            velocity_sigma: [f32::MAX; 6],
+            accel_sigma: [f32::MAX; 6],
+        }),
     };
     assert_eq!(postcard_len(&p), ConfigPatch::MAX_SIZE);
     let begin = UploadHeader {
@@ -148,10 +154,11 @@ fn max_sizes_are_exact() {
     assert_eq!(postcard_len(&chunk), UploadChunk::MAX_SIZE);
     assert_eq!(postcard_len(&t.upload), auv_link::UploadStatus::MAX_SIZE);
     assert_eq!(
-        postcard_len(&Command::Upload(UploadPart::Chunk(chunk))),
+        postcard_len(&Command::SetConfig(p)),
         Command::MAX_SIZE,
-        "an upload chunk is the largest command"
+        "a whole SetConfig is the largest command (protocol 7)"
     );
+    assert!(postcard_len(&Command::Upload(UploadPart::Chunk(chunk))) < Command::MAX_SIZE);
     assert_eq!(postcard_len(&Msg::Telemetry(t)), Msg::MAX_SIZE);
     assert_eq!(postcard_len(&largest()), Envelope::MAX_SIZE);
     // Every other kind is no larger.
@@ -165,10 +172,12 @@ fn largest_message_fits_max_frame_exactly() {
     // Protocol 3's commands, by hand from the layout: a full ConfigPatch is 6 + 2 + 5 + 5 + 2
     // + 2 (protocol 2) + 2 (unit) + 2 (mask) + 31 (priority: 6 ranks, 6 weights) bytes; a
     // StartMission is its tag, the path (17), the heading (1) and the time scale (4).
-    assert_eq!(ConfigPatch::MAX_SIZE, 57);
+    // Protocol 7 adds the estimator's settings: a tag, a bool and 18 f32 (74 bytes).
+    assert_eq!(ConfigPatch::MAX_SIZE, 57 + 74);
     assert_eq!(MissionPlan::MAX_SIZE + 1, 23);
-    // Protocol 5's upload chunk: the command's tag, the part's tag, the index, 32 words.
-    assert_eq!(Command::MAX_SIZE, 1 + 1 + 1 + 32 * 4);
+    // Protocol 5's upload chunk (the command's tag, the part's tag, the index, 32 words: 131
+    // bytes) was the largest command; protocol 7's whole SetConfig is one byte more.
+    assert_eq!(Command::MAX_SIZE, 1 + 57 + 74);
     // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes); protocol 5's
     // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes); protocol 6's
     // configuration digest one u32 varint more (5 bytes).
@@ -251,7 +260,7 @@ fn a_new_wire_variant_comes_with_a_new_protocol_version() {
     // commands). A board refuses a tag past its own variants, so a variant added to
     // `MissionSpec` or `Command` is a new protocol: this fails until PROTOCOL_VERSION is
     // bumped and its row added here.
-    const CARRIED: [(u8, usize, usize); 2] = [(5, 5, 6), (6, 5, 6)];
+    const CARRIED: [(u8, usize, usize); 3] = [(5, 5, 6), (6, 5, 6), (7, 5, 6)];
     let now = (
         PROTOCOL_VERSION,
         TrajectoryKind::EXAMPLES.len(),

@@ -3,10 +3,10 @@
 //! never panic.
 
 use auv_link::{
-    decode_frame, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, Refusal, StateFrame,
-    Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, UploadStatus, MAX_FRAME,
-    PROTOCOL_VERSION,
+    decode_frame, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings,
+    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, Refusal,
+    StateFrame, Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, UploadStatus,
+    MAX_FRAME, PROTOCOL_VERSION,
 };
 use controller_core::TrajectoryKind;
 use proptest::prelude::*;
@@ -152,6 +152,7 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
         proptest::option::of(any_unit()),
         any::<Option<u8>>(),
         proptest::option::of(any_priority()),
+        proptest::option::of(any_estimator()),
     )
         .prop_map(
             |(
@@ -164,6 +165,7 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
                 thrust_unit,
                 reversed_thrusters,
                 priority,
+                estimator,
             )| ConfigPatch {
                 rate_hz,
                 robust,
@@ -174,6 +176,25 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
                 thrust_unit,
                 reversed_thrusters,
                 priority,
+                estimator,
+            },
+        )
+        .boxed()
+}
+
+fn any_estimator() -> BoxedStrategy<EstimatorSettings> {
+    (
+        any::<bool>(),
+        prop::array::uniform6(any_f32()),
+        prop::array::uniform6(any_f32()),
+        prop::array::uniform6(any_f32()),
+    )
+        .prop_map(
+            |(kalman, position_sigma, velocity_sigma, accel_sigma)| EstimatorSettings {
+                kalman,
+                position_sigma,
+                velocity_sigma,
+                accel_sigma,
             },
         )
         .boxed()

@@ -41,9 +41,9 @@ fn arm(seq: u16) -> Envelope {
 
 #[test]
 fn a_signed_frame_is_the_documented_layout() {
-    // postcard(Envelope{6, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
+    // postcard(Envelope{7, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
     // the first 6 bytes of HMAC-SHA-256(key, everything before the MAC) ‖ CRC-16 of it all.
-    let covered = [6u8, 0xAC, 0x02, 0x01, 0x00];
+    let covered = [7u8, 0xAC, 0x02, 0x01, 0x00];
     let id_time = [0u8, 5, 0, 0, 0, 0, 0];
     let mut mac = <Hmac<Sha256> as KeyInit>::new_from_slice(&KEY).unwrap();
     mac.update(&covered);

@@ -51,7 +51,9 @@ pub(super) struct SetUp {
 
 impl Session {
     /// The session of `scenario`'s validated controller and mission, paced by `pacing`.
-    /// Refuses a thruster geometry the link cannot carry.
+    /// Refuses a thruster geometry the link cannot carry. The whole configuration is sent
+    /// (`ConfigPatch::whole`: the law's settings, the thruster chain and the state estimator's
+    /// settings, from which the board computes its gains, Choice 361).
     pub(super) fn new(scenario: &Scenario, pacing: Pacing) -> Result<Self, Error> {
         let c = scenario.controller().config();
         // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
@@ -59,17 +61,7 @@ impl Session {
         let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let mission = scenario.trajectory().mission();
         Ok(Session {
-            config: ConfigPatch {
-                rate_hz: Some(c.rate_hz),
-                robust: Some(c.robust),
-                delta_max: Some(c.delta_max),
-                voltage_limit: Some(c.voltage_limit),
-                stale_periods: Some(DEFAULT_STALE_PERIODS),
-                lockstep: Some(pacing == Pacing::Lockstep),
-                thrust_unit: Some(thrust_unit),
-                reversed_thrusters: Some(mounting),
-                priority: Some(c.priority.into()),
-            },
+            config: ConfigPatch::whole(c, DEFAULT_STALE_PERIODS, pacing == Pacing::Lockstep),
             mission: MissionPlan::from(mission),
             upload: MissionUpload::of(&mission),
             thrust_unit,

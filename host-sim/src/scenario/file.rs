@@ -504,4 +504,34 @@ pub struct ControllerTable {
     pub axis_priority: Option<Vec<String>>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub reversed_thrusters: Option<Vec<String>>,
+    /// The state estimator the law flies on (docs/law.md#the-state-estimator): `"off"` (the
+    /// default) or `"kalman"`, and its noise settings per axis of η.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub estimator: Option<EstimatorName>,
+    #[serde(
+        default,
+        deserialize_with = "fixed_arrays::option",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub estimator_position_sigma: Option<[f64; 6]>,
+    #[serde(
+        default,
+        deserialize_with = "fixed_arrays::option",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub estimator_velocity_sigma: Option<[f64; 6]>,
+    #[serde(
+        default,
+        deserialize_with = "fixed_arrays::option",
+        skip_serializing_if = "Option::is_none"
+    )]
+    pub estimator_accel_sigma: Option<[f64; 6]>,
+}
+
+/// `controller.estimator`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum EstimatorName {
+    Off,
+    Kalman,
 }

@@ -7,12 +7,14 @@ use controller_core::allocation::AxisPriority;
 use controller_core::axes::NAMES as AXIS_NAMES;
 use controller_core::effectiveness::THRUSTER_NAMES;
 use controller_core::model::ParamVariation;
-use controller_core::{BBound, ControllerConfig, HeadingMode, RobustLaw, ThrustUnit};
+use controller_core::{
+    BBound, ControllerConfig, EstimatorKind, HeadingMode, RobustLaw, ThrustUnit,
+};
 
 use super::file::{
-    AttitudeName, BBoundName, BoundTable, ControllerTable, CurrentName, CurrentTable, HeadingName,
-    LawName, LinkFaultsTable, NoiseTable, ProfileName, ScenarioFile, StepTable, ThrustUnitName,
-    VariationTable,
+    AttitudeName, BBoundName, BoundTable, ControllerTable, CurrentName, CurrentTable,
+    EstimatorName, HeadingName, LawName, LinkFaultsTable, NoiseTable, ProfileName, ScenarioFile,
+    StepTable, ThrustUnitName, VariationTable,
 };
 use super::{f32_decimal, parse, InitialAttitude, SimConfig, TickRange};
 use crate::plant::{CurrentModel, VariationProfile};
@@ -202,6 +204,7 @@ fn controller(c: &ControllerConfig) -> Result<ControllerTable, Unwritable> {
         field: "controller.geometry",
         why: "a file's thrusters are the AUV-150 layout, some reversed",
     })?;
+    let on = c.estimator.kind != EstimatorKind::Off;
     Ok(ControllerTable {
         robust: Some(c.robust),
         law: Some(match c.law {
@@ -234,6 +237,12 @@ fn controller(c: &ControllerConfig) -> Result<ControllerTable, Unwritable> {
                 .map(|(_, n)| n.to_string())
                 .collect(),
         ),
+        // Written only when on, so that a file written for a controller without the estimator
+        // reads as it did before the estimator existed.
+        estimator: on.then_some(EstimatorName::Kalman),
+        estimator_position_sigma: on.then(|| f32_decimals(c.estimator.position_sigma)),
+        estimator_velocity_sigma: on.then(|| f32_decimals(c.estimator.velocity_sigma)),
+        estimator_accel_sigma: on.then(|| f32_decimals(c.estimator.accel_sigma)),
     })
 }
 

@@ -5,14 +5,16 @@
 use controller_core::effectiveness::ThrusterGeometry;
 use controller_core::model::{ParamVariation, VARIED_PARAMETER_NAMES};
 use controller_core::{allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
-use controller_core::{BBound, ControllerConfig, HeadingMode, RobustLaw, Table1Case, ThrustUnit};
+use controller_core::{
+    BBound, ControllerConfig, EstimatorKind, HeadingMode, RobustLaw, Table1Case, ThrustUnit,
+};
 
 use controller_core::effectiveness::THRUSTER_NAMES;
 
 use super::file::{
     spelled, AttitudeName, BBoundName, ControllerTable, CurrentName, CurrentTable, Delta,
-    HeadingName, LawName, LinkFaultsTable, ProfileName, ScenarioFile, ThrustUnitName,
-    VariationTable,
+    EstimatorName, HeadingName, LawName, LinkFaultsTable, ProfileName, ScenarioFile,
+    ThrustUnitName, VariationTable,
 };
 use super::paper;
 use super::validate::invalid;
@@ -307,6 +309,21 @@ fn build_controller(raw: &ControllerTable) -> Res<ControllerConfig> {
     }
     if let Some(order) = &raw.axis_priority {
         c.priority = axis_priority(order)?;
+    }
+    if let Some(kind) = raw.estimator {
+        c.estimator.kind = match kind {
+            EstimatorName::Off => EstimatorKind::Off,
+            EstimatorName::Kalman => EstimatorKind::Kalman,
+        };
+    }
+    if let Some(x) = raw.estimator_position_sigma {
+        c.estimator.position_sigma = to_f32_array("controller.estimator_position_sigma", x)?;
+    }
+    if let Some(x) = raw.estimator_velocity_sigma {
+        c.estimator.velocity_sigma = to_f32_array("controller.estimator_velocity_sigma", x)?;
+    }
+    if let Some(x) = raw.estimator_accel_sigma {
+        c.estimator.accel_sigma = to_f32_array("controller.estimator_accel_sigma", x)?;
     }
     if let Some(names) = &raw.reversed_thrusters {
         c.geometry =

@@ -3,7 +3,7 @@
 //! hardware in the loop), a period's answer is a [`ControlOut`].
 
 use controller_core::effectiveness::THRUSTERS;
-use controller_core::{Controller, Trajectory};
+use controller_core::{Controller, Estimate, Solution, Trajectory};
 
 use super::record::{BoardLoss, BoardReport, ControlStatus, UploadRound};
 use crate::scenario::Scenario;
@@ -55,10 +55,12 @@ pub trait ControlSource {
 }
 
 /// The f32 core on the host, as the firmware runs it (software in the loop): the scenario's
-/// controller and trajectory.
+/// controller and trajectory, and the estimator's memory (docs/law.md#the-state-estimator;
+/// untouched while the scenario's estimator is off).
 pub struct LocalController<'a> {
     controller: &'a Controller,
     trajectory: &'a Trajectory,
+    memory: Estimate,
 }
 
 impl<'a> LocalController<'a> {
@@ -66,13 +68,22 @@ impl<'a> LocalController<'a> {
         LocalController {
             controller: scenario.controller(),
             trajectory: scenario.trajectory(),
+            memory: Estimate::new(),
         }
     }
 }
 
 impl ControlSource for LocalController<'_> {
     fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, Stop> {
-        let out = self.controller.update(k, eta, nu, self.trajectory);
+        // The simulated solution holds at the period it is measured in (stamp = k).
+        let solution = Solution {
+            stamp: k,
+            eta: *eta,
+            nu: *nu,
+        };
+        let out =
+            self.controller
+                .update_from_solution(&mut self.memory, k, &solution, self.trajectory);
         Ok(ControlOut {
             status: ControlStatus::Law(out.status),
             tau: out.tau,

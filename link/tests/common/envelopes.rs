@@ -5,9 +5,9 @@
 #![allow(dead_code)]
 
 use auv_link::{
-    encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
-    FrameDecoder, Heading, LinkError, MissionPlan, Msg, Refusal, StateFrame, Telemetry, ThrustUnit,
-    UploadChunk, UploadHeader, UploadPart, UploadStatus, MAX_FRAME,
+    encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings,
+    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, Msg, Refusal, StateFrame,
+    Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, UploadStatus, MAX_FRAME,
 };
 use controller_core::TrajectoryKind;
 
@@ -141,6 +141,12 @@ pub fn every_kind() -> Vec<Envelope> {
             priority: Some(AxisPriority {
                 rank: [5, 4, 3, 0, 2, 1],
                 weight: [1.0, 2.0, 0.5, 1.0, 3.0, 0.25],
+            }),
+            estimator: Some(EstimatorSettings {
+                kalman: true,
+                position_sigma: [0.005, 0.005, 0.005, 0.001, 0.001, 0.001],
+                velocity_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],
+                accel_sigma: [f32::MAX, 0.02, -0.0, 0.004, f32::MIN_POSITIVE, 1e-30],
             }),
         })),
         Msg::Command(Command::SetConfig(ConfigPatch {

@@ -170,13 +170,25 @@ pub fn same_command(a: &Command, b: &Command) -> bool {
                 thrust_unit,
                 reversed_thrusters,
                 priority,
+                estimator,
             } = a;
+            let same_estimator = match (estimator, &b.estimator) {
+                (None, None) => true,
+                (Some(e), Some(g)) => {
+                    e.kalman == g.kalman
+                        && fs(&e.position_sigma, &g.position_sigma)
+                        && fs(&e.velocity_sigma, &g.velocity_sigma)
+                        && fs(&e.accel_sigma, &g.accel_sigma)
+                }
+                _ => false,
+            };
             let same_priority = match (priority, &b.priority) {
                 (None, None) => true,
                 (Some(p), Some(q)) => p.rank == q.rank && fs(&p.weight, &q.weight),
                 _ => false,
             };
             same_priority
+                && same_estimator
                 && *thrust_unit == b.thrust_unit
                 && *reversed_thrusters == b.reversed_thrusters
                 && *rate_hz == b.rate_hz

@@ -188,6 +188,7 @@ pub fn run(update_max: u32) -> bool {
     };
     let counter = Counter::new();
     stages(&counter, &with, &without, &GOLDEN);
+    let estimator_ok = crate::estimator::run(&counter);
     let kernels_ok = crate::kernels::run(&counter);
-    update_ok && kernels_ok
+    update_ok && estimator_ok && kernels_ok
 }

@@ -5,13 +5,13 @@
 use auv_link::{MissionSpec, UploadBuffer, UploadChunk, UploadHeader, UploadPart};
 use controller_core::{Mission, Table1Case, Trajectory};
 
-pub use crate::vector::Golden;
+pub use crate::vector::{estimator_steps, EstimatorGolden, Golden};
 
 /// build.rs's output: `GOLDEN`, `SURVEY_HEADER` and `SURVEY_CHUNKS`, written as the values'
 /// `Debug` form (every `f32` prints as the shortest literal that parses to its bits), so it
 /// names the wire types' variants unqualified.
 mod generated {
-    use super::{Golden, UploadChunk, UploadHeader};
+    use super::{EstimatorGolden, Golden, UploadChunk, UploadHeader};
     use auv_link::Heading::*;
     use auv_link::MissionPlan;
     use auv_link::MissionSpec::*;
@@ -19,7 +19,7 @@ mod generated {
     include!(concat!(env!("OUT_DIR"), "/golden.rs"));
 }
 
-pub use generated::{GOLDEN, SURVEY_CHUNKS, SURVEY_HEADER};
+pub use generated::{ESTIMATOR_GOLDEN, GOLDEN, SURVEY_CHUNKS, SURVEY_HEADER};
 
 impl Golden {
     /// The mission this vector samples: a closed form from its plan, the survey from its

@@ -9,6 +9,7 @@
 
 mod cost;
 mod counter;
+mod estimator;
 mod flight;
 mod golden;
 mod kernels;

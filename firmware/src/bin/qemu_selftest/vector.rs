@@ -31,3 +31,42 @@ pub struct Golden {
     /// 0: `Status::Ok`, 1: a fault.
     pub status: u8,
 }
+
+/// One golden vector of the state estimator (docs/law.md#the-state-estimator): the host's
+/// output of the last of [`estimator_steps`] on `GOLDEN[vector]`'s inputs, the controller the
+/// default with the estimator on.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorGolden {
+    /// The index of the golden vector whose mission and inputs it flies.
+    pub vector: usize,
+    /// The host's voltages.
+    pub voltage: [f32; THRUSTERS],
+    /// The host's τ.
+    pub tau: [f32; 6],
+}
+
+/// The estimator's case on a golden vector's inputs at tick k (≥ 3): the solution of tick
+/// k − 3 taken; tick k − 2 flown on it predicted (the navigation computer repeats its stamp);
+/// then at tick k the solution stamped k − 1 (one period late), 3 mm further in x: its
+/// correction at an old stamp, with both predictions and the recorded accelerations, is the
+/// estimator's largest fixed work. `(ticks, solution)` in order; `None` before tick 3.
+pub fn estimator_steps(g: &Golden) -> Option<[(u64, controller_core::Solution); 3]> {
+    let k = g.ticks;
+    if k < 3 {
+        return None;
+    }
+    let at = |stamp: u64, dx: f32| {
+        let mut eta = g.eta;
+        eta[0] += dx;
+        controller_core::Solution {
+            stamp,
+            eta,
+            nu: g.nu,
+        }
+    };
+    Some([
+        (k - 3, at(k - 3, 0.0)),
+        (k - 2, at(k - 3, 0.0)),
+        (k, at(k - 1, 0.003)),
+    ])
+}
