@@ -272,11 +272,11 @@ pub fn share(
 /// demand there is a violation.
 pub fn keep(envelope: ThrustEnvelope, thrust: &[f64; THRUSTERS]) -> ThrustEnvelope {
     let mut e = envelope;
-    for i in 0..THRUSTERS {
-        if thrust[i] == 0.0 {
+    for (i, &t) in thrust.iter().enumerate() {
+        if t == 0.0 {
             continue;
         }
-        let n = thrust[i] as f32;
+        let n = t as f32;
         e.min[i] = (e.min[i] + n).min(0.0);
         e.max[i] = (e.max[i] - n).max(0.0);
         if e.max[i] <= e.min[i] {
