@@ -2,7 +2,11 @@
 //! shipped campaign's white `[noise]`: max path, saturation, and the thrusters' chatter (sign
 //! reversals per second through a ±0.5 V dead band, command total variation per second), per
 //! thruster. `cargo run --profile host -p host-sim --example navigation_presets [filter]`
-//! (docs/navigation.md#what-the-shipped-missions-do).
+//! (docs/navigation.md#what-the-shipped-missions-do). The controller is the scenario's (the real
+//! chain's default: the estimator on); `EST=0` flies the solution as told, `EST=1` the core's
+//! default estimator, `ESTP=`/`ESTV=`/`ESTA=` set its σ on x y (x y z), `NOFIX=1` drops the
+//! preset's fixes and `FIX=rate,σ,latency` sets them. The thruster columns are main, vert
+//! fore, vert aft, horz fore, horz aft.
 
 use host_sim::scenario::navigation::{NavigationModel, Preset};
 use host_sim::scenario::{load_scenario, Scenario, SensorNoise, SimConfig};
@@ -29,17 +33,17 @@ const BAND: f64 = 0.5;
 
 #[derive(Default)]
 struct Chatter {
-    state: [i8; 4],
-    reversals: [u64; 4],
-    variation: [f64; 4],
-    last: Option<[f64; 4]>,
+    state: [i8; 5],
+    reversals: [u64; 5],
+    variation: [f64; 5],
+    last: Option<[f64; 5]>,
     t: f64,
     truth: Vec<[f64; 3]>,
 }
 
 impl Observer for Chatter {
     fn sample(&mut self, s: &Sample) {
-        for i in 0..4 {
+        for i in 0..5 {
             let v = s.voltage[i];
             let sign = if v > BAND {
                 1
@@ -73,7 +77,7 @@ fn main() {
         .filter(|p| p.to_string_lossy().contains(&filter))
         .collect();
     files.sort();
-    println!("| mission | navigation | outcome | max path (mm) | max navigation position error (mm) | saturated (%) | peak V | reversals/s vf/va/hf/ha | TV (V/s) vf/va/hf/ha |");
+    println!("| mission | navigation | outcome | max path (mm) | max navigation position error (mm) | saturated (%) | peak V | reversals/s main/vf/va/hf/ha | TV (V/s) main/vf/va/hf/ha |");
     println!("|---|---|---|---|---|---|---|---|---|");
     for f in files {
         let base = load_scenario(&f).unwrap();
@@ -94,6 +98,42 @@ fn main() {
 /// case), the shipped campaign's white noise if `noise`.
 fn configure(c: &mut SimConfig, label: &str, preset: Option<Preset>, noise: bool) {
     c.navigation = preset.and_then(|p| NavigationModel::preset(p, 1));
+    match std::env::var("EST").as_deref() {
+        Ok("1") => c.controller.estimator.kind = controller_core::estimator::EstimatorKind::Kalman,
+        Ok("0") => c.controller.estimator = controller_core::EstimatorConfig::default(),
+        _ => {}
+    }
+    if let (Ok("1"), Some(m)) = (std::env::var("NOFIX").as_deref(), &mut c.navigation) {
+        m.fix = None;
+    }
+    if let Ok(v) = std::env::var("ESTV") {
+        let v: f32 = v.parse().unwrap();
+        c.controller.estimator.velocity_sigma[0] = v;
+        c.controller.estimator.velocity_sigma[1] = v;
+        c.controller.estimator.velocity_sigma[2] = v;
+    }
+    if let Ok(v) = std::env::var("ESTA") {
+        let v: f32 = v.parse().unwrap();
+        c.controller.estimator.accel_sigma[0] = v;
+        c.controller.estimator.accel_sigma[1] = v;
+        c.controller.estimator.accel_sigma[2] = v;
+    }
+    if let Ok(v) = std::env::var("ESTP") {
+        let v: f32 = v.parse().unwrap();
+        c.controller.estimator.position_sigma[0] = v;
+        c.controller.estimator.position_sigma[1] = v;
+    }
+    if let (Ok(f), Some(m)) = (std::env::var("FIX"), &mut c.navigation) {
+        let v: Vec<f64> = f.split(',').map(|x| x.parse().unwrap()).collect();
+        m.fix = Some(host_sim::scenario::navigation::Source {
+            timing: host_sim::scenario::navigation::Timing {
+                rate_hz: v[0],
+                latency: v[2],
+                outages: Vec::new(),
+            },
+            error: host_sim::scenario::navigation::ErrorModel::white_gm([v[1]; 2], [0.0; 2], 600.0),
+        });
+    }
     if let (Some(m), true) = (&mut c.navigation, label.ends_with("no bias")) {
         // The white noise and the latencies alone: every bias σ 0.
         m.ins.attitude.bias_sigma = [0.0; 3];

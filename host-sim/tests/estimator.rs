@@ -47,6 +47,10 @@ fn the_estimator_is_turned_on_in_the_controller_table_and_its_settings_named_whe
 fn noisy_real_circle() -> SimConfig {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut c = load_config(&root.join("scenarios/real/circular-10R.toml")).unwrap();
+    // The exact state with white noise, told as is: the real chain's default (survey, the
+    // estimator on: docs/navigation.md#the-default) pinned off.
+    c.navigation = None;
+    c.controller.estimator = controller_core::EstimatorConfig::default();
     c.noise = Some(SensorNoise {
         eta_sigma: [0.005, 0.005, 0.005, 0.001, 0.001, 0.001],
         nu_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],

@@ -282,6 +282,8 @@ fn preflight_table(p: &Preflight) -> String {
             100.0 * t.usage
         ));
     }
+    s.push_str(&p.navigation.describe());
+    s.push('\n');
     if let Some(k) = p.smallest_time_scale {
         s.push_str(&format!(
             "smallest feasible time scale: {k} (the same path then takes {:.1} s)\n",

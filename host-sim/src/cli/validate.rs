@@ -11,6 +11,7 @@ use super::common::check_run_count;
 use super::json::print_json;
 use super::Exit;
 use crate::output::{atomic, OutputDir};
+use crate::scenario::navigation::Preset;
 use crate::sim::progress::Progress;
 use crate::studies::preflight::DEFAULT_MARGIN;
 use crate::studies::validation::{self, Campaign, Measure, DEFAULT_RANDOM, TEAM_MOUNTINGS};
@@ -36,6 +37,13 @@ pub struct ValidateArgs {
     pub random: usize,
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
+    /// The navigation presets every mission is flown under (comma-separated).
+    #[arg(long, value_delimiter = ',', value_parser = parse_preset, default_values = ["ideal", "survey"])]
+    pub navigation: Vec<Preset>,
+    /// Random missions also draw a thruster lag (0.05–0.3 s) and, on half, a Gauss–Markov
+    /// current.
+    #[arg(long)]
+    pub disturbed: bool,
     #[arg(long, default_value_t = DEFAULT_MARGIN)]
     pub margin: f64,
     #[arg(long)]
@@ -63,6 +71,8 @@ pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result
         },
         random: args.random,
         seed: args.seed,
+        navigation: args.navigation.clone(),
+        disturbed: args.disturbed,
     };
     let missions = campaign.missions()?;
     let dir = OutputDir::prepare(&args.out)?;
@@ -90,4 +100,12 @@ pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result
     } else {
         Exit::Success
     })
+}
+
+/// `--navigation`'s values: a preset's name.
+fn parse_preset(name: &str) -> Result<Preset, String> {
+    [Preset::Ideal, Preset::Survey, Preset::LowCost]
+        .into_iter()
+        .find(|p| p.name() == name)
+        .ok_or_else(|| format!("{name:?} is not one of ideal, survey, low-cost"))
 }

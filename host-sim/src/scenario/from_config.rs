@@ -104,8 +104,22 @@ impl TryFrom<&SimConfig> for ScenarioFile {
             nu_sigma: Some(n.nu_sigma),
             seed: Some(n.seed),
         });
-        file.navigation = c.navigation.as_ref().map(super::navigation::table);
+        file.navigation = match &c.navigation {
+            Some(m) => Some(super::navigation::table(m)),
+            // The real chain's default is not the exact state (Choice 370): written out.
+            None if !c.ideal_actuators => Some(super::navigation::NavigationTable {
+                preset: Some(super::navigation::Preset::Ideal),
+                ..Default::default()
+            }),
+            None => None,
+        };
         file.controller = Some(controller(&c.controller)?);
+        if let Some(t) = &mut file.controller {
+            // The real chain's default estimator is on (Choice 370): off is written out there.
+            if !c.ideal_actuators && t.estimator.is_none() {
+                t.estimator = Some(EstimatorName::Off);
+            }
+        }
         file.bound = c.bound_setting.map(BoundTable::from);
         let ranges =
             |v: &[TickRange]| Some(v.iter().map(|r| format!("{}..{}", r.from, r.to)).collect());

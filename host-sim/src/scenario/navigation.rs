@@ -166,7 +166,7 @@ impl NavigationModel {
                 },
                 dvl: Dvl {
                     timing: timing(8.0, 0.03),
-                    velocity: ErrorModel::white_gm([0.005; 3], [0.001; 3], 600.0),
+                    velocity: ErrorModel::white_gm([SURVEY_DVL_SIGMA; 3], [0.001; 3], 600.0),
                     min_altitude: 0.3,
                     max_altitude: 75.0,
                     seabed_depth: None,
@@ -175,7 +175,11 @@ impl NavigationModel {
                     timing: timing(8.0, 0.02),
                     error: ErrorModel::white_gm([0.002], [0.005], 600.0),
                 },
-                fix: None,
+                // Choice 371: a survey AUV's LBL fixes bound the dead reckoning's drift.
+                fix: Some(Source {
+                    timing: timing(2.0, 0.1),
+                    error: ErrorModel::white_gm([SURVEY_FIX_SIGMA; 2], [0.0; 2], 600.0),
+                }),
             }),
             Preset::LowCost => Some(NavigationModel {
                 preset,
@@ -378,12 +382,42 @@ fn over_source<const N: usize>(s: &mut Source<N>, t: &SourceTable<N>) {
     );
 }
 
+/// The navigation a real-chain scenario (`ideal_actuators = false`) flies on when its file has
+/// no `[navigation]`: `survey` (**Choice 370**, docs/navigation.md#the-default). A file on the
+/// ideal actuators keeps the exact state (Table 1 and the paper's missions bit for bit).
+pub fn real_chain_default(seed: u64) -> Option<NavigationModel> {
+    NavigationModel::preset(Preset::Survey, seed)
+}
+
+/// The estimator a real-chain scenario flies on when its `[controller]` does not say
+/// `estimator` (**Choice 370**): on, with the survey preset's own figures for what it filters —
+/// σₚ of x y the LBL fix's 0.01 m, σᵥ of x y z the DVL's single ping 0.005 m/s — and a model
+/// error σₐ of 0.01 m/s² on x y z; the other axes keep `EstimatorConfig::default`'s
+/// (docs/navigation.md#the-default, measured there).
+pub fn real_chain_estimator() -> controller_core::EstimatorConfig {
+    let mut e = controller_core::EstimatorConfig {
+        kind: controller_core::EstimatorKind::Kalman,
+        ..Default::default()
+    };
+    e.position_sigma[..2].copy_from_slice(&[SURVEY_FIX_SIGMA as f32; 2]);
+    e.velocity_sigma[..3].copy_from_slice(&[SURVEY_DVL_SIGMA as f32; 3]);
+    e.accel_sigma[..3].copy_from_slice(&[REAL_CHAIN_ACCEL_SIGMA; 3]);
+    e
+}
+
+/// The real chain's estimator's model error on x y z (m/s², Choice 370).
+const REAL_CHAIN_ACCEL_SIGMA: f32 = 0.01;
+/// The survey preset's LBL fix σ per horizontal axis (m, Choice 371).
+const SURVEY_FIX_SIGMA: f64 = 0.01;
+/// The survey preset's DVL single-ping σ (m/s, Choice 331).
+const SURVEY_DVL_SIGMA: f64 = 0.005;
+
 /// The model `[navigation]` describes: its preset with the given keys over it; `None` for
 /// `ideal` (which takes no other key than `seed`). A `[fix]` over a preset without fixes
 /// starts from fixes at 1 Hz, 0 s late, exact.
 pub fn build(t: &NavigationTable, default_seed: u64) -> Res<Option<NavigationModel>> {
-    // Choice 333: the default is the exact state, on the real chain too (measured:
-    // docs/navigation.md#the-default).
+    // A `[navigation]` without a preset is the exact state; a real-chain file without the
+    // table at all flies `real_chain_default` (Choice 370).
     let preset = t.preset.unwrap_or(Preset::Ideal);
     let seed = t.seed.unwrap_or(default_seed);
     let Some(mut m) = NavigationModel::preset(preset, seed) else {

@@ -91,6 +91,15 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
             )
         })?);
     }
+    // Which of the estimator's keys the file gives (the real chain's default fills the rest).
+    let est_keys = raw.controller.as_ref().map_or([false; 4], |c| {
+        [
+            c.estimator.is_some(),
+            c.estimator_position_sigma.is_some(),
+            c.estimator_velocity_sigma.is_some(),
+            c.estimator_accel_sigma.is_some(),
+        ]
+    });
     if let Some(raw) = raw.controller {
         config.controller = build_controller(&raw)?;
     }
@@ -138,6 +147,22 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     }
     if let Some(raw) = &raw.navigation {
         config.navigation = super::navigation::build(raw, DEFAULT_SEED)?;
+    } else if !config.ideal_actuators {
+        config.navigation = super::navigation::real_chain_default(DEFAULT_SEED);
+    }
+    if !est_keys[0] && !config.ideal_actuators {
+        let d = super::navigation::real_chain_estimator();
+        let e = &mut config.controller.estimator;
+        e.kind = d.kind;
+        if !est_keys[1] {
+            e.position_sigma = d.position_sigma;
+        }
+        if !est_keys[2] {
+            e.velocity_sigma = d.velocity_sigma;
+        }
+        if !est_keys[3] {
+            e.accel_sigma = d.accel_sigma;
+        }
     }
     if let Some(raw) = raw.link_faults {
         config.link_faults = build_link_faults(&raw)?;

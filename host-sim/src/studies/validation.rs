@@ -16,14 +16,16 @@
 //! ([`Missions`]).
 
 use controller_core::effectiveness::{ThrusterGeometry, THRUSTERS};
-use rand::SeedableRng;
+use rand::{RngExt, SeedableRng};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use super::mission_space::{self, Reach};
 use super::preflight::{self, CheckError, Verdict};
 use crate::interrupt;
-use crate::scenario::{real_vehicle, Scenario, ScenarioError};
+use crate::plant::CurrentModel;
+use crate::scenario::navigation::{NavigationModel, Preset};
+use crate::scenario::{real_vehicle, Scenario, ScenarioError, SimConfig};
 use crate::sim::{self, bound, LocalController, Recording};
 
 /// The vertical × horizontal mountings a team would build: each vertical pair combination
@@ -37,17 +39,34 @@ pub fn all_mountings() -> Vec<u8> {
 }
 
 pub use super::mission_space::RANDOM_MAX_CURRENT;
+/// A random mission's thruster time constant is drawn in this range (s): real thrusters answer
+/// in 0.05–0.3 s (issue 28's missions).
+pub const RANDOM_LAG: [f64; 2] = [0.05, 0.3];
+/// A Gauss–Markov current's σ per horizontal axis is drawn in this range (m/s), its
+/// correlation time [`RANDOM_GM_TAU`].
+pub const RANDOM_GM_SIGMA: [f64; 2] = [0.02, 0.05];
+/// … its correlation time (s).
+pub const RANDOM_GM_TAU: f64 = 60.0;
 /// Relative resolution of the smallest flying time scale, found by bisection.
 pub const FLYING_TOLERANCE: f64 = 0.02;
 
 /// Which missions a campaign flies: the real paths under each mounting of `masks`, and
-/// `random` random missions from `seed`.
+/// `random` random missions from `seed`, all of them under each navigation preset of
+/// `navigation` (Choice 373).
 #[derive(Clone, Debug, PartialEq, Eq, Serialize, Deserialize)]
 pub struct Campaign {
     pub masks: Vec<u8>,
     pub random: usize,
     pub seed: u64,
+    pub navigation: Vec<Preset>,
+    /// Whether the random missions draw a thruster lag and (on half) a Gauss–Markov current
+    /// (Choice 373; off by default until the check answers for them: measured, docs).
+    pub disturbed: bool,
 }
+
+/// The presets the contract flies every mission under (Choice 373): the exact state (told as
+/// is, the estimator off) and the real chain's default.
+pub const CONTRACT_PRESETS: [Preset; 2] = [Preset::Ideal, Preset::Survey];
 
 impl Default for Campaign {
     /// The contract's campaign (docs/real-vehicle.md#the-preflights-contract): every mounting, 200 random missions, seed 1.
@@ -56,6 +75,8 @@ impl Default for Campaign {
             masks: all_mountings(),
             random: DEFAULT_RANDOM,
             seed: 1,
+            navigation: CONTRACT_PRESETS.to_vec(),
+            disturbed: false,
         }
     }
 }
@@ -82,9 +103,9 @@ pub struct Missions<'a> {
 }
 
 impl Missions<'_> {
-    /// How many: the real paths under each mounting, and the random ones.
+    /// How many: the real paths under each mounting, and the random ones, under each preset.
     pub fn len(&self) -> usize {
-        self.matrix_len() + self.campaign.random
+        (self.matrix_len() + self.campaign.random) * self.campaign.navigation.len()
     }
 
     /// Whether there are none.
@@ -96,15 +117,35 @@ impl Missions<'_> {
         self.campaign.masks.len() * self.real.len()
     }
 
-    /// Mission `i` (< [`Missions::len`]).
+    /// Mission `i` (< [`Missions::len`]): mission i mod (matrix + random) of the list, under
+    /// preset i / (matrix + random), its navigation seed drawn from (seed, i).
     pub fn get(&self, i: usize) -> Result<Scenario, ScenarioError> {
-        match i.checked_sub(self.matrix_len()) {
+        let per_preset = self.matrix_len() + self.campaign.random;
+        let (preset, j) = (self.campaign.navigation[i / per_preset], i % per_preset);
+        let mission = match j.checked_sub(self.matrix_len()) {
             None => matrix_mission(
-                &self.real[i % self.real.len()],
-                self.campaign.masks[i / self.real.len()],
+                &self.real[j % self.real.len()],
+                self.campaign.masks[j / self.real.len()],
             ),
-            Some(r) => random_mission(&self.real[0], self.campaign.seed, r),
-        }
+            Some(r) => random_mission(
+                &self.real[0],
+                self.campaign.seed,
+                r,
+                self.campaign.disturbed,
+            ),
+        }?;
+        let seed = rand::rngs::StdRng::seed_from_u64(
+            self.campaign.seed ^ (i as u64).wrapping_mul(0xD1B5_4A32_D192_ED03),
+        )
+        .random::<u64>();
+        mission.with(|c| {
+            c.name = format!("{}-{}", c.name, preset.name());
+            c.navigation = NavigationModel::preset(preset, seed);
+            if preset == Preset::Ideal {
+                // The exact state needs no filter: told as is, as the contract always flew it.
+                c.controller.estimator.kind = controller_core::EstimatorKind::Off;
+            }
+        })
     }
 }
 
@@ -127,6 +168,8 @@ pub struct ContractSummary {
 #[derive(Clone, Debug, Serialize)]
 pub struct MissionResult {
     pub name: String,
+    /// The navigation preset it was checked and flown on.
+    pub navigation: Preset,
     /// The reversed-thruster mask.
     pub mounting: u8,
     /// The preflight's verdict at time scale 1 (as written).
@@ -166,6 +209,8 @@ pub struct Validation {
     pub false_feasible: usize,
     /// Median of [`MissionResult::ratio`] over the flown missions within bound.
     pub median_ratio: f64,
+    /// The same numbers per navigation preset (Choice 373).
+    pub per_preset: Vec<PresetFigures>,
     /// Interrupted: the missions not yet done are missing.
     pub partial: bool,
 }
@@ -183,19 +228,56 @@ fn matrix_mission(s: &Scenario, mask: u8) -> Result<Scenario, ScenarioError> {
 
 /// Random mission `i` of `seed`, on the first real mission `base` (see the module docs): it
 /// depends only on (seed, i), drawn by [`mission_space::mission`] from a generator (Choice
-/// 410). A draw the core refuses (a tangent heading too slow somewhere) is drawn again.
-fn random_mission(base: &Scenario, seed: u64, i: usize) -> Result<Scenario, ScenarioError> {
+/// 410); `disturbed` then draws its thrusters' lag and, on half of them, a Gauss–Markov current
+/// about the drawn mean (Choice 373). A draw the core refuses (a tangent heading too slow
+/// somewhere) is drawn again.
+fn random_mission(
+    base: &Scenario,
+    seed: u64,
+    i: usize,
+    disturbed: bool,
+) -> Result<Scenario, ScenarioError> {
     let mut rng =
         rand::rngs::StdRng::seed_from_u64(seed ^ (i as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
     loop {
         let name = format!("random-{i:03}");
-        match mission_space::mission(base, Reach::Contract, name, CONTRACT_DURATION, &mut rng) {
+        let made = mission_space::mission(base, Reach::Contract, name, CONTRACT_DURATION, &mut rng)
+            .and_then(|s| {
+                if disturbed {
+                    disturb(&s, &mut rng)
+                } else {
+                    Ok(s)
+                }
+            });
+        match made {
             Ok(s) => return Ok(s),
             // Too slow for the tangent heading somewhere: draw again.
             Err(ScenarioError::Invalid { key, .. }) if key.starts_with("trajectory") => continue,
             Err(e) => return Err(e),
         }
     }
+}
+
+/// A contract mission with the thrusters' lag drawn in [`RANDOM_LAG`] and, on half of the
+/// missions, a Gauss–Markov current of σ in [`RANDOM_GM_SIGMA`] about its constant one (Choice
+/// 373).
+fn disturb(s: &Scenario, rng: &mut impl RngExt) -> Result<Scenario, ScenarioError> {
+    let lag = RANDOM_LAG[0] + (RANDOM_LAG[1] - RANDOM_LAG[0]) * rng.random::<f64>();
+    let wander = rng.random::<bool>();
+    let sigma =
+        RANDOM_GM_SIGMA[0] + (RANDOM_GM_SIGMA[1] - RANDOM_GM_SIGMA[0]) * rng.random::<f64>();
+    let seed = rng.random::<u64>();
+    s.with(|c: &mut SimConfig| {
+        c.thruster_lag = Some(lag);
+        if let (true, CurrentModel::Constant(mean)) = (wander, &c.current) {
+            c.current = CurrentModel::GaussMarkov {
+                mean: *mean,
+                sigma: [sigma, sigma, 0.0],
+                tau: RANDOM_GM_TAU,
+                seed,
+            };
+        }
+    })
 }
 
 /// How long the contract's random missions fly (s, at time scale 1): the paper's 70 s.
@@ -277,6 +359,11 @@ pub fn check_and_fly(
     };
     let mut out = MissionResult {
         name: base.config().name.clone(),
+        navigation: base
+            .config()
+            .navigation
+            .as_ref()
+            .map_or(Preset::Ideal, |m| m.preset),
         mounting,
         verdict: p.verdict,
         proposed,
@@ -367,16 +454,69 @@ pub fn validate(
         })
         .collect();
     let done: Vec<MissionResult> = results?.into_iter().flatten().collect();
-    let mut ratios: Vec<f64> = done.iter().filter_map(MissionResult::ratio).collect();
-    ratios.sort_by(f64::total_cmp);
+    let mut presets: Vec<Preset> = Vec::new();
+    for m in &done {
+        if !presets.contains(&m.navigation) {
+            presets.push(m.navigation);
+        }
+    }
+    let per_preset = presets
+        .into_iter()
+        .map(|p| {
+            let of: Vec<&MissionResult> = done.iter().filter(|m| m.navigation == p).collect();
+            PresetFigures::of(p, &of)
+        })
+        .collect();
+    let all: Vec<&MissionResult> = done.iter().collect();
+    let whole = PresetFigures::of(Preset::Ideal, &all);
     Ok(Validation {
-        flown: done.iter().filter(|m| m.within.is_some()).count(),
-        refused: done.iter().filter(|m| m.proposed.is_none()).count(),
-        false_feasible: done.iter().filter(|m| m.false_feasible()).count(),
-        median_ratio: ratios.get(ratios.len() / 2).copied().unwrap_or(f64::NAN),
+        flown: whole.flown,
+        refused: whole.refused,
+        false_feasible: whole.false_feasible,
+        median_ratio: whole.median_ratio,
         partial: done.len() < missions.len(),
+        per_preset,
         missions: done,
     })
+}
+
+/// The contract's numbers over the missions flown on one navigation preset.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PresetFigures {
+    pub navigation: Preset,
+    pub missions: usize,
+    pub flown: usize,
+    pub refused: usize,
+    pub false_feasible: usize,
+    pub median_ratio: f64,
+}
+
+impl PresetFigures {
+    fn of(navigation: Preset, done: &[&MissionResult]) -> Self {
+        let mut ratios: Vec<f64> = done.iter().filter_map(|m| m.ratio()).collect();
+        ratios.sort_by(f64::total_cmp);
+        PresetFigures {
+            navigation,
+            missions: done.len(),
+            flown: done.iter().filter(|m| m.within.is_some()).count(),
+            refused: done.iter().filter(|m| m.proposed.is_none()).count(),
+            false_feasible: done.iter().filter(|m| m.false_feasible()).count(),
+            median_ratio: ratios.get(ratios.len() / 2).copied().unwrap_or(f64::NAN),
+        }
+    }
+
+    /// One line: `survey: 392 missions, 380 flown, 12 refused, false feasible 0, median 1.10×`.
+    pub fn line(&self) -> String {
+        format!(
+            "{}: {} missions, {} flown, {} refused, false feasible {}, conservativeness median {:.2}×",
+            self.navigation.name(),
+            self.missions,
+            self.flown,
+            self.refused,
+            self.false_feasible,
+            self.median_ratio
+        )
+    }
 }
 
 impl Validation {
@@ -404,7 +544,11 @@ impl Validation {
             self.refused,
             self.false_feasible,
             self.median_ratio
-        )
+        ) + &self
+            .per_preset
+            .iter()
+            .map(|p| format!("; {}", p.line()))
+            .collect::<String>()
     }
 
     /// The report: the two numbers, then one row per mission.
@@ -415,6 +559,7 @@ impl Validation {
              scale). **False feasible: {}** (called feasible, missed the bound when flown). \
              **Conservativeness: median {:.2}×** (the proposed scale over the smallest that \
              flies within the bound, found by flying).\n\n\
+             {}\n\n\
              | mission | mounting | verdict at k = 1 | proposed k | max path (m) | saturated | \
              within bound | smallest flying k |\n|---|---|---|---:|---:|---:|---|---:|\n",
             self.missions.len(),
@@ -426,7 +571,12 @@ impl Validation {
             self.flown,
             self.refused,
             self.false_feasible,
-            self.median_ratio
+            self.median_ratio,
+            self.per_preset
+                .iter()
+                .map(|p| format!("- {}", p.line()))
+                .collect::<Vec<_>>()
+                .join("\n")
         );
         let opt = |x: Option<f64>, f: &dyn Fn(f64) -> String| x.map_or("—".to_string(), f);
         for m in &self.missions {

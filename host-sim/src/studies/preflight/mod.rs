@@ -49,6 +49,7 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
+pub mod navigation;
 pub mod profile;
 mod sweep;
 
@@ -236,6 +237,9 @@ pub struct Preflight {
     /// The same check over every corner of the configured parameter box (`None`: not asked
     /// for, [`check_as_written`]).
     pub whole_box: Option<ScopeVerdict>,
+    /// The navigation the check assumed, the thrust its noise takes per thruster (kept on each
+    /// side of the margin envelope), and what the mission needs of it.
+    pub navigation: navigation::NavigationShare,
 }
 
 impl Preflight {
@@ -398,6 +402,9 @@ fn check_scopes(
         })
         .collect();
     let mask = cfg.controller.geometry.auv150_reversed();
+    let margin_envelope = envelope.scaled(margin as f32);
+    let extremes = peaks.map(|(min, _, max, _)| (min, max));
+    let navigation = navigation::share(scenario, Some((&extremes, &margin_envelope)));
     Ok(Preflight {
         name: cfg.name.clone(),
         verdict: as_written.verdict,
@@ -418,6 +425,7 @@ fn check_scopes(
         first_violation: as_written.first_violation,
         static_violation: as_written.static_violation,
         whole_box,
+        navigation,
     })
 }
 

@@ -170,7 +170,11 @@ impl<'a> Checker<'a> {
         let law_model = controller.params().cast(f64::from);
         let nominal = Plant::new(law_model, PlantTerms::default())
             .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
-        let margin_envelope = controller.envelope().scaled(margin as f32);
+        // The navigation's noise force is kept on each side (Choice 372).
+        let margin_envelope = super::navigation::keep(
+            controller.envelope().scaled(margin as f32),
+            &super::navigation::share(scenario, None).thrust,
+        );
         let margin_allocator = Allocator::new(
             controller.allocation(),
             &margin_envelope,
