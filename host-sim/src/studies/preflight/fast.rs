@@ -168,34 +168,18 @@ fn heel(
 
 /// The inputs of a sample that its forces depend on (the reference's attitude and rates, and
 /// the mission-as-written case's plant and swing there), bit for bit: a sweep judges each key
-/// once (Choice 391). At rest (1/k = 0) the rates enter only as η̇·0 and η̈·0, zeros: the key
-/// is the attitude alone, and without a current the roll and pitch alone (the heading then
-/// only turns zeros; a zero's sign aside, the forces are the same).
+/// once (Choice 391).
 #[derive(Default)]
 pub(super) struct SampleKeys(HashSet<Vec<u64>>);
 
 impl SampleKeys {
-    /// Records the key of sample `smp` at prepared index `m` of `cases`, at 1/k = `inv_k`
-    /// with `current` whether any current is checked; false if it was already there.
-    pub(super) fn insert(
-        &mut self,
-        smp: &PathSample,
-        cases: &[CasePlants<'_>],
-        m: usize,
-        inv_k: f64,
-        current: bool,
-    ) -> bool {
+    /// Records the key of sample `smp` at prepared index `m` of `cases`; false if it was
+    /// already there.
+    pub(super) fn insert(&mut self, smp: &PathSample, cases: &[CasePlants<'_>], m: usize) -> bool {
         let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
-        let at_rest = inv_k == 0.0;
-        let angles = match (at_rest, current) {
-            (true, false) => 2,
-            _ => 3,
-        };
-        key.extend(smp.eta.iter().skip(3).take(angles).map(|x| x.to_bits()));
-        if !at_rest {
-            key.extend(smp.eta_dot.iter().map(|x| x.to_bits()));
-            key.extend(smp.eta_ddot.iter().map(|x| x.to_bits()));
-        }
+        key.extend(smp.eta.iter().skip(3).map(|x| x.to_bits()));
+        key.extend(smp.eta_dot.iter().map(|x| x.to_bits()));
+        key.extend(smp.eta_ddot.iter().map(|x| x.to_bits()));
         // A case constant along the path (every corner of the box) adds nothing.
         for (plant, amplitude) in cases.iter().filter_map(|c| c.key(m)) {
             key.push(plant as u64);

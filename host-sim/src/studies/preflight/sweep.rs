@@ -119,8 +119,6 @@ pub(super) struct Checker<'a> {
     margin_allocator: Allocator,
     margin_envelope: ThrustEnvelope,
     engine: Engine,
-    /// Whether any checked current is not zero.
-    any_current: bool,
     /// Per scope, where the last infeasible probe failed (Choice 392).
     hint: [std::cell::Cell<Option<PointId>>; 2],
 }
@@ -222,7 +220,6 @@ impl<'a> Checker<'a> {
         let nominal = Plant::new(law_model, PlantTerms::default())
             .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
         let currents = currents(&cfg.current);
-        let any_current = currents.iter().any(|c| *c != Vector3::zeros());
         let margin_envelope = controller.envelope().scaled(margin as f32);
         let margin_allocator = Allocator::new(
             controller.allocation(),
@@ -245,7 +242,6 @@ impl<'a> Checker<'a> {
             margin_allocator,
             margin_envelope,
             engine,
-            any_current,
             hint: Default::default(),
         })
     }
@@ -493,9 +489,7 @@ impl<'a> Checker<'a> {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
             let smp = self.sample(peak, j);
-            if self.engine == Engine::Fast
-                && !seen.insert(smp, &prepared.cases, m, inv_k, self.any_current)
-            {
+            if self.engine == Engine::Fast && !seen.insert(smp, &prepared.cases, m) {
                 continue;
             }
             let ctx = self.at_sample(smp, inv_k);
