@@ -278,7 +278,20 @@ impl Plant {
         nu_dot: &Vector6<f64>,
         current: &Vector3<f64>,
     ) -> Vector6<f64> {
-        let att = Attitude::from_eta(&s.eta);
+        self.required_force_at(s, &Attitude::from_eta(&s.eta), nu_dot, current)
+    }
+
+    /// [`required_force`](Self::required_force) with the attitude's sines and cosines given
+    /// (`att` must be those of `s.eta`'s Euler angles): the same arithmetic, bit for bit, for
+    /// a caller that holds them already (the preflight's sweep, Choice 390).
+    pub fn required_force_at(
+        &self,
+        s: &PlantState,
+        att: &Attitude<f64>,
+        nu_dot: &Vector6<f64>,
+        current: &Vector3<f64>,
+    ) -> Vector6<f64> {
+        let att = *att;
         let omega = Vector3::new(s.nu[3], s.nu[4], s.nu[5]);
         let vc_body = kinematics::rotation(&att).transpose() * current;
         let nu_c = Vector6::new(vc_body.x, vc_body.y, vc_body.z, 0.0, 0.0, 0.0);

@@ -49,7 +49,9 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
+mod fast;
 pub mod navigation;
+pub mod period;
 pub mod profile;
 mod sweep;
 
@@ -117,14 +119,28 @@ pub(super) fn poll() -> Result<(), CheckError> {
     }
 }
 
+/// How a sweep evaluates its points (docs/real-vehicle.md#how-the-check-is-made, **Choices
+/// 390–392**). Both give the same verdicts, time scales, violations and peaks, bit for bit
+/// (tests/preflight_engines.rs).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Engine {
+    /// What `check` runs: each sample's shared work formed once, each distinct sample judged
+    /// once per sweep, a bisection's probe starting where the last one failed.
+    #[default]
+    Fast,
+    /// The reference: every case of every sample evaluated from scratch, as written
+    /// (Eq 1 per point, [`attitude`]'s functions as they are).
+    Exhaustive,
+}
+
 /// Which payloads and currents a verdict covers.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Scope {
     /// The scenario's own payload profile and current.
-    AsWritten,
+    AsWritten = 0,
     /// Every corner of the controller's parameter box, held constant, under the configured
     /// current.
-    WholeBox,
+    WholeBox = 1,
 }
 
 /// What one thruster is asked for over the mission (at the scenario's time scale).
@@ -354,7 +370,7 @@ impl ScopeVerdict {
 /// [`CheckError::Invalid`]: a margin outside (0, 1], or a scenario whose allocator or plants
 /// cannot be built; [`CheckError::Interrupted`]: a stop was requested.
 pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
-    check_scopes(scenario, margin, true)
+    check_with(scenario, margin, true, Engine::Fast)
 }
 
 /// [`check`] of the mission as written only (no [`Preflight::whole_box`]): what flying it
@@ -363,13 +379,19 @@ pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> 
 /// # Errors
 /// As [`check`].
 pub fn check_as_written(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> {
-    check_scopes(scenario, margin, false)
+    check_with(scenario, margin, false, Engine::Fast)
 }
 
-fn check_scopes(
+/// [`check`] (`whole_box`) or [`check_as_written`] by `engine`: the reference engine
+/// ([`Engine::Exhaustive`]) is what the fast one is tested against.
+///
+/// # Errors
+/// As [`check`].
+pub fn check_with(
     scenario: &Scenario,
     margin: f64,
     whole_box: bool,
+    engine: Engine,
 ) -> Result<Preflight, CheckError> {
     if !(margin > 0.0 && margin <= 1.0) {
         return Err(CheckError::Invalid(format!(
@@ -377,7 +399,7 @@ fn check_scopes(
             Readable(margin)
         )));
     }
-    let checker = Checker::new(scenario, margin)?;
+    let checker = Checker::new(scenario, margin, engine)?;
     let cfg = scenario.config();
     let k = time_scale(cfg.time_scale);
     let (as_written, peaks) = verdict(&checker, Scope::AsWritten, k)?;
@@ -431,7 +453,8 @@ fn check_scopes(
 
 /// The verdict over `scope` at the scenario's scale `k`, and the peaks of the full sweep there.
 fn verdict(checker: &Checker, scope: Scope, k: f64) -> Result<(ScopeVerdict, Peaks), CheckError> {
-    let own = checker.sweep(scope, 1.0 / k, true)?;
+    // The box's peaks are not reported: its sweep may stop at its first violation.
+    let own = checker.sweep(scope, 1.0 / k, scope == Scope::AsWritten)?;
     let at_rest = checker.sweep(scope, 0.0, false)?;
     let statically_infeasible = at_rest.first.is_some();
     let smallest = if statically_infeasible {
@@ -472,9 +495,7 @@ fn smallest_time_scale(
     known: Option<f64>,
 ) -> Result<Option<f64>, CheckError> {
     let max = f64::from(Trajectory::MAX_TIME_SCALE);
-    let feasible_at = |k: f64| -> Result<bool, CheckError> {
-        Ok(checker.sweep(scope, 1.0 / k, false)?.first.is_none())
-    };
+    let feasible_at = |k: f64| checker.feasible(scope, 1.0 / k);
     if known == Some(1.0) || feasible_at(1.0)? {
         return Ok(Some(1.0));
     }

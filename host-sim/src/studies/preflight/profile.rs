@@ -40,7 +40,7 @@ use serde::{Deserialize, Serialize};
 use controller_core::trajectory::{Route, SpeedList, DEFAULT_SPEED_CHANGE, MAX_SPEED};
 
 use super::sweep::Checker;
-use super::{CheckError, Scope};
+use super::{CheckError, Engine, Scope};
 use crate::scenario::{path_time, Scenario, SimConfig, MAX_DURATION};
 
 /// Every this many samples of the path (0.5 s of path time at 20 Hz) in the per-part search.
@@ -116,6 +116,18 @@ struct Parts {
 /// [`CheckError::NoProfile`] if a part cannot be flown over the whole box even at the slowest
 /// speed; [`CheckError::Interrupted`].
 pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>, CheckError> {
+    propose_with(scenario, margin, Engine::Fast)
+}
+
+/// [`propose`] by `engine` (the reference engine is what the fast one is tested against).
+///
+/// # Errors
+/// As [`propose`].
+pub fn propose_with(
+    scenario: &Scenario,
+    margin: f64,
+    engine: Engine,
+) -> Result<Option<SpeedProfile>, CheckError> {
     let cfg = scenario.config();
     let TrajectoryKind::Waypoints {
         speed,
@@ -142,7 +154,7 @@ pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>,
         // The f32 as the decimal it was written as (0.05, not 0.0500000007).
         accel: super::time_scale(speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
     };
-    let checker = Checker::new(&constant, margin)?;
+    let checker = Checker::new(&constant, margin, engine)?;
     let (fastest, limiting) = per_part_speeds(&checker, &parts)?;
     let uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
     let mut speeds = fastest.clone();
@@ -150,9 +162,9 @@ pub fn propose(scenario: &Scenario, margin: f64) -> Result<Option<SpeedProfile>,
         let rounded = round_down(&speeds);
         let fitted = fit_changes(&parts, &rounded);
         let flown = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
-        let checker = Checker::new(&flown, margin)?;
-        let ok = checker.sweep(Scope::WholeBox, 1.0, false)?.first.is_none()
-            && checker.sweep(Scope::AsWritten, 1.0, false)?.first.is_none();
+        let checker = Checker::new(&flown, margin, engine)?;
+        let ok =
+            checker.feasible(Scope::WholeBox, 1.0)? && checker.feasible(Scope::AsWritten, 1.0)?;
         if ok || round == MAX_VERIFY_ROUNDS {
             // A part step 2 slowed is limited by the changes, not by what bounded its search.
             let limiting = limiting

@@ -13,7 +13,11 @@ use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 
 use super::attitude::{self, Swing};
-use super::{poll, time_scale, CheckError, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ};
+use super::fast::{self, RollConsts, SampleKeys, Shared};
+use super::period;
+use super::{
+    poll, time_scale, CheckError, Engine, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ,
+};
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::{InitialAttitude, Scenario};
 
@@ -25,12 +29,12 @@ const ROLL: usize = 3;
 const PITCH: usize = 4;
 
 /// The reference at one sample of the path, at k = 1.
-struct PathSample {
+pub(super) struct PathSample {
     /// Path time (s, at k = 1).
-    s: f64,
-    eta: Vector6<f64>,
-    eta_dot: Vector6<f64>,
-    eta_ddot: Vector6<f64>,
+    pub s: f64,
+    pub eta: Vector6<f64>,
+    pub eta_dot: Vector6<f64>,
+    pub eta_ddot: Vector6<f64>,
 }
 
 /// Per thruster: the smallest demand (N) and when (s), the largest and when.
@@ -40,21 +44,54 @@ pub(super) type Peaks = [(f64, f64, f64, f64); THRUSTERS];
 pub(super) struct Sweep {
     pub first: Option<Violation>,
     pub peaks: Peaks,
+    /// Where the first violation was: the next probe of a bisection tries it first.
+    at: Option<PointId>,
+}
+
+/// One point of a sweep: a regular sample (`peak` false) or a corner's extreme, the case and
+/// the current.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+struct PointId {
+    peak: bool,
+    sample: usize,
+    case: usize,
+    current: usize,
+}
+
+/// The regular times and the corners' extremes' (with their index) in time order.
+type Merged = Vec<(f64, Option<usize>)>;
+
+/// The cases of a sweep at one 1/k: the sample times, the plants the mission as written meets
+/// there, and each case's plant and swing per sample.
+struct Prepared<'p> {
+    times: Vec<f64>,
+    cases: Vec<CasePlants<'p>>,
 }
 
 /// The plant of a case at each sample, and its roll swing there.
-struct CasePlants<'p> {
+pub(super) struct CasePlants<'p> {
     /// Index into `plants` per sample (one entry: the same plant throughout).
     at: Vec<usize>,
     plants: Vec<&'p Plant>,
+    /// Each plant's roll constants (the fast engine's, Choice 390).
+    roll: Vec<RollConsts>,
     /// The swing's amplitude per sample (one entry: the same throughout), and its ω.
     amplitude: Vec<f64>,
     omega: f64,
 }
 
 impl CasePlants<'_> {
+    fn index(&self, j: usize) -> usize {
+        self.at[j.min(self.at.len() - 1)]
+    }
     fn plant(&self, j: usize) -> &Plant {
-        self.plants[self.at[j.min(self.at.len() - 1)]]
+        self.plants[self.index(j)]
+    }
+    /// The plant's index and the swing's amplitude at sample `j`; `None` when both are the
+    /// same throughout.
+    pub(super) fn key(&self, j: usize) -> Option<(usize, f64)> {
+        (self.at.len() > 1 || self.amplitude.len() > 1)
+            .then(|| (self.index(j), self.swing(j).amplitude))
     }
     fn swing(&self, j: usize) -> Swing {
         Swing {
@@ -81,6 +118,9 @@ pub(super) struct Checker<'a> {
     currents: Vec<Vector3<f64>>,
     margin_allocator: Allocator,
     margin_envelope: ThrustEnvelope,
+    engine: Engine,
+    /// Per scope, where the last infeasible probe failed (Choice 392).
+    hint: [std::cell::Cell<Option<PointId>>; 2],
 }
 
 /// The currents the check takes (see the module docs of [`super`]).
@@ -128,7 +168,11 @@ fn state_at(
 }
 
 impl<'a> Checker<'a> {
-    pub(super) fn new(scenario: &'a Scenario, margin: f64) -> Result<Self, CheckError> {
+    pub(super) fn new(
+        scenario: &'a Scenario,
+        margin: f64,
+        engine: Engine,
+    ) -> Result<Self, CheckError> {
         let invalid = CheckError::Invalid;
         let cfg = scenario.config();
         let controller = scenario.controller();
@@ -139,7 +183,12 @@ impl<'a> Checker<'a> {
         })
         .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / time_scale(cfg.time_scale);
-        let n = (span * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
+        // A periodic mission: its first period (Choice 393), by the fast engine.
+        let checked = match (engine, period::period(cfg)) {
+            (Engine::Fast, Some(p)) => span.min(p),
+            _ => span,
+        };
+        let n = (checked * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
         let samples = (0..=n)
             .map(|j| {
                 if j % 4096 == 0 {
@@ -170,6 +219,7 @@ impl<'a> Checker<'a> {
         let law_model = controller.params().cast(f64::from);
         let nominal = Plant::new(law_model, PlantTerms::default())
             .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
+        let currents = currents(&cfg.current);
         // The navigation's noise force is kept on each side (Choice 372).
         let margin_envelope = super::navigation::keep(
             controller.envelope().scaled(margin as f32),
@@ -192,9 +242,11 @@ impl<'a> Checker<'a> {
             accel_bound: f64::from(path.accel_bound()),
             corners,
             nominal,
-            currents: currents(&cfg.current),
+            currents,
             margin_allocator,
             margin_envelope,
+            engine,
+            hint: Default::default(),
         })
     }
 
@@ -231,6 +283,7 @@ impl<'a> Checker<'a> {
                     CasePlants {
                         at: vec![0],
                         plants: vec![p],
+                        roll: vec![RollConsts::of(p)],
                         amplitude: vec![start.map_or(0.0, |s| (heel - s).abs())],
                         omega: attitude::roll_frequency(p, self.samples[0].eta[PITCH]),
                     }
@@ -254,6 +307,7 @@ impl<'a> Checker<'a> {
                 vec![CasePlants {
                     at,
                     plants: owned.iter().collect(),
+                    roll: owned.iter().map(RollConsts::of).collect(),
                     amplitude,
                     omega,
                 }]
@@ -286,13 +340,37 @@ impl<'a> Checker<'a> {
         if out.first.is_some() && !full {
             return Ok(out);
         }
+        self.sweep_peaks(scope, inv_k, full, &mut out)?;
+        Ok(out)
+    }
+
+    /// The corners' extremes of [`Checker::sweep`], after its regular samples (`out`).
+    fn sweep_peaks(
+        &self,
+        scope: Scope,
+        inv_k: f64,
+        full: bool,
+        out: &mut Sweep,
+    ) -> Result<(), CheckError> {
         if self.corners_peaks.is_empty() {
-            return Ok(out);
+            return Ok(());
         }
+        let (merged, owned) = self.merged(scope, inv_k)?;
+        let prepared = self.prepare_at(scope, merged.iter().map(|m| m.0).collect(), &owned);
         // The cases over the regular times and the extremes' merged in order, so that the
         // payload and the roll swing at an extreme are those of its time.
+        let points = merged
+            .iter()
+            .enumerate()
+            .filter_map(|(m, &(_, peak))| peak.map(|j| (m, j)));
+        self.sweep_points(&prepared, points, true, inv_k, full, out)
+    }
+
+    /// The regular times at 1/k = `inv_k` and the extremes' merged in time order (each with
+    /// its index into the extremes), and the plants the mission as written meets at them.
+    fn merged(&self, scope: Scope, inv_k: f64) -> Result<(Merged, Vec<Plant>), CheckError> {
         let k = self.scale(inv_k);
-        let mut merged: Vec<(f64, Option<usize>)> = self
+        let mut merged: Merged = self
             .times(inv_k)
             .into_iter()
             .map(|t| (t, None))
@@ -304,36 +382,64 @@ impl<'a> Checker<'a> {
             )
             .collect();
         merged.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let times: Vec<f64> = merged.iter().map(|m| m.0).collect();
-        let owned = match scope {
-            Scope::AsWritten => self.profile_plants(&times).map_err(CheckError::Invalid)?,
-            Scope::WholeBox => Vec::new(),
-        };
-        let cases = self.cases(scope, &times, &owned);
-        for (m, &(t, peak)) in merged.iter().enumerate() {
-            let Some(j) = peak else { continue };
-            let smp = &self.corners_peaks[j];
-            poll()?;
-            let stiffness = self.pitch_stiffness(smp, inv_k);
-            for case in &cases {
-                for current in &self.currents {
-                    let at = Point {
-                        smp,
-                        t,
-                        inv_k,
-                        plant: case.plant(m),
-                        swing: case.swing(m),
-                        current,
-                        stiffness,
-                    };
-                    self.check_point(&at, full, &mut out);
-                    if out.first.is_some() && !full {
-                        return Ok(out);
-                    }
-                }
+        let owned = self.owned(scope, merged.iter().map(|m| m.0))?;
+        Ok((merged, owned))
+    }
+
+    /// The plants of `scope` at `times`: the mission's own (as written), none for the box.
+    fn owned(
+        &self,
+        scope: Scope,
+        times: impl Iterator<Item = f64>,
+    ) -> Result<Vec<Plant>, CheckError> {
+        match scope {
+            Scope::AsWritten => self
+                .profile_plants(&times.collect::<Vec<_>>())
+                .map_err(CheckError::Invalid),
+            Scope::WholeBox => Ok(Vec::new()),
+        }
+    }
+
+    fn prepare_at<'p>(&'p self, scope: Scope, times: Vec<f64>, owned: &'p [Plant]) -> Prepared<'p> {
+        let cases = self.cases(scope, &times, owned);
+        Prepared { times, cases }
+    }
+
+    /// Whether every point of `scope` fits at 1/k = `inv_k` ([`Checker::sweep`]'s verdict
+    /// only). The fast engine tries first the point where the last infeasible probe of this
+    /// scope failed (Choice 392): a bisection's infeasible probes then stop at once.
+    pub(super) fn feasible(&self, scope: Scope, inv_k: f64) -> Result<bool, CheckError> {
+        let slot = &self.hint[scope as usize];
+        if let (Engine::Fast, Some(id)) = (self.engine, slot.get()) {
+            if self.violates(scope, inv_k, id)? {
+                return Ok(false);
             }
         }
-        Ok(out)
+        let out = self.sweep(scope, inv_k, false)?;
+        if self.engine == Engine::Fast && out.at.is_some() {
+            slot.set(out.at);
+        }
+        Ok(out.first.is_none())
+    }
+
+    /// Whether the point `id` violates the margin envelope at 1/k = `inv_k`.
+    fn violates(&self, scope: Scope, inv_k: f64, id: PointId) -> Result<bool, CheckError> {
+        let mut out = Sweep::new();
+        if id.peak {
+            let (merged, owned) = self.merged(scope, inv_k)?;
+            let m = merged.iter().position(|x| x.1 == Some(id.sample));
+            let prepared = self.prepare_at(scope, merged.iter().map(|m| m.0).collect(), &owned);
+            if let Some(m) = m {
+                let ctx = self.at_sample(self.sample(true, id.sample), inv_k);
+                self.check_one(&prepared, m, id, &ctx, false, &mut out);
+            }
+        } else {
+            let owned = self.owned(scope, self.times(inv_k).into_iter())?;
+            let prepared = self.prepare_at(scope, self.times(inv_k), &owned);
+            let ctx = self.at_sample(self.sample(false, id.sample), inv_k);
+            self.check_one(&prepared, id.sample, id, &ctx, false, &mut out);
+        }
+        Ok(out.first.is_some())
     }
 
     /// The time scale of 1/k = `inv_k` (at rest: the scenario's).
@@ -360,39 +466,107 @@ impl<'a> Checker<'a> {
         stride: usize,
     ) -> Result<Sweep, CheckError> {
         let times = self.times(inv_k);
-        let owned = match scope {
-            Scope::AsWritten => self.profile_plants(&times).map_err(CheckError::Invalid)?,
-            Scope::WholeBox => Vec::new(),
-        };
-        let cases = self.cases(scope, &times, &owned);
-        let mut out = Sweep {
-            first: None,
-            peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
-        };
-        for j in range.step_by(stride.max(1)) {
-            let smp = &self.samples[j];
+        let owned = self.owned(scope, times.iter().copied())?;
+        let prepared = self.prepare_at(scope, times, &owned);
+        let mut out = Sweep::new();
+        let points = range.step_by(stride.max(1)).map(|j| (j, j));
+        self.sweep_points(&prepared, points, false, inv_k, full, &mut out)?;
+        Ok(out)
+    }
+
+    /// Every case and current at each point `(m, j)` of `points` (m: index into the prepared
+    /// times, j: into the regular samples or, if `peak`, the corners' extremes), in order;
+    /// stops at the first violation unless `full`. The fast engine skips a point whose
+    /// inputs equal, bit for bit, a point already judged in this sweep (Choice 391): it
+    /// would give the same forces, so neither the first violation nor a peak can change.
+    fn sweep_points(
+        &self,
+        prepared: &Prepared,
+        points: impl Iterator<Item = (usize, usize)>,
+        peak: bool,
+        inv_k: f64,
+        full: bool,
+        out: &mut Sweep,
+    ) -> Result<(), CheckError> {
+        let mut seen = SampleKeys::default();
+        for (m, j) in points {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
-            let stiffness = self.pitch_stiffness(smp, inv_k);
-            for case in &cases {
-                for current in &self.currents {
-                    let at = Point {
-                        smp,
-                        t: times[j],
-                        inv_k,
-                        plant: case.plant(j),
-                        swing: case.swing(j),
+            let smp = self.sample(peak, j);
+            if self.engine == Engine::Fast && !seen.insert(smp, &prepared.cases, m) {
+                continue;
+            }
+            let ctx = self.at_sample(smp, inv_k);
+            for case in 0..prepared.cases.len() {
+                for current in 0..self.currents.len() {
+                    let id = PointId {
+                        peak,
+                        sample: j,
+                        case,
                         current,
-                        stiffness,
                     };
-                    self.check_point(&at, full, &mut out);
+                    self.check_one(prepared, m, id, &ctx, full, out);
+                    if out.first.is_some() && out.at.is_none() {
+                        out.at = Some(id);
+                    }
                     if out.first.is_some() && !full {
-                        return Ok(out);
+                        return Ok(());
                     }
                 }
             }
         }
-        Ok(out)
+        Ok(())
+    }
+
+    fn sample(&self, peak: bool, j: usize) -> &PathSample {
+        match peak {
+            true => &self.corners_peaks[j],
+            false => &self.samples[j],
+        }
+    }
+
+    /// What every case at sample `smp` shares at 1/k = `inv_k`.
+    fn at_sample(&self, smp: &PathSample, inv_k: f64) -> AtSample {
+        AtSample {
+            inv_k,
+            stiffness: self.pitch_stiffness(smp, inv_k),
+            shared: match self.engine {
+                Engine::Fast => Some(Shared::new(smp, inv_k)),
+                Engine::Exhaustive => None,
+            },
+        }
+    }
+
+    /// The point `id` at prepared index `m`, by the checker's engine.
+    fn check_one(
+        &self,
+        prepared: &Prepared,
+        m: usize,
+        id: PointId,
+        ctx: &AtSample,
+        full: bool,
+        out: &mut Sweep,
+    ) {
+        let smp = self.sample(id.peak, id.sample);
+        let case = &prepared.cases[id.case];
+        let at = Point {
+            smp,
+            t: prepared.times[m],
+            inv_k: ctx.inv_k,
+            plant: case.plant(m),
+            swing: case.swing(m),
+            current: &self.currents[id.current],
+            stiffness: ctx.stiffness,
+        };
+        match &ctx.shared {
+            None => self.check_point(&at, full, out),
+            Some(shared) => {
+                let roll = &case.roll[case.index(m)];
+                fast::check_point(self, &at, shared, roll, &mut |t, tau| {
+                    self.judge(t, tau, full, out)
+                });
+            }
+        }
     }
 
     /// The law's pitch stiffness on the reference at sample `smp` ([`attitude::pitch_stiffness`]).
@@ -411,6 +585,10 @@ impl<'a> Checker<'a> {
 
     /// One point: the attitude the vehicle holds there, the force it needs at each extreme of
     /// its roll swing, each through the margin allocator.
+    pub(super) fn nominal(&self) -> &Plant {
+        &self.nominal
+    }
+
     fn check_point(&self, at: &Point, full: bool, out: &mut Sweep) {
         let (smp, inv_k, plant, current) = (at.smp, at.inv_k, at.plant, at.current);
         let level = Self::static_heel(plant, smp);
@@ -529,12 +707,30 @@ fn blend_peaks(path: &Trajectory, span: f64) -> Vec<PathSample> {
 
 /// One point of a sweep: a sample, the case's plant and swing there, a current, and the law's
 /// pitch stiffness there.
-struct Point<'s> {
-    smp: &'s PathSample,
-    t: f64,
+pub(super) struct Point<'s> {
+    pub smp: &'s PathSample,
+    pub t: f64,
+    pub inv_k: f64,
+    pub plant: &'s Plant,
+    pub swing: Swing,
+    pub current: &'s Vector3<f64>,
+    pub stiffness: f64,
+}
+
+/// What every case of one sample shares: 1/k, the law's pitch stiffness there, and the fast
+/// engine's [`Shared`].
+struct AtSample {
     inv_k: f64,
-    plant: &'s Plant,
-    swing: Swing,
-    current: &'s Vector3<f64>,
     stiffness: f64,
+    shared: Option<Shared>,
+}
+
+impl Sweep {
+    fn new() -> Self {
+        Sweep {
+            first: None,
+            peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
+            at: None,
+        }
+    }
 }

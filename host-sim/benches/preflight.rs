@@ -1,0 +1,38 @@
+//! Preflight benchmarks (docs/real-vehicle.md#how-the-check-is-made): `host-sim check`'s work —
+//! the verdict over both scopes and, for a waypoint mission, the speed profile's search — on
+//! the shipped survey, a 32-point route (a payload staircase, a current) and a day-long
+//! circle. `cargo bench --profile host -p host-sim --bench preflight`; one thread.
+
+use std::hint::black_box;
+use std::path::Path;
+
+use criterion::{criterion_group, criterion_main, Criterion};
+use host_sim::scenario::{load_scenario, Scenario};
+use host_sim::studies::preflight::{self, profile, Engine, DEFAULT_MARGIN};
+
+fn scenario(path: &str) -> Scenario {
+    load_scenario(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).expect("the scenario")
+}
+
+/// What `host-sim check` computes.
+fn check(s: &Scenario, engine: Engine) {
+    preflight::check_with(s, DEFAULT_MARGIN, true, engine).expect("the check");
+    profile::propose_with(s, DEFAULT_MARGIN, engine).expect("the profile");
+}
+
+fn bench(c: &mut Criterion) {
+    let mut group = c.benchmark_group("check");
+    group.sample_size(10);
+    for (name, path) in [
+        ("survey-200x100", "scenarios/real/survey-200x100.toml"),
+        ("route32", "benches/route32.toml"),
+        ("day-circle", "benches/day-circle.toml"),
+    ] {
+        let s = scenario(path);
+        group.bench_function(name, |b| b.iter(|| check(black_box(&s), Engine::Fast)));
+    }
+    group.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);

@@ -1,0 +1,190 @@
+//! The fast engine's work at one point of a sweep (docs/real-vehicle.md#how-the-check-is-made,
+//! **Choices 390–391**): the same arithmetic as the reference engine's
+//! [`Checker::check_point`](super::sweep::Checker), bit for bit, with what does not change
+//! between the cases of a sample formed once per sample ([`Shared`]: the heading's and the
+//! path pitch's sines and cosines, the reference rates at the time scale) and what does not
+//! change along the path formed once per plant ([`RollConsts`]: the heeling and righting
+//! moments, the static heel and its sines), so that a point's sines and cosines are only
+//! those of its own roll and pitch offset; and the key by which a sweep recognises a sample
+//! it has already judged ([`SampleKeys`]).
+
+use std::collections::HashSet;
+
+use controller_core::kinematics::{self, Attitude};
+use nalgebra::{Vector3, Vector6};
+
+use super::attitude;
+use super::sweep::{CasePlants, Checker, PathSample, Point};
+use crate::plant::{roll_moments, Plant, PlantState};
+
+/// Index of roll and pitch in η, ν and τ.
+const ROLL: usize = 3;
+const PITCH: usize = 4;
+
+/// A plant's roll constants: the heeling moment m_y, the righting coefficient k₄, ρ = |(m_y,
+/// k₄)| and the static heel atan2(m_y, k₄) with its sine and cosine
+/// ([`plant::static_heel`](crate::plant::static_heel), [`attitude::heel`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct RollConsts {
+    k4: f64,
+    rho: f64,
+    phi0: f64,
+    phi0_sin_cos: (f64, f64),
+}
+
+impl RollConsts {
+    pub(super) fn of(plant: &Plant) -> Self {
+        let (my, k4) = roll_moments(plant.params());
+        let phi0 = my.atan2(k4);
+        RollConsts {
+            k4,
+            rho: my.hypot(k4),
+            phi0,
+            phi0_sin_cos: phi0.sin_cos(),
+        }
+    }
+}
+
+/// What every case of one sample at one 1/k shares.
+pub(super) struct Shared {
+    /// sin, cos of ψ_d and of θ_d (+ 0, as the reference engine forms it).
+    psi: (f64, f64),
+    theta: f64,
+    theta_sin_cos: (f64, f64),
+    /// cos θ_d, and whether |cos θ_d| > 0 (the static heel exists).
+    cos_theta: f64,
+    level_pitch: bool,
+    /// η̇_d/k and η̈_d/k².
+    eta_dot: Vector6<f64>,
+    eta_ddot: Vector6<f64>,
+}
+
+impl Shared {
+    pub(super) fn new(smp: &PathSample, inv_k: f64) -> Self {
+        let theta = smp.eta[PITCH] + 0.0;
+        Shared {
+            psi: smp.eta[5].sin_cos(),
+            theta,
+            theta_sin_cos: theta.sin_cos(),
+            cos_theta: theta.cos(),
+            level_pitch: smp.eta[PITCH].cos().abs() > 0.0,
+            eta_dot: smp.eta_dot * inv_k,
+            eta_ddot: smp.eta_ddot * (inv_k * inv_k),
+        }
+    }
+
+    fn attitude(&self, phi: (f64, f64), theta: (f64, f64)) -> Attitude<f64> {
+        Attitude {
+            sphi: phi.0,
+            cphi: phi.1,
+            stheta: theta.0,
+            ctheta: theta.1,
+            spsi: self.psi.0,
+            cpsi: self.psi.1,
+        }
+    }
+
+    /// The state on the sample with roll `phi`, pitch `theta` (their sines and cosines in
+    /// `att`) and roll acceleration `p_dot`: the reference engine's `state_at`.
+    fn state(
+        &self,
+        smp: &PathSample,
+        phi: f64,
+        theta: f64,
+        att: &Attitude<f64>,
+        p_dot: f64,
+    ) -> (PlantState, Vector6<f64>) {
+        let mut eta = smp.eta;
+        eta[ROLL] = phi;
+        eta[PITCH] = theta;
+        let jinv = kinematics::jacobian_inv(att);
+        let nu = jinv * self.eta_dot;
+        let jjn = kinematics::jinv_jdot_nu(att, &nu).unwrap_or_else(|_| Vector6::zeros());
+        let mut nu_dot = jinv * self.eta_ddot - jjn;
+        nu_dot[ROLL] += p_dot;
+        (PlantState { eta, nu }, nu_dot)
+    }
+}
+
+/// One point (the reference engine's `check_point`): the heel, the pitch offset, the force at
+/// each extreme of the roll swing, each handed to `judge` with its time.
+pub(super) fn check_point(
+    checker: &Checker,
+    at: &Point,
+    shared: &Shared,
+    roll: &RollConsts,
+    judge: &mut dyn FnMut(f64, &Vector6<f32>),
+) {
+    let (smp, plant, current) = (at.smp, at.plant, at.current);
+    let static_heel = roll.k4 > 0.0 && shared.level_pitch;
+    let (level, level_sc) = match static_heel {
+        true => (roll.phi0, roll.phi0_sin_cos),
+        false => (0.0, 0.0f64.sin_cos()),
+    };
+    let att = shared.attitude(level_sc, shared.theta_sin_cos);
+    let (state, nu_dot) = shared.state(smp, level, shared.theta, &att, 0.0);
+    let heel = heel(plant, roll, shared, &state, &att, &nu_dot, current).unwrap_or(level);
+    // The pitch error that holds the law's model mismatch in pitch, at the heel.
+    let att = shared.attitude(heel.sin_cos(), shared.theta_sin_cos);
+    let (state, nu_dot) = shared.state(smp, heel, shared.theta, &att, 0.0);
+    let needed = plant.required_force_at(&state, &att, &nu_dot, current)[PITCH];
+    let modelled = checker
+        .nominal()
+        .required_force_at(&state, &att, &nu_dot, &Vector3::zeros())[PITCH];
+    let d_theta = attitude::pitch_offset(needed - modelled, at.stiffness);
+    let theta = smp.eta[PITCH] + d_theta;
+    let theta_sc = theta.sin_cos();
+    for (phi, p_dot) in at.swing.extremes(heel) {
+        let att = shared.attitude(phi.sin_cos(), theta_sc);
+        let (state, nu_dot) = shared.state(smp, phi, theta, &att, p_dot);
+        let tau = plant
+            .required_force_at(&state, &att, &nu_dot, current)
+            .cast::<f32>();
+        judge(at.t, &tau);
+    }
+}
+
+/// [`attitude::heel`] at the static heel's state `state` (attitude `att`), with the plant's
+/// roll constants.
+fn heel(
+    plant: &Plant,
+    roll: &RollConsts,
+    shared: &Shared,
+    state: &PlantState,
+    att: &Attitude<f64>,
+    nu_dot: &Vector6<f64>,
+    current: &Vector3<f64>,
+) -> Option<f64> {
+    let c_theta = shared.cos_theta;
+    if roll.k4 <= 0.0 || c_theta.abs() < 1e-6 {
+        return None;
+    }
+    // Here the static heel exists (k₄ > 0, cos θ ≠ 0): `state` is at it, as `attitude::heel`
+    // puts it.
+    let dynamic = plant.required_force_at(state, att, nu_dot, current)[ROLL];
+    let s = (-dynamic / (c_theta * roll.rho)).clamp(-1.0, 1.0);
+    Some(roll.phi0 + s.asin())
+}
+
+/// The inputs of a sample that its forces depend on (the reference's attitude and rates, and
+/// the mission-as-written case's plant and swing there), bit for bit: a sweep judges each key
+/// once (Choice 391).
+#[derive(Default)]
+pub(super) struct SampleKeys(HashSet<Vec<u64>>);
+
+impl SampleKeys {
+    /// Records the key of sample `smp` at prepared index `m` of `cases`; false if it was
+    /// already there.
+    pub(super) fn insert(&mut self, smp: &PathSample, cases: &[CasePlants<'_>], m: usize) -> bool {
+        let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
+        key.extend(smp.eta.iter().skip(3).map(|x| x.to_bits()));
+        key.extend(smp.eta_dot.iter().map(|x| x.to_bits()));
+        key.extend(smp.eta_ddot.iter().map(|x| x.to_bits()));
+        // A case constant along the path (every corner of the box) adds nothing.
+        for (plant, amplitude) in cases.iter().filter_map(|c| c.key(m)) {
+            key.push(plant as u64);
+            key.push(amplitude.to_bits());
+        }
+        self.0.insert(key)
+    }
+}

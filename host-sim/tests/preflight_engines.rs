@@ -1,0 +1,180 @@
+//! The fast preflight engine against the reference (docs/real-vehicle.md#how-the-check-is-made,
+//! Choices 390–392): the reference engine evaluates every case of every sample from scratch,
+//! as the check was first written; the fast one must give the same [`Preflight`] (verdicts,
+//! time scales, first violations, peaks) and the same speed profiles, bit for bit.
+
+use controller_core::effectiveness::ThrusterGeometry;
+use controller_core::TrajectoryKind;
+use host_sim::plant::{CurrentModel, VariationProfile};
+use host_sim::scenario::{load_scenario, real_vehicle, Scenario};
+use host_sim::studies::preflight::{
+    self, period, profile, Engine, Preflight, ScopeVerdict, DEFAULT_MARGIN,
+};
+use host_sim::studies::validation::Campaign;
+use rayon::prelude::*;
+
+/// Both engines' check of `s` (`whole_box`: both scopes; else the contract's own call).
+fn both(s: &Scenario, whole_box: bool) -> (Preflight, Preflight) {
+    let fast = preflight::check_with(s, DEFAULT_MARGIN, whole_box, Engine::Fast).unwrap();
+    let reference =
+        preflight::check_with(s, DEFAULT_MARGIN, whole_box, Engine::Exhaustive).unwrap();
+    (fast, reference)
+}
+
+/// Whether the fast engine checks `s` over one period only (Choice 393): fewer samples than
+/// the reference, so the same verdicts but peaks at other times.
+fn one_period(s: &Scenario) -> bool {
+    let cfg = s.config();
+    let span = cfg.duration / f64::from(cfg.time_scale);
+    period::period(cfg).is_some_and(|p| p < span)
+}
+
+/// What must agree whatever the samples: the verdicts and proposed scales of both scopes, and
+/// whether there is a first and a static violation.
+fn verdicts(p: &Preflight) -> impl PartialEq + std::fmt::Debug {
+    let scope = |b: &ScopeVerdict| (b.verdict, b.smallest_time_scale);
+    (
+        p.verdict,
+        p.smallest_time_scale,
+        p.first_violation.is_some(),
+        p.static_violation.is_some(),
+        p.whole_box.as_ref().map(scope),
+    )
+}
+
+/// `fast` and `reference` agree: bit for bit, or (checked over one period) in their verdicts.
+fn agree(s: &Scenario, fast: &Preflight, reference: &Preflight) -> Result<(), String> {
+    let same = match one_period(s) {
+        false => fast == reference,
+        true => verdicts(fast) == verdicts(reference),
+    };
+    match same {
+        true => Ok(()),
+        false => Err(format!("{}: {fast:#?}\nvs {reference:#?}", s.config().name)),
+    }
+}
+
+/// Every mission of the contract's campaign (the six real paths under all 32 mountings, 200
+/// random missions of seed 1), checked as the contract checks them (as written): the same
+/// verdict, proposed scale, violations and peaks (the verdicts and scales where the fast
+/// engine checks one period).
+#[test]
+fn the_engines_agree_on_every_contract_mission_as_written() {
+    let campaign = Campaign::default();
+    let missions = campaign.missions().unwrap();
+    assert_eq!(missions.len(), 392);
+    let results: Vec<(bool, Result<(), String>)> = (0..missions.len())
+        .into_par_iter()
+        .map(|i| {
+            let s = missions.get(i).unwrap();
+            let (fast, reference) = both(&s, false);
+            (one_period(&s), agree(&s, &fast, &reference))
+        })
+        .collect();
+    let differ: Vec<&String> = results.iter().filter_map(|r| r.1.as_ref().err()).collect();
+    assert!(differ.is_empty(), "{differ:#?}");
+    // Both kinds of agreement were tested.
+    let periodic = results.iter().filter(|r| r.0).count();
+    assert!(
+        periodic > 20 && periodic < 300,
+        "{periodic} checked over one period"
+    );
+}
+
+/// The contract's random circles and figure-eights held at a constant payload (their own at
+/// 20 s) over three periods: checked over one period by the fast engine, the same verdicts
+/// and scales as over all three by the reference.
+#[test]
+fn the_engines_agree_on_periodic_missions_over_several_periods() {
+    let campaign = Campaign::default();
+    let missions = campaign.missions().unwrap();
+    let periodic: Vec<Scenario> = (192..392)
+        .map(|i| missions.get(i).unwrap())
+        .filter_map(|s| {
+            let payload = s.config().variation.at(20.0);
+            let s = s
+                .with(|c| c.variation = VariationProfile::Constant(payload))
+                .unwrap();
+            let p = period::period(s.config())?;
+            (p <= 200.0).then(|| s.with(|c| c.duration = 3.0 * p).unwrap())
+        })
+        .take(16)
+        .collect();
+    assert_eq!(periodic.len(), 16);
+    let differ: Vec<String> = periodic
+        .par_iter()
+        .filter_map(|s| {
+            assert!(one_period(s));
+            let (fast, reference) = both(s, false);
+            agree(s, &fast, &reference).err()
+        })
+        .collect();
+    assert!(differ.is_empty(), "{differ:#?}");
+}
+
+/// The whole box too (2⁹ corners, the costly scope) on the six real paths under their own
+/// mounting and with the vertical pair both pushing up, and every twentieth random mission; the
+/// verdicts cover feasible, needs-time-scale and a bisection over the box.
+#[test]
+fn the_engines_agree_over_the_whole_box() {
+    let campaign = Campaign::default();
+    let missions = campaign.missions().unwrap();
+    let real = real_vehicle::real_scenarios().unwrap();
+    let mut chosen: Vec<Scenario> = real.clone();
+    chosen.extend(real.iter().map(|s| {
+        s.with(|c| c.controller.geometry = ThrusterGeometry::auv150(0b11110))
+            .unwrap()
+    }));
+    chosen.extend((192..392).step_by(20).map(|i| missions.get(i).unwrap()));
+    let results: Vec<(Preflight, Preflight)> = chosen.par_iter().map(|s| both(s, true)).collect();
+    for (s, (fast, reference)) in chosen.iter().zip(&results) {
+        agree(s, fast, reference).unwrap();
+    }
+    let verdicts = |v: preflight::Verdict| {
+        results
+            .iter()
+            .filter(|(f, _)| f.whole_box.as_ref().map(|b| b.verdict) == Some(v))
+            .count()
+    };
+    assert!(verdicts(preflight::Verdict::Feasible) > 0);
+    assert!(verdicts(preflight::Verdict::NeedsTimeScale) > 0);
+}
+
+/// The speed profile of waypoint missions (per-part bisections, the check as flown, its
+/// shrink rounds): the shipped short survey as written, under a constant current, and under a
+/// Gauss–Markov one (eight current corners).
+#[test]
+fn the_engines_propose_the_same_speed_profiles() {
+    let file =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/waypoints-short.toml");
+    let base = load_scenario(&file).unwrap();
+    let unpinned = base
+        .with(|c| {
+            if let TrajectoryKind::Waypoints { speeds, .. } = &mut c.trajectory {
+                *speeds = None;
+            }
+        })
+        .unwrap();
+    let currents = [
+        CurrentModel::None,
+        CurrentModel::Constant([0.15, -0.1, 0.0]),
+        CurrentModel::GaussMarkov {
+            mean: [0.1, 0.05, 0.0],
+            sigma: [0.03, 0.03, 0.01],
+            tau: 20.0,
+            seed: 3,
+        },
+    ];
+    let chosen: Vec<Scenario> = currents
+        .iter()
+        .map(|m| unpinned.with(|c| c.current = m.clone()).unwrap())
+        .collect();
+    for s in &chosen {
+        let fast = profile::propose_with(s, DEFAULT_MARGIN, Engine::Fast).unwrap();
+        let reference = profile::propose_with(s, DEFAULT_MARGIN, Engine::Exhaustive).unwrap();
+        assert!(fast.is_some());
+        assert_eq!(fast, reference, "{}", s.config().name);
+        let (f, r) = both(s, true);
+        assert_eq!(f, r, "{}", s.config().name);
+    }
+}
