@@ -41,6 +41,12 @@ fn bench(c: &mut Criterion) {
     c.bench_function("nu_dot: M⁻¹ product", |b| {
         b.iter(|| m_inv * black_box(tau))
     });
+    missions(c);
+    currents(c);
+}
+
+/// Whole missions: the paper's lawn-mower and one run of the shipped real-chain campaign.
+fn missions(c: &mut Criterion) {
     let scenario = paper::scenario(Table1Case::LawnMower30x15, true).expect("the paper's case");
     let mut group = c.benchmark_group("mission");
     group.sample_size(20);
@@ -83,6 +89,10 @@ fn bench(c: &mut Criterion) {
         });
     }
     group.finish();
+}
+
+/// A wandering current against a constant one on the same route.
+fn currents(c: &mut Criterion) {
     // A wandering current against a constant one (Choice 401): 100 s of the shipped waypoint
     // route, flown as `run` flies it (plot series kept), the preflight aside.
     let route =

@@ -9,28 +9,26 @@ use host_sim::sim::{self, bound};
 use host_sim::studies::preflight::{self, Verdict, DEFAULT_MARGIN};
 use host_sim::studies::validation::{self, Campaign, Measure};
 
-/// A fixed-seed sample of the contract's campaign on the exact state: the six real paths
-/// under the eight team mountings and 12 random missions: no mission the preflight called
-/// feasible misses the bound when flown at its proposed scale. The whole campaign (32 masks,
-/// 200 random, each preset) is the main job's (`validate-preflight`); on `survey` it does not
-/// hold yet (docs/real-vehicle.md#the-preflights-contract).
+/// Every mounting (all 32 masks) on the six real paths, and 200 random missions, on the exact
+/// state: no mission the preflight called feasible misses the bound when flown at its
+/// proposed scale. The same campaign on `survey` is the main job's (`validate-preflight`); it
+/// does not hold there yet (docs/real-vehicle.md#the-preflights-contract).
 #[test]
 fn no_mission_called_feasible_misses_the_bound_when_flown() {
     let campaign = Campaign {
-        masks: validation::TEAM_MOUNTINGS.to_vec(),
-        random: 12,
         navigation: vec![Preset::Ideal],
         ..Campaign::default()
     };
     let missions = campaign.missions().unwrap();
-    assert_eq!(missions.len(), 8 * 6 + 12);
+    assert_eq!(missions.len(), 32 * 6 + 200);
     let v = validation::validate(&missions, DEFAULT_MARGIN, Measure::Verdicts, || {}).unwrap();
     let broken: Vec<_> = v.missions.iter().filter(|m| m.false_feasible()).collect();
     assert!(broken.is_empty(), "false feasible: {broken:#?}");
     assert_eq!(v.per_preset.len(), 1, "{}", v.headline());
-    assert!(v.flown > 40, "{}", v.headline());
+    // The campaign is not empty of decisions: scales above 1 were proposed, and flown.
+    assert!(v.flown > 300, "{}", v.headline());
     assert!(
-        v.missions.iter().filter(|m| m.proposed > Some(1.0)).count() > 5,
+        v.missions.iter().filter(|m| m.proposed > Some(1.0)).count() > 50,
         "{}",
         v.headline()
     );

@@ -6,6 +6,7 @@
 use controller_core::effectiveness::ThrusterGeometry;
 use controller_core::TrajectoryKind;
 use host_sim::plant::{CurrentModel, VariationProfile};
+use host_sim::scenario::navigation::Preset;
 use host_sim::scenario::{load_scenario, real_vehicle, Scenario};
 use host_sim::studies::preflight::{
     self, period, profile, Engine, Preflight, ScopeVerdict, DEFAULT_MARGIN,
@@ -54,16 +55,43 @@ fn agree(s: &Scenario, fast: &Preflight, reference: &Preflight) -> Result<(), St
     }
 }
 
-/// Every mission of the contract's campaign (the six real paths under all 32 mountings, 200
-/// random missions of seed 1), checked as the contract checks them (as written): the same
-/// verdict, proposed scale, violations and peaks (the verdicts and scales where the fast
-/// engine checks one period).
+/// The contract's missions on the exact state (its first preset): the engines differ in how
+/// they sample, not in the navigation's share, which both take from the same `keep`.
+fn exact_state_contract() -> Campaign {
+    Campaign {
+        navigation: vec![Preset::Ideal],
+        ..Campaign::default()
+    }
+}
+
+/// Every seventh mission of the contract's campaign (56: 28 of the matrix, each real path
+/// under several mountings since 7 and 6 are coprime, and 28 random missions), checked as the contract checks them (as written): the
+/// same verdict, proposed scale, violations and peaks (the verdicts and scales where the fast
+/// engine checks one period). Opt-in with the whole campaign below and the whole box (`cargo
+/// test --profile host -p host-sim --test preflight_engines -- --ignored`, minutes each: the
+/// reference engine is the slow one, and CI's 20 minutes cannot hold it).
 #[test]
+#[ignore = "minutes: the reference engine on 56 contract missions"]
+fn the_engines_agree_on_every_seventh_contract_mission() {
+    agree_on_contract_missions(7, 1);
+}
+
+/// All 392 missions of the contract's campaign (opt-in: the reference engine takes minutes).
+#[test]
+#[ignore = "minutes: the reference engine on all 392 contract missions"]
 fn the_engines_agree_on_every_contract_mission_as_written() {
-    let campaign = Campaign::default();
+    agree_on_contract_missions(1, 20);
+}
+
+/// The contract's missions 0, `every`, 2·`every`, …: both engines agree on each, and at least
+/// `periodic` of them are checked over one period (both kinds of agreement tested).
+fn agree_on_contract_missions(every: usize, periodic: usize) {
+    let campaign = exact_state_contract();
     let missions = campaign.missions().unwrap();
     assert_eq!(missions.len(), 392);
     let results: Vec<(bool, Result<(), String>)> = (0..missions.len())
+        .step_by(every)
+        .collect::<Vec<_>>()
         .into_par_iter()
         .map(|i| {
             let s = missions.get(i).unwrap();
@@ -73,20 +101,20 @@ fn the_engines_agree_on_every_contract_mission_as_written() {
         .collect();
     let differ: Vec<&String> = results.iter().filter_map(|r| r.1.as_ref().err()).collect();
     assert!(differ.is_empty(), "{differ:#?}");
-    // Both kinds of agreement were tested.
-    let periodic = results.iter().filter(|r| r.0).count();
+    let one = results.iter().filter(|r| r.0).count();
     assert!(
-        periodic > 20 && periodic < 300,
-        "{periodic} checked over one period"
+        one >= periodic && one < results.len(),
+        "{one} of {} checked over one period",
+        results.len()
     );
 }
 
-/// The contract's random circles and figure-eights held at a constant payload (their own at
+/// Six of the contract's random circles and figure-eights held at a constant payload (their own at
 /// 20 s) over three periods: checked over one period by the fast engine, the same verdicts
 /// and scales as over all three by the reference.
 #[test]
 fn the_engines_agree_on_periodic_missions_over_several_periods() {
-    let campaign = Campaign::default();
+    let campaign = exact_state_contract();
     let missions = campaign.missions().unwrap();
     let periodic: Vec<Scenario> = (192..392)
         .map(|i| missions.get(i).unwrap())
@@ -98,9 +126,9 @@ fn the_engines_agree_on_periodic_missions_over_several_periods() {
             let p = period::period(s.config())?;
             (p <= 200.0).then(|| s.with(|c| c.duration = 3.0 * p).unwrap())
         })
-        .take(16)
+        .take(6)
         .collect();
-    assert_eq!(periodic.len(), 16);
+    assert_eq!(periodic.len(), 6);
     let differ: Vec<String> = periodic
         .par_iter()
         .filter_map(|s| {
@@ -116,8 +144,9 @@ fn the_engines_agree_on_periodic_missions_over_several_periods() {
 /// mounting and with the vertical pair both pushing up, and every twentieth random mission; the
 /// verdicts cover feasible, needs-time-scale and a bisection over the box.
 #[test]
+#[ignore = "minutes: the reference engine over 2⁹ corners of 22 missions"]
 fn the_engines_agree_over_the_whole_box() {
-    let campaign = Campaign::default();
+    let campaign = exact_state_contract();
     let missions = campaign.missions().unwrap();
     let real = real_vehicle::real_scenarios().unwrap();
     let mut chosen: Vec<Scenario> = real.clone();

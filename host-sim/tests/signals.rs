@@ -212,7 +212,12 @@ fn check_json_prints_the_verdict_so_far_when_interrupted() {
     assert_eq!(code, Some(130), "{lines:?}");
     let v = one_object(&stdout);
     assert_eq!(v["interrupted"], true, "{v}");
-    assert_eq!(v["verdict"], "feasible", "{v}");
+    // The verdict reached before the profile search (the pipeline's depends on the default
+    // navigation's share: docs/real-vehicle.md).
+    assert!(
+        ["feasible", "needs-time-scale"].contains(&v["verdict"].as_str().unwrap_or("")),
+        "{v}"
+    );
     assert!(
         v["thrusters"].is_array() && v["speed_profile"].is_null(),
         "{v}"
@@ -235,9 +240,11 @@ fn check_json_prints_the_verdict_so_far_when_interrupted() {
     assert_eq!(v, serde_json::json!({"interrupted": true}));
 }
 
-/// A day-long circle: its preflight alone is minutes of work (1.7·10⁶ samples × 2⁹ corners).
-const DAY: &str =
-    "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n";
+/// A day-long circle whose payload varies (|sin| at 0.1 rad/s, incommensurate with the circle):
+/// its preflight alone is minutes of work (1.7·10⁶ distinct samples × 2⁹ corners). A circle
+/// with a constant payload is checked over one period (Choice 393), in milliseconds, so it
+/// would no longer be interrupted in its preflight.
+const DAY: &str = "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n[variation]\nprofile = \"abs-sin\"\n";
 
 /// SIGINT 1.5 s into a day-long run used to act after about 80 s (the preflight did
 /// not look at the flag). Measured after the fix: ≈ 0.1 s. The bound is generous for a loaded

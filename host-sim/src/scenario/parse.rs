@@ -91,15 +91,7 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
             )
         })?);
     }
-    // Which of the estimator's keys the file gives (the real chain's default fills the rest).
-    let est_keys = raw.controller.as_ref().map_or([false; 4], |c| {
-        [
-            c.estimator.is_some(),
-            c.estimator_position_sigma.is_some(),
-            c.estimator_velocity_sigma.is_some(),
-            c.estimator_accel_sigma.is_some(),
-        ]
-    });
+    let est_keys = raw.controller.as_ref().map_or([false; 4], estimator_keys);
     if let Some(raw) = raw.controller {
         config.controller = build_controller(&raw)?;
     }
@@ -145,7 +137,32 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
             seed: raw.seed.unwrap_or(DEFAULT_SEED),
         });
     }
-    if let Some(raw) = &raw.navigation {
+    navigation_and_filter(&mut config, raw.navigation.as_ref(), est_keys)?;
+    if let Some(raw) = raw.link_faults {
+        config.link_faults = build_link_faults(&raw)?;
+    }
+    Ok(config)
+}
+
+/// Which of the estimator's four keys a `[controller]` table gives (the real chain's default
+/// fills the rest).
+fn estimator_keys(c: &ControllerTable) -> [bool; 4] {
+    [
+        c.estimator.is_some(),
+        c.estimator_position_sigma.is_some(),
+        c.estimator_velocity_sigma.is_some(),
+        c.estimator_accel_sigma.is_some(),
+    ]
+}
+
+/// The file's navigation, else the real chain's default one with its filter for the estimator
+/// keys the file does not give (Choices 370–371).
+fn navigation_and_filter(
+    config: &mut SimConfig,
+    navigation: Option<&super::navigation::NavigationTable>,
+    est_keys: [bool; 4],
+) -> Res<()> {
+    if let Some(raw) = navigation {
         config.navigation = super::navigation::build(raw, DEFAULT_SEED)?;
     } else if !config.ideal_actuators {
         config.navigation = super::navigation::real_chain_default(DEFAULT_SEED);
@@ -164,10 +181,7 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
             e.accel_sigma = d.accel_sigma;
         }
     }
-    if let Some(raw) = raw.link_faults {
-        config.link_faults = build_link_faults(&raw)?;
-    }
-    Ok(config)
+    Ok(())
 }
 
 /// The file's `duration`, else a waypoint mission's whole path (Choice 312); a path that

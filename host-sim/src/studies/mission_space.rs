@@ -199,8 +199,17 @@ pub fn mission(
         c.variation = variation;
         c.trimmed = true;
         c.current = CurrentModel::Constant(mean);
+        // The contract's missions are told the exact state, without a filter, as its `ideal`
+        // preset flies them (Choice 373); the realities draw their navigation, and a drawn
+        // `ideal` is flown the same way.
+        let told = c.controller.estimator.kind;
+        c.navigation = None;
+        c.controller.estimator.kind = controller_core::EstimatorKind::Off;
         if let Some(r) = realities {
             c.current = r.current;
+            if r.navigation.is_some() {
+                c.controller.estimator.kind = told;
+            }
             c.navigation = r.navigation;
             c.thruster_lag = r.lag;
             c.initial_offset = r.offset;

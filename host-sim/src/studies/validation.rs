@@ -138,13 +138,17 @@ impl Missions<'_> {
             self.campaign.seed ^ (i as u64).wrapping_mul(0xD1B5_4A32_D192_ED03),
         )
         .random::<u64>();
+        // The real chain's own filter (a random mission is drawn without one).
+        let filter = self.real[0].config().controller.estimator.kind;
         mission.with(|c| {
             c.name = format!("{}-{}", c.name, preset.name());
             c.navigation = NavigationModel::preset(preset, seed);
-            if preset == Preset::Ideal {
+            c.controller.estimator.kind = if preset == Preset::Ideal {
                 // The exact state needs no filter: told as is, as the contract always flew it.
-                c.controller.estimator.kind = controller_core::EstimatorKind::Off;
-            }
+                controller_core::EstimatorKind::Off
+            } else {
+                filter
+            };
         })
     }
 }

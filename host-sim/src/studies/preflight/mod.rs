@@ -49,7 +49,6 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
-mod fast;
 pub mod navigation;
 pub mod period;
 pub mod profile;

@@ -3,6 +3,8 @@
 //! scale — the attitude the vehicle holds there ([`super::attitude`]), the force it needs,
 //! the board's allocator on the margin envelope.
 
+mod fast;
+
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
@@ -13,13 +15,13 @@ use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 
 use super::attitude::{self, Swing};
-use super::fast::{self, RollConsts, SampleKeys, Shared};
 use super::period;
 use super::{
     poll, time_scale, CheckError, Engine, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ,
 };
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::{InitialAttitude, Scenario};
+use fast::{RollConsts, SampleKeys, Shared};
 
 /// An unallocated part above this (relative to 1 + |τ|) means the axis was given up; below it
 /// is the f32 rounding of an axis met on its bound.
@@ -167,6 +169,54 @@ fn state_at(
     (PlantState { eta, nu }, nu_dot)
 }
 
+/// A parameter set's bits, equal exactly when the sets are `==` (−0 taken as +0; no field is
+/// NaN in a plant that builds).
+fn params_key(p: &VehicleParams<f64>) -> Vec<u64> {
+    let fields = [p.mass, p.buoyancy, p.z_b_roll, p.z_b_pitch, p.gravity]
+        .into_iter()
+        .chain(p.r_g)
+        .chain(p.inertia)
+        .chain(p.added_mass)
+        .chain(p.damping)
+        .chain(p.r_b_xy);
+    fields.map(|x| (x + 0.0).to_bits()).collect()
+}
+
+/// The path at k = 1 sampled at [`SAMPLE_RATE_HZ`] over its first `checked` seconds.
+fn path_samples(path: &Trajectory, checked: f64) -> Result<Vec<PathSample>, CheckError> {
+    let n = (checked * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
+    (0..=n)
+        .map(|j| {
+            if j % 4096 == 0 {
+                poll()?;
+            }
+            let d = path.sample(j, SAMPLE_RATE_HZ);
+            Ok(PathSample {
+                s: j as f64 / f64::from(SAMPLE_RATE_HZ),
+                eta: d.eta.cast::<f64>(),
+                eta_dot: d.eta_dot.cast::<f64>(),
+                eta_ddot: d.eta_ddot.cast::<f64>(),
+            })
+        })
+        .collect()
+}
+
+/// The plant at every corner of the parameter box `bx` (trimmed to neutral buoyancy when the
+/// scenario's payload is).
+fn corner_plants(bx: ParamBox<f64>, trimmed: bool) -> Result<Vec<Plant>, CheckError> {
+    let nominal = VehicleParams::auv150();
+    (0..ParamBox::<f64>::CORNERS)
+        .map(|c| {
+            let mut p = nominal.with_variation(&bx.corner(c));
+            if trimmed {
+                p = plant::trimmed(&p);
+            }
+            Plant::new(p, PlantTerms::default())
+                .map_err(|e| CheckError::Invalid(format!("parameter box corner {c}: {e}")))
+        })
+        .collect()
+}
+
 impl<'a> Checker<'a> {
     pub(super) fn new(
         scenario: &'a Scenario,
@@ -188,34 +238,9 @@ impl<'a> Checker<'a> {
             (Engine::Fast, Some(p)) => span.min(p),
             _ => span,
         };
-        let n = (checked * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
-        let samples = (0..=n)
-            .map(|j| {
-                if j % 4096 == 0 {
-                    poll()?;
-                }
-                let d = path.sample(j, SAMPLE_RATE_HZ);
-                Ok(PathSample {
-                    s: j as f64 / f64::from(SAMPLE_RATE_HZ),
-                    eta: d.eta.cast::<f64>(),
-                    eta_dot: d.eta_dot.cast::<f64>(),
-                    eta_ddot: d.eta_ddot.cast::<f64>(),
-                })
-            })
-            .collect::<Result<_, CheckError>>()?;
+        let samples = path_samples(&path, checked)?;
         let corners_peaks = blend_peaks(&path, span);
-        let bx = controller.config().uncertainty.cast(f64::from);
-        let nominal = VehicleParams::auv150();
-        let corners = (0..ParamBox::<f64>::CORNERS)
-            .map(|c| {
-                let mut p = nominal.with_variation(&bx.corner(c));
-                if cfg.trimmed {
-                    p = plant::trimmed(&p);
-                }
-                Plant::new(p, PlantTerms::default())
-                    .map_err(|e| invalid(format!("parameter box corner {c}: {e}")))
-            })
-            .collect::<Result<_, _>>()?;
+        let corners = corner_plants(controller.config().uncertainty.cast(f64::from), cfg.trimmed)?;
         let law_model = controller.params().cast(f64::from);
         let nominal = Plant::new(law_model, PlantTerms::default())
             .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
@@ -316,17 +341,23 @@ impl<'a> Checker<'a> {
     }
 
     /// The plants the mission as written meets at the sample times `times`, one per distinct
-    /// parameter set.
-    fn profile_plants(&self, times: &[f64]) -> Result<Vec<Plant>, String> {
+    /// parameter set, in the order first met. Distinct sets are found by their bits (a hash
+    /// set), not by comparing each with every one before: a payload that varies all along a
+    /// day-long mission meets ~10⁶ of them, and the pairwise search was quadratic (and did not
+    /// look at a stop request).
+    fn profile_plants(&self, times: &[f64]) -> Result<Vec<Plant>, CheckError> {
         let cfg = self.scenario.config();
+        let mut seen = std::collections::HashSet::new();
         let mut out: Vec<Plant> = Vec::new();
-        for &t in times {
+        for (i, &t) in times.iter().enumerate() {
+            if i % 4096 == 0 {
+                poll()?;
+            }
             let p = cfg.plant_params_at(t);
-            if !out.iter().any(|q| *q.params() == p) {
-                out.push(
-                    Plant::new(p, PlantTerms::default())
-                        .map_err(|e| format!("the payload at t = {t:.2} s: {e}"))?,
-                );
+            if seen.insert(params_key(&p)) {
+                out.push(Plant::new(p, PlantTerms::default()).map_err(|e| {
+                    CheckError::Invalid(format!("the payload at t = {t:.2} s: {e}"))
+                })?);
             }
         }
         Ok(out)
@@ -393,9 +424,7 @@ impl<'a> Checker<'a> {
         times: impl Iterator<Item = f64>,
     ) -> Result<Vec<Plant>, CheckError> {
         match scope {
-            Scope::AsWritten => self
-                .profile_plants(&times.collect::<Vec<_>>())
-                .map_err(CheckError::Invalid),
+            Scope::AsWritten => self.profile_plants(&times.collect::<Vec<_>>()),
             Scope::WholeBox => Ok(Vec::new()),
         }
     }

@@ -1,6 +1,6 @@
 //! The fast engine's work at one point of a sweep (docs/real-vehicle.md#how-the-check-is-made,
 //! **Choices 390–391**): the same arithmetic as the reference engine's
-//! [`Checker::check_point`](super::sweep::Checker), bit for bit, with what does not change
+//! [`Checker::check_point`](super::Checker), bit for bit, with what does not change
 //! between the cases of a sample formed once per sample ([`Shared`]: the heading's and the
 //! path pitch's sines and cosines, the reference rates at the time scale) and what does not
 //! change along the path formed once per plant ([`RollConsts`]: the heeling and righting
@@ -13,9 +13,9 @@ use std::collections::HashSet;
 use controller_core::kinematics::{self, Attitude};
 use nalgebra::{Vector3, Vector6};
 
-use super::attitude;
-use super::sweep::{CasePlants, Checker, PathSample, Point};
+use super::{CasePlants, Checker, PathSample, Point};
 use crate::plant::{roll_moments, Plant, PlantState};
+use crate::studies::preflight::attitude;
 
 /// Index of roll and pitch in η, ν and τ.
 const ROLL: usize = 3;
