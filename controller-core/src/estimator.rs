@@ -410,10 +410,13 @@ impl Estimate {
     /// Records the acceleration `a` applied over period `ticks` (a non-finite one is recorded
     /// as zero: unknown), after moving the state's stamp past the period whose entry it
     /// replaces, so that the prediction from the stamp never loses an acceleration it used.
+    /// Period `ticks` recorded again (lock-step: the board ran it once without a fresh frame,
+    /// then on the frame, Choice 362) replaces its own entry: the state at the stamp does not
+    /// depend on it, so the stamp stays (moved, the next solution would be refused as old).
     pub fn applied(&mut self, gains: &EstimatorGains, ticks: u64, a: &[f32; 6]) {
         let j = (ticks % HORIZON as u64) as usize;
         let old = self.accel_tick[j];
-        if self.valid && old != u64::MAX && old == self.stamp {
+        if self.valid && old != u64::MAX && old != ticks && old == self.stamp {
             let (o, v) = self.predicted(gains, self.stamp, self.stamp + 1);
             self.offset = o;
             self.velocity = v;

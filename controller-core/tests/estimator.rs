@@ -446,6 +446,33 @@ fn a_solution_too_old_repeated_or_from_the_future_is_refused_and_the_state_held(
     }
 }
 
+/// A period recorded twice (lock-step: the board ran it once without a fresh frame, then on
+/// the frame) is as if recorded once with its last acceleration: the next solution is taken
+/// (not refused as older than the state) and the memory is the same, bit for bit.
+#[test]
+fn a_period_recorded_again_replaces_its_own_acceleration_and_keeps_the_stamp() {
+    let g = gains(0.005, 0.002, 0.02);
+    let z = |k: u64| [1.0 + 0.005 * k as f32, 2.0, 3.0, 0.0, 0.1, 0.2];
+    let zd = [0.5f32, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let a = [0.3f32, -0.1, 0.0, 0.0, 0.0, 0.02];
+    let mut once = Estimate::new();
+    once.step(&g, 100, 100, &z(100), &zd).unwrap();
+    once.applied(&g, 100, &a);
+    let mut twice = once;
+    // The repeat: tick 100's solution predicted to 101, its thrust recorded for 101.
+    twice.step(&g, 101, 100, &z(100), &zd).unwrap();
+    twice.applied(&g, 101, &[5.0; 6]);
+    for m in [&mut once, &mut twice] {
+        m.step(&g, 101, 101, &z(101), &zd).unwrap();
+        m.applied(&g, 101, &a);
+        assert_eq!(m.stamp(), 101, "tick 101's solution taken");
+    }
+    assert_eq!(twice, once);
+    let next_once = once.step(&g, 102, 102, &z(102), &zd);
+    assert_eq!(twice.step(&g, 102, 102, &z(102), &zd), next_once);
+    assert_eq!(twice.stamp(), 102, "tick 102's solution taken");
+}
+
 /// A position fix jumps the solution by 1 m (docs/board.md#the-state-estimator-on-the-board):
 /// no gate refuses it; it enters through the gain at once (the estimate moves by K·[d, 0]) and
 /// the error then decays as the closed-form recursion e⁺ = (I − K)F e, with K the gain of the

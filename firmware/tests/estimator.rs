@@ -204,3 +204,26 @@ fn an_estimator_setting_the_core_refuses_is_refused_whole() {
     assert_eq!(s.controller().config().estimator.kind, EstimatorKind::Off);
     assert_eq!(s.rate_hz(), 100, "nothing of the patch applied");
 }
+
+/// Lock-step PIL: the board's virtual clock sometimes runs a period before the host's next
+/// frame arrives (the host skips that period's answer). The repeat predicts tick k's frame
+/// to k + 1 and records its thrust for k + 1; frame k + 1 then flies k + 1 again and must
+/// command exactly what SIL (one period per frame) commands, and so must every frame after.
+#[test]
+fn a_lock_step_period_without_a_frame_leaves_the_next_frames_as_sil_flies_them() {
+    let (mut s, mut h, c) = flying(true);
+    let mut memory = Estimate::new();
+    for k in 0..120 {
+        let f = noisy(k);
+        h.give(&mut s, Msg::State(f));
+        let step = s.step(false, NOW);
+        assert_eq!(step.telemetry.status, BoardStatus::Running, "tick {k}");
+        let want = host_voltages(&c, &mut memory, k, k, &f);
+        assert_eq!(bits(&step.voltages), bits(&want), "tick {k}");
+        if k % 7 == 3 {
+            // The board's timer runs out before frame k + 1: a repeat of frame k.
+            let repeat = s.step(false, NOW);
+            assert_eq!(repeat.telemetry.status, BoardStatus::Running, "repeat {k}");
+        }
+    }
+}
