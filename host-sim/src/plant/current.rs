@@ -88,9 +88,9 @@ impl OceanCurrent {
                 Some(tr) if tr.h == h => tr,
                 _ => *self.transition.insert(Transition::new(h, sigma, *tau)),
             };
-            for i in 0..3 {
+            for ((v, m), b) in self.v.iter_mut().zip(mean).zip(tr.b) {
                 let w: f64 = StandardNormal.sample(&mut self.rng);
-                self.v[i] = mean[i] + tr.a * (self.v[i] - mean[i]) + tr.b[i] * w;
+                *v = m + tr.a * (*v - m) + b * w;
             }
         }
     }

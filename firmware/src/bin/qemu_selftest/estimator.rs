@@ -52,9 +52,9 @@ pub fn run(counter: &Counter) -> bool {
                 e.vector, o.tau, e.tau
             );
         }
-        let copy = counter.count(|| black_box(black_box(&before).clone()));
+        let copy = counter.count(|| black_box(*black_box(&before)));
         let with = counter.count(|| {
-            let mut m = black_box(&before).clone();
+            let mut m = *black_box(&before);
             c.update_from_solution(
                 black_box(&mut m),
                 black_box(ticks),
