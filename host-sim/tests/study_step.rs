@@ -138,7 +138,7 @@ fn statistics(sigma: [f64; 3], tau: f64, h: f64, n: usize, lags: &[usize]) -> Ve
         tau,
         seed: 11,
     });
-    let mut xs = vec![Vec::with_capacity(n); 3];
+    let mut xs = (0..3).map(|_| Vec::with_capacity(n)).collect::<Vec<_>>();
     for _ in 0..n {
         c.step(h);
         for (a, x) in xs.iter_mut().enumerate() {
