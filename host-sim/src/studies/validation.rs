@@ -47,6 +47,14 @@ pub const RANDOM_LAG: [f64; 2] = [0.05, 0.3];
 pub const RANDOM_GM_SIGMA: [f64; 2] = [0.02, 0.05];
 /// … its correlation time (s).
 pub const RANDOM_GM_TAU: f64 = 60.0;
+// The disturbed contract's draws lie inside the space the falsifier searches
+// (`mission_space`), so a falsifier's verdict covers them: checked when this compiles.
+const _: () = {
+    use super::mission_space::{GM_TAU_RANGE, MAX_GM_SIGMA, MAX_LAG};
+    assert!(0.0 <= RANDOM_LAG[0] && RANDOM_LAG[1] <= MAX_LAG);
+    assert!(0.0 <= RANDOM_GM_SIGMA[0] && RANDOM_GM_SIGMA[1] <= MAX_GM_SIGMA);
+    assert!(GM_TAU_RANGE[0] <= RANDOM_GM_TAU && RANDOM_GM_TAU <= GM_TAU_RANGE[1]);
+};
 /// Relative resolution of the smallest flying time scale, found by bisection.
 pub const FLYING_TOLERANCE: f64 = 0.02;
 
