@@ -123,6 +123,50 @@ fn currents(c: &mut Criterion) {
         });
     }
     group.finish();
+    real_chain_currents(c);
+}
+
+/// Choice 461: the flying cost of a wandering current on the full real chain (survey
+/// navigation, estimator, Eqs 31–32, metrics only as a campaign flies), at the 1 ms plant and
+/// at the study-grade step (Choice 400): the ratio of each pair is the cost.
+fn real_chain_currents(c: &mut Criterion) {
+    let circle =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenarios/real/circular-10R.toml");
+    let circle = host_sim::scenario::load_scenario(&circle).expect("the real circle");
+    let mut group = c.benchmark_group("current (real chain)");
+    group.sample_size(10);
+    for (step, h) in [("1 ms plant", 0.001), ("control-period plant", 0.01)] {
+        for (name, current) in [
+            ("constant", CurrentModel::Constant([0.1, 0.05, 0.0])),
+            (
+                "gauss-markov",
+                CurrentModel::GaussMarkov {
+                    mean: [0.1, 0.05, 0.0],
+                    sigma: [0.03, 0.03, 0.01],
+                    tau: 20.0,
+                    seed: 7,
+                },
+            ),
+        ] {
+            let s = circle
+                .with(|c| {
+                    c.plant_step = h;
+                    c.current = current;
+                })
+                .expect("the circle with a current");
+            group.bench_function(format!("real circle 70 s, {step}, {name} current"), |b| {
+                b.iter(|| {
+                    host_sim::sim::fly(
+                        black_box(&s),
+                        &mut host_sim::sim::LocalController::new(&s),
+                        &mut (),
+                        host_sim::sim::Recording::MetricsOnly,
+                    )
+                })
+            });
+        }
+    }
+    group.finish();
 }
 
 criterion_group!(benches, bench);

@@ -126,7 +126,7 @@ pub fn fly(
         };
         sample.thrust = thrust;
         sample.tau_applied = thrusters.wrench(&thrust).into();
-        recorder.record(sample);
+        recorder.record(&sample);
         if let Err((t, reason)) = held {
             outcome = Outcome::Diverged { t, reason };
             break;

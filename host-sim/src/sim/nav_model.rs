@@ -81,6 +81,10 @@ struct Stream<const N: usize> {
     rng: StdRng,
     gm: [f64; N],
     walk: [f64; N],
+    /// The step [`Stream::advance`] formed its factors for, and the factors: e^(−dt/τ),
+    /// σ_b·√(1 − a²) and σ_w·√dt per axis (**Choice 462**: formed once per run, the loop steps
+    /// with one dt; the same products as before, so the same bits).
+    step: Option<(f64, f64, [f64; N], [f64; N])>,
 }
 
 impl<const N: usize> Stream<N> {
@@ -98,19 +102,29 @@ impl<const N: usize> Stream<N> {
             rng,
             gm,
             walk: [0.0; N],
+            step: None,
         }
     }
 
     /// Advances the bias by `dt`: the Gauss–Markov part exactly (its discrete form keeps the
     /// steady σ), the walk by σ_w·√dt.
     fn advance(&mut self, dt: f64) {
-        let a = (-dt / self.model.bias_tau).exp();
-        let b = (1.0 - a * a).sqrt();
+        let (a, sb, sw) = match self.step {
+            Some((h, a, sb, sw)) if h == dt => (a, sb, sw),
+            _ => {
+                let a = (-dt / self.model.bias_tau).exp();
+                let b = (1.0 - a * a).sqrt();
+                let sb = self.model.bias_sigma.map(|s| s * b);
+                let sw = self.model.bias_walk.map(|w| w * dt.sqrt());
+                self.step = Some((dt, a, sb, sw));
+                (a, sb, sw)
+            }
+        };
         for i in 0..N {
             let n1: f64 = StandardNormal.sample(&mut self.rng);
             let n2: f64 = StandardNormal.sample(&mut self.rng);
-            self.gm[i] = a * self.gm[i] + self.model.bias_sigma[i] * b * n1;
-            self.walk[i] += self.model.bias_walk[i] * dt.sqrt() * n2;
+            self.gm[i] = a * self.gm[i] + sb[i] * n1;
+            self.walk[i] += sw[i] * n2;
         }
     }
 
@@ -153,9 +167,12 @@ impl Clock {
         let taken = self.ratio >= 1.0
             || j == 0
             || (j as f64 * self.ratio).floor() != ((j - 1) as f64 * self.ratio).floor();
+        if !taken {
+            return None;
+        }
         let t = j as f64 / self.rate_hz;
         let out = self.outages.iter().any(|[a, b]| *a <= t && t < *b);
-        (taken && !out).then_some(j)
+        (!out).then_some(j)
     }
 }
 

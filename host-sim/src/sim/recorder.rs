@@ -43,12 +43,12 @@ impl<'o> Recorder<'o> {
         }
     }
 
-    pub fn record(&mut self, s: Sample) {
-        self.metrics.push(&s);
-        self.faults.record(&s);
-        self.observer.sample(&s);
+    pub fn record(&mut self, s: &Sample) {
+        self.metrics.push(s);
+        self.faults.record(s);
+        self.observer.sample(s);
         if let Some(plot) = &mut self.plot {
-            plot.push(&s);
+            plot.push(s);
         }
     }
 

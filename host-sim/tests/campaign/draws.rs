@@ -65,3 +65,69 @@ fn drawn_values_lie_in_their_boxes() {
         }
     }
 }
+
+/// Choice 460: the drawn noise seed seeds the navigation model too. Two runs told the same true
+/// states are told different navigation solutions (before, every run of a real-chain campaign
+/// flew the default preset's one realisation, seed 1), and a run's written scenario carries its
+/// navigation seed, so `run` on it flies the campaign's run bit for bit.
+#[test]
+fn each_run_draws_its_navigation_noise_and_replays_it_from_its_file() {
+    use host_sim::plant::PlantState;
+    use host_sim::scenario::parse_scenario;
+    use host_sim::sim::navigation::Navigation;
+    use nalgebra::Vector6;
+
+    let dir = tempdir("navigation-seed");
+    // Study-grade, as the shipped campaign flies (Choice 400): the file keeps its step.
+    let text =
+        campaign_text(2, 3).replace("metrics =", "plant_step = \"control-period\"\nmetrics =");
+    let file = write_campaign(&dir, &text);
+    let c = Campaign::load(&file).unwrap();
+    let told = |i: u64| {
+        let s = c.scenario(i, &c.draw(i)).unwrap();
+        let mut cfg = s.config().clone();
+        assert!(
+            cfg.navigation.is_some(),
+            "the real chain flies a navigation model"
+        );
+        // The navigation model's noise alone: `[noise]` off.
+        cfg.noise = None;
+        let mut nav = Navigation::of(&cfg);
+        let state = PlantState {
+            eta: Vector6::new(1.0, 2.0, 5.0, 0.0, 0.0, 0.3),
+            nu: Vector6::new(0.5, 0.0, 0.0, 0.0, 0.0, 0.05),
+        };
+        (0..200).map(|_| nav.measure(&state)).collect::<Vec<_>>()
+    };
+    let (a, b) = (told(0), told(1));
+    assert_ne!(c.draw(0).noise_seed, c.draw(1).noise_seed);
+    assert!(
+        a.iter().zip(&b).any(|(x, y)| x != y),
+        "two runs were told the same navigation solutions"
+    );
+    // The run's file: the same navigation model, and the same flight.
+    for i in 0..2 {
+        let d = c.draw(i);
+        let flown = c.scenario(i, &d).unwrap();
+        let text = c.scenario_text(i, &d).unwrap();
+        let replay = parse_scenario(&text).unwrap();
+        assert_eq!(
+            replay.config().navigation,
+            flown.config().navigation,
+            "run {i}"
+        );
+        let record = c.fly(i).unwrap();
+        let again = host_sim::sim::fly(
+            &replay,
+            &mut host_sim::sim::LocalController::new(&replay),
+            &mut (),
+            host_sim::sim::Recording::MetricsOnly,
+        );
+        let bits = |m: &[f64]| m.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(
+            bits(&record.metrics),
+            bits(&again.metrics.values()),
+            "run {i}"
+        );
+    }
+}

@@ -17,7 +17,8 @@
 //! parameters = "uniform"       # "uniform" in the Table-3 box | "corners" of it | "none"
 //! current = 0.2                # a constant horizontal current, speed uniform in [0, v] m/s,
 //!                              # direction uniform
-//! noise_seed = true            # the base's [noise] seed, drawn (the base must have [noise])
+//! noise_seed = true            # the seed of the run's sensor noise, drawn: [noise]'s and the
+//!                              # navigation model's (Choice 460; the base must have one)
 //! initial_offset = [0.05, 0.05, 0.05, 0.0, 0.0, 0.05]  # uniform in ±w, added to the base's
 //! time_scale = [1.0, 1.5]      # the mission's time scale k, uniform in [lo, hi] ⊂ [1, 100]
 //! mountings = [["vert fore", "horz fore", "horz aft"], []]  # thruster mountings, one drawn
@@ -310,10 +311,10 @@ fn base_from_text(name: &str, text: &str, spec: &CampaignSpec) -> Result<Base, C
             )
         })?;
     }
-    if spec.draw.noise_seed && cfg.noise.is_none() {
+    if spec.draw.noise_seed && cfg.noise.is_none() && cfg.navigation.is_none() {
         return Err(invalid(
             "draw.noise_seed",
-            format!("base {name} has no [noise] whose seed could be drawn"),
+            format!("base {name} has no [noise] and no navigation model whose seed could be drawn"),
         ));
     }
     Ok(Base {

@@ -22,6 +22,7 @@ use crate::plant::{CurrentModel, VariationProfile};
 use crate::scenario::file::{
     BoundTable, CurrentName, CurrentTable, ProfileName, ScenarioFile, VariationTable,
 };
+use crate::scenario::navigation::NavigationTable;
 use crate::scenario::{Scenario, ScenarioError};
 use crate::sim::{self, LocalController, Metrics, Recording};
 
@@ -47,7 +48,8 @@ pub struct Draw {
     pub variation: [f64; VARIED_PARAMETERS],
     /// The constant current (north, east, down), m/s; zeros when not drawn.
     pub current: [f64; 3],
-    /// The noise seed (the base's when not drawn).
+    /// The seed of the run's sensor noise (the base's `[noise]` seed when not drawn). Drawn,
+    /// it seeds both `[noise]` and the navigation model (**Choice 460**).
     pub noise_seed: u64,
     /// The start offset, the base's plus the drawn one.
     pub initial_offset: [f64; 6],
@@ -156,9 +158,9 @@ impl Campaign {
             variation,
             current,
             noise_seed: match (&base.noise, d.noise_seed) {
-                (Some(_), true) => noise_seed,
+                (_, true) => noise_seed,
                 (Some(n), false) => n.seed,
-                (None, _) => 0,
+                (None, false) => 0,
             },
             initial_offset,
             time_scale: match d.time_scale {
@@ -196,8 +198,16 @@ impl Campaign {
             if spec.draw.current.is_some() {
                 c.current = CurrentModel::Constant(d.current);
             }
-            if let Some(n) = c.noise.as_mut() {
-                n.seed = d.noise_seed;
+            if spec.draw.noise_seed {
+                // Choice 460: the drawn seed seeds every noise the run's navigation makes, the
+                // navigation model's as much as `[noise]`'s (each source of the model draws
+                // from its own generator, seeded apart from `[noise]`'s: navigation.rs).
+                if let Some(n) = c.noise.as_mut() {
+                    n.seed = d.noise_seed;
+                }
+                if let Some(m) = c.navigation.as_mut() {
+                    m.seed = d.noise_seed;
+                }
             }
             c.initial_offset = d.initial_offset;
             c.time_scale = d.time_scale;
@@ -272,6 +282,12 @@ impl Campaign {
         let mut file =
             ScenarioFile::from_toml(&base.text).map_err(|e| format!("base {}: {e}", base.path))?;
         file.name = Some(self.run_name(i));
+        if let Some(step) = self.spec.plant_step {
+            // Choice 460: a study-grade run (Choice 400) replays at its own step.
+            let mut c = base.scenario.config().clone();
+            step.apply(&mut c);
+            file.plant_step = Some(c.plant_step);
+        }
         if self.spec.draw.parameters != ParameterDraw::None {
             file.variation = Some(VariationTable {
                 profile: ProfileName::Constant,
@@ -287,8 +303,20 @@ impl Campaign {
                 ..CurrentTable::new(CurrentName::Constant)
             });
         }
-        if let Some(n) = file.noise.as_mut() {
-            n.seed = Some(d.noise_seed);
+        if self.spec.draw.noise_seed {
+            if let Some(n) = file.noise.as_mut() {
+                n.seed = Some(d.noise_seed);
+            }
+            // Choice 460: the navigation model's seed, written in; a base without the table
+            // flies the real chain's default preset, which the table names.
+            if let Some(m) = &base.scenario.config().navigation {
+                file.navigation
+                    .get_or_insert_with(|| NavigationTable {
+                        preset: Some(m.preset),
+                        ..NavigationTable::default()
+                    })
+                    .seed = Some(d.noise_seed);
+            }
         }
         file.initial_offset = Some(d.initial_offset);
         if self.spec.draw.mountings.is_some() {
