@@ -92,10 +92,10 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 642 on the survey's golden vectors,
         // against 468 for the closed forms.
         stages: [560, 720, 760, 1_000, 1_250],
-        // Measured 6 278 (was 7 200 before Choices 430–431). Issue 28's target is ≤ 4 000,
+        // Measured 6 273 (was 7 200 before Choices 430–431). Issue 28's target is ≤ 4 000,
         // not met: the law alone is ≈ 3 900 on the same inputs (docs/law.md#the-state-estimator).
         update_from_solution: 6_600,
-        // solution, filter, estimate, record: measured 443, 1 038, 403, 533.
+        // solution, filter, estimate, record: measured 443, 1 040, 407, 530.
         estimator_stages: [500, 1_200, 450, 600],
         // Measured 29 160 (the whole patch host-sim sends, protocol 7: its digest covers the
         // estimator's 73 bytes too, and the rebuild checks the box its bounds are of, Choice
