@@ -211,7 +211,15 @@ pub struct Controller {
     cos_pitch_limit: f32,
     /// The estimator's gains and 1/M̂ᵢᵢ for its model (Choice 340); `None`: off, and nothing
     /// of it computed.
-    estimator: Option<(EstimatorGains, [f32; 6])>,
+    estimator: Option<EstimatorParts>,
+}
+
+/// What the estimator flies on: its gains and 1/M̂ᵢᵢ for its model (Choice 340).
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct EstimatorParts {
+    pub gains: EstimatorGains,
+    pub m_diag_inv: [f32; 6],
 }
 
 /// The suprema over a parameter box ([`UncertaintyBounds`]) with the vehicle parameters and
@@ -223,11 +231,23 @@ pub struct BoxBounds {
     pub bounds: UncertaintyBounds<f32>,
 }
 
-/// The state the law flies on with the estimator on, and J's kinematics there.
-struct Estimated {
-    eta: [f32; 6],
-    nu: [f32; 6],
-    kin: Kinematics<f32>,
+/// The state the law flies on with the estimator on, with J's kinematics there and η̇ = J ν,
+/// formed once by the estimator's stages and passed down to the law (Choice 431).
+#[doc(hidden)]
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Estimated {
+    pub eta: [f32; 6],
+    pub nu: [f32; 6],
+    pub eta_dot: Vector6<f32>,
+    pub kin: Kinematics<f32>,
+    pub cos_theta_abs: f32,
+}
+
+/// What the law's first stage is given: the solution as [`Controller::update`] is told it, or
+/// the estimator's state with its kinematics already formed.
+enum LawInput<'a> {
+    Told { eta: &'a [f32; 6], nu: &'a [f32; 6] },
+    Estimated(&'a Estimated),
 }
 
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
@@ -449,7 +469,15 @@ impl Controller {
         nu: &[f32; 6],
         trajectory: &Trajectory,
     ) -> Output {
-        match self.step(ticks, eta, nu, trajectory) {
+        self.fly(ticks, &LawInput::Told { eta, nu }, trajectory)
+    }
+
+    /// The law's stages on `input`, checked: the one body of [`Controller::update`] and of
+    /// [`Controller::update_from_solution`] (Choice 364: one caller of the stages, so they
+    /// stay inlined).
+    #[inline(never)]
+    fn fly(&self, ticks: u64, input: &LawInput, trajectory: &Trajectory) -> Output {
+        match self.step(ticks, input, trajectory) {
             Ok(out) if out.all_finite() => out,
             Ok(_) => Output::fail_safe(Fault::NonFiniteResult),
             Err(fault) => Output::fail_safe(fault),
@@ -461,14 +489,19 @@ impl Controller {
     /// exactly [`Controller::update`] on the solution's η, ν (the memory untouched); with it
     /// on, the solution is checked as `update` checks it (a fault gives the same fail-safe and
     /// the memory does not take the solution), converted to η̇ = J(η)ν, filtered at its stamp
-    /// and predicted to `ticks`, and [`Controller::update`] runs on the estimate (η̂,
-    /// ν̂ = J(η̂)⁻¹η̂̇); the acceleration the applied thrust gives under the nominal model is
-    /// then recorded for the next predictions.
+    /// and predicted to `ticks`, and the law runs on the estimate (η̂, ν̂ = J(η̂)⁻¹η̂̇); the
+    /// acceleration the applied thrust gives under the nominal model is then recorded for the
+    /// next predictions. Its stages are [`EstimatorStage::ALL`], around the law's.
     ///
-    /// **Choice 364:** the law on the estimate is `update` itself, called, not a second copy
-    /// of its stages: on the board each stage's code then has one caller and is inlined into
-    /// `update` as before the estimator (two callers made the compiler outline them, and
+    /// **Choice 364:** the law on the estimate is `update`'s own body (`fly`), called, not a
+    /// second copy of its stages: on the board each stage's code then has one caller and is
+    /// inlined as before the estimator (two callers made the compiler outline them, and
     /// `update` alone went from 3 920 to 6 160 instructions in the self-test).
+    ///
+    /// **Choice 431:** J(η̂)'s sines, cosines and matrices are formed once, by the estimate
+    /// stage, and passed down: the law takes them with η̂̇ itself (not J(η̂)J(η̂)⁻¹η̂̇ again), and
+    /// the recorded acceleration uses them too. Before, the attitude's maths ran three times
+    /// a period (the solution's, the estimate's, and the law's own on the estimate).
     #[inline(never)]
     pub fn update_from_solution(
         &self,
@@ -477,84 +510,139 @@ impl Controller {
         solution: &Solution,
         trajectory: &Trajectory,
     ) -> Output {
-        let Some((gains, m_diag_inv)) = &self.estimator else {
+        let Some(parts) = &self.estimator else {
             return self.update(ticks, &solution.eta, &solution.nu, trajectory);
         };
-        let (out, accel) = match self.estimate(memory, gains, ticks, solution) {
-            Err(fault) => (Output::fail_safe(fault), [0.0; 6]),
-            Ok(Estimated { eta, nu, kin }) => {
-                let out = self.update(ticks, &eta, &nu, trajectory);
-                let accel = match out.status {
-                    Status::Ok => estimator::applied_acceleration(
-                        &Vector6::from(out.u),
-                        &kin,
-                        m_diag_inv,
-                        &Vector6::from(out.tau),
-                        &Vector6::from(out.tau_achieved),
-                    )
-                    .into(),
-                    Status::Fault(_) => [0.0; 6],
-                };
-                (out, accel)
+        let estimated = self.estimator_solution_stage(solution).and_then(|told| {
+            let state = Self::estimator_filter_stage(parts, memory, ticks, solution, &told);
+            self.estimator_estimate_stage(state, &told)
+        });
+        match estimated {
+            Err(fault) => {
+                memory.applied(&parts.gains, ticks, &[0.0; 6]);
+                Output::fail_safe(fault)
             }
-        };
-        memory.applied(gains, ticks, &accel);
-        out
+            Ok(est) => {
+                let out = self.fly(ticks, &LawInput::Estimated(&est), trajectory);
+                Self::estimator_record_stage(parts, memory, ticks, &est, &out);
+                out
+            }
+        }
     }
 
-    /// The state the law flies on with the estimator on: the solution checked as
-    /// [`Controller::update`] checks it, taken into `memory` at its stamp and predicted to
-    /// `ticks` (η̂, ν̂ = J(η̂)⁻¹η̂̇, and J(η̂)'s kinematics), or the solution as told before any
-    /// could be taken.
-    fn estimate(
-        &self,
+    /// The estimator's parts (`None`: off).
+    #[doc(hidden)]
+    pub fn estimator_parts(&self) -> Option<&EstimatorParts> {
+        self.estimator.as_ref()
+    }
+
+    /// Stage [`EstimatorStage::Solution`]: the solution checked as [`Controller::update`]
+    /// checks it, J at its attitude and its η̇ = J(η)ν, as an [`Estimated`] state (the law
+    /// flies it so before any solution is taken).
+    #[doc(hidden)]
+    #[inline]
+    pub fn estimator_solution_stage(&self, solution: &Solution) -> Result<Estimated, Fault> {
+        check_inputs(&solution.eta, &solution.nu)?;
+        let (kin, cos_theta_abs) = self.checked_kinematics(&solution.eta)?;
+        Ok(Estimated {
+            eta: solution.eta,
+            nu: solution.nu,
+            eta_dot: kin.eta_dot(&Vector6::from(solution.nu)),
+            kin,
+            cos_theta_abs,
+        })
+    }
+
+    /// Stage [`EstimatorStage::Filter`]: the solution (η, η̇ of `told`) taken into `memory` at
+    /// its stamp and the state predicted to `ticks` ([`Estimate::step`]).
+    #[doc(hidden)]
+    #[inline]
+    pub fn estimator_filter_stage(
+        parts: &EstimatorParts,
         memory: &mut Estimate,
-        gains: &EstimatorGains,
         ticks: u64,
         solution: &Solution,
-    ) -> Result<Estimated, Fault> {
-        check_inputs(&solution.eta, &solution.nu)?;
-        let kin = self.checked_kinematics(&solution.eta)?;
-        let eta_dot = kin.eta_dot(&Vector6::from(solution.nu));
-        match memory.step(gains, ticks, solution.stamp, &solution.eta, &eta_dot.into()) {
-            Some((eta, eta_dot)) => {
-                if !eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite()) {
-                    return Err(Fault::NonFiniteResult);
-                }
-                let kin = self.checked_kinematics(&eta)?;
-                let nu = kin.jinv_mul(&Vector6::from(eta_dot));
-                Ok(Estimated {
-                    eta,
-                    nu: nu.into(),
-                    kin,
-                })
-            }
-            None => Ok(Estimated {
-                eta: solution.eta,
-                nu: solution.nu,
-                kin,
-            }),
-        }
+        told: &Estimated,
+    ) -> Option<([f32; 6], [f32; 6])> {
+        memory.step(
+            &parts.gains,
+            ticks,
+            solution.stamp,
+            &solution.eta,
+            &told.eta_dot.into(),
+        )
     }
 
-    /// J(η)'s kinematics, with the pitch limit (η finite).
-    fn checked_kinematics(&self, eta: &[f32; 6]) -> Result<Kinematics<f32>, Fault> {
+    /// Stage [`EstimatorStage::Estimate`]: the state the law flies on: the filter's (η̂, η̂̇)
+    /// with J(η̂) (pitch limit checked) and ν̂ = J(η̂)⁻¹η̂̇, or the solution as told (`told`)
+    /// before any could be taken.
+    #[doc(hidden)]
+    #[inline]
+    pub fn estimator_estimate_stage(
+        &self,
+        state: Option<([f32; 6], [f32; 6])>,
+        told: &Estimated,
+    ) -> Result<Estimated, Fault> {
+        let Some((eta, eta_dot)) = state else {
+            return Ok(*told);
+        };
+        if !eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite()) {
+            return Err(Fault::NonFiniteResult);
+        }
+        let (kin, cos_theta_abs) = self.checked_kinematics(&eta)?;
+        let eta_dot = Vector6::from(eta_dot);
+        Ok(Estimated {
+            eta,
+            nu: kin.jinv_mul(&eta_dot).into(),
+            eta_dot,
+            kin,
+            cos_theta_abs,
+        })
+    }
+
+    /// Stage [`EstimatorStage::Record`]: the acceleration the applied thrust gives under the
+    /// nominal model at the estimate ([`estimator::applied_acceleration`], zero after a
+    /// fault) recorded into `memory` for period `ticks`.
+    #[doc(hidden)]
+    #[inline]
+    pub fn estimator_record_stage(
+        parts: &EstimatorParts,
+        memory: &mut Estimate,
+        ticks: u64,
+        est: &Estimated,
+        out: &Output,
+    ) {
+        let accel = match out.status {
+            Status::Ok => estimator::applied_acceleration(
+                &Vector6::from(out.u),
+                &est.kin,
+                &parts.m_diag_inv,
+                &Vector6::from(out.tau),
+                &Vector6::from(out.tau_achieved),
+            )
+            .into(),
+            Status::Fault(_) => [0.0; 6],
+        };
+        memory.applied(&parts.gains, ticks, &accel);
+    }
+
+    /// J(η)'s kinematics and |cos θ|, with the pitch limit (η finite).
+    fn checked_kinematics(&self, eta: &[f32; 6]) -> Result<(Kinematics<f32>, f32), Fault> {
         let att = Attitude::from_eta_f32(&Vector6::from(*eta));
-        if att.ctheta.abs() < self.cos_pitch_limit {
+        let cos_theta_abs = att.ctheta.abs();
+        if cos_theta_abs < self.cos_pitch_limit {
             return Err(Fault::PitchLimit);
         }
-        Kinematics::new(att).map_err(|_| Fault::PitchLimit)
+        let kin = Kinematics::new(att).map_err(|_| Fault::PitchLimit)?;
+        Ok((kin, cos_theta_abs))
     }
 
     /// The stages of [`Stage::ALL`] in order, then the output.
-    fn step(
-        &self,
-        ticks: u64,
-        eta: &[f32; 6],
-        nu: &[f32; 6],
-        trajectory: &Trajectory,
-    ) -> Result<Output, Fault> {
-        let kin = self.kinematics_stage(eta, nu)?;
+    fn step(&self, ticks: u64, input: &LawInput, trajectory: &Trajectory) -> Result<Output, Fault> {
+        let kin = match input {
+            LawInput::Told { eta, nu } => self.kinematics_stage(eta, nu)?,
+            LawInput::Estimated(est) => self.estimated_kinematics(est)?,
+        };
         let desired = self.trajectory_stage(ticks, trajectory);
         let law = self.law_stage(&kin, &desired, trajectory)?;
         let alloc = self.allocation_stage(&law.tau);
@@ -601,6 +689,22 @@ impl Controller {
             cos_theta_abs,
             eta_dot,
             jinv_jdot_nu,
+        })
+    }
+
+    /// Stage [`Stage::Kinematics`] on the estimator's state, whose J, η̇ and pitch check its
+    /// stages made (Choice 431): the input checks and J⁻¹J̇ν only.
+    #[inline]
+    fn estimated_kinematics(&self, est: &Estimated) -> Result<StepKinematics, Fault> {
+        check_inputs(&est.eta, &est.nu)?;
+        let nu = Vector6::from(est.nu);
+        Ok(StepKinematics {
+            eta: Vector6::from(est.eta),
+            nu,
+            kin: est.kin,
+            cos_theta_abs: est.cos_theta_abs,
+            eta_dot: est.eta_dot,
+            jinv_jdot_nu: est.kin.jinv_jdot_nu(&nu),
         })
     }
 
@@ -741,6 +845,41 @@ impl Stage {
     }
 }
 
+/// The stages [`Controller::update_from_solution`] adds around the law's ([`Stage`]) when
+/// the estimator is on, in its order; each is a method of [`Controller`] the firmware
+/// self-test counts on the estimator's golden vectors (Choice 432).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum EstimatorStage {
+    /// The solution's input checks, J at its attitude (pitch limit) and η̇ = J(η)ν.
+    Solution,
+    /// The filter: the correction at the solution's stamp and the prediction to the period.
+    Filter,
+    /// J at the estimate's attitude (pitch limit) and ν̂ = J(η̂)⁻¹η̂̇.
+    Estimate,
+    /// The acceleration the applied thrust gives, recorded for the next predictions.
+    Record,
+}
+
+impl EstimatorStage {
+    /// Every estimator stage, in `update_from_solution`'s order.
+    pub const ALL: [EstimatorStage; 4] = [
+        EstimatorStage::Solution,
+        EstimatorStage::Filter,
+        EstimatorStage::Estimate,
+        EstimatorStage::Record,
+    ];
+
+    /// Stable name for logs and budgets, e.g. `"estimator-filter"`.
+    pub const fn name(self) -> &'static str {
+        match self {
+            EstimatorStage::Solution => "estimator-solution",
+            EstimatorStage::Filter => "estimator-filter",
+            EstimatorStage::Estimate => "estimator-estimate",
+            EstimatorStage::Record => "estimator-record",
+        }
+    }
+}
+
 /// What [`Stage::Kinematics`] gives the later stages.
 #[doc(hidden)]
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -772,7 +911,7 @@ pub struct StepLaw {
 fn estimator_parts(
     config: &ControllerConfig,
     m_hat: &Matrix6<f32>,
-) -> Result<Option<(EstimatorGains, [f32; 6])>, ConfigError> {
+) -> Result<Option<EstimatorParts>, ConfigError> {
     match config.estimator.kind {
         EstimatorKind::Off => Ok(None),
         EstimatorKind::Kalman => {
@@ -780,7 +919,7 @@ fn estimator_parts(
                 .map_err(|axis| ConfigError::EstimatorGain { axis })?;
             // M̂ is positive definite (checked over the box): its diagonal is > 0.
             let m_diag_inv = core::array::from_fn(|i| 1.0 / m_hat[(i, i)]);
-            Ok(Some((gains, m_diag_inv)))
+            Ok(Some(EstimatorParts { gains, m_diag_inv }))
         }
     }
 }

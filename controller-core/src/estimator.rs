@@ -13,8 +13,8 @@
 //! of standard deviation σₐ per period (Q = σₐ² g gᵀ); the solution measures both components,
 //! z = x + n, R = diag(σₚ², σᵥ²). The gain K = P⁻(P⁻ + R)⁻¹ is the steady state of the
 //! discrete Riccati equation, solved once at configuration ([`steady_state_gain`]); per period
-//! the work is fixed: one correction at the solution's stamp and two sums over the last
-//! [`HORIZON`] applied accelerations.
+//! the work is fixed: one correction at the solution's stamp and two predictions, each a
+//! difference of running sums of the applied accelerations (Choice 430, [`Estimate`]).
 //!
 //! **Choice 341:** the filter's state is kept at the stamp of the newest solution taken (the
 //! delayed horizon), and the estimate the law uses is that state predicted forward to the
@@ -249,9 +249,58 @@ pub fn applied_acceleration(
     u - kin.eta_dot(&shortfall)
 }
 
+/// No period recorded yet.
+const NONE: u64 = u64::MAX;
+
+/// The ring slot of period `t`.
+fn slot(t: u64) -> usize {
+    (t % HORIZON as u64) as usize
+}
+
+/// A count of periods as f32 (exact below 2²⁴; a u32's conversion is one instruction on the
+/// board, a u64's a library call).
+fn periods(n: u64) -> f32 {
+    n.min(u64::from(u32::MAX)) as u32 as f32
+}
+
+/// Sums of the accelerations applied in the periods [b, τ) of one set of running sums (base
+/// b, **Choice 430**), per axis: `a` = Σ aₜ and `b` = Σ aₜ (τ − t − ½). A prediction from s
+/// to τ (b ≤ s ≤ τ) adds T²·(B(τ) − B(s) − (τ − s)·A(s)) to η and T·(A(τ) − A(s)) to η̇; one
+/// period on, A′ = A + a and B′ = B + A + a/2.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Sums {
+    a: [f32; 6],
+    b: [f32; 6],
+}
+
+impl Sums {
+    const ZERO: Sums = Sums {
+        a: [0.0; 6],
+        b: [0.0; 6],
+    };
+}
+
+/// Where a set's sums at a period are: the sums at a held period, and how many periods past
+/// it (0: the sums themselves; m > 0: the last period recorded, its acceleration added, then
+/// m − 1 periods without one, B′ = B + (m − 1)·A).
+struct At<'a> {
+    sums: &'a Sums,
+    past: u32,
+}
+
 /// The board's estimator memory: the filter's state at its stamp and the accelerations
-/// applied over the last [`HORIZON`] periods. Owned by whoever flies the controller
-/// ([`crate::Controller::update_from_solution`]); a new mission starts from [`Estimate::new`].
+/// applied over the last [`HORIZON`] periods, as running sums. Owned by whoever flies the
+/// controller ([`crate::Controller::update_from_solution`]); a new mission starts from
+/// [`Estimate::new`].
+///
+/// **Choice 430:** a prediction is fixed O(1) work: two sets of running sums ([`Sums`]) of
+/// the applied accelerations, each kept per period of the ring, give the sums over any range
+/// of held periods as a difference. A running sum kept for ever would lose the small
+/// difference to the large sum (and drift); each set instead starts again from exact zeros
+/// every 2·[`HORIZON`] periods, the two staggered by [`HORIZON`], so that one of them always
+/// starts at or before the oldest period a prediction may start from and no sum ever spans
+/// more than 2·[`HORIZON`] periods: the error is that of ≤ 32 additions, for ever
+/// (tests/estimator.rs flies against an f64 reference, and a day of periods opt-in).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Estimate {
     /// η at `stamp` is `anchor + offset` (valid only when `valid`): the anchor is the last
@@ -264,36 +313,21 @@ pub struct Estimate {
     velocity: [f32; 6],
     stamp: u64,
     valid: bool,
-    /// a of period t at index t mod HORIZON; `accel_tick` says which t (u64::MAX: none).
-    accel: [[f32; 6]; HORIZON],
-    accel_tick: [u64; HORIZON],
+    /// The latest period recorded ([`NONE`]: none). The ring holds every period of
+    /// (last − HORIZON, last], a period the board did not run as a zero acceleration.
+    last: u64,
+    /// The acceleration of period `last`.
+    accel: [f32; 6],
+    /// The period each set of sums starts from (its sums are zero there).
+    base: [u64; 2],
+    /// Each set's sums before period t (over [base, t)) at slot t mod HORIZON.
+    before: [[Sums; 2]; HORIZON],
 }
 
 impl Default for Estimate {
     fn default() -> Self {
         Self::new()
     }
-}
-
-/// Weights of the accelerations applied in [from, to) for a prediction from `from` to `to`:
-/// Δη = Σ aₜ T² (to − t − ½), Δη̇ = Σ aₜ T over the periods held; an entry outside the range
-/// weighs 0. Fixed work: every entry is visited.
-fn weights(
-    accel_tick: &[u64; HORIZON],
-    from: u64,
-    to: u64,
-    t: f32,
-) -> ([f32; HORIZON], [f32; HORIZON]) {
-    let mut w_pos = [0.0f32; HORIZON];
-    let mut w_vel = [0.0f32; HORIZON];
-    for j in 0..HORIZON {
-        let tick = accel_tick[j];
-        let held = tick >= from && tick < to;
-        let lead = to.wrapping_sub(tick) as f32 - 0.5;
-        w_pos[j] = if held { t * t * lead } else { 0.0 };
-        w_vel[j] = if held { t } else { 0.0 };
-    }
-    (w_pos, w_vel)
 }
 
 impl Estimate {
@@ -305,8 +339,10 @@ impl Estimate {
             velocity: [0.0; 6],
             stamp: 0,
             valid: false,
-            accel: [[0.0; 6]; HORIZON],
-            accel_tick: [u64::MAX; HORIZON],
+            last: NONE,
+            accel: [0.0; 6],
+            base: [0; 2],
+            before: [[Sums::ZERO; 2]; HORIZON],
         }
     }
 
@@ -328,22 +364,78 @@ impl Estimate {
         )
     }
 
+    /// Forgets everything, in place (as [`Estimate::new`]: the ring's sums are read only
+    /// for periods recorded after this).
+    fn reset(&mut self) {
+        self.valid = false;
+        self.stamp = 0;
+        self.last = NONE;
+        self.base = [0; 2];
+    }
+
+    /// The oldest period the ring holds (0 before any is recorded).
+    fn oldest(&self) -> u64 {
+        match self.last {
+            NONE => 0,
+            last => (last + 1).saturating_sub(HORIZON as u64),
+        }
+    }
+
+    /// Set `k`'s sums over [base, t), for t ≥ the set's base and t ≥ [`Estimate::oldest`]
+    /// (zero at or before its base: nothing is counted there).
+    fn at(&self, k: usize, t: u64) -> At<'_> {
+        if self.last == NONE || t <= self.base[k] {
+            At {
+                sums: &Sums::ZERO,
+                past: 0,
+            }
+        } else if t <= self.last {
+            At {
+                sums: &self.before[slot(t)][k],
+                past: 0,
+            }
+        } else {
+            At {
+                sums: &self.before[slot(self.last)][k],
+                past: (t - self.last).min(u64::from(u32::MAX)) as u32,
+            }
+        }
+    }
+
+    /// Axis `i` of the sums `at` points to: (A, B).
+    fn sums_at(&self, at: &At, i: usize) -> (f32, f32) {
+        let (a, b) = (at.sums.a[i], at.sums.b[i]);
+        if at.past == 0 {
+            return (a, b);
+        }
+        let a1 = a + self.accel[i];
+        (a1, b + a + 0.5 * self.accel[i] + (at.past - 1) as f32 * a1)
+    }
+
     /// The state predicted from `from` (the stamp) to `to` with the accelerations applied
-    /// since: the position as its offset from the anchor, and the velocity.
+    /// since: the position as its offset from the anchor, and the velocity. Periods older
+    /// than the ring weigh zero. Fixed work (Choice 430).
     fn predicted(&self, gains: &EstimatorGains, from: u64, to: u64) -> ([f32; 6], [f32; 6]) {
-        let (w_pos, w_vel) = weights(&self.accel_tick, from, to, gains.period);
-        let dt = to.saturating_sub(from) as f32 * gains.period;
+        let t = gains.period;
+        let dt = periods(to.saturating_sub(from)) * t;
+        let lo = from.max(self.oldest());
+        let hi = to.max(lo);
+        let n = periods(hi - lo);
+        // The set that starts latest at or before `lo` (either, when neither does: then
+        // nothing was recorded before `lo` and both count from zero).
+        let k = match (self.base[0] <= lo, self.base[1] <= lo) {
+            (true, true) => usize::from(self.base[1] > self.base[0]),
+            (false, true) => 1,
+            _ => 0,
+        };
+        let (s, e) = (self.at(k, lo), self.at(k, hi));
         let mut p = self.offset;
         let mut v = self.velocity;
         for i in 0..6 {
-            let mut dp = 0.0f32;
-            let mut dv = 0.0f32;
-            for j in 0..HORIZON {
-                dp += w_pos[j] * self.accel[j][i];
-                dv += w_vel[j] * self.accel[j][i];
-            }
-            p[i] += v[i] * dt + dp;
-            v[i] += dv;
+            let (sa, sb) = self.sums_at(&s, i);
+            let (ea, eb) = self.sums_at(&e, i);
+            p[i] += v[i] * dt + t * t * (eb - sb - n * sa);
+            v[i] += t * (ea - sa);
         }
         (p, v)
     }
@@ -363,7 +455,7 @@ impl Estimate {
     ) -> Option<([f32; 6], [f32; 6])> {
         if self.valid && ticks < self.stamp {
             // Time went back: a new mission.
-            *self = Estimate::new();
+            self.reset();
         }
         let finite = eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite());
         let in_window = stamp <= ticks && ticks - stamp <= HORIZON as u64;
@@ -408,22 +500,66 @@ impl Estimate {
     }
 
     /// Records the acceleration `a` applied over period `ticks` (a non-finite one is recorded
-    /// as zero: unknown), after moving the state's stamp past the period whose entry it
-    /// replaces, so that the prediction from the stamp never loses an acceleration it used.
-    /// Period `ticks` recorded again (lock-step: the board ran it once without a fresh frame,
-    /// then on the frame, Choice 362) replaces its own entry: the state at the stamp does not
-    /// depend on it, so the stamp stays (moved, the next solution would be refused as old).
+    /// as zero: unknown). The state's stamp is first moved, predicted, to the oldest period
+    /// the ring then holds, so that a prediction from the stamp never loses an acceleration
+    /// it used. Period `ticks` recorded again (lock-step: the board ran it once without a
+    /// fresh frame, then on the frame, Choice 362) replaces its own entry: the state at the
+    /// stamp does not depend on it, so the stamp stays (moved, the next solution would be
+    /// refused as old). A period older than the last recorded is dropped.
+    ///
+    /// O(1) when `ticks` follows the last period recorded or repeats it (every period the
+    /// board flies); periods the board did not run are recorded as zero accelerations, at
+    /// most [`HORIZON`] of them.
     pub fn applied(&mut self, gains: &EstimatorGains, ticks: u64, a: &[f32; 6]) {
-        let j = (ticks % HORIZON as u64) as usize;
-        let old = self.accel_tick[j];
-        if self.valid && old != u64::MAX && old != ticks && old == self.stamp {
-            let (o, v) = self.predicted(gains, self.stamp, self.stamp + 1);
+        let finite = a.iter().all(|x| x.is_finite());
+        if self.last != NONE && ticks <= self.last {
+            if ticks == self.last {
+                self.accel = if finite { *a } else { [0.0; 6] };
+            }
+            return;
+        }
+        let h = HORIZON as u64;
+        let oldest = (ticks + 1).saturating_sub(h);
+        if self.valid && self.stamp < oldest {
+            let (o, v) = self.predicted(gains, self.stamp, oldest);
             self.offset = o;
             self.velocity = v;
-            self.stamp += 1;
+            self.stamp = oldest;
         }
-        let finite = a.iter().all(|x| x.is_finite());
-        self.accel[j] = if finite { *a } else { [0.0; 6] };
-        self.accel_tick[j] = ticks;
+        let start = if self.last == NONE || ticks - self.last > h {
+            // Nothing the ring holds reaches this period: both sets start afresh here, and
+            // the periods before it weigh zero (the sums are zero up to their base).
+            self.base = [ticks; 2];
+            ticks
+        } else {
+            self.last + 1
+        };
+        for t in start..=ticks {
+            // The set that started earlier starts again once the other is HORIZON old.
+            let newer = usize::from(self.base[1] > self.base[0]);
+            if t - self.base[newer] >= h {
+                self.base[1 - newer] = t;
+            }
+            // Each set's sums before t: zero at its base, else one period on from t − 1's
+            // (the acceleration of t − 1 is `accel` for the first, zero for the missed ones).
+            let (p, j) = (slot(t.wrapping_sub(1)), slot(t));
+            for k in 0..2 {
+                if t <= self.base[k] {
+                    self.before[j][k] = Sums::ZERO;
+                } else {
+                    for i in 0..6 {
+                        let (a0, b0) = (self.before[p][k].a[i], self.before[p][k].b[i]);
+                        let acc = self.accel[i];
+                        self.before[j][k].a[i] = a0 + acc;
+                        self.before[j][k].b[i] = b0 + a0 + 0.5 * acc;
+                    }
+                }
+            }
+            self.accel = [0.0; 6];
+            self.last = t;
+        }
+        if finite {
+            self.accel = *a;
+        }
     }
 }

@@ -21,7 +21,9 @@ pub mod trajectory;
 pub mod uncertainty;
 
 pub use config::{BBound, ConfigError, ControllerConfig};
-pub use controller::{BoxBounds, Controller, Fault, Output, Solution, Stage, Status};
+pub use controller::{
+    BoxBounds, Controller, EstimatorStage, Fault, Output, Solution, Stage, Status,
+};
 pub use estimator::{Estimate, EstimatorConfig, EstimatorKind};
 pub use law::RobustLaw;
 pub use thruster::{ThrustUnit, DEFAULT_V_LIMIT};

@@ -2,7 +2,7 @@
 //! instruction counts against `firmware::budget`, and the failure injection that proves each
 //! kind of failure is visible.
 
-use controller_core::Stage;
+use controller_core::{EstimatorStage, Stage};
 use firmware::budget;
 use firmware::qemu_clock::INSTRUCTIONS_PER_TICK;
 use firmware::qemu_runner::TIMED_OUT;
@@ -187,8 +187,9 @@ fn max_of(log: &str, prefix: &str) -> Option<u32> {
         .and_then(|n| n.parse().ok())
 }
 
-/// Every stage of `update` (`controller_core::Stage`) must have its `stage NAME: max=N` line,
-/// within its budget in `firmware::budget`.
+/// Every stage of `update` (`controller_core::Stage`) and of the estimator
+/// (`controller_core::EstimatorStage`) must have its `stage NAME: max=N` line, within its
+/// budget in `firmware::budget`.
 fn check_stage_budgets(ci: &mut Ci, backend: &str, log: &str) {
     let Some(budget) = budget::for_backend(backend) else {
         ci.fail(format!(
@@ -197,9 +198,9 @@ fn check_stage_budgets(ci: &mut Ci, backend: &str, log: &str) {
         return;
     };
     let mut shown = Vec::new();
-    for stage in Stage::ALL {
-        let name = stage.name();
-        let limit = budget.stage(stage);
+    let law = Stage::ALL.map(|s| (s.name(), budget.stage(s)));
+    let estimator = EstimatorStage::ALL.map(|s| (s.name(), budget.estimator_stage(s)));
+    for (name, limit) in law.into_iter().chain(estimator) {
         match max_of(log, &format!("stage {name}:")) {
             None => ci.fail(format!(
                 "self-test ({backend}): no `stage {name}: max=N` line in its log"
