@@ -522,7 +522,7 @@ impl<'a> Checker<'a> {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
             let smp = self.sample(peak, j);
-            if self.engine == Engine::Fast && !seen.insert(smp, &prepared.cases, m) {
+            if self.engine == Engine::Fast && !seen.insert(smp, inv_k, &prepared.cases, m) {
                 continue;
             }
             let ctx = self.at_sample(smp, inv_k);

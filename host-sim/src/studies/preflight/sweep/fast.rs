@@ -1,5 +1,5 @@
 //! The fast engine's work at one point of a sweep (docs/real-vehicle.md#how-the-check-is-made,
-//! **Choices 390–391**): the same arithmetic as the reference engine's
+//! **Choices 390–391, 450–451**): the same arithmetic as the reference engine's
 //! [`Checker::check_point`](super::Checker), bit for bit, with what does not change
 //! between the cases of a sample formed once per sample ([`Shared`]: the heading's and the
 //! path pitch's sines and cosines, the reference rates at the time scale) and what does not
@@ -8,6 +8,7 @@
 //! those of its own roll and pitch offset; and the key by which a sweep recognises a sample
 //! it has already judged ([`SampleKeys`]).
 
+use std::cell::RefCell;
 use std::collections::HashSet;
 
 use controller_core::kinematics::{self, Attitude};
@@ -57,6 +58,10 @@ pub(super) struct Shared {
     /// η̇_d/k and η̈_d/k².
     eta_dot: Vector6<f64>,
     eta_ddot: Vector6<f64>,
+    /// The states at the static heels met so far on this sample, by the heel's bits (Choice
+    /// 451): the box's 2⁹ corners have at most 8 static heels (only Δm, Δy_G and Δz_G move
+    /// it), so the state at each is formed once per sample, not once per corner.
+    level: RefCell<Vec<(u64, PlantState, Vector6<f64>)>>,
 }
 
 impl Shared {
@@ -70,7 +75,28 @@ impl Shared {
             level_pitch: smp.eta[PITCH].cos().abs() > 0.0,
             eta_dot: smp.eta_dot * inv_k,
             eta_ddot: smp.eta_ddot * (inv_k * inv_k),
+            level: RefCell::new(Vec::new()),
         }
+    }
+
+    /// [`Shared::state`] at roll `level` (a static heel, sines and cosines `level_sc`), the
+    /// sample's pitch and no roll acceleration: formed once per distinct `level` (its bits:
+    /// the same inputs, the same state).
+    fn level_state(
+        &self,
+        smp: &PathSample,
+        level: f64,
+        level_sc: (f64, f64),
+    ) -> (PlantState, Vector6<f64>, Attitude<f64>) {
+        let att = self.attitude(level_sc, self.theta_sin_cos);
+        let bits = level.to_bits();
+        let mut seen = self.level.borrow_mut();
+        if let Some((_, state, nu_dot)) = seen.iter().find(|e| e.0 == bits) {
+            return (*state, *nu_dot, att);
+        }
+        let (state, nu_dot) = self.state(smp, level, self.theta, &att, 0.0);
+        seen.push((bits, state, nu_dot));
+        (state, nu_dot, att)
     }
 
     fn attitude(&self, phi: (f64, f64), theta: (f64, f64)) -> Attitude<f64> {
@@ -121,8 +147,7 @@ pub(super) fn check_point(
         true => (roll.phi0, roll.phi0_sin_cos),
         false => (0.0, 0.0f64.sin_cos()),
     };
-    let att = shared.attitude(level_sc, shared.theta_sin_cos);
-    let (state, nu_dot) = shared.state(smp, level, shared.theta, &att, 0.0);
+    let (state, nu_dot, att) = shared.level_state(smp, level, level_sc);
     let heel = heel(plant, roll, shared, &state, &att, &nu_dot, current).unwrap_or(level);
     // The pitch error that holds the law's model mismatch in pitch, at the heel.
     let att = shared.attitude(heel.sin_cos(), shared.theta_sin_cos);
@@ -166,20 +191,29 @@ fn heel(
     Some(roll.phi0 + s.asin())
 }
 
-/// The inputs of a sample that its forces depend on (the reference's attitude and rates, and
-/// the mission-as-written case's plant and swing there), bit for bit: a sweep judges each key
-/// once (Choice 391).
+/// The inputs of a sample that its forces depend on (the reference's attitude, its rates at
+/// the sweep's time scale — η̇_d/k and η̈_d/k², as [`Shared`] forms them — and the
+/// mission-as-written case's plant and swing there), bit for bit: a sweep judges each key
+/// once (Choice 391). Keyed at the time scale, not at k = 1 (Choice 450): at rest (1/k = 0)
+/// every sample of one attitude is one key, so a straight leg with its speed changes, or a
+/// whole lawn-mower line, is judged once.
 #[derive(Default)]
 pub(super) struct SampleKeys(HashSet<Vec<u64>>);
 
 impl SampleKeys {
-    /// Records the key of sample `smp` at prepared index `m` of `cases`; false if it was
-    /// already there.
-    pub(super) fn insert(&mut self, smp: &PathSample, cases: &[CasePlants<'_>], m: usize) -> bool {
+    /// Records the key of sample `smp` at 1/k = `inv_k` and prepared index `m` of `cases`;
+    /// false if it was already there.
+    pub(super) fn insert(
+        &mut self,
+        smp: &PathSample,
+        inv_k: f64,
+        cases: &[CasePlants<'_>],
+        m: usize,
+    ) -> bool {
         let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
         key.extend(smp.eta.iter().skip(3).map(|x| x.to_bits()));
-        key.extend(smp.eta_dot.iter().map(|x| x.to_bits()));
-        key.extend(smp.eta_ddot.iter().map(|x| x.to_bits()));
+        key.extend((smp.eta_dot * inv_k).iter().map(|x| x.to_bits()));
+        key.extend((smp.eta_ddot * (inv_k * inv_k)).iter().map(|x| x.to_bits()));
         // A case constant along the path (every corner of the box) adds nothing.
         for (plant, amplitude) in cases.iter().filter_map(|c| c.key(m)) {
             key.push(plant as u64);
