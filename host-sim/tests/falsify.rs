@@ -2,13 +2,14 @@
 //! the robustness against the bound's own verdict, the cross-entropy method against a known
 //! optimum, sharding, replay, and the search itself against a weakened preflight.
 
+use host_sim::scenario::navigation::Preset;
 use host_sim::scenario::{parse_scenario, Bound};
 use host_sim::sim::bound::{self, miss};
 use host_sim::sim::{self, LocalController, Metrics, Recording};
 use host_sim::studies::falsify::cross_entropy::{self, Search};
 use host_sim::studies::falsify::{self, Method, Setup, Spec};
 use host_sim::studies::mission_space::Reach;
-use host_sim::studies::rate_bound::clopper_pearson_upper;
+use host_sim::studies::rate_bound::{clopper_pearson_upper, Counts};
 use rand::{RngExt, SeedableRng};
 
 #[test]
@@ -37,6 +38,53 @@ fn the_rate_bound_meets_its_closed_forms() {
     assert!((tail - 0.05).abs() < 1e-9, "{p}: {tail}");
     assert_eq!(clopper_pearson_upper(5, 5, 0.95), 1.0);
     assert!(clopper_pearson_upper(0, 0, 0.95).is_nan());
+    // Large n, few failures: n · bound tends to the one-sided 95 % Poisson upper limit of k
+    // events, as tabulated (Gehrels 1986, ApJ 303, Table 1: 3.00, 4.74, 6.30, 7.75), an
+    // independent table, not this code's formula.
+    let n = 10_000_000;
+    for (k, limit) in [(0u64, 2.996), (1, 4.744), (2, 6.296), (3, 7.754)] {
+        let np = n as f64 * clopper_pearson_upper(k, n, 0.95);
+        assert!(
+            (np - limit).abs() < 2e-3,
+            "k = {k}: n·p = {np}, table {limit}"
+        );
+    }
+}
+
+#[test]
+fn the_contract_sentence_counts_both_and_bounds_the_sampled_only() {
+    let none = Counts {
+        sampled: 300,
+        adversarial: 48,
+        ..Counts::default()
+    };
+    let text = none.sentence();
+    assert!(
+        text.starts_with("0 false feasible in 300 sampled and 48 adversarial evaluations; 95 % upper bound on the false-feasible rate: 0.99 %"),
+        "{text}"
+    );
+    assert!(text.contains("rule of three 3/S = 1.00 %"), "{text}");
+    // Adversarial false feasibles are in N, not in the rate.
+    let searched = Counts {
+        adversarial_false_feasible: 2,
+        ..none
+    };
+    assert_eq!(searched.upper_bound(), none.upper_bound());
+    assert!(
+        searched.sentence().starts_with(
+            "2 false feasible in 300 sampled and 48 adversarial evaluations (0 sampled, 2 adversarial)"
+        ),
+        "{}",
+        searched.sentence()
+    );
+    let sampled = Counts {
+        sampled_false_feasible: 1,
+        ..none
+    };
+    assert_eq!(sampled.upper_bound(), clopper_pearson_upper(1, 300, 0.95));
+    assert!(Counts::default()
+        .sentence()
+        .contains("none (nothing sampled)"));
 }
 
 #[test]
@@ -154,6 +202,7 @@ fn a_sharded_falsification_merges_into_the_unsharded_one() {
         seed: 5,
         budget: 6,
         restarts: 3,
+        navigation: None,
     };
     let whole = falsify::run_shard(&spec, 0, 1, &|| ()).unwrap();
     let a = falsify::run_shard(&spec, 0, 2, &|| ()).unwrap();
@@ -184,6 +233,7 @@ fn against_a_weakened_preflight_the_search_finds_what_random_search_at_its_budge
             seed,
             budget: 40,
             restarts: 1,
+            navigation: None,
         };
         let shard = falsify::run_shard(&spec, 0, 1, &|| ()).unwrap();
         let found = |m: Method| {
@@ -246,4 +296,88 @@ fn the_command_writes_a_falsifying_mission_that_run_replays() {
         .unwrap();
     assert_eq!(replay.status.code(), Some(4), "{replay:?}");
     let _ = std::fs::remove_dir_all(&out);
+}
+
+/// `--navigation`: the realities' preset coordinate is held at the preset; a contract mission
+/// is told its state through it as the contract's campaign flies it (the preset's sources, the
+/// estimator off on `ideal`, the real chain's filter otherwise), the same for the same point.
+#[test]
+fn a_pinned_preset_is_what_every_candidate_is_told_its_state_through() {
+    let mut rng = rand::rngs::StdRng::seed_from_u64(11);
+    let real_filter = host_sim::scenario::real_vehicle::real_scenarios().unwrap()[0]
+        .config()
+        .controller
+        .estimator
+        .kind;
+    for reach in [Reach::Contract, Reach::Realities] {
+        for preset in Preset::ALL {
+            let setup = Setup::new(reach, 0.8, SHORT)
+                .unwrap()
+                .with_navigation(Some(preset));
+            let mut made = 0;
+            while made < 4 {
+                let x: Vec<f64> = (0..setup.dims()).map(|_| rng.random::<f64>()).collect();
+                let Ok(m) = setup.mission(&x, "pinned") else {
+                    continue;
+                };
+                let c = m.config();
+                assert_eq!(
+                    c.navigation.as_ref().map_or(Preset::Ideal, |n| n.preset),
+                    preset,
+                    "{reach:?}"
+                );
+                if reach == Reach::Contract {
+                    let expected = if preset == Preset::Ideal {
+                        controller_core::EstimatorKind::Off
+                    } else {
+                        real_filter
+                    };
+                    assert_eq!(c.controller.estimator.kind, expected, "{preset:?}");
+                }
+                // The same point, the same mission (its navigation seed included).
+                assert_eq!(setup.mission(&x, "pinned").unwrap().config(), c);
+                made += 1;
+            }
+        }
+    }
+}
+
+/// CI's fixed-seed falsification budget (Choice 473, docs/search.md#cis-fixed-seed-budget): against the
+/// real preflight (the contract's margin), on the contract's space flown on the `ideal` preset, a small search of both
+/// methods finds no mission the preflight calls feasible that misses its bound. A regression
+/// guard, not a proof: docs/search.md#against-the-real-preflight says what 10 000 evaluations
+/// found.
+#[test]
+fn against_the_real_preflight_a_small_fixed_seed_search_on_ideal_finds_no_false_feasible() {
+    // The contract's space: the realities' on `ideal` (thruster lag, wandering current) have
+    // false feasibles within a few draws (docs/search.md#against-the-real-preflight).
+    let spec = Spec {
+        reach: Reach::Contract,
+        margin: host_sim::studies::preflight::DEFAULT_MARGIN,
+        duration: SHORT,
+        seed: 1,
+        budget: 24,
+        restarts: 1,
+        navigation: Some(Preset::Ideal),
+    };
+    let shard = falsify::run_shard(&spec, 0, 1, &|| ()).unwrap();
+    for r in &shard.restarts {
+        let counted = r.trace.iter().flatten().count();
+        println!(
+            "{}: {counted} of {} counted, least robustness {:?}",
+            r.method.name(),
+            r.trace.len(),
+            r.min_robustness()
+        );
+        // The search flew missions (a budget spent on refusals guards nothing).
+        assert!(counted >= 12, "{}: {counted} counted", r.method.name());
+        assert_eq!(
+            r.first_falsified,
+            None,
+            "{}: {:?}",
+            r.method.name(),
+            r.worst
+        );
+        assert!(r.min_robustness() > Some(0.0), "{:?}", r.worst);
+    }
 }

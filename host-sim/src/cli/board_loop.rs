@@ -203,6 +203,7 @@ pub(super) fn fly(
             incomplete,
             preflight: Vec::new(),
             contract: None,
+            contract_statistics: Vec::new(),
         };
         print_json(stdout, &cases)?;
     } else {

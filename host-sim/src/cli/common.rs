@@ -146,6 +146,7 @@ pub(super) fn print_runs(
             incomplete,
             preflight: checks.to_vec(),
             contract: None,
+            contract_statistics: Vec::new(),
         };
         print_json(stdout, &cases)?;
     } else {
@@ -215,6 +216,7 @@ pub(super) fn interrupted_before_runs(
             incomplete: Vec::new(),
             preflight: Vec::new(),
             contract: None,
+            contract_statistics: Vec::new(),
         };
         print_json(stdout, &cases)?;
     } else {

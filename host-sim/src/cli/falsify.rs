@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! host-sim falsify [--budget B] [--restarts R] [--seed S] [--margin M] [--duration D]
-//!                  [--reach contract|realities] [--shard I/N] [--json] --out DIR
+//!                  [--reach contract|realities] [--navigation PRESET] [--shard I/N] [--json]
+//!                  --out DIR
 //! host-sim falsify --merge DIR… --out DIR
 //! ```
 //!
@@ -24,6 +25,7 @@ use super::Exit;
 use crate::output::falsify::{plot_robustness, report_markdown, Written};
 use crate::output::{atomic, OutputDir};
 use crate::scenario::file::ScenarioFile;
+use crate::scenario::navigation::Preset;
 use crate::sim::progress::Progress;
 use crate::studies::falsify::{self, Restart, ShardResult, Spec};
 use crate::studies::mission_space::Reach;
@@ -49,6 +51,10 @@ pub struct FalsifyArgs {
     /// Which mission space: the contract's draws, or those and the realities a team writes.
     #[arg(long, value_enum, default_value_t = Reach::Realities)]
     pub reach: Reach,
+    /// Every candidate told its state through this navigation preset (ideal, survey,
+    /// low-cost); default: the contract's exact state, or a drawn preset for the realities.
+    #[arg(long, value_parser = super::validate::parse_preset)]
+    pub navigation: Option<Preset>,
     /// This shard, I/N: restarts r ≡ I (mod N); default from the engine's environment.
     #[arg(long)]
     pub shard: Option<String>,
@@ -145,6 +151,7 @@ fn search(args: &FalsifyArgs) -> Result<ShardResult> {
         seed: args.seed,
         budget: args.budget,
         restarts: args.restarts,
+        navigation: args.navigation,
     };
     let mine = crate::studies::campaign::Shard {
         runs: args.restarts,
@@ -161,14 +168,24 @@ fn search(args: &FalsifyArgs) -> Result<ShardResult> {
 
 /// Each restart's worst candidate that is a false feasible, as a scenario file at its
 /// proposed scale (the one writer, [`ScenarioFile`]).
-fn write_falsifying(spec: &Spec, restarts: &[Restart], dir: &OutputDir) -> Result<Vec<Written>> {
+pub(super) fn write_falsifying(
+    spec: &Spec,
+    restarts: &[Restart],
+    dir: &OutputDir,
+) -> Result<Vec<Written>> {
     let setup = spec.setup()?;
     let mut out = Vec::new();
     for (k, r) in restarts.iter().enumerate() {
         let Some(w) = r.worst.as_ref().filter(|w| w.falsified) else {
             continue;
         };
-        let name = format!("falsified-{}-r{}", r.method.name(), r.index);
+        let name = format!(
+            "falsified-{}-r{}{}",
+            r.method.name(),
+            r.index,
+            spec.navigation
+                .map_or(String::new(), |p| format!("-{}", p.name()))
+        );
         let Some(s) = falsify::flown_mission(&setup, &w.x, &name).map_err(|e| anyhow!(e))? else {
             continue;
         };

@@ -5,6 +5,7 @@ use std::io::Write;
 use anyhow::{Context, Result};
 use serde::{Deserialize, Serialize};
 
+use crate::studies::contract_statistics::PresetStatistics;
 use crate::studies::preflight::Preflight;
 use crate::studies::validation::ContractSummary;
 
@@ -23,6 +24,10 @@ pub struct Cases<T> {
     /// docs/real-vehicle.md#the-preflights-contract).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub contract: Option<ContractSummary>,
+    /// The contract's statistics per navigation preset, sampled and searched (`table1`;
+    /// docs/search.md#the-contract-in-the-main-jobs-report).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub contract_statistics: Vec<PresetStatistics>,
 }
 
 /// One JSON line: the value through `serde_json::Value`, so the keys come out sorted.

@@ -21,6 +21,7 @@ use crate::scenario::Scenario;
 use crate::sim::progress::Progress;
 use crate::sim::record::RunSummary;
 use crate::sim::RunResult;
+use crate::studies::contract_statistics::{self, PresetStatistics};
 use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
 use crate::studies::table1 as paper_table1;
 use crate::studies::validation::{self, Campaign, Measure, Validation, TEAM_MOUNTINGS};
@@ -113,12 +114,16 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         Some(campaign) => Some(contract(&campaign, args.json)?),
         None => None,
     };
+    let statistics = match &contract {
+        Some((campaign, v)) => Some(statistics(campaign, v, &dir, args.json)?),
+        None => None,
+    };
     let sections = real_sections(
         &real_rows,
         &checks,
         real_runs.iter().chain(chain_runs),
         contract.as_ref().map(|(_, v)| v),
-    );
+    ) + statistics.as_ref().map_or("", |(_, md)| md.as_str());
     let mut incomplete = incomplete.into_inner();
     let report = write_report(
         &dir,
@@ -131,7 +136,10 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
     report_incomplete(&incomplete);
     // The paper's missions through the real chain are expected to fail: they show what an
     // infeasible verdict means, and do not make the command fail.
-    let broken = contract.as_ref().is_some_and(|(_, v)| v.false_feasible > 0);
+    let broken = contract.as_ref().is_some_and(|(_, v)| v.false_feasible > 0)
+        || statistics
+            .as_ref()
+            .is_some_and(|(st, _)| st.iter().any(PresetStatistics::broken));
     let exit = runs_exit(
         paper_runs.iter().chain(real_runs),
         !incomplete.is_empty(),
@@ -143,6 +151,7 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
             incomplete,
             preflight: checks,
             contract: contract.map(|(c, v)| v.summary(&c)),
+            contract_statistics: statistics.map(|(st, _)| st).unwrap_or_default(),
         };
         print_json(stdout, &cases)?;
     } else {
@@ -152,6 +161,7 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
             &checks,
             &real_rows,
             contract.as_ref().map(|(_, v)| v),
+            statistics.as_ref().map_or(&[][..], |(st, _)| &st[..]),
             &report,
         )?;
     }
@@ -241,6 +251,42 @@ fn contract(campaign: &Campaign, json: bool) -> Result<(Campaign, Validation)> {
     Ok((campaign.clone(), v))
 }
 
+/// The contract's statistics per preset of `campaign` (docs/search.md#the-contract-in-the-main-jobs-report,
+/// Choices 471–472): the sampled figures from its flights `v`, the adversarial ones from a
+/// small fixed-seed search per preset, each falsifying mission written into `dir`; the
+/// figures and the report's section.
+fn statistics(
+    campaign: &Campaign,
+    v: &Validation,
+    dir: &OutputDir,
+    json: bool,
+) -> Result<(Vec<PresetStatistics>, String)> {
+    let presets = &campaign.navigation;
+    let progress = Progress::start(
+        "preflight contract (searched)",
+        (presets.len() * contract_statistics::SEARCH_BUDGET) as u64,
+        !json,
+    );
+    let counter = progress.observer();
+    let start = std::time::Instant::now();
+    let mut stats = Vec::new();
+    let mut written = Vec::new();
+    for &preset in presets {
+        let restart =
+            contract_statistics::search(preset, &|| counter.add(1)).map_err(|e| anyhow!(e))?;
+        let files = super::falsify::write_falsifying(
+            &contract_statistics::search_spec(preset),
+            std::slice::from_ref(&restart),
+            dir,
+        )?;
+        written.extend(files.into_iter().map(|w| w.file));
+        stats.push(PresetStatistics::of(preset, v, Some(&restart)));
+    }
+    progress.finish();
+    let md = contract_statistics::markdown(&stats, start.elapsed().as_secs_f64(), &written);
+    Ok((stats, md))
+}
+
 /// The text `table1` prints: the paper's table, the real vehicle's verdicts and table, the
 /// preflight contract's two numbers, the report's path.
 fn print_text(
@@ -249,6 +295,7 @@ fn print_text(
     checks: &[Preflight],
     real_rows: &[RealRow],
     contract: Option<&Validation>,
+    statistics: &[PresetStatistics],
     report: &Path,
 ) -> Result<()> {
     writeln!(stdout, "{}", output::table_text(rows))?;
@@ -264,6 +311,14 @@ fn print_text(
     writeln!(stdout, "{}\n", output::report::real_table_legend())?;
     if let Some(v) = contract {
         writeln!(stdout, "{}\n", v.headline())?;
+    }
+    for p in statistics {
+        writeln!(
+            stdout,
+            "contract on {}: {}",
+            p.navigation.name(),
+            p.counts.sentence()
+        )?;
     }
     writeln!(stdout, "report: {}", report.display())?;
     Ok(())

@@ -103,8 +103,8 @@ pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result
 }
 
 /// `--navigation`'s values: a preset's name.
-fn parse_preset(name: &str) -> Result<Preset, String> {
-    [Preset::Ideal, Preset::Survey, Preset::LowCost]
+pub(super) fn parse_preset(name: &str) -> Result<Preset, String> {
+    Preset::ALL
         .into_iter()
         .find(|p| p.name() == name)
         .ok_or_else(|| format!("{name:?} is not one of ideal, survey, low-cost"))

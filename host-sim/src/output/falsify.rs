@@ -6,7 +6,8 @@ use std::path::Path;
 use anyhow::Result;
 
 use super::plot::{self, Line, Panel, Stroke, C_WITH, C_WITHOUT};
-use crate::studies::falsify::{Method, Restart};
+use crate::studies::falsify::{Evaluation, Method, Restart};
+use crate::studies::rate_bound;
 
 fn color(m: Method) -> plotters::style::RGBColor {
     match m {
@@ -111,13 +112,16 @@ pub fn report_markdown(
     written: &[Written],
     seconds: f64,
 ) -> String {
-    use crate::studies::rate_bound;
     let mut s = format!(
         "# host-sim falsify\n\n\
-         Candidates: the {:?} mission space (docs/search.md#the-mission-space), {} s at time \
+         Candidates: the {:?} mission space (docs/search.md#the-mission-space){}, {} s at time \
          scale 1, preflight margin {}, seed {}; {} restarts of each method at {} evaluations \
          each; {:.1} s of wall time{}.\n\n",
         spec.reach,
+        spec.navigation.map_or(String::new(), |p| format!(
+            ", every candidate on the `{}` navigation preset",
+            p.name()
+        )),
         spec.duration,
         spec.margin,
         spec.seed,
@@ -131,25 +135,10 @@ pub fn report_markdown(
         }
     );
     s += &methods_table(restarts);
-    let random_counted: u64 = restarts
-        .iter()
-        .filter(|r| r.method == Method::Random)
-        .map(|r| r.trace.iter().flatten().count() as u64)
-        .sum();
-    let random_ff: u64 = restarts
-        .iter()
-        .filter(|r| r.method == Method::Random)
-        .map(|r| r.trace.iter().flatten().filter(|v| **v < 0.0).count() as u64)
-        .sum();
-    let adversarial: u64 = restarts
-        .iter()
-        .filter(|r| r.method == Method::CrossEntropy)
-        .map(|r| r.trace.iter().flatten().count() as u64)
-        .sum();
     s += &format!(
         "\n**The contract over this space** (the random search's flown candidates are independent \
-         uniform draws of it): {}.\n\n",
-        rate_bound::contract_sentence(random_ff, random_counted, adversarial)
+         uniform draws of it, the cross-entropy method's are adversarial): {}.\n\n",
+        counts(restarts).sentence()
     );
     s += &restarts_table(restarts, written);
     if !written.is_empty() {
@@ -166,6 +155,30 @@ pub fn report_markdown(
     s
 }
 
+/// The contract's counts of a search: the random search's flown candidates are the sampled
+/// evaluations, the cross-entropy method's the adversarial ones.
+pub fn counts(restarts: &[Restart]) -> rate_bound::Counts {
+    let of = |m: Method, ff: bool| -> u64 {
+        restarts
+            .iter()
+            .filter(|r| r.method == m)
+            .map(|r| {
+                r.trace
+                    .iter()
+                    .flatten()
+                    .filter(|v| !ff || Evaluation::is_false_feasible(**v))
+                    .count() as u64
+            })
+            .sum()
+    };
+    rate_bound::Counts {
+        sampled: of(Method::Random, false),
+        sampled_false_feasible: of(Method::Random, true),
+        adversarial: of(Method::CrossEntropy, false),
+        adversarial_false_feasible: of(Method::CrossEntropy, true),
+    }
+}
+
 /// Per method: evaluations, counted, false feasibles, the restarts that found one, the least robustness.
 fn methods_table(restarts: &[Restart]) -> String {
     let mut s = String::new();
@@ -176,7 +189,13 @@ fn methods_table(restarts: &[Restart]) -> String {
         let counted: usize = mine.iter().map(|r| r.trace.iter().flatten().count()).sum();
         let ff: usize = mine
             .iter()
-            .map(|r| r.trace.iter().flatten().filter(|v| **v < 0.0).count())
+            .map(|r| {
+                r.trace
+                    .iter()
+                    .flatten()
+                    .filter(|v| Evaluation::is_false_feasible(**v))
+                    .count()
+            })
             .sum();
         let found = mine.iter().filter(|r| r.first_falsified.is_some()).count();
         let least = mine

@@ -32,6 +32,9 @@ pub enum Preset {
 }
 
 impl Preset {
+    /// Every preset, in the order a point of the mission space indexes them.
+    pub const ALL: [Preset; 3] = [Preset::Ideal, Preset::Survey, Preset::LowCost];
+
     /// The name as written in a scenario.
     pub fn name(self) -> &'static str {
         match self {

@@ -217,6 +217,38 @@ pub fn mission(
     })
 }
 
+/// `mission` told its state through `preset` as the contract flies every mission under it
+/// (Choice 373): the preset's sources from `seed`, the exact state told as is (the estimator
+/// off) for `ideal`, the real chain's filter `filter` otherwise.
+pub fn under_preset(
+    mission: &Scenario,
+    preset: Preset,
+    seed: u64,
+    filter: controller_core::EstimatorKind,
+) -> Result<Scenario, ScenarioError> {
+    mission.with(|c| {
+        c.navigation = NavigationModel::preset(preset, seed);
+        c.controller.estimator.kind = if preset == Preset::Ideal {
+            controller_core::EstimatorKind::Off
+        } else {
+            filter
+        };
+    })
+}
+
+/// The point `x` with its navigation preset coordinate ([`slot::NAV_PRESET`]) set to
+/// `preset` (the middle of its cell).
+pub fn with_preset(x: &[f64], preset: Preset) -> Vec<f64> {
+    let mut y = x.to_vec();
+    if let (Some(u), Some(i)) = (
+        y.get_mut(slot::NAV_PRESET),
+        Preset::ALL.iter().position(|&p| p == preset),
+    ) {
+        *u = (i as f64 + 0.5) / Preset::ALL.len() as f64;
+    }
+    y
+}
+
 /// What [`Reach::Realities`] adds to a contract mission.
 struct Realities {
     depth: f64,
@@ -247,8 +279,7 @@ impl Realities {
                 }
             }
         };
-        let preset = [Preset::Ideal, Preset::Survey, Preset::LowCost]
-            [d.below_u32(slot::NAV_PRESET, 3) as usize];
+        let preset = Preset::ALL[d.below_u32(slot::NAV_PRESET, Preset::ALL.len() as u32) as usize];
         let error = NAV_SCALE.0 * (NAV_SCALE.1 / NAV_SCALE.0).powf(d.unit(slot::NAV_ERROR));
         let latency = NAV_SCALE.1.powf(d.unit(slot::NAV_LATENCY));
         let navigation = NavigationModel::preset(preset, seed(d, slot::NAV_SEED))

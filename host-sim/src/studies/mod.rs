@@ -9,8 +9,11 @@
 //! | [`montecarlo`] | Monte Carlo over the Table-3 box, on one machine |
 //! | [`campaign`] | Monte Carlo campaigns in shards on any engine (Slurm, Kubernetes), merged, worst cases reproducible |
 //! | [`validation`] | does the preflight's verdict hold: missions checked, then flown |
+//! | [`falsify`] | searching for the mission the preflight gets wrong (`host-sim falsify`) |
+//! | [`contract_statistics`] | the contract's false feasibles per preset, sampled and searched, with their rate bound |
 
 pub mod campaign;
+pub mod contract_statistics;
 pub mod falsify;
 pub mod mission_space;
 pub mod montecarlo;

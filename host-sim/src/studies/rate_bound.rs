@@ -45,21 +45,56 @@ fn binomial_cdf(k: u64, n: u64, p: f64) -> f64 {
     sum
 }
 
-/// "0 false feasible in N sampled and M adversarial evaluations, 95 % upper bound on the rate
-/// …": the contract's statistics in a sentence. The bound is over the `sampled` draws only
-/// (independent draws of the contract's distribution); the adversarial evaluations are
-/// counted, not folded into the rate (a search's candidates are not independent draws).
-pub fn contract_sentence(false_feasible: u64, sampled: u64, adversarial: u64) -> String {
-    let bound = clopper_pearson_upper(false_feasible, sampled, 0.95);
-    format!(
-        "{false_feasible} false feasible in {sampled} sampled and {adversarial} adversarial \
-         evaluations, 95 % upper bound on the rate over the sampled missions {:.2} % \
-         (one-sided Clopper–Pearson{})",
-        100.0 * bound,
-        if false_feasible == 0 && sampled > 0 {
-            format!("; rule of three 3/N = {:.2} %", 300.0 / sampled as f64)
+/// What the contract's sentence counts: false feasibles among independent draws of the
+/// mission space (`sampled`) and among a search's candidates (`adversarial`), each of the
+/// evaluations that counted (flown at a proposed scale).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Counts {
+    pub sampled: u64,
+    pub sampled_false_feasible: u64,
+    pub adversarial: u64,
+    pub adversarial_false_feasible: u64,
+}
+
+impl Counts {
+    /// The one-sided 95 % Clopper–Pearson upper bound on the false-feasible rate over the
+    /// sampled draws (NaN when none was sampled).
+    pub fn upper_bound(&self) -> f64 {
+        clopper_pearson_upper(self.sampled_false_feasible, self.sampled, 0.95)
+    }
+
+    /// "N false feasible in S sampled and A adversarial evaluations; 95 % upper bound on the
+    /// false-feasible rate: x %": the contract's statistics in a sentence (**Choice 415**).
+    /// The bound is over the sampled draws only (independent draws of the space); the
+    /// adversarial evaluations are counted, not folded into the rate (a search's candidates are
+    /// not independent draws), and their false feasibles are in N.
+    pub fn sentence(&self) -> String {
+        let total = self.sampled_false_feasible + self.adversarial_false_feasible;
+        let split = if total > 0 {
+            format!(
+                " ({} sampled, {} adversarial)",
+                self.sampled_false_feasible, self.adversarial_false_feasible
+            )
         } else {
             String::new()
-        }
-    )
+        };
+        let bound = self.upper_bound();
+        format!(
+            "{total} false feasible in {} sampled and {} adversarial evaluations{split}; 95 % \
+             upper bound on the false-feasible rate: {} (one-sided Clopper–Pearson over the \
+             sampled draws{})",
+            self.sampled,
+            self.adversarial,
+            if bound.is_nan() {
+                "none (nothing sampled)".to_string()
+            } else {
+                format!("{:.2} %", 100.0 * bound)
+            },
+            if self.sampled_false_feasible == 0 && self.sampled > 0 {
+                format!("; rule of three 3/S = {:.2} %", 300.0 / self.sampled as f64)
+            } else {
+                String::new()
+            }
+        )
+    }
 }

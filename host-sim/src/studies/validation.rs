@@ -24,7 +24,7 @@ use super::mission_space::{self, Reach};
 use super::preflight::{self, CheckError, Verdict};
 use crate::interrupt;
 use crate::plant::CurrentModel;
-use crate::scenario::navigation::{NavigationModel, Preset};
+use crate::scenario::navigation::Preset;
 use crate::scenario::{real_vehicle, Scenario, ScenarioError, SimConfig};
 use crate::sim::{self, bound, LocalController, Recording};
 
@@ -121,6 +121,11 @@ impl Missions<'_> {
         self.len() == 0
     }
 
+    /// Whether mission `i` is one of the random missions (under any preset).
+    pub fn is_sampled(&self, i: usize) -> bool {
+        i % (self.matrix_len() + self.campaign.random) >= self.matrix_len()
+    }
+
     fn matrix_len(&self) -> usize {
         self.campaign.masks.len() * self.real.len()
     }
@@ -148,16 +153,8 @@ impl Missions<'_> {
         .random::<u64>();
         // The real chain's own filter (a random mission is drawn without one).
         let filter = self.real[0].config().controller.estimator.kind;
-        mission.with(|c| {
-            c.name = format!("{}-{}", c.name, preset.name());
-            c.navigation = NavigationModel::preset(preset, seed);
-            c.controller.estimator.kind = if preset == Preset::Ideal {
-                // The exact state needs no filter: told as is, as the contract always flew it.
-                controller_core::EstimatorKind::Off
-            } else {
-                filter
-            };
-        })
+        mission_space::under_preset(&mission, preset, seed, filter)?
+            .with(|c| c.name = format!("{}-{}", c.name, preset.name()))
     }
 }
 
@@ -196,6 +193,9 @@ pub struct MissionResult {
     /// The smallest time scale (to [`FLYING_TOLERANCE`]) at which a flight stays within the
     /// bound, when the proposed one does.
     pub smallest_flying: Option<f64>,
+    /// One of the campaign's random missions (an independent draw), not of its matrix of real
+    /// paths × mountings (an enumeration): only these bound a rate (Choice 471).
+    pub sampled: bool,
 }
 
 impl MissionResult {
@@ -383,6 +383,7 @@ pub fn check_and_fly(
         saturated: None,
         within: None,
         smallest_flying: None,
+        sampled: false,
     };
     let Some(k) = proposed else {
         return Ok(Some((out, None)));
@@ -460,7 +461,12 @@ pub fn validate(
                 return Ok(None);
             }
             let m = missions.get(i).map_err(|e| e.to_string())?;
-            let r = validate_one(&m, margin, measure);
+            let r = validate_one(&m, margin, measure).map(|r| {
+                r.map(|r| MissionResult {
+                    sampled: missions.is_sampled(i),
+                    ..r
+                })
+            });
             on_done();
             r
         })

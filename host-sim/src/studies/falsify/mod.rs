@@ -19,6 +19,7 @@ use serde::{Deserialize, Serialize};
 
 use super::mission_space::{self, Point, Reach};
 use super::validation;
+use crate::scenario::navigation::Preset;
 use crate::scenario::{real_vehicle, Bound, Scenario, ScenarioError};
 use crate::sim::bound;
 
@@ -34,6 +35,9 @@ pub struct Setup {
     pub margin: f64,
     /// Each candidate's duration at time scale 1 (s).
     pub duration: f64,
+    /// Every candidate told its state through this preset (`None`: as the reach has it — the
+    /// exact state for the contract's, a drawn preset for the realities).
+    pub navigation: Option<Preset>,
 }
 
 impl Setup {
@@ -45,7 +49,19 @@ impl Setup {
             reach,
             margin,
             duration,
+            navigation: None,
         })
+    }
+
+    /// The same candidates, each told its state through `preset` (Choice 470): the realities'
+    /// preset coordinate is held at it; a contract mission is flown under it as the contract
+    /// flies every mission under each of its presets ([`mission_space::under_preset`]), its
+    /// navigation seed a function of the point.
+    pub fn with_navigation(self, preset: Option<Preset>) -> Self {
+        Setup {
+            navigation: preset,
+            ..self
+        }
     }
 
     /// The cube's dimension.
@@ -55,14 +71,40 @@ impl Setup {
 
     /// The mission at `x`, named `name` (unflown, at time scale 1).
     pub fn mission(&self, x: &[f64], name: &str) -> Result<Scenario, ScenarioError> {
-        mission_space::mission(
+        let held;
+        let x = match (self.navigation, self.reach) {
+            (Some(p), Reach::Realities) => {
+                held = mission_space::with_preset(x, p);
+                &held[..]
+            }
+            _ => x,
+        };
+        let m = mission_space::mission(
             &self.base,
             self.reach,
             name.to_string(),
             self.duration,
             &mut Point(x),
-        )
+        )?;
+        match (self.navigation, self.reach) {
+            (Some(p), Reach::Contract) => mission_space::under_preset(
+                &m,
+                p,
+                point_seed(x),
+                self.base.config().controller.estimator.kind,
+            ),
+            _ => Ok(m),
+        }
     }
+}
+
+/// A navigation seed from a point's bits (within a TOML integer): the same point, the same
+/// seed.
+fn point_seed(x: &[f64]) -> u64 {
+    let h = x.iter().fold(0xCBF2_9CE4_8422_2325u64, |h, v| {
+        (h ^ v.to_bits()).wrapping_mul(0x0000_0100_0000_01B3)
+    });
+    (h ^ (h >> 32)) & u64::from(u32::MAX)
 }
 
 /// One candidate, evaluated.
@@ -85,6 +127,12 @@ impl Evaluation {
         let r = t.into_iter().fold(f64::INFINITY, f64::min);
         // A run that ended early (diverged) is outside the bound whatever its terms say.
         Some(if self.falsified { r.min(-0.0) } else { r })
+    }
+
+    /// Whether a robustness of the trace is a false feasible: below 0, or −0 (a run that ended
+    /// early with every term inside its limit, [`Evaluation::robustness`]).
+    pub fn is_false_feasible(robustness: f64) -> bool {
+        robustness.is_sign_negative()
     }
 
     /// What a minimiser sees: the robustness, +∞ when it does not count.
@@ -283,12 +331,15 @@ pub struct Spec {
     pub budget: usize,
     /// Restarts of each method.
     pub restarts: u64,
+    /// The navigation preset every candidate is told its state through ([`Setup::navigation`]).
+    #[serde(default)]
+    pub navigation: Option<Preset>,
 }
 
 impl Spec {
     /// Its candidates' setup.
     pub fn setup(&self) -> Result<Setup, ScenarioError> {
-        Setup::new(self.reach, self.margin, self.duration)
+        Ok(Setup::new(self.reach, self.margin, self.duration)?.with_navigation(self.navigation))
     }
 }
 
