@@ -1,5 +1,6 @@
 //! host-sim's own drawing of the Foxglove layout's plot panels from a flight log
-//! (docs/logs.md#layouts, Choice 383): the picture the README shows.
+//! (docs/logs.md#layouts, Choice 383), without a browser (the README's picture is Foxglove's,
+//! `scripts/viewer-screenshot.sh`).
 //!
 //!     cargo run --profile host -p host-sim --example layout_views -- \
 //!         layouts/auv150.foxglove.json runs/x/circle-with.mcap docs/images/flight-views.png

@@ -121,7 +121,10 @@ impl<'c> McapLog<'c> {
             .map_err(|e| incomplete(format!("starting it: {e}")))?;
         let cfg = scenario.config();
         let rate_hz = u64::from(cfg.controller.rate_hz.max(1));
-        let (channels, every) = declare(&mut writer, rate_hz, source).map_err(incomplete)?;
+        // The metadata and attachments before the channels (Choice 481): a metadata record
+        // closes the open chunk, and the chunk of the channels alone would hold no message,
+        // which the TypeScript MCAP reader (Foxglove) refuses ("Chunks without message
+        // indexes"). Declared after them, the channels share the first second's chunk.
         writer
             .write_metadata(&run_metadata(scenario, source))
             .and_then(|()| {
@@ -130,6 +133,7 @@ impl<'c> McapLog<'c> {
                     .try_for_each(|a| writer.attach(a))
             })
             .map_err(|e| incomplete(format!("writing its metadata: {e}")))?;
+        let (channels, every) = declare(&mut writer, rate_hz, source).map_err(incomplete)?;
         Ok(McapLog {
             path: path.to_path_buf(),
             writer: Some(writer),

@@ -5,7 +5,9 @@
 //! `diff` command reads the fields back by the same names.
 //!
 //! JSON Schema with JSON messages: what Foxglove and PlotJuggler open without a plugin
-//! (**Choice 350**). A number that is not finite is written `null` (JSON has no NaN).
+//! (**Choice 350**). A number that is not finite is left out of its message (JSON has no NaN),
+//! and a number's schema is the one type `number`, not optional in the schema's `required`
+//! (**Choice 480**: Foxglove reads only a single `type` and refuses `["number", "null"]`).
 
 use std::fmt::Write as _;
 
@@ -17,7 +19,7 @@ use crate::sim::Sample;
 /// What a field holds.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Kind {
-    /// A number (or `null` when it is not finite, or not known this period).
+    /// A number (left out of the message when it is not finite, or not known this period).
     Number,
     Integer,
     Boolean,
@@ -27,7 +29,7 @@ pub enum Kind {
 impl Kind {
     fn json_type(self) -> Value {
         match self {
-            Kind::Number => json!(["number", "null"]),
+            Kind::Number => json!("number"),
             Kind::Integer => json!("integer"),
             Kind::Boolean => json!("boolean"),
             Kind::Text => json!("string"),
@@ -270,7 +272,7 @@ pub const CHANNELS: [ChannelSpec; 15] = [
             one(
                 "ball_radius",
                 Kind::Number,
-                "Eq 40's X = √(μδ / (2 λ_min(Q))); 0 for Eq 26, null without Δu",
+                "Eq 40's X = √(μδ / (2 λ_min(Q))); 0 for Eq 26, left out without Δu",
             ),
             one(
                 "status",
@@ -327,7 +329,7 @@ pub const CHANNELS: [ChannelSpec; 15] = [
             group(
                 "velocity",
                 LINEAR,
-                "velocity over the bottom measured (m/s); null without bottom lock",
+                "velocity over the bottom measured (m/s); left out without bottom lock",
             ),
         ],
         rate: Rate::Arrival,
@@ -495,7 +497,14 @@ pub const CHANNELS: [ChannelSpec; 15] = [
     },
 ];
 
-/// The JSON Schema (draft 2020-12) of a channel: every field required.
+/// Whether a field of this kind is in every message (its schema's `required`): all but a
+/// number, which is left out when it is not finite (Choice 480).
+fn always_there(kind: Kind) -> bool {
+    kind != Kind::Number
+}
+
+/// The JSON Schema (draft 2020-12) of a channel: every field required but a number (Choice
+/// 480); a group (an object of numbers) is always there, its members are numbers.
 pub fn json_schema(spec: &ChannelSpec) -> Value {
     let mut properties = Map::new();
     for f in spec.fields {
@@ -506,17 +515,23 @@ pub fn json_schema(spec: &ChannelSpec) -> Value {
                     .iter()
                     .map(|m| (m.to_string(), json!({"type": f.kind.json_type()})))
                     .collect();
+                let required: &[&str] = if always_there(f.kind) { members } else { &[] };
                 json!({
                     "type": "object",
                     "description": f.about,
                     "properties": inner,
-                    "required": members,
+                    "required": required,
                 })
             }
         };
         properties.insert(f.name.to_string(), schema);
     }
-    let required: Vec<&str> = spec.fields.iter().map(|f| f.name).collect();
+    let required: Vec<&str> = spec
+        .fields
+        .iter()
+        .filter(|f| f.members.is_some() || always_there(f.kind))
+        .map(|f| f.name)
+        .collect();
     json!({
         "$schema": "https://json-schema.org/draft/2020-12/schema",
         "title": spec.schema,
@@ -551,24 +566,38 @@ impl<'o> Message<'o> {
         }
     }
 
-    /// The next field's name (a comma before all but the first).
-    fn key(&mut self, kind: Kind, group: bool) -> Option<&'static Field> {
+    /// The next field of the declaration, which must be of `kind`.
+    fn next_field(&mut self, kind: Kind, group: bool) -> Option<&'static Field> {
         let f = self.fields.next();
         debug_assert!(
             f.is_some_and(|f| f.kind == kind && f.members.is_some() == group),
             "{f:?} is not a {kind:?} (group {group})"
         );
-        let f = f?;
+        f
+    }
+
+    /// A name into the message (a comma before all but the first).
+    fn write_key(&mut self, name: &str) {
         if self.out.len() > 1 {
             self.out.push(',');
         }
-        let _ = write!(self.out, "\"{}\":", f.name);
+        let _ = write!(self.out, "\"{name}\":");
+    }
+
+    /// The next field, its name written.
+    fn key(&mut self, kind: Kind, group: bool) -> Option<&'static Field> {
+        let f = self.next_field(kind, group)?;
+        self.write_key(f.name);
         Some(f)
     }
 
+    /// A number; left out, name and all, when it is not finite (Choice 480).
     pub fn num(&mut self, x: impl JsonNumber) -> &mut Self {
-        if self.key(Kind::Number, false).is_some() {
-            x.put(self.out);
+        if let Some(f) = self.next_field(Kind::Number, false) {
+            if x.finite() {
+                self.write_key(f.name);
+                x.put(self.out);
+            }
         }
         self
     }
@@ -594,37 +623,49 @@ impl<'o> Message<'o> {
         self
     }
 
-    /// A group of numbers, one per member (missing ones `null`).
+    /// A group of numbers, one per member (a missing or non-finite one left out, Choice 480).
     pub fn nums<T: JsonNumber>(&mut self, xs: impl IntoIterator<Item = T>) -> &mut Self {
-        self.group(Kind::Number, xs, |out, x| x.put(out))
+        self.group(Kind::Number, xs, |out, x| {
+            if x.finite() {
+                x.put(out);
+            }
+            x.finite()
+        })
     }
 
     /// A group of booleans, one per member.
     pub fn bools(&mut self, xs: impl IntoIterator<Item = bool>) -> &mut Self {
         self.group(Kind::Boolean, xs, |out, b| {
             let _ = write!(out, "{b}");
+            true
         })
     }
 
+    /// An object of the field's members; `put` writes one value and says whether it did (a
+    /// member without a value, or whose value `put` leaves out, is left out, name and all).
     fn group<T>(
         &mut self,
         kind: Kind,
         xs: impl IntoIterator<Item = T>,
-        put: impl Fn(&mut String, T),
+        put: impl Fn(&mut String, T) -> bool,
     ) -> &mut Self {
         let Some(members) = self.key(kind, true).and_then(|f| f.members) else {
             return self;
         };
         self.out.push('{');
         let mut xs = xs.into_iter();
-        for (i, m) in members.iter().enumerate() {
-            if i > 0 {
+        let mut first = true;
+        for m in members {
+            let Some(x) = xs.next() else { break };
+            let mark = self.out.len();
+            if !first {
                 self.out.push(',');
             }
             let _ = write!(self.out, "\"{m}\":");
-            match xs.next() {
-                Some(x) => put(self.out, x),
-                None => self.out.push_str("null"),
+            if put(self.out, x) {
+                first = false;
+            } else {
+                self.out.truncate(mark);
             }
         }
         self.out.push('}');
@@ -638,29 +679,31 @@ impl<'o> Message<'o> {
 }
 
 /// A number as JSON: its type's shortest round-trip decimal (an f32 as the f32's digits,
-/// `0.1`, not the widened `0.10000000149011612`: the value the law had, in fewer bytes), and
-/// `null` when it is not finite.
+/// `0.1`, not the widened `0.10000000149011612`: the value the law had, in fewer bytes). A
+/// number that is not finite has no JSON: the message leaves it out (Choice 480).
 pub trait JsonNumber: Copy {
+    fn finite(self) -> bool;
+    /// Writes a finite number.
     fn put(self, out: &mut String);
 }
 
 impl JsonNumber for f64 {
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
     fn put(self, out: &mut String) {
-        if self.is_finite() {
-            let _ = write!(out, "{self}");
-        } else {
-            out.push_str("null");
-        }
+        debug_assert!(self.is_finite());
+        let _ = write!(out, "{self}");
     }
 }
 
 impl JsonNumber for f32 {
+    fn finite(self) -> bool {
+        self.is_finite()
+    }
     fn put(self, out: &mut String) {
-        if self.is_finite() {
-            let _ = write!(out, "{self}");
-        } else {
-            out.push_str("null");
-        }
+        debug_assert!(self.is_finite());
+        let _ = write!(out, "{self}");
     }
 }
 
@@ -863,25 +906,101 @@ pub fn event(kind: &str, status: &str, text: &str, out: &mut String) {
 mod tests {
     use super::*;
 
-    /// Every channel's fields are in its schema, required, and the topics and schema names are
-    /// distinct: the table is a closed set indexed by [`Topic`].
+    /// Every channel's fields are in its schema, required but for a lone number (Choice 480),
+    /// and the topics and schema names are distinct: the table is a closed set indexed by
+    /// [`Topic`].
     #[test]
     fn the_table_is_indexed_by_topic_and_each_schema_requires_its_fields() {
         for (i, t) in Topic::ALL.iter().enumerate() {
             assert_eq!(*t as usize, i);
             let spec = t.spec();
             let schema = json_schema(spec);
+            let required: Vec<&str> = schema["required"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(Value::as_str)
+                .collect();
             for f in spec.fields {
                 assert!(schema["properties"][f.name].is_object(), "{}", f.name);
+                let lone_number = f.members.is_none() && f.kind == Kind::Number;
+                assert_eq!(required.contains(&f.name), !lone_number, "{}", f.name);
             }
-            assert_eq!(
-                schema["required"].as_array().map(Vec::len),
-                Some(spec.fields.len())
-            );
         }
         let mut topics: Vec<_> = CHANNELS.iter().map(|c| c.topic).collect();
         topics.sort_unstable();
         topics.dedup();
         assert_eq!(topics.len(), CHANNELS.len());
+    }
+
+    /// Every `type` in every channel's schema, at any depth, is one string of the six Foxglove
+    /// Studio's JSON Schema reader takes (`boolean`, `string`, `number`, `integer`, `object`,
+    /// `array`: its `parseJsonSchema` switches on a single `type` and refuses anything else,
+    /// `["number", "null"]` included, so the channel's messages cannot be plotted). Choice 480.
+    #[test]
+    fn every_type_in_the_schemas_is_one_foxglove_reads() {
+        fn walk(v: &Value, at: &str, bad: &mut Vec<String>) {
+            match v {
+                Value::Object(m) => {
+                    if let Some(t) = m.get("type") {
+                        let ok = ["boolean", "string", "number", "integer", "object", "array"];
+                        if !t.as_str().is_some_and(|t| ok.contains(&t)) {
+                            bad.push(format!("{at}: {t}"));
+                        }
+                    }
+                    for (k, sub) in m {
+                        walk(sub, &format!("{at}.{k}"), bad);
+                    }
+                }
+                Value::Array(xs) => xs.iter().for_each(|x| walk(x, at, bad)),
+                _ => {}
+            }
+        }
+        let mut bad = Vec::new();
+        for spec in &CHANNELS {
+            walk(&json_schema(spec), spec.topic, &mut bad);
+        }
+        assert!(bad.is_empty(), "types Foxglove refuses: {bad:?}");
+    }
+
+    /// A number that is not finite is left out of its message, name and all, in a lone field
+    /// and in a group; what is left is JSON the schema takes (its required keys all there).
+    #[test]
+    fn a_number_that_is_not_finite_is_left_out_of_its_message() {
+        let mut out = String::new();
+        Message::new(Topic::Depth.spec(), &mut out)
+            .num(f64::NAN)
+            .num(2.5)
+            .end();
+        assert_eq!(out, r#"{"z":2.5}"#);
+        Message::new(Topic::Depth.spec(), &mut out)
+            .num(1.0)
+            .num(f64::INFINITY)
+            .end();
+        assert_eq!(out, r#"{"t_sampled":1}"#);
+        let spec = Topic::Truth.spec();
+        let mut m = Message::new(spec, &mut out);
+        for f in spec.fields {
+            let n = f.members.map_or(1, <[_]>::len);
+            let mut xs = vec![0.5f64; n];
+            xs[n / 2] = f64::NAN;
+            match f.members {
+                Some(_) => m.nums(xs),
+                None => m.num(xs[0]),
+            };
+        }
+        m.end();
+        let v: Value = serde_json::from_str(&out).expect("JSON");
+        let schema = json_schema(spec);
+        for f in spec.fields {
+            if let Some(members) = f.members {
+                let got = v[f.name].as_object().expect("a group is there");
+                assert_eq!(got.len(), members.len() - 1, "{}: {got:?}", f.name);
+                assert!(!got.contains_key(members[members.len() / 2]));
+            }
+        }
+        for key in schema["required"].as_array().expect("required") {
+            assert!(v.get(key.as_str().expect("a name")).is_some(), "{key}");
+        }
     }
 }

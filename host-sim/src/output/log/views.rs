@@ -1,9 +1,9 @@
 //! host-sim's own drawing of a Foxglove layout's plot panels from a flight
 //! (docs/logs.md#layouts, **Choice 383**): each `Plot` panel of the layout is drawn from the
 //! flight's series it names (a message path `/topic.field.member`), over time or, for a panel
-//! with a custom x axis, one path against another. The README's picture of the layout's views
-//! is made so (`examples/layout_views.rs`) from a real log: neither Foxglove nor PlotJuggler
-//! runs without a display here. Text panels (state transitions) are not drawn.
+//! with a custom x axis, one path against another (`examples/layout_views.rs`): the layout's
+//! views from a real log without a browser; the README's picture is Foxglove's own
+//! (`scripts/viewer-screenshot.sh`, Choice 482). Text panels (state transitions) are not drawn.
 
 use std::path::Path;
 
