@@ -20,8 +20,8 @@
 //!   time scale the preflight proposes ([`validation::check_and_fly`]): max path error,
 //!   reversals per second, command total variation, saturated fraction, and the proposed time
 //!   scale (a refused mission counts as [`Trajectory::MAX_TIME_SCALE`]); each as p95 (nearest
-//!   rank) and worst. The search minimises the five p95s; a flight that ended early or with a
-//!   metric not a number is a constraint violation.
+//!   rank) and worst. The search minimises the five p95s; a refused mission and a flight with
+//!   a metric not a number are constraint violations (Deb's rule: fewer first).
 //! - The search ([`nsga2`], Choice 441) in restarts, the shards' unit (**Choice 445**): restart
 //!   r is its own stream of the seed, its first member the shipped gains; the merge takes the
 //!   non-dominated set of every restart's last population.
@@ -182,11 +182,11 @@ impl Spec {
 /// its cost bounded (measured in docs/tune.md).
 pub const MAIN_JOB_TUNE: Spec = Spec {
     seed: 1,
-    missions: 3,
+    missions: 6,
     duration: 20.0,
     margin: crate::studies::preflight::DEFAULT_MARGIN,
-    population: 8,
-    generations: 3,
+    population: 12,
+    generations: 6,
     restarts: 1,
 };
 
@@ -256,11 +256,13 @@ pub struct Scores {
 }
 
 impl Scores {
-    /// What the search sees.
+    /// What the search sees: the five p95s, and as the violation the missions refused or
+    /// failed (a refused mission is not flown, so its path, chatter and saturation would
+    /// otherwise go unscored: a candidate must not look better by being refused).
     pub fn scored(&self) -> nsga2::Scored {
         nsga2::Scored {
             objectives: self.p95.to_vec(),
-            violation: self.failed as f64,
+            violation: (self.failed + self.refused) as f64,
         }
     }
 }
