@@ -10,7 +10,7 @@ use std::process::ExitCode;
 use clap::{Parser, Subcommand};
 use host_sim::cli::{
     self, CampaignArgs, CheckArgs, DiffArgs, FalsifyArgs, HilArgs, ImportPlanArgs, MonteCarloArgs,
-    PilArgs, RunArgs, Table1Args, ValidateArgs,
+    PilArgs, RunArgs, Table1Args, TuneArgs, ValidateArgs,
 };
 
 #[derive(Parser)]
@@ -60,6 +60,11 @@ enum Command {
     /// campaign, `--merge` keeps the worst); writes each falsifying mission as a scenario
     /// file. Exit 1 if one was found.
     Falsify(FalsifyArgs),
+    /// A multi-objective study (NSGA-II) of the controller's gains, K₁, K₂ by axis group, μ,
+    /// δ_max and the estimator's σₐ, each candidate scored on one fixed sample of missions
+    /// (sharded as a campaign, `--merge` unions the fronts); writes the Pareto front, its
+    /// projections and the chosen point as a `[controller]` block beside the shipped gains.
+    Tune(TuneArgs),
     /// A QGroundControl `.plan` (its waypoints) as a waypoint scenario on stdout, in the NED
     /// frame of the plan's home position, each altitude in its item's frame. Exit 2 if the file
     /// is not a plan of waypoints, on what the scenario would refuse (named by plan item:
@@ -107,6 +112,7 @@ fn main() -> ExitCode {
         Command::ValidatePreflight(args) => cli::validate_preflight(&args, stdout),
         Command::Campaign(args) => cli::campaign(&args, stdout),
         Command::Falsify(args) => cli::falsify(&args, stdout),
+        Command::Tune(args) => cli::tune(&args, stdout),
         Command::ImportPlan(args) => cli::import_plan(&args, stdout),
         Command::Diff(args) => cli::diff(&args, stdout),
     };

@@ -14,7 +14,15 @@ fn scenario_dir() -> std::path::PathBuf {
 fn table1_json_has_the_twelve_cases_in_the_documented_schema() {
     let out_dir = tempdir("table1");
     let out = host_sim()
-        .args(["table1", "--contract", "none", "--json", "--out"])
+        .args([
+            "table1",
+            "--contract",
+            "none",
+            "--tune",
+            "none",
+            "--json",
+            "--out",
+        ])
         .arg(&out_dir)
         .output()
         .unwrap();

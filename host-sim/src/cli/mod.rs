@@ -5,7 +5,7 @@
 //!
 //! ```text
 //! host-sim                                   # = host-sim table1
-//! host-sim table1 [--json] [--out DIR]
+//! host-sim table1 [--json] [--out DIR] [--contract full|team|none] [--tune main|none]
 //! host-sim run --scenario FILE.toml [--json] [--out DIR] [--allow-long-run]
 //! host-sim pil (--scenario FILE | --table1) [--duration S] [--drop A..B …] [--link-key-file F] [--json] [--out DIR]
 //! host-sim hil --port PATH [--baud N] [--pacing lockstep|realtime] [--reply-timeout S] (--scenario FILE | --table1) [the pil flags] [--json] [--out DIR]
@@ -13,6 +13,7 @@
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
 //! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR] [--allow-long-run]
 //! host-sim falsify [--budget B] [--restarts R] [--seed S] [--margin M] [--duration D] [--reach contract|realities] [--shard I/N] --out DIR | --merge DIR… --out DIR
+//! host-sim tune [--missions M] [--duration D] [--population P] [--generations G] [--restarts R] [--seed S] [--shard I/N] --out DIR | --merge DIR… --out DIR
 //! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! host-sim import-plan FILE.plan [--speed 0.5] [--name NAME]    # the scenario TOML on stdout
 //! host-sim diff A B [--abs X] [--rel Y] [--out DIR]              # two flights (MCAP or CSV)
@@ -70,6 +71,7 @@ mod monte_carlo;
 mod pil;
 mod run;
 mod table1;
+mod tune;
 mod validate;
 
 pub use board_loop::LoopArgs;
@@ -83,7 +85,8 @@ pub use json::Cases;
 pub use monte_carlo::{monte_carlo, MonteCarloArgs};
 pub use pil::{pil, PilArgs};
 pub use run::{run, RunArgs};
-pub use table1::{table1, ContractRun, Table1Args, DEFAULT_TABLE1_OUT};
+pub use table1::{table1, ContractRun, Table1Args, TuneRun, DEFAULT_TABLE1_OUT};
+pub use tune::{tune, write_study as write_tune_study, TuneArgs};
 pub use validate::{validate_preflight, Mountings, ValidateArgs};
 
 /// How a command ended, as the process's exit code (see the module doc).

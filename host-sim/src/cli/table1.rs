@@ -24,6 +24,7 @@ use crate::sim::RunResult;
 use crate::studies::contract_statistics::{self, PresetStatistics};
 use crate::studies::preflight::{Preflight, DEFAULT_MARGIN};
 use crate::studies::table1 as paper_table1;
+use crate::studies::tune;
 use crate::studies::validation::{self, Campaign, Measure, Validation, TEAM_MOUNTINGS};
 
 /// Default report folder of `table1`.
@@ -43,6 +44,18 @@ pub struct Table1Args {
     /// eight mountings a team would build and no random missions (`team`), or none.
     #[arg(long, value_enum, default_value_t = ContractRun::Full)]
     pub contract: ContractRun,
+    /// The main job's small fixed-seed gain-tuning study (docs/tune.md#in-the-main-job,
+    /// [`MAIN_JOB_TUNE`](crate::studies::tune::MAIN_JOB_TUNE)): its Pareto front and chosen point
+    /// in the report (`tune-*` files), or none.
+    #[arg(long, value_enum, default_value_t = TuneRun::Main)]
+    pub tune: TuneRun,
+}
+
+/// Whether `table1` runs the main job's tuning study.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
+pub enum TuneRun {
+    Main,
+    None,
 }
 
 /// How much of the preflight's validation campaign `table1` flies.
@@ -74,6 +87,7 @@ impl Default for Table1Args {
             json: false,
             out: PathBuf::from(DEFAULT_TABLE1_OUT),
             contract: ContractRun::Full,
+            tune: TuneRun::Main,
         }
     }
 }
@@ -118,12 +132,15 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         Some((campaign, v)) => Some(statistics(campaign, v, &dir, args.json)?),
         None => None,
     };
-    let sections = real_sections(
+    let mut sections = real_sections(
         &real_rows,
         &checks,
         real_runs.iter().chain(chain_runs),
         contract.as_ref().map(|(_, v)| v),
     ) + statistics.as_ref().map_or("", |(_, md)| md.as_str());
+    if args.tune == TuneRun::Main {
+        sections += &main_job_tune(&dir, args.json)?;
+    }
     let mut incomplete = incomplete.into_inner();
     let report = write_report(
         &dir,
@@ -285,6 +302,21 @@ fn statistics(
     progress.finish();
     let md = contract_statistics::markdown(&stats, start.elapsed().as_secs_f64(), &written);
     Ok((stats, md))
+}
+
+/// The main job's tuning study (Choice 447), its files as `tune-*`; its report section.
+fn main_job_tune(dir: &OutputDir, json: bool) -> Result<String> {
+    let spec = tune::MAIN_JOB_TUNE;
+    let progress = Progress::start(
+        "gain tuning (evaluations)",
+        spec.restarts * spec.evaluations_per_restart() as u64,
+        !json,
+    );
+    let counter = progress.observer();
+    let shard = tune::run_shard(&spec, 0, 1, &|| counter.add(1)).map_err(|e| anyhow!(e))?;
+    progress.finish();
+    let study = tune::merge(&[shard])?;
+    super::tune::write_study(&study, dir, "tune-", "\n##")
 }
 
 /// The text `table1` prints: the paper's table, the real vehicle's verdicts and table, the

@@ -25,6 +25,7 @@ mod plot;
 pub mod report;
 pub mod sections;
 pub mod speed_plot;
+pub mod tune;
 pub mod waypoint_plot;
 
 pub use self::csv::{partial_name, write_csv, CsvStream, CSV_COLUMNS};

@@ -20,4 +20,5 @@ pub mod montecarlo;
 pub mod preflight;
 pub mod rate_bound;
 pub mod table1;
+pub mod tune;
 pub mod validation;

@@ -30,6 +30,19 @@ pub struct LawInside {
     pub ball_radius: Option<f64>,
 }
 
+/// Eq 40's radius X = √(μδ / (2 λ_min(Q))) for the configuration `config` at δ = `delta`: 0
+/// for the discontinuous law (Theorem 3), `None` without Δu (no theorem applies).
+pub fn ball_radius(config: &controller_core::ControllerConfig, delta: f64) -> Option<f64> {
+    match (config.robust, config.law) {
+        (false, _) => None,
+        (true, RobustLaw::Discontinuous) => Some(0.0),
+        (true, RobustLaw::BoundaryLayer) => {
+            let lambda_min = f64::from(config.q[0].min(config.q[1]));
+            Some((f64::from(config.mu) * delta / (2.0 * lambda_min)).sqrt())
+        }
+    }
+}
+
 /// What the inside needs of the controller, taken once per run.
 pub struct InsideOf<'c> {
     controller: &'c Controller,
@@ -42,15 +55,7 @@ impl<'c> InsideOf<'c> {
 
     /// The inside at `s`.
     pub fn at(&self, s: &Sample) -> LawInside {
-        let config = self.controller.config();
-        let ball_radius = match (config.robust, config.law) {
-            (false, _) => None,
-            (true, RobustLaw::Discontinuous) => Some(0.0),
-            (true, RobustLaw::BoundaryLayer) => {
-                let lambda_min = f64::from(config.q[0].min(config.q[1]));
-                Some((f64::from(config.mu) * s.delta / (2.0 * lambda_min)).sqrt())
-            }
-        };
+        let ball_radius = ball_radius(self.controller.config(), s.delta);
         let Ok(kin) = self
             .controller
             .kinematics_stage(&s.signals.eta_told, &s.signals.nu_told)
