@@ -111,9 +111,10 @@ pub const BUDGETS: [StepBudget; 3] = [
         backend: "libm",
         update: 25_000,
         stages: [8_400, 6_200, 1_000, 1_000, 8_000],
-        // Not yet measured (set from the kernels' plus libm's sinf/cosf twice, ≈ 14 000).
-        update_from_solution: 45_000,
-        estimator_stages: [9_000, 1_200, 9_000, 600],
+        // Measured 31 860; solution, filter, estimate, record: 7 592, 1 028, 7 570, 529 (libm's
+        // sinf/cosf in the solution's and the estimate's attitude).
+        update_from_solution: 35_000,
+        estimator_stages: [8_400, 1_150, 8_400, 600],
         // Measured 34 720, 1 281 440 and 1 448 480 (libm's cosf in the rebuild, its sin/cos in
         // the waypoint build).
         work: WorkBudget {
@@ -128,9 +129,9 @@ pub const BUDGETS: [StepBudget; 3] = [
         update: 4_200,
         // The waypoint path's trajectory stage: 600 measured (docs/board.md#the-self-test-and-its-budgets).
         stages: [500, 680, 780, 1_000, 1_250],
-        // Not yet measured (set from the kernels').
-        update_from_solution: 7_000,
-        estimator_stages: [600, 1_200, 600, 600],
+        // Measured 6 151; solution, filter, estimate, record: 398, 1 032, 387, 532.
+        update_from_solution: 6_800,
+        estimator_stages: [450, 1_150, 450, 600],
         // Measured as the kernels: 29 160, 1 051 200 and 1 218 200.
         work: WorkBudget {
             set_config: 34_000,

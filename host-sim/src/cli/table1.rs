@@ -124,23 +124,14 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         .chain(chain_runs.iter().zip(chain_checks))
         .map(|(run, preflight)| RealRow { run, preflight })
         .collect();
-    let contract = match args.contract.campaign() {
-        Some(campaign) => Some(contract(&campaign, args.json)?),
-        None => None,
-    };
-    let statistics = match &contract {
-        Some((campaign, v)) => Some(statistics(campaign, v, &dir, args.json)?),
-        None => None,
-    };
+    let (contract, statistics) = contract_and_statistics(args, &dir)?;
     let mut sections = real_sections(
         &real_rows,
         &checks,
         real_runs.iter().chain(chain_runs),
         contract.as_ref().map(|(_, v)| v),
     ) + statistics.as_ref().map_or("", |(_, md)| md.as_str());
-    if args.tune == TuneRun::Main {
-        sections += &main_job_tune(&dir, args.json)?;
-    }
+    sections += &main_job_tune(args, &dir)?;
     let mut incomplete = incomplete.into_inner();
     let report = write_report(
         &dir,
@@ -183,6 +174,26 @@ pub fn table1(args: &Table1Args, stdout: &mut dyn Write) -> Result<Exit> {
         )?;
     }
     Ok(exit)
+}
+
+/// The contract `args` asks for (none with `--contract none`) and its statistics per preset.
+#[allow(clippy::type_complexity)]
+fn contract_and_statistics(
+    args: &Table1Args,
+    dir: &OutputDir,
+) -> Result<(
+    Option<(Campaign, Validation)>,
+    Option<(Vec<PresetStatistics>, String)>,
+)> {
+    let contract = match args.contract.campaign() {
+        Some(campaign) => Some(contract(&campaign, args.json)?),
+        None => None,
+    };
+    let statistics = match &contract {
+        Some((campaign, v)) => Some(statistics(campaign, v, dir, args.json)?),
+        None => None,
+    };
+    Ok((contract, statistics))
 }
 
 /// The plots of every run (the paper's rows, then the real missions without a companion), the
@@ -304,8 +315,13 @@ fn statistics(
     Ok((stats, md))
 }
 
-/// The main job's tuning study (Choice 447), its files as `tune-*`; its report section.
-fn main_job_tune(dir: &OutputDir, json: bool) -> Result<String> {
+/// The main job's tuning study (Choice 447), its files as `tune-*`; its report section (none
+/// with `--tune none`).
+fn main_job_tune(args: &Table1Args, dir: &OutputDir) -> Result<String> {
+    if args.tune != TuneRun::Main {
+        return Ok(String::new());
+    }
+    let json = args.json;
     let spec = tune::MAIN_JOB_TUNE;
     let progress = Progress::start(
         "gain tuning (evaluations)",

@@ -82,6 +82,7 @@ pub mod path_time;
 pub mod plan;
 pub mod real_vehicle;
 mod start;
+pub mod ultimate_bound;
 mod validate;
 mod write;
 

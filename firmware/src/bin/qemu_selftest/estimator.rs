@@ -23,6 +23,9 @@ const STAGES: usize = EstimatorStage::ALL.len();
 
 /// Checks and counts; false if a vector differs from the host's, none ran, or the largest
 /// `update_from_solution` is over its budget.
+// Long: each golden vector is checked, counted whole, then counted stage by stage on the
+// intermediate values its own call made (the filter's state, the estimate), in one pass; a split
+// would hand a dozen locals across, and moving counted code changes the snapshot's counts.
 pub fn run(counter: &Counter) -> bool {
     let mut cfg = ControllerConfig::default();
     cfg.estimator.kind = EstimatorKind::Kalman;

@@ -7,8 +7,10 @@
 //! the board nothing. ‖w‖ and δ are the law's own (its output).
 
 use controller_core::axes::ACTUATED;
-use controller_core::law::{self, RobustLaw};
+use controller_core::law;
 use controller_core::Controller;
+
+use crate::scenario::ultimate_bound::ball_radius;
 use nalgebra::Vector6;
 
 use crate::sim::Sample;
@@ -28,19 +30,6 @@ pub struct LawInside {
     /// Eq 40: X = √(μδ / (2 λ_min(Q))), Q = diag(q₁, q₂) per axis; 0 for the discontinuous
     /// law (Theorem 3: V decreases everywhere outside e = 0); `None` without Δu (no theorem).
     pub ball_radius: Option<f64>,
-}
-
-/// Eq 40's radius X = √(μδ / (2 λ_min(Q))) for the configuration `config` at δ = `delta`: 0
-/// for the discontinuous law (Theorem 3), `None` without Δu (no theorem applies).
-pub fn ball_radius(config: &controller_core::ControllerConfig, delta: f64) -> Option<f64> {
-    match (config.robust, config.law) {
-        (false, _) => None,
-        (true, RobustLaw::Discontinuous) => Some(0.0),
-        (true, RobustLaw::BoundaryLayer) => {
-            let lambda_min = f64::from(config.q[0].min(config.q[1]));
-            Some((f64::from(config.mu) * delta / (2.0 * lambda_min)).sqrt())
-        }
-    }
 }
 
 /// What the inside needs of the controller, taken once per run.

@@ -36,8 +36,8 @@ use serde::{Deserialize, Serialize};
 
 use super::campaign::PlantStep;
 use super::validation::{self, CheckFlyError};
-use crate::output::log::inside;
 use crate::scenario::navigation::Preset;
+use crate::scenario::ultimate_bound;
 use crate::scenario::{real_vehicle, Scenario, ScenarioError};
 
 pub mod nsga2;
@@ -136,7 +136,7 @@ pub enum Refusal {
 
 /// Theorem 4's ball (Eq 40) at δ = δ_max for `c` (the log's own formula).
 pub fn ball_at_delta_max(c: &ControllerConfig) -> f64 {
-    inside::ball_radius(c, f64::from(c.delta_max)).unwrap_or(0.0)
+    ultimate_bound::ball_radius(c, f64::from(c.delta_max)).unwrap_or(0.0)
 }
 
 /// `base` with `gains`, if the law's conditions hold (Choice 442): the core's own checks,
