@@ -98,6 +98,30 @@ fn load(path: &Path) -> Result<Campaign> {
     Campaign::load(path).map_err(anyhow::Error::new)
 }
 
+/// A sharded search's restarts (`falsify`, `tune`): this shard's, or the merge of shards'
+/// folders; the shards' unit is the restart (r ≡ I mod N).
+#[derive(clap::Args, Clone, Debug, PartialEq)]
+pub struct RestartShards {
+    /// This shard, I/N: restarts r ≡ I (mod N); default from the engine's environment.
+    #[arg(long)]
+    pub shard: Option<String>,
+    /// The shard count with JOB_COMPLETION_INDEX (as `campaign run`).
+    #[arg(long)]
+    pub shards: Option<u64>,
+    /// Merge these shard folders (their `shard.json`) instead of searching.
+    #[arg(long, num_args = 1..)]
+    pub merge: Vec<PathBuf>,
+}
+
+impl RestartShards {
+    /// The shard I/N these flags and the engine's environment name ([`resolve_shard`]).
+    pub fn resolve(&self) -> Result<(u64, u64)> {
+        resolve_shard(self.shard.as_deref(), self.shards, |k| {
+            std::env::var(k).ok()
+        })
+    }
+}
+
 /// The shard I/N from `--shard`, else the engine's environment (`env`), else 0/1
 /// (**Choice 137**); what is ambiguous is refused with the reason (**Choice 246**).
 pub fn resolve_shard(

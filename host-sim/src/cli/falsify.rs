@@ -19,7 +19,7 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 
-use super::campaign::resolve_shard;
+use super::campaign::RestartShards;
 use super::json::print_json;
 use super::Exit;
 use crate::output::falsify::{plot_robustness, report_markdown, Written};
@@ -55,15 +55,8 @@ pub struct FalsifyArgs {
     /// low-cost); default: the contract's exact state, or a drawn preset for the realities.
     #[arg(long, value_parser = super::validate::parse_preset)]
     pub navigation: Option<Preset>,
-    /// This shard, I/N: restarts r ≡ I (mod N); default from the engine's environment.
-    #[arg(long)]
-    pub shard: Option<String>,
-    /// The shard count with JOB_COMPLETION_INDEX (as `campaign run`).
-    #[arg(long)]
-    pub shards: Option<u64>,
-    /// Merge these shard folders (their `shard.json`) instead of searching.
-    #[arg(long, num_args = 1..)]
-    pub merge: Vec<PathBuf>,
+    #[command(flatten)]
+    pub shards: RestartShards,
     #[arg(long)]
     pub json: bool,
     #[arg(long, default_value = "runs/falsify")]
@@ -73,7 +66,7 @@ pub struct FalsifyArgs {
 /// `falsify`: a shard's search (or the merge of shards), its report and files.
 pub fn falsify(args: &FalsifyArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let dir = OutputDir::prepare(&args.out)?;
-    let (spec, restarts, missing, seconds) = if args.merge.is_empty() {
+    let (spec, restarts, missing, seconds) = if args.shards.merge.is_empty() {
         let shard = search(args)?;
         let text = serde_json::to_string_pretty(&shard)?;
         let path = dir.claim("shard.json")?;
@@ -91,6 +84,7 @@ pub fn falsify(args: &FalsifyArgs, stdout: &mut dyn Write) -> Result<Exit> {
         (spec, restarts, missing, seconds)
     } else {
         let shards = args
+            .shards
             .merge
             .iter()
             .map(|d| {
@@ -141,9 +135,7 @@ fn search(args: &FalsifyArgs) -> Result<ShardResult> {
     if !(args.duration > 0.0 && args.duration.is_finite()) || args.budget == 0 {
         bail!("--duration must be > 0 s and --budget ≥ 1");
     }
-    let (i, n) = resolve_shard(args.shard.as_deref(), args.shards, |k| {
-        std::env::var(k).ok()
-    })?;
+    let (i, n) = args.shards.resolve()?;
     let spec = Spec {
         reach: args.reach,
         margin: args.margin,

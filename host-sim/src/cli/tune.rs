@@ -18,7 +18,7 @@ use std::path::PathBuf;
 use anyhow::{anyhow, bail, Context, Result};
 use clap::Args;
 
-use super::campaign::resolve_shard;
+use super::campaign::RestartShards;
 use super::json::print_json;
 use super::Exit;
 use crate::output::tune::{controller_block, front_csv, plot_front, report_markdown};
@@ -49,15 +49,8 @@ pub struct TuneArgs {
     /// The preflight's margin (a fraction of the envelope in (0, 1]).
     #[arg(long, default_value_t = DEFAULT_MARGIN)]
     pub margin: f64,
-    /// This shard, I/N: restarts r ≡ I (mod N); default from the engine's environment.
-    #[arg(long)]
-    pub shard: Option<String>,
-    /// The shard count with JOB_COMPLETION_INDEX (as `campaign run`).
-    #[arg(long)]
-    pub shards: Option<u64>,
-    /// Merge these shard folders (their `shard.json`) instead of searching.
-    #[arg(long, num_args = 1..)]
-    pub merge: Vec<PathBuf>,
+    #[command(flatten)]
+    pub shards: RestartShards,
     #[arg(long)]
     pub json: bool,
     #[arg(long, default_value = "runs/tune")]
@@ -94,7 +87,7 @@ impl TuneArgs {
 /// `tune`: a shard's study (or the merge of shards), its report and files.
 pub fn tune(args: &TuneArgs, stdout: &mut dyn Write) -> Result<Exit> {
     let dir = OutputDir::prepare(&args.out)?;
-    let shards = if args.merge.is_empty() {
+    let shards = if args.shards.merge.is_empty() {
         let shard = search(args)?;
         let text = serde_json::to_string_pretty(&shard)?;
         let path = dir.claim("shard.json")?;
@@ -102,7 +95,8 @@ pub fn tune(args: &TuneArgs, stdout: &mut dyn Write) -> Result<Exit> {
             .with_context(|| format!("writing {}", path.display()))?;
         vec![shard]
     } else {
-        args.merge
+        args.shards
+            .merge
             .iter()
             .map(|d| {
                 let p = d.join("shard.json");
@@ -177,9 +171,7 @@ pub fn write_study(study: &Study, dir: &OutputDir, prefix: &str, heading: &str) 
 /// Runs this shard's restarts, with progress.
 fn search(args: &TuneArgs) -> Result<ShardResult> {
     let spec = args.spec()?;
-    let (i, n) = resolve_shard(args.shard.as_deref(), args.shards, |k| {
-        std::env::var(k).ok()
-    })?;
+    let (i, n) = args.shards.resolve()?;
     let mine = crate::studies::campaign::Shard {
         runs: args.restarts,
         index: i,
