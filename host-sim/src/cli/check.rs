@@ -284,6 +284,10 @@ fn preflight_table(p: &Preflight) -> String {
     }
     s.push_str(&p.navigation.describe());
     s.push('\n');
+    if let Some(b) = &p.path_budget {
+        s.push_str(&b.describe());
+        s.push('\n');
+    }
     if let Some(k) = p.smallest_time_scale {
         s.push_str(&format!(
             "smallest feasible time scale: {k} (the same path then takes {:.1} s)\n",

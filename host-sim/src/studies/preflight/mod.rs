@@ -50,6 +50,7 @@ use crate::scenario::Scenario;
 
 pub mod attitude;
 pub mod navigation;
+pub mod path_budget;
 pub mod period;
 pub mod profile;
 mod sweep;
@@ -255,6 +256,10 @@ pub struct Preflight {
     /// The navigation the check assumed, the thrust its noise takes per thruster (kept on each
     /// side of the margin envelope), and what the mission needs of it.
     pub navigation: navigation::NavigationShare,
+    /// The path error the mission will show on its navigation, against the bound (`None`: the
+    /// scenario has no bound), Choice 424: a mission whose force fits but whose budget does
+    /// not is not feasible at its scale.
+    pub path_budget: Option<path_budget::PathBudget>,
 }
 
 impl Preflight {
@@ -324,6 +329,17 @@ impl fmt::Display for Preflight {
                 )?;
                 if let Some(v) = &self.first_violation {
                     write!(f, ": first at t = {:.2} s, {}", v.t, fmt_violation(v))?;
+                }
+                if let Some(b) = self.path_budget.as_ref().filter(|b| !b.fits()) {
+                    write!(
+                        f,
+                        ": path-error budget {:.1} mm over the {:.0} mm bound",
+                        1e3 * b.total,
+                        1e3 * b.bound
+                    )?;
+                    if let Some(n) = &b.needs {
+                        write!(f, " at every time scale ({n})")?;
+                    }
                 }
                 match self.smallest_time_scale {
                     Some(k) => write!(f, "; feasible from time scale {k}")?,
@@ -401,7 +417,15 @@ pub fn check_with(
     let checker = Checker::new(scenario, margin, engine)?;
     let cfg = scenario.config();
     let k = time_scale(cfg.time_scale);
-    let (as_written, peaks) = verdict(&checker, Scope::AsWritten, k)?;
+    let (mut as_written, peaks) = verdict(&checker, Scope::AsWritten, k)?;
+    let budget = path_budget::Budget::new(scenario)?;
+    let path_budget = match &budget {
+        Some(b) => Some(b.evaluate()?),
+        None => None,
+    };
+    if let (Some(b), Some(pb)) = (&budget, &path_budget) {
+        with_budget(&checker, &mut as_written, k, b, pb)?;
+    }
     let whole_box = match whole_box {
         true => Some(verdict(&checker, Scope::WholeBox, k)?.0),
         false => None,
@@ -447,7 +471,58 @@ pub fn check_with(
         static_violation: as_written.static_violation,
         whole_box,
         navigation,
+        path_budget,
     })
+}
+
+/// The force verdict `v` at the scenario's scale `k` joined with the path-error budget
+/// (Choice 424): feasible only when both fit at `k`; the proposed scale the smallest at which
+/// both fit (the budget's smallest, raised by steps until the force fits too); infeasible when
+/// the budget fits at no scale.
+fn with_budget(
+    checker: &Checker,
+    v: &mut ScopeVerdict,
+    k: f64,
+    budget: &path_budget::Budget,
+    pb: &path_budget::PathBudget,
+) -> Result<(), CheckError> {
+    if matches!(
+        v.verdict,
+        Verdict::StaticallyInfeasible | Verdict::Infeasible
+    ) {
+        return Ok(());
+    }
+    let Some(kb) = pb.smallest_time_scale else {
+        v.verdict = Verdict::Infeasible;
+        v.smallest_time_scale = None;
+        return Ok(());
+    };
+    let Some(kf) = v.smallest_time_scale else {
+        return Ok(());
+    };
+    if kb <= kf && budget.fits_at(kf)? {
+        return Ok(());
+    }
+    let max = f64::from(Trajectory::MAX_TIME_SCALE);
+    let mut at = kb.max(kf);
+    let mut found = None;
+    for _ in 0..=MAX_ROUNDING_STEPS {
+        if at > max {
+            break;
+        }
+        if checker.feasible(Scope::AsWritten, 1.0 / at)? && budget.fits_at(at)? {
+            found = Some(at);
+            break;
+        }
+        at = ((at + TIME_SCALE_STEP) * 100.0).round() / 100.0;
+    }
+    v.smallest_time_scale = found;
+    v.verdict = match found {
+        Some(s) if s <= k => Verdict::Feasible,
+        Some(_) => Verdict::NeedsTimeScale,
+        None => Verdict::Infeasible,
+    };
+    Ok(())
 }
 
 /// The verdict over `scope` at the scenario's scale `k`, and the peaks of the full sweep there.

@@ -1,0 +1,872 @@
+//! The path-error budget (docs/real-vehicle.md#the-path-error-budget, **Choices 420–424**): the
+//! path error a mission will show on its navigation, predicted before it flies, against the
+//! bound. The force check ([`super::navigation`], Choice 372) sees the thrust noise costs; it
+//! cannot see a vehicle that follows its navigation's error within every envelope.
+//!
+//! Per translational axis i of η (x, y, z) the loop is linearised as the law flies it, one
+//! period T at a time (the same loop as [`super::navigation`]'s): the vehicle's error
+//! s = [e, ė] moves as s⁺ = F s + g(u + d) (F = [[1, T], [0, 1]], g = [T²/2, T]), d the
+//! acceleration the law's nominal model does not explain; the law's input is u = −G ŝ with
+//! G = [K₁ + (δ_max/μ)p₁₂, K₂ + (δ_max/μ)p₂₂] (Eq 17, and Δu of Eq 30 inside its boundary
+//! layer), ŝ the solution as told (s + n) or the estimator's posterior
+//! x̂⁺ = (I − K)(F − gG)x̂ + K(s⁺ + n⁺) (the steady-state gain K of
+//! `controller_core::estimator`; its prediction uses u, so d is what it does not know).
+//!
+//! **Navigation error n** (Choice 421): not white. Its position part is the last fix's error
+//! (σ_f, a new draw at each fix, held in between) plus its bias, plus the dead reckoning's
+//! drift since the fix: n_p⁺ = n_p + T n_v; its velocity part is the last DVL ping's error
+//! (σ_v, held until the next ping) plus the DVL's bias and the heading bias's share of the
+//! speed (V σ_ψ), plus the INS's acceleration bias integrated since the ping:
+//! n_v⁺ = n_v + T b_a. For z the fixes are the pressure depths. Fixes and pings come at their
+//! sources' rates, none in their outages; with no fixes the position drifts for the whole
+//! mission. The scenario's `[noise]` adds white noise per period. The covariance of the whole
+//! state [s, x̂, n] is propagated period by period over the flight (P⁺ = A P Aᵀ + Q, a fix or
+//! ping replacing its state's row by a fresh draw), and σᵢ = maxₜ √P_ee(t).
+//!
+//! **Confidence** (Choice 422): a mission's largest error per axis is over N = D·f_fix
+//! independent fixes (D the flight's duration, at least 1); with the mission's miss
+//! probability p = [`MISS_PROBABILITY`] shared by the 3 axes and N fixes (a union bound), the
+//! axis's noise term is q·σᵢ with 2φ(q)/q = p/(3N) (Mills' bound on the Gaussian tail, so q is
+//! never too small).
+//!
+//! **Lag** (Choice 423): d is deterministic for a given mission: the plant as written (its
+//! payload, the current's mean and a Gauss–Markov current's ±3σ corners) against the law's
+//! nominal model along the reference, d = J M⁻¹(τ̂ − τ) (τ̂ the nominal model's force for the
+//! reference, τ the plant's), plus the thrusters' lag τ_L times the reference's jerk. Its
+//! error is bounded by the ℓ₁ norm of the loop's impulse response from d to e:
+//! |e| ≤ ‖h‖₁ · max|d| for every d of that amplitude (the bound is reached only by a d that
+//! flips sign with h; on a constant d it is the DC gain, for the loop without the estimator
+//! 1/G₁ — tests/path_budget.rs). With no estimator a solution τ_lat late adds V·τ_lat.
+//!
+//! **Budget** (Choice 424): per axis eᵢ = q·σᵢ + ‖hᵢ‖₁ max|dᵢ| (+ V τ_lat), and the path
+//! error √(Σ eᵢ²), as the run's max path combines its axes' maxima. At time scale k the
+//! reference's speed falls as 1/k, its acceleration as 1/k², its jerk as 1/k³: the budget's
+//! mismatch and lag fall with them; its navigation part does not (only the heading's share
+//! and a drift over the longer flight change). The budget at k = [`MAX_TIME_SCALE`] is the
+//! mission's speed-independent error: beyond the bound, no time scale helps.
+
+use controller_core::estimator::{steady_state_gain, EstimatorKind};
+use controller_core::kinematics::{self, Attitude};
+use controller_core::model::VehicleParams;
+use controller_core::{Mission, Trajectory};
+use nalgebra::{Matrix2, SMatrix, Vector2, Vector3, Vector6};
+use serde::{Deserialize, Serialize};
+
+use super::{period, CheckError, SAMPLE_PERIOD};
+use crate::plant::{CurrentModel, Plant, PlantState, PlantTerms};
+use crate::scenario::navigation::{ErrorModel, Timing};
+use crate::scenario::Scenario;
+
+/// The probability a mission the budget passes may still exceed it (Choice 422): 1 %.
+pub const MISS_PROBABILITY: f64 = 0.01;
+/// The slowest time scale the budget tries (the trajectory's own limit).
+pub const MAX_TIME_SCALE: f64 = controller_core::Trajectory::MAX_TIME_SCALE as f64;
+/// The longest flight whose covariance is propagated (s): beyond, the budget of a mission
+/// with fixes is periodic, and one without fixes has long left any bound.
+const MAX_PROPAGATION: f64 = 4.0 * 3600.0;
+/// How long a flight with fixes is propagated (s): its covariance repeats with its fixes
+/// long before (the loop settles in seconds; the biases are constant).
+const SETTLED: f64 = 120.0;
+/// Periods of the impulse response summed for ‖h‖₁, at most (a stable loop's has died long
+/// before: 600 s at 100 Hz).
+const MAX_IMPULSE_PERIODS: usize = 60_000;
+/// Standard deviations of a Gauss–Markov current's corners (as the force check's).
+const CURRENT_SIGMAS: f64 = super::GAUSS_MARKOV_SIGMAS;
+
+/// The three translational axes.
+const AXES: usize = 3;
+const AXIS_NAMES: [&str; AXES] = ["x", "y", "z"];
+
+/// The budget of one mission at one time scale (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PathBudget {
+    /// The bound on the max path error (m).
+    pub bound: f64,
+    /// The time scale the figures below are at.
+    pub time_scale: f64,
+    /// The mission's miss probability the budget allows, and the q it gives per axis.
+    pub miss_probability: f64,
+    pub quantile: [f64; AXES],
+    /// σ of the vehicle's true error on x y z under the navigation's draws (fixes, pings,
+    /// white noise) and under its biases (m).
+    pub noise_sigma: [f64; AXES],
+    pub bias_sigma: [f64; AXES],
+    /// The loop's ℓ₁ gain from unexplained acceleration d to the error (m per m/s²), and
+    /// max|d| at this scale (m/s²).
+    pub lag_gain: [f64; AXES],
+    pub mismatch: [f64; AXES],
+    /// Per axis: q·σ, ‖h‖₁·max|d| (+ V·τ_lat), and their sum (m).
+    pub noise: [f64; AXES],
+    pub lag: [f64; AXES],
+    pub axis: [f64; AXES],
+    /// √(Σ axis²) (m): the predicted max path error.
+    pub total: f64,
+    /// The same at the slowest scale: the part no time scale removes (m).
+    pub speed_independent: f64,
+    /// The smallest time scale at which `total` fits the bound (`None`: none up to
+    /// [`MAX_TIME_SCALE`]).
+    pub smallest_time_scale: Option<f64>,
+    /// When no scale fits: what navigation the mission needs.
+    pub needs: Option<String>,
+}
+
+impl PathBudget {
+    /// Fits the bound at its time scale.
+    pub fn fits(&self) -> bool {
+        self.total <= self.bound
+    }
+
+    /// One line for `check`.
+    pub fn describe(&self) -> String {
+        let mut s = format!(
+            "path-error budget at time scale {}: {:.1} mm of the {:.0} mm bound ({:.0} % miss \
+             probability; navigation {:.1}/{:.1}/{:.1} mm, lag {:.1}/{:.1}/{:.1} mm on x/y/z); \
+             speed-independent {:.1} mm",
+            self.time_scale,
+            1e3 * self.total,
+            1e3 * self.bound,
+            100.0 * self.miss_probability,
+            1e3 * self.noise[0],
+            1e3 * self.noise[1],
+            1e3 * self.noise[2],
+            1e3 * self.lag[0],
+            1e3 * self.lag[1],
+            1e3 * self.lag[2],
+            1e3 * self.speed_independent,
+        );
+        match (self.smallest_time_scale, &self.needs) {
+            (_, Some(n)) => s.push_str(&format!("; no time scale fits: {n}")),
+            (Some(k), None) => s.push_str(&format!("; fits from time scale {k}")),
+            (None, None) => {}
+        }
+        s
+    }
+}
+
+/// One axis's navigation error sources (module docs), in the η axis's units.
+#[derive(Clone, Debug, Default)]
+struct AxisNoise {
+    /// The position source resetting the drift (fix or pressure depth): σ, bias σ, its
+    /// timing.
+    fix: Option<(f64, f64, Timing)>,
+    /// DVL ping: σ, bias σ (with the heading's share), timing; `None`: no velocity aiding.
+    ping: Option<(f64, f64, Timing)>,
+    /// INS acceleration bias σ (m/s²).
+    accel_bias: f64,
+    /// White noise per period from `[noise]` (position, velocity).
+    white: [f64; 2],
+}
+
+fn steady<const N: usize>(e: &ErrorModel<N>, i: usize) -> f64 {
+    e.bias[i].hypot(e.bias_sigma[i])
+}
+
+/// The error sources of axis `i` of `scenario` at reference speed `speed` (m/s).
+fn axis_noise(scenario: &Scenario, i: usize, speed: f64) -> AxisNoise {
+    let cfg = scenario.config();
+    let mut a = AxisNoise::default();
+    if let Some(m) = &cfg.navigation {
+        let horizontal = i < 2;
+        a.fix = if horizontal {
+            m.fix
+                .as_ref()
+                .map(|f| (f.error.sigma[i], steady(&f.error, i), f.timing.clone()))
+        } else {
+            Some((
+                m.depth.error.sigma[0],
+                steady(&m.depth.error, 0),
+                m.depth.timing.clone(),
+            ))
+        };
+        // The DVL measures in the body frame: either horizontal η axis may carry surge's or
+        // sway's error; the heading's bias turns the speed into a velocity error.
+        let v = &m.dvl.velocity;
+        let (sigma, bias) = if horizontal {
+            (
+                v.sigma[0].max(v.sigma[1]),
+                steady(v, 0)
+                    .max(steady(v, 1))
+                    .hypot(speed * steady(&m.ins.attitude, 2)),
+            )
+        } else {
+            (
+                v.sigma[2],
+                steady(v, 2).hypot(speed * steady(&m.ins.attitude, 1)),
+            )
+        };
+        a.ping = Some((sigma, bias, m.dvl.timing.clone()));
+        let ab = &m.ins.accel;
+        a.accel_bias = if horizontal {
+            steady(ab, 0).max(steady(ab, 1))
+        } else {
+            steady(ab, 2)
+        };
+    }
+    if let Some(n) = &cfg.noise {
+        a.white = [n.eta_sigma[i], n.nu_sigma[i]];
+    }
+    a
+}
+
+/// Whether a source of `timing` samples at control period `k` (T each), outside its outages.
+fn samples_at(timing: &Timing, k: u64, t_period: f64) -> bool {
+    let every = (1.0 / (timing.rate_hz * t_period)).round().max(1.0) as u64;
+    let t = k as f64 * t_period;
+    k % every == 0 && !timing.outages.iter().any(|o| t >= o[0] && t < o[1])
+}
+
+/// The law's linear loop on one axis: T, G, and the estimator's K (`None`: off).
+#[derive(Clone, Copy, Debug)]
+struct Loop {
+    t: f64,
+    gain: [f64; 2],
+    k: Option<Matrix2<f64>>,
+}
+
+impl Loop {
+    fn of(scenario: &Scenario, axis: usize) -> Result<Self, CheckError> {
+        let controller = scenario.controller();
+        let c = controller.config();
+        let lyap = controller.lyapunov();
+        let robust = if c.robust {
+            f64::from(c.delta_max / c.mu)
+        } else {
+            0.0
+        };
+        let t = 1.0 / f64::from(c.rate_hz);
+        let gain = [
+            f64::from(c.k1[axis]) + robust * f64::from(lyap[axis].p12),
+            f64::from(c.k2[axis]) + robust * f64::from(lyap[axis].p22),
+        ];
+        let e = &scenario.config().controller.estimator;
+        let k = match e.kind {
+            EstimatorKind::Off => None,
+            EstimatorKind::Kalman => Some(
+                steady_state_gain(
+                    t as f32,
+                    e.position_sigma[axis],
+                    e.velocity_sigma[axis],
+                    e.accel_sigma[axis],
+                )
+                .map_err(|_| {
+                    CheckError::Invalid(format!("the estimator has no steady state on axis {axis}"))
+                })?
+                .k
+                .cast::<f64>(),
+            ),
+        };
+        Ok(Loop { t, gain, k })
+    }
+
+    fn f(&self) -> Matrix2<f64> {
+        Matrix2::new(1.0, self.t, 0.0, 1.0)
+    }
+
+    fn g(&self) -> Vector2<f64> {
+        Vector2::new(0.5 * self.t * self.t, self.t)
+    }
+
+    /// ‖h‖₁ of the impulse response from d (one period of unit unexplained acceleration) to
+    /// the position error e; `None` when the loop is unstable.
+    fn lag_gain(&self) -> Option<f64> {
+        let (f, g) = (self.f(), self.g());
+        let gr = nalgebra::RowVector2::new(self.gain[0], self.gain[1]);
+        let mut s = g;
+        let mut xh = match self.k {
+            Some(k) => k * g,
+            None => Vector2::zeros(),
+        };
+        let mut sum = 0.0;
+        for n in 0..MAX_IMPULSE_PERIODS {
+            sum += s[0].abs();
+            let est = if self.k.is_some() { xh } else { s };
+            let u = -(gr * est)[0];
+            let s_next = f * s + g * u;
+            if let Some(k) = self.k {
+                xh = (Matrix2::identity() - k) * (f * xh + g * u) + k * s_next;
+            }
+            s = s_next;
+            if !s.iter().all(|x| x.is_finite()) {
+                return None;
+            }
+            if n > 100 && s.amax() < 1e-15 * sum.max(1e-300) && xh.amax() < 1e-15 * sum.max(1e-300)
+            {
+                return Some(sum);
+            }
+        }
+        (s.amax() < 1e-6 * sum).then_some(sum)
+    }
+}
+
+/// The state of the noise propagation: [s₀, s₁, x̂₀, x̂₁, f, h, b_v, b_a, b_p] (module docs:
+/// f the held fix error and its drift, h the held ping error and its drift).
+const N: usize = 9;
+type Cov = SMatrix<f64, N, N>;
+
+/// σ = maxₜ √P_ee over a flight of `duration` s (module docs), and whether it stayed finite.
+fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> f64 {
+    let (t, f, g) = (lp.t, lp.f(), lp.g());
+    let gr = nalgebra::RowVector2::new(lp.gain[0], lp.gain[1]);
+    let (fix_s, fix_b) = noise.fix.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
+    let (ping_s, ping_b) = noise.ping.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
+    let mut p = Cov::zeros();
+    p[(4, 4)] = fix_s * fix_s;
+    p[(5, 5)] = ping_s * ping_s;
+    p[(6, 6)] = ping_b * ping_b;
+    p[(7, 7)] = noise.accel_bias * noise.accel_bias;
+    p[(8, 8)] = fix_b * fix_b;
+    // The loop's step after the noise (module docs), as a map on the state.
+    let mut loop_step = Cov::identity();
+    // s⁺ = F s − g G ŝ.
+    loop_step.fixed_view_mut::<2, 2>(0, 0).copy_from(&f);
+    let ggr = g * gr;
+    match lp.k {
+        Some(_) => {
+            // x̂ is the estimate; s⁺ = F s − gG x̂, and x̂⁺ = (I−K)(F−gG)x̂ + K(s⁺ + m⁺).
+            loop_step.fixed_view_mut::<2, 2>(0, 2).copy_from(&(-ggr));
+        }
+        None => {
+            // ŝ = s + m: s⁺ = (F − gG)s − gG m.
+            loop_step.fixed_view_mut::<2, 2>(0, 0).copy_from(&(f - ggr));
+            let mut m = SMatrix::<f64, 2, N>::zeros();
+            m[(0, 4)] = 1.0;
+            m[(0, 8)] = 1.0;
+            m[(1, 5)] = 1.0;
+            m[(1, 6)] = 1.0;
+            let cols = -ggr * m;
+            for c in 4..N {
+                for r in 0..2 {
+                    loop_step[(r, c)] = cols[(r, c)];
+                }
+            }
+        }
+    }
+    // The drift of the noise: f⁺ = f + T(h + b_v), h⁺ = h + T b_a.
+    let mut drift = Cov::identity();
+    drift[(4, 5)] = t;
+    drift[(4, 6)] = t;
+    drift[(5, 7)] = t;
+    // The estimator's correction with the new noise: x̂⁺ = (I−K)(F−gG)x̂ + K(s + m).
+    let correct = lp.k.map(|k| {
+        let mut c = Cov::identity();
+        let a = (Matrix2::identity() - k) * (f - ggr);
+        c.fixed_view_mut::<2, 2>(2, 2).copy_from(&a);
+        c.fixed_view_mut::<2, 2>(2, 0).copy_from(&k);
+        // m = [f + b_p, h + b_v].
+        for r in 0..2 {
+            c[(2 + r, 4)] = k[(r, 0)];
+            c[(2 + r, 8)] = k[(r, 0)];
+            c[(2 + r, 5)] = k[(r, 1)];
+            c[(2 + r, 6)] = k[(r, 1)];
+        }
+        c
+    });
+    let white = Matrix2::new(noise.white[0].powi(2), 0.0, 0.0, noise.white[1].powi(2));
+    // White measurement noise enters through −gG (off) or K (estimator).
+    let mut q_white = Cov::zeros();
+    let wb = match lp.k {
+        Some(k) => (2, k),
+        None => (0, -ggr),
+    };
+    q_white
+        .fixed_view_mut::<2, 2>(wb.0, wb.0)
+        .copy_from(&(wb.1 * white * wb.1.transpose()));
+    let reset = |p: &mut Cov, i: usize, var: f64| {
+        for j in 0..N {
+            p[(i, j)] = 0.0;
+            p[(j, i)] = 0.0;
+        }
+        p[(i, i)] = var;
+    };
+    // With fixes and no outages the covariance is periodic once the loop has settled.
+    let held = noise.fix.as_ref().is_some_and(|f| f.2.outages.is_empty())
+        && noise.ping.as_ref().is_none_or(|p| p.2.outages.is_empty());
+    let span = if held {
+        duration.min(SETTLED)
+    } else {
+        duration
+    };
+    let steps = (span.min(MAX_PROPAGATION) / t).ceil() as u64;
+    let mut worst = 0.0f64;
+    for n in 0..steps {
+        p = loop_step * p * loop_step.transpose();
+        if lp.k.is_none() {
+            p += q_white;
+        }
+        p = drift * p * drift.transpose();
+        if let Some((_, _, timing)) = &noise.fix {
+            if samples_at(timing, n + 1, t) {
+                reset(&mut p, 4, fix_s * fix_s);
+            }
+        }
+        if let Some((_, _, timing)) = &noise.ping {
+            if samples_at(timing, n + 1, t) {
+                reset(&mut p, 5, ping_s * ping_s);
+            }
+        }
+        if let Some(c) = &correct {
+            p = c * p * c.transpose() + q_white;
+        }
+        worst = worst.max(p[(0, 0)]);
+        if !worst.is_finite() || worst.sqrt() > stop_above {
+            return worst.sqrt();
+        }
+    }
+    worst.max(0.0).sqrt()
+}
+
+/// q with 2φ(q)/q = `tail` (Mills' bound on P(|x| > q) for a standard normal x).
+fn quantile(tail: f64) -> f64 {
+    let bound = |q: f64| 2.0 * (-0.5 * q * q).exp() / (q * (2.0 * std::f64::consts::PI).sqrt());
+    let (mut lo, mut hi) = (0.5, 40.0);
+    for _ in 0..100 {
+        let mid = 0.5 * (lo + hi);
+        if bound(mid) > tail {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    hi
+}
+
+/// One sample of the reference at k = 1: η_d, η̇_d, η̈_d and the jerk.
+#[derive(Clone, Copy, Debug)]
+struct RefSample {
+    s: f64,
+    eta: Vector6<f64>,
+    eta_dot: Vector6<f64>,
+    eta_ddot: Vector6<f64>,
+    jerk: Vector6<f64>,
+}
+
+/// What the budget needs of a mission, computed once; evaluated at any time scale.
+pub struct Budget<'a> {
+    scenario: &'a Scenario,
+    bound: f64,
+    loops: [Loop; AXES],
+    lag_gain: [f64; AXES],
+    samples: Vec<RefSample>,
+    currents: Vec<Vector3<f64>>,
+    nominal: Plant,
+    /// Max reference speed per axis at k = 1, and the horizontal speed (m/s).
+    speed: [f64; AXES],
+    latency: f64,
+    /// The reference's period (s of path time), when it repeats.
+    period: Option<f64>,
+}
+
+impl<'a> Budget<'a> {
+    /// The budget's model of `scenario`; `None` when the scenario has no bound.
+    ///
+    /// # Errors
+    /// [`CheckError::Invalid`] for a loop the budget cannot model (an unstable one, an
+    /// estimator without a steady state, a nominal model that cannot be built).
+    pub fn new(scenario: &'a Scenario) -> Result<Option<Self>, CheckError> {
+        let cfg = scenario.config();
+        let Some(bound) = cfg.bound() else {
+            return Ok(None);
+        };
+        let invalid = CheckError::Invalid;
+        let loops = [
+            Loop::of(scenario, 0)?,
+            Loop::of(scenario, 1)?,
+            Loop::of(scenario, 2)?,
+        ];
+        let mut lag_gain = [0.0; AXES];
+        for (i, l) in loops.iter().enumerate() {
+            lag_gain[i] = l.lag_gain().ok_or_else(|| {
+                invalid(format!("the law's loop on {} is not stable", AXIS_NAMES[i]))
+            })?;
+        }
+        let path = Trajectory::new(Mission {
+            time_scale: 1.0,
+            ..cfg.mission()
+        })
+        .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
+        let span = cfg.duration / super::time_scale(cfg.time_scale);
+        let checked = period::period(cfg).map_or(span, |p| span.min(p + SAMPLE_PERIOD));
+        let rate = (1.0 / SAMPLE_PERIOD).round() as u32;
+        let n = (checked / SAMPLE_PERIOD).ceil().max(1.0) as u64;
+        let mut samples: Vec<RefSample> = Vec::with_capacity(n as usize + 2);
+        let mut speed = [0.0f64; AXES];
+        for j in 0..=n + 1 {
+            if j % 4096 == 0 {
+                super::poll()?;
+            }
+            let d = path.sample(j, rate);
+            let s = RefSample {
+                s: j as f64 * SAMPLE_PERIOD,
+                eta: d.eta.cast(),
+                eta_dot: d.eta_dot.cast(),
+                eta_ddot: d.eta_ddot.cast(),
+                jerk: Vector6::zeros(),
+            };
+            if let Some(prev) = samples.last_mut() {
+                prev.jerk = (s.eta_ddot - prev.eta_ddot) / SAMPLE_PERIOD;
+            }
+            samples.push(s);
+        }
+        // The last sample has no jerk of its own: it only closed its neighbour's.
+        samples.pop();
+        for s in &samples {
+            for (i, v) in speed.iter_mut().enumerate() {
+                *v = v.max(s.eta_dot[i].abs());
+            }
+        }
+        let nominal = Plant::new(
+            scenario.controller().params().cast(f64::from),
+            PlantTerms::default(),
+        )
+        .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
+        let currents = match &cfg.current {
+            CurrentModel::None => vec![Vector3::zeros()],
+            CurrentModel::Constant(c) => vec![Vector3::from(*c)],
+            CurrentModel::GaussMarkov { mean, sigma, .. } => {
+                let mut v = Vec::new();
+                for sx in [-1.0, 0.0, 1.0] {
+                    for sy in [-1.0, 0.0, 1.0] {
+                        v.push(Vector3::new(
+                            mean[0] + sx * CURRENT_SIGMAS * sigma[0],
+                            mean[1] + sy * CURRENT_SIGMAS * sigma[1],
+                            mean[2],
+                        ));
+                    }
+                }
+                v
+            }
+        };
+        let latency = match (&cfg.navigation, cfg.controller.estimator.kind) {
+            (Some(m), EstimatorKind::Off) => m.ins.timing.latency,
+            _ => 0.0,
+        };
+        Ok(Some(Budget {
+            scenario,
+            bound: bound.max_path,
+            loops,
+            lag_gain,
+            samples,
+            currents,
+            nominal,
+            speed,
+            latency,
+            period: period::period(cfg),
+        }))
+    }
+
+    /// d along the reference at time scale `k` (module docs): per current corner, per sample,
+    /// d on x y z (m/s²).
+    fn mismatch(&self, k: f64) -> Result<Vec<Vec<[f64; AXES]>>, CheckError> {
+        let cfg = self.scenario.config();
+        let lag = cfg.thruster_lag.unwrap_or(0.0);
+        let mut out = vec![Vec::with_capacity(self.samples.len()); self.currents.len()];
+        let mut plant: Option<(VehicleParams<f64>, Plant)> = None;
+        for (j, r) in self.samples.iter().enumerate() {
+            if j % 4096 == 0 {
+                super::poll()?;
+            }
+            let (v, a) = (r.eta_dot / k, r.eta_ddot / (k * k));
+            let att = Attitude::from_eta(&r.eta);
+            let rot = kinematics::rotation(&att);
+            let lin = rot.transpose() * Vector3::new(v[0], v[1], v[2]);
+            let omega = Vector3::new(v[3], v[4], v[5]);
+            let nu = Vector6::new(lin.x, lin.y, lin.z, omega.x, omega.y, omega.z);
+            let lin_dot = rot.transpose() * Vector3::new(a[0], a[1], a[2]) - omega.cross(&lin);
+            let nu_dot = Vector6::new(lin_dot.x, lin_dot.y, lin_dot.z, a[3], a[4], a[5]);
+            let state = PlantState { eta: r.eta, nu };
+            let params = cfg.plant_params_at(r.s * k);
+            if plant.as_ref().is_none_or(|(had, _)| *had != params) {
+                let p = Plant::new(params, PlantTerms::default())
+                    .map_err(|e| CheckError::Invalid(format!("the plant: {e}")))?;
+                plant = Some((params, p));
+            }
+            let Some((_, true_plant)) = &plant else {
+                continue;
+            };
+            // The translational block: a moment the models disagree on is held by the
+            // attitude (the heel roll settles at, the pitch and yaw loops), not the path.
+            let minv = true_plant
+                .mass_matrix()
+                .fixed_view::<3, 3>(0, 0)
+                .into_owned()
+                .try_inverse()
+                .ok_or_else(|| CheckError::Invalid("the plant's mass matrix".to_string()))?;
+            let nominal = self
+                .nominal
+                .required_force(&state, &nu_dot, &Vector3::zeros());
+            for (c, o) in self.currents.iter().zip(out.iter_mut()) {
+                let truth = true_plant.required_force(&state, &nu_dot, c);
+                let dtau = nominal - truth;
+                let d = rot * (minv * Vector3::new(dtau[0], dtau[1], dtau[2]));
+                // The thrust lags the command by τ_L: the acceleration by τ_L·jerk.
+                o.push(std::array::from_fn(|i| {
+                    d[i] - lag * r.jerk[i] / (k * k * k)
+                }));
+            }
+        }
+        Ok(out)
+    }
+
+    /// max|eᵢ| of the linear loop of axis `i` flown on d (one current corner's, at time scale
+    /// `k`) over a flight of `duration` s: d at the control periods by linear interpolation
+    /// between the reference's samples (a periodic mission's repeating).
+    fn lag_response(&self, i: usize, d: &[[f64; AXES]], k: f64, duration: f64) -> f64 {
+        let lp = &self.loops[i];
+        let (f, g) = (lp.f(), lp.g());
+        let gr = nalgebra::RowVector2::new(lp.gain[0], lp.gain[1]);
+        let span_samples = d.len().saturating_sub(1).max(1) as f64 * SAMPLE_PERIOD;
+        let at = |t: f64| -> f64 {
+            let mut s = t / k;
+            if let Some(p) = self.period {
+                s %= p;
+            }
+            let x = (s / SAMPLE_PERIOD).min(span_samples / SAMPLE_PERIOD);
+            let j = (x.floor() as usize).min(d.len().saturating_sub(1));
+            let j1 = (j + 1).min(d.len() - 1);
+            let w = x - j as f64;
+            d[j][i] * (1.0 - w) + d[j1][i] * w
+        };
+        let steps = (duration.min(MAX_PROPAGATION) / lp.t).ceil() as u64;
+        let (mut s, mut xh) = (Vector2::zeros(), Vector2::zeros());
+        let mut worst = 0.0f64;
+        for n in 0..steps {
+            let est = if lp.k.is_some() { xh } else { s };
+            let u = -(gr * est)[0];
+            let s_next = f * s + g * (u + at(n as f64 * lp.t));
+            if let Some(kk) = lp.k {
+                xh = (Matrix2::identity() - kk) * (f * xh + g * u) + kk * s_next;
+            }
+            s = s_next;
+            worst = worst.max(s[0].abs());
+        }
+        worst
+    }
+
+    /// The budget at time scale `k` (without the search: `smallest_time_scale` and `needs`
+    /// unset).
+    fn at(&self, k: f64) -> Result<PathBudget, CheckError> {
+        self.at_for(k, self.duration(k))
+    }
+
+    /// The flight's duration at time scale `k` (s): the same path.
+    fn duration(&self, k: f64) -> f64 {
+        let cfg = self.scenario.config();
+        cfg.duration * k / super::time_scale(cfg.time_scale)
+    }
+
+    /// Whether the budget fits the bound at time scale `k`.
+    ///
+    /// # Errors
+    /// [`CheckError::Interrupted`].
+    pub fn fits_at(&self, k: f64) -> Result<bool, CheckError> {
+        Ok(self.at(k)?.fits())
+    }
+
+    /// The budget at time scale `k` over a flight of `duration` s.
+    fn at_for(&self, k: f64, duration: f64) -> Result<PathBudget, CheckError> {
+        let d = self.mismatch(k)?;
+        let mismatch: [f64; AXES] = std::array::from_fn(|i| {
+            d.iter()
+                .flat_map(|c| c.iter().map(move |x| x[i].abs()))
+                .fold(0.0, f64::max)
+        });
+        let horizontal = self.speed[0].hypot(self.speed[1]) / k;
+        let mut out = PathBudget {
+            bound: self.bound,
+            time_scale: k,
+            miss_probability: MISS_PROBABILITY,
+            quantile: [0.0; AXES],
+            noise_sigma: [0.0; AXES],
+            bias_sigma: [0.0; AXES],
+            lag_gain: self.lag_gain,
+            mismatch,
+            noise: [0.0; AXES],
+            lag: [0.0; AXES],
+            axis: [0.0; AXES],
+            total: 0.0,
+            speed_independent: 0.0,
+            smallest_time_scale: None,
+            needs: None,
+        };
+        for i in 0..AXES {
+            let noise = axis_noise(self.scenario, i, horizontal);
+            let fixes = noise
+                .fix
+                .as_ref()
+                .map_or(1.0, |(_, _, t)| (duration * t.rate_hz).max(1.0));
+            // The draws (a fix's, a ping's, white noise: new ones all flight) and the biases
+            // (one draw a flight), each at its own quantile (Choice 422).
+            let mut draws = noise.clone();
+            draws.accel_bias = 0.0;
+            for src in [&mut draws.fix, &mut draws.ping].into_iter().flatten() {
+                src.1 = 0.0;
+            }
+            let mut biases = noise;
+            biases.white = [0.0; 2];
+            for src in [&mut biases.fix, &mut biases.ping].into_iter().flatten() {
+                src.0 = 0.0;
+            }
+            let q = quantile(MISS_PROBABILITY / (AXES as f64 * fixes));
+            // σ beyond the bound: the budget cannot fit (q > 1), no need to fly further.
+            let stop = self.bound;
+            let sigma = noise_sigma(&self.loops[i], &draws, duration, stop);
+            let bias = noise_sigma(&self.loops[i], &biases, duration, stop);
+            out.quantile[i] = q;
+            out.noise_sigma[i] = sigma;
+            out.bias_sigma[i] = bias;
+            out.noise[i] = q * sigma + quantile(MISS_PROBABILITY / AXES as f64) * bias;
+            let response = d
+                .iter()
+                .map(|c| self.lag_response(i, c, k, duration))
+                .fold(0.0, f64::max);
+            out.lag[i] = response + self.speed[i] / k * self.latency;
+            out.axis[i] = out.noise[i] + out.lag[i];
+        }
+        out.total = out.axis.iter().map(|x| x * x).sum::<f64>().sqrt();
+        Ok(out)
+    }
+
+    /// The budget at the scenario's own scale, with the smallest scale that fits and, when
+    /// none does, what the navigation would have to be.
+    ///
+    /// # Errors
+    /// As [`Budget::new`]; [`CheckError::Interrupted`].
+    pub fn evaluate(&self) -> Result<PathBudget, CheckError> {
+        let k0 = super::time_scale(self.scenario.config().time_scale);
+        let mut out = self.at(k0)?;
+        // The speed-independent part: the reference slowed to the slowest scale, over the
+        // flight as written (a slower flight drifts longer: the search below flies that).
+        let slowest = self.at_for(MAX_TIME_SCALE, self.duration(k0))?;
+        out.speed_independent = slowest.total;
+        if out.fits() {
+            out.smallest_time_scale = Some(self.smallest(1.0, k0)?);
+        } else if !slowest.fits() {
+            out.needs = Some(self.needs(&slowest));
+        } else {
+            // Doubling to a scale that fits (a flight without fixes drifts longer as it slows:
+            // there may be none), then bisection.
+            let mut hi = k0;
+            let mut found = None;
+            while hi < MAX_TIME_SCALE {
+                let lo = hi;
+                hi = (2.0 * hi).min(MAX_TIME_SCALE);
+                if self.at(hi)?.fits() {
+                    found = Some(self.smallest(lo, hi)?);
+                    break;
+                }
+            }
+            match found {
+                Some(k) => out.smallest_time_scale = Some(k),
+                None => out.needs = Some(self.needs(&slowest)),
+            }
+        }
+        Ok(out)
+    }
+
+    /// The smallest k in [lo, hi] at which the budget fits (it fits at hi), by bisection to
+    /// [`super::TIME_SCALE_TOLERANCE`], rounded up to [`super::TIME_SCALE_STEP`].
+    fn smallest(&self, lo: f64, hi: f64) -> Result<f64, CheckError> {
+        if self.at(lo)?.fits() {
+            return Ok(lo);
+        }
+        let (mut lo, mut hi) = (lo, hi);
+        while hi / lo > 1.0 + super::TIME_SCALE_TOLERANCE {
+            let mid = (lo * hi).sqrt();
+            if self.at(mid)?.fits() {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let mut k =
+            ((hi / super::TIME_SCALE_STEP).ceil() * super::TIME_SCALE_STEP * 100.0).round() / 100.0;
+        while k < MAX_TIME_SCALE && !self.at(k)?.fits() {
+            k = ((k + super::TIME_SCALE_STEP) * 100.0).round() / 100.0;
+        }
+        Ok(k.min(MAX_TIME_SCALE))
+    }
+
+    /// What the navigation must deliver for the speed-independent budget `slowest` to fit: the
+    /// position error per axis it leaves room for, and how often fixes must come for it.
+    fn needs(&self, slowest: &PathBudget) -> String {
+        // The navigation part scales with the navigation's error: the room left after the lag.
+        let lag2: f64 = slowest.lag.iter().map(|x| x * x).sum();
+        let room = (self.bound * self.bound - lag2).max(0.0).sqrt();
+        let nav = slowest.noise.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if room <= 0.0 || nav <= 0.0 {
+            return format!(
+                "the lag alone is {:.1} mm at the slowest scale",
+                1e3 * lag2.sqrt()
+            );
+        }
+        let scale = room / nav;
+        let worst = (0..AXES)
+            .max_by(|&a, &b| slowest.noise_sigma[a].total_cmp(&slowest.noise_sigma[b]))
+            .unwrap_or(0);
+        let sigma = scale * slowest.noise_sigma[worst];
+        let mut s = format!(
+            "needs position error σ ≤ {:.1} mm on {} (assumed {:.1} mm)",
+            1e3 * sigma,
+            AXIS_NAMES[worst],
+            1e3 * slowest.noise_sigma[worst],
+        );
+        if let Some(p) = self.fix_period_needed(slowest.time_scale) {
+            s.push_str(&format!(": fixes at least every {p:.1} s"));
+        }
+        s
+    }
+
+    /// The longest fix period (s) at which the navigation part fits at scale `k`, the fixes'
+    /// σ as configured (an LBL's 1 cm when the navigation has none).
+    fn fix_period_needed(&self, k: f64) -> Option<f64> {
+        let k0 = super::time_scale(self.scenario.config().time_scale);
+        let base = self.scenario.config().navigation.as_ref()?;
+        let with_period = |period: f64| -> Option<bool> {
+            let mut m = base.clone();
+            let mut fix = m
+                .fix
+                .clone()
+                .unwrap_or(crate::scenario::navigation::Source {
+                    timing: Timing {
+                        rate_hz: 1.0,
+                        latency: 0.0,
+                        outages: Vec::new(),
+                    },
+                    error: ErrorModel::white_gm([0.01; 2], [0.0; 2], 600.0),
+                });
+            fix.timing.rate_hz = 1.0 / period;
+            m.fix = Some(fix);
+            let s = self.scenario.with(|c| c.navigation = Some(m)).ok()?;
+            let b = Budget::new(&s).ok()??;
+            Some(b.at_for(k, self.duration(k0)).ok()?.fits())
+        };
+        let control = 1.0 / f64::from(self.scenario.config().controller.rate_hz);
+        if !with_period(control)? {
+            return None;
+        }
+        let (mut lo, mut hi) = (control, 600.0);
+        if with_period(hi)? {
+            return Some(hi);
+        }
+        while hi / lo > 1.01 {
+            let mid = (lo * hi).sqrt();
+            if with_period(mid)? {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Some(lo)
+    }
+}
+
+/// The budget of `scenario` (module docs); `None` when it has no bound.
+///
+/// # Errors
+/// As [`Budget::new`].
+pub fn budget(scenario: &Scenario) -> Result<Option<PathBudget>, CheckError> {
+    match Budget::new(scenario)? {
+        Some(b) => Ok(Some(b.evaluate()?)),
+        None => Ok(None),
+    }
+}
