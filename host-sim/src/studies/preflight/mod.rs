@@ -423,13 +423,18 @@ pub fn check_with(
         Some(b) => Some(b.evaluate()?),
         None => None,
     };
-    if let (Some(b), Some(pb)) = (&budget, &path_budget) {
-        with_budget(&checker, &mut as_written, k, b, pb)?;
-    }
-    let whole_box = match whole_box {
+    let mut whole_box = match whole_box {
         true => Some(verdict(&checker, Scope::WholeBox, k)?.0),
         false => None,
     };
+    // Both scopes' verdicts join the budget: the box's too, or its line would call a mission
+    // feasible at a scale whose path error the budget refuses.
+    if let (Some(b), Some(pb)) = (&budget, &path_budget) {
+        with_budget(&checker, Scope::AsWritten, &mut as_written, k, b, pb)?;
+        if let Some(v) = whole_box.as_mut() {
+            with_budget(&checker, Scope::WholeBox, v, k, b, pb)?;
+        }
+    }
     let envelope = scenario.controller().envelope();
     let thrusters = (0..THRUSTERS)
         .map(|i| {
@@ -475,12 +480,13 @@ pub fn check_with(
     })
 }
 
-/// The force verdict `v` at the scenario's scale `k` joined with the path-error budget
-/// (Choice 424): feasible only when both fit at `k`; the proposed scale the smallest at which
+/// The force verdict `v` over `scope` at the scenario's scale `k` joined with the path-error
+/// budget of the mission as written (Choice 424): feasible only when both fit at `k`; the proposed scale the smallest at which
 /// both fit (the budget's smallest, raised by steps until the force fits too); infeasible when
 /// the budget fits at no scale.
 fn with_budget(
     checker: &Checker,
+    scope: Scope,
     v: &mut ScopeVerdict,
     k: f64,
     budget: &path_budget::Budget,
@@ -510,7 +516,7 @@ fn with_budget(
         if at > max {
             break;
         }
-        if checker.feasible(Scope::AsWritten, 1.0 / at)? && budget.fits_at(at)? {
+        if checker.feasible(scope, 1.0 / at)? && budget.fits_at(at)? {
             found = Some(at);
             break;
         }

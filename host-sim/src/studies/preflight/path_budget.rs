@@ -212,7 +212,7 @@ fn axis_noise(scenario: &Scenario, i: usize, speed: f64) -> AxisNoise {
 fn samples_at(timing: &Timing, k: u64, t_period: f64) -> bool {
     let every = (1.0 / (timing.rate_hz * t_period)).round().max(1.0) as u64;
     let t = k as f64 * t_period;
-    k % every == 0 && !timing.outages.iter().any(|o| t >= o[0] && t < o[1])
+    k.is_multiple_of(every) && !timing.outages.iter().any(|o| t >= o[0] && t < o[1])
 }
 
 /// The law's linear loop on one axis: T, G, and the estimator's K (`None`: off).
@@ -303,18 +303,19 @@ impl Loop {
 const N: usize = 9;
 type Cov = SMatrix<f64, N, N>;
 
-/// σ = maxₜ √P_ee over a flight of `duration` s (module docs), and whether it stayed finite.
-fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> f64 {
+/// One period's maps of the noise propagation (module docs): the loop's step, the noise's
+/// drift, the estimator's correction, and the white noise's covariance.
+struct PeriodMaps {
+    loop_step: Cov,
+    drift: Cov,
+    correct: Option<Cov>,
+    q_white: Cov,
+}
+
+/// The maps of one period of the loop `lp` under `noise`.
+fn period_maps(lp: &Loop, noise: &AxisNoise) -> PeriodMaps {
     let (t, f, g) = (lp.t, lp.f(), lp.g());
     let gr = nalgebra::RowVector2::new(lp.gain[0], lp.gain[1]);
-    let (fix_s, fix_b) = noise.fix.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
-    let (ping_s, ping_b) = noise.ping.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
-    let mut p = Cov::zeros();
-    p[(4, 4)] = fix_s * fix_s;
-    p[(5, 5)] = ping_s * ping_s;
-    p[(6, 6)] = ping_b * ping_b;
-    p[(7, 7)] = noise.accel_bias * noise.accel_bias;
-    p[(8, 8)] = fix_b * fix_b;
     // The loop's step after the noise (module docs), as a map on the state.
     let mut loop_step = Cov::identity();
     // s⁺ = F s − g G ŝ.
@@ -371,6 +372,31 @@ fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> 
     q_white
         .fixed_view_mut::<2, 2>(wb.0, wb.0)
         .copy_from(&(wb.1 * white * wb.1.transpose()));
+    PeriodMaps {
+        loop_step,
+        drift,
+        correct,
+        q_white,
+    }
+}
+
+/// σ = maxₜ √P_ee over a flight of `duration` s (module docs), and whether it stayed finite.
+fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> f64 {
+    let t = lp.t;
+    let (fix_s, fix_b) = noise.fix.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
+    let (ping_s, ping_b) = noise.ping.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
+    let mut p = Cov::zeros();
+    p[(4, 4)] = fix_s * fix_s;
+    p[(5, 5)] = ping_s * ping_s;
+    p[(6, 6)] = ping_b * ping_b;
+    p[(7, 7)] = noise.accel_bias * noise.accel_bias;
+    p[(8, 8)] = fix_b * fix_b;
+    let PeriodMaps {
+        loop_step,
+        drift,
+        correct,
+        q_white,
+    } = period_maps(lp, noise);
     let reset = |p: &mut Cov, i: usize, var: f64| {
         for j in 0..N {
             p[(i, j)] = 0.0;
@@ -486,56 +512,13 @@ impl<'a> Budget<'a> {
         .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / super::time_scale(cfg.time_scale);
         let checked = period::period(cfg).map_or(span, |p| span.min(p + SAMPLE_PERIOD));
-        let rate = (1.0 / SAMPLE_PERIOD).round() as u32;
-        let n = (checked / SAMPLE_PERIOD).ceil().max(1.0) as u64;
-        let mut samples: Vec<RefSample> = Vec::with_capacity(n as usize + 2);
-        let mut speed = [0.0f64; AXES];
-        for j in 0..=n + 1 {
-            if j % 4096 == 0 {
-                super::poll()?;
-            }
-            let d = path.sample(j, rate);
-            let s = RefSample {
-                s: j as f64 * SAMPLE_PERIOD,
-                eta: d.eta.cast(),
-                eta_dot: d.eta_dot.cast(),
-                eta_ddot: d.eta_ddot.cast(),
-                jerk: Vector6::zeros(),
-            };
-            if let Some(prev) = samples.last_mut() {
-                prev.jerk = (s.eta_ddot - prev.eta_ddot) / SAMPLE_PERIOD;
-            }
-            samples.push(s);
-        }
-        // The last sample has no jerk of its own: it only closed its neighbour's.
-        samples.pop();
-        for s in &samples {
-            for (i, v) in speed.iter_mut().enumerate() {
-                *v = v.max(s.eta_dot[i].abs());
-            }
-        }
+        let (samples, speed) = reference_samples(&path, checked)?;
         let nominal = Plant::new(
             scenario.controller().params().cast(f64::from),
             PlantTerms::default(),
         )
         .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
-        let currents = match &cfg.current {
-            CurrentModel::None => vec![Vector3::zeros()],
-            CurrentModel::Constant(c) => vec![Vector3::from(*c)],
-            CurrentModel::GaussMarkov { mean, sigma, .. } => {
-                let mut v = Vec::new();
-                for sx in [-1.0, 0.0, 1.0] {
-                    for sy in [-1.0, 0.0, 1.0] {
-                        v.push(Vector3::new(
-                            mean[0] + sx * CURRENT_SIGMAS * sigma[0],
-                            mean[1] + sy * CURRENT_SIGMAS * sigma[1],
-                            mean[2],
-                        ));
-                    }
-                }
-                v
-            }
-        };
+        let currents = current_corners(&cfg.current);
         let latency = match (&cfg.navigation, cfg.controller.estimator.kind) {
             (Some(m), EstimatorKind::Off) => m.ins.timing.latency,
             _ => 0.0,
@@ -868,5 +851,64 @@ pub fn budget(scenario: &Scenario) -> Result<Option<PathBudget>, CheckError> {
     match Budget::new(scenario)? {
         Some(b) => Ok(Some(b.evaluate()?)),
         None => Ok(None),
+    }
+}
+
+/// The reference at time scale 1 every [`SAMPLE_PERIOD`] over `checked` s of path time, each
+/// sample with its jerk (a finite difference of η̈), and the largest speed per axis.
+fn reference_samples(
+    path: &Trajectory,
+    checked: f64,
+) -> Result<(Vec<RefSample>, [f64; AXES]), CheckError> {
+    let rate = (1.0 / SAMPLE_PERIOD).round() as u32;
+    let n = (checked / SAMPLE_PERIOD).ceil().max(1.0) as u64;
+    let mut samples: Vec<RefSample> = Vec::with_capacity(n as usize + 2);
+    let mut speed = [0.0f64; AXES];
+    for j in 0..=n + 1 {
+        if j % 4096 == 0 {
+            super::poll()?;
+        }
+        let d = path.sample(j, rate);
+        let s = RefSample {
+            s: j as f64 * SAMPLE_PERIOD,
+            eta: d.eta.cast(),
+            eta_dot: d.eta_dot.cast(),
+            eta_ddot: d.eta_ddot.cast(),
+            jerk: Vector6::zeros(),
+        };
+        if let Some(prev) = samples.last_mut() {
+            prev.jerk = (s.eta_ddot - prev.eta_ddot) / SAMPLE_PERIOD;
+        }
+        samples.push(s);
+    }
+    // The last sample has no jerk of its own: it only closed its neighbour's.
+    samples.pop();
+    for s in &samples {
+        for (i, v) in speed.iter_mut().enumerate() {
+            *v = v.max(s.eta_dot[i].abs());
+        }
+    }
+    Ok((samples, speed))
+}
+
+/// The currents the budget flies: the constant one, or a Gauss–Markov one's mean and its
+/// ±[`CURRENT_SIGMAS`]σ corners on x and y.
+fn current_corners(current: &CurrentModel) -> Vec<Vector3<f64>> {
+    match current {
+        CurrentModel::None => vec![Vector3::zeros()],
+        CurrentModel::Constant(c) => vec![Vector3::from(*c)],
+        CurrentModel::GaussMarkov { mean, sigma, .. } => {
+            let mut v = Vec::new();
+            for sx in [-1.0, 0.0, 1.0] {
+                for sy in [-1.0, 0.0, 1.0] {
+                    v.push(Vector3::new(
+                        mean[0] + sx * CURRENT_SIGMAS * sigma[0],
+                        mean[1] + sy * CURRENT_SIGMAS * sigma[1],
+                        mean[2],
+                    ));
+                }
+            }
+            v
+        }
     }
 }
