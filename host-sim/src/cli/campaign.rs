@@ -120,6 +120,20 @@ impl RestartShards {
             std::env::var(k).ok()
         })
     }
+
+    /// Each `--merge` folder's `shard.json`, read as a shard of `what` (named in the error).
+    pub fn read_merged<T: serde::de::DeserializeOwned>(&self, what: &str) -> Result<Vec<T>> {
+        self.merge
+            .iter()
+            .map(|d| {
+                let p = d.join("shard.json");
+                let text = std::fs::read_to_string(&p)
+                    .with_context(|| format!("reading {}", p.display()))?;
+                serde_json::from_str::<T>(&text)
+                    .with_context(|| format!("{} is not a {what} shard", p.display()))
+            })
+            .collect()
+    }
 }
 
 /// The shard I/N from `--shard`, else the engine's environment (`env`), else 0/1

@@ -83,18 +83,7 @@ pub fn falsify(args: &FalsifyArgs, stdout: &mut dyn Write) -> Result<Exit> {
         restarts.sort_by_key(|r| (r.method == falsify::Method::Random, r.index));
         (spec, restarts, missing, seconds)
     } else {
-        let shards = args
-            .shards
-            .merge
-            .iter()
-            .map(|d| {
-                let p = d.join("shard.json");
-                let text = std::fs::read_to_string(&p)
-                    .with_context(|| format!("reading {}", p.display()))?;
-                serde_json::from_str::<ShardResult>(&text)
-                    .with_context(|| format!("{} is not a falsify shard", p.display()))
-            })
-            .collect::<Result<Vec<_>>>()?;
+        let shards = args.shards.read_merged::<ShardResult>("falsify")?;
         let (spec, restarts, missing) = falsify::merge(&shards)?;
         let seconds = shards.iter().map(|s| s.seconds).sum();
         (spec, restarts, missing, seconds)

@@ -95,17 +95,7 @@ pub fn tune(args: &TuneArgs, stdout: &mut dyn Write) -> Result<Exit> {
             .with_context(|| format!("writing {}", path.display()))?;
         vec![shard]
     } else {
-        args.shards
-            .merge
-            .iter()
-            .map(|d| {
-                let p = d.join("shard.json");
-                let text = std::fs::read_to_string(&p)
-                    .with_context(|| format!("reading {}", p.display()))?;
-                serde_json::from_str::<ShardResult>(&text)
-                    .with_context(|| format!("{} is not a tune shard", p.display()))
-            })
-            .collect::<Result<Vec<_>>>()?
+        args.shards.read_merged::<ShardResult>("tune")?
     };
     let interrupted = shards.iter().any(|s| s.restarts.iter().any(|r| r.partial));
     let study = tune::merge(&shards)?;
