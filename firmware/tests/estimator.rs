@@ -77,18 +77,32 @@ fn bits(v: &[f32; 5]) -> [u32; 5] {
     v.map(f32::to_bits)
 }
 
+/// Gives the board frame `k` of the noisy solution and runs its period: the board is running
+/// and commands what the host's core commands at tick `k` (SIL); returns those voltages.
+fn fly_frame_as_sil(
+    s: &mut Supervisor,
+    h: &mut Host,
+    c: &Controller,
+    memory: &mut Estimate,
+    k: u64,
+) -> [f32; 5] {
+    let f = noisy(k);
+    h.give(s, Msg::State(f));
+    let step = s.step(false, NOW);
+    assert_eq!(step.telemetry.status, BoardStatus::Running, "tick {k}");
+    let want = host_voltages(c, memory, k, k, &f);
+    assert_eq!(bits(&step.voltages), bits(&want), "tick {k}");
+    want
+}
+
 #[test]
 fn the_board_flies_the_estimator_as_the_host_core_does() {
     let (mut s, mut h, c) = flying(true);
     let mut memory = Estimate::new();
     let mut differs = 0;
     for k in 0..200 {
+        let want = fly_frame_as_sil(&mut s, &mut h, &c, &mut memory, k);
         let f = noisy(k);
-        h.give(&mut s, Msg::State(f));
-        let step = s.step(false, NOW);
-        assert_eq!(step.telemetry.status, BoardStatus::Running, "tick {k}");
-        let want = host_voltages(&c, &mut memory, k, k, &f);
-        assert_eq!(bits(&step.voltages), bits(&want), "tick {k}");
         // The law on the raw solution commands something else: the board does filter.
         let raw = c.update(k, &f.eta, &f.nu, &circle()).voltage;
         differs += usize::from(bits(&raw) != bits(&want));
@@ -104,13 +118,7 @@ fn a_repeated_lock_step_stamp_is_dropped_predicted_then_latches_stale_state() {
     let (mut s, mut h, c) = flying(true);
     let mut memory = Estimate::new();
     for k in 0..50 {
-        let f = noisy(k);
-        h.give(&mut s, Msg::State(f));
-        let step = s.step(false, NOW);
-        assert_eq!(
-            bits(&step.voltages),
-            bits(&host_voltages(&c, &mut memory, k, k, &f))
-        );
+        fly_frame_as_sil(&mut s, &mut h, &c, &mut memory, k);
     }
     // The navigation computer's solution stops: it repeats tick 49's frame (new sequence
     // numbers). Off the mission clock: counted and dropped, so the board flies tick 49's
@@ -145,13 +153,7 @@ fn a_late_frame_free_running_is_predicted_over_the_periods_it_missed() {
     // Free-running: mission time is the board's own periods since StartMission; the frame of
     // a period holds at that period.
     for k in 0..30 {
-        let f = noisy(k);
-        h.give(&mut s, Msg::State(f));
-        let step = s.step(false, NOW);
-        assert_eq!(
-            bits(&step.voltages),
-            bits(&host_voltages(&c, &mut memory, k, k, &f))
-        );
+        fly_frame_as_sil(&mut s, &mut h, &c, &mut memory, k);
     }
     // Period 30's frame is late: the board flies period 29's solution one period old, ...
     let step = s.step(false, NOW);
@@ -214,12 +216,7 @@ fn a_lock_step_period_without_a_frame_leaves_the_next_frames_as_sil_flies_them()
     let (mut s, mut h, c) = flying(true);
     let mut memory = Estimate::new();
     for k in 0..120 {
-        let f = noisy(k);
-        h.give(&mut s, Msg::State(f));
-        let step = s.step(false, NOW);
-        assert_eq!(step.telemetry.status, BoardStatus::Running, "tick {k}");
-        let want = host_voltages(&c, &mut memory, k, k, &f);
-        assert_eq!(bits(&step.voltages), bits(&want), "tick {k}");
+        fly_frame_as_sil(&mut s, &mut h, &c, &mut memory, k);
         if k % 7 == 3 {
             // The board's timer runs out before frame k + 1: a repeat of frame k.
             let repeat = s.step(false, NOW);
