@@ -628,7 +628,9 @@ proptest! {
 /// The filter of docs/law.md#the-state-estimator as it was before Choice 430, written again
 /// over any float: the prediction sums every held period's acceleration with its weight
 /// (Δη = Σ aₜ T² (to − t − ½), Δη̇ = Σ aₜ T), the stamp moved on when its period's entry is
-/// replaced. In f64 it is the reference; in f32 it is the implementation Choice 430 replaced.
+/// replaced (and, as Choice 430's filter does, a past period recorded again other than the latest
+/// dropped). In f64 it is the reference; in f32 it is that weighted-sum filter, which differs from
+/// the code Choice 430 replaced in that drop only.
 #[derive(Clone, Copy)]
 struct Weighted<T> {
     anchor: [T; 6],
