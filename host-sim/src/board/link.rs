@@ -61,13 +61,18 @@ impl Link {
         key: Option<&LinkKey>,
         reply_timeout: Duration,
     ) -> Self {
+        let mut decoder = match key {
+            Some(k) => FrameDecoder::signed(Verifier::new(k, Direction::FromBoard)),
+            None => FrameDecoder::new(),
+        };
+        // Joined mid-stream: what precedes the first delimiter is no frame (Choice 490).
+        if stream.joins_mid_stream() {
+            decoder.resync();
+        }
         Link {
             stream,
             context,
-            decoder: match key {
-                Some(k) => FrameDecoder::signed(Verifier::new(k, Direction::FromBoard)),
-                None => FrameDecoder::new(),
-            },
+            decoder,
             signer: key.map(|k| Signer::new(k, Direction::ToBoard)),
             seq: 0,
             telemetry_seq: SeqCheck::new(),
@@ -287,5 +292,86 @@ impl Link {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A transport that hands out `bytes` once, then nothing.
+    struct Script {
+        bytes: VecDeque<u8>,
+        mid_stream: bool,
+    }
+
+    impl Transport for Script {
+        fn read_some(&mut self, buf: &mut [u8]) -> io::Result<usize> {
+            let n = buf.len().min(self.bytes.len());
+            for (slot, b) in buf.iter_mut().zip(self.bytes.drain(..n)) {
+                *slot = b;
+            }
+            Ok(n)
+        }
+        fn write_frame(&mut self, _: &[u8]) -> io::Result<()> {
+            Ok(())
+        }
+        fn set_read_timeout(&mut self, _: Duration) -> io::Result<()> {
+            Ok(())
+        }
+        fn joins_mid_stream(&self) -> bool {
+            self.mid_stream
+        }
+    }
+
+    fn frame(seq: u16) -> Vec<u8> {
+        let env = Envelope {
+            version: PROTOCOL_VERSION,
+            seq,
+            msg: Msg::Telemetry(Telemetry::LARGEST),
+        };
+        let mut buf = [0u8; MAX_FRAME];
+        let n = encode(&env, &mut buf).expect("a telemetry frame fits");
+        buf[..n].to_vec()
+    }
+
+    fn link(bytes: Vec<u8>, mid_stream: bool) -> Link {
+        let stream = Script {
+            bytes: bytes.into(),
+            mid_stream,
+        };
+        Link::new(
+            Box::new(stream),
+            String::new(),
+            None,
+            Duration::from_secs(1),
+        )
+    }
+
+    /// A serial port opened while the board talks starts inside a frame: its tail is not a
+    /// refused frame (the HIL lock-step over QEMU's pty counted one, now and then, in CI).
+    #[test]
+    fn a_serial_line_joined_mid_frame_refuses_nothing() {
+        let first = frame(7);
+        let mut bytes = first[first.len() / 2..].to_vec();
+        bytes.extend(frame(8));
+        bytes.extend(frame(9));
+        let mut l = link(bytes, true);
+        assert_eq!(l.next_telemetry().ok().map(|_| ()), Some(()));
+        assert_eq!(l.next_telemetry().ok().map(|_| ()), Some(()));
+        assert_eq!(l.telemetry_counts(), (2, 0));
+    }
+
+    /// A socket starts at a frame's first byte: that frame is taken, and a broken one refused.
+    #[test]
+    fn a_socket_takes_its_first_frame_and_refuses_a_broken_one() {
+        let mut bytes = frame(1);
+        let second = frame(2);
+        bytes.extend(&second[second.len() / 2..]);
+        bytes.extend(frame(3));
+        let mut l = link(bytes, false);
+        assert!(l.next_telemetry().is_ok());
+        assert!(l.next_telemetry().is_ok());
+        assert_eq!(l.telemetry_counts(), (2, 1));
     }
 }

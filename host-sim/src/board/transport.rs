@@ -24,6 +24,13 @@ pub trait Transport: Send {
     fn write_frame(&mut self, bytes: &[u8]) -> io::Result<()>;
     /// The longest a [`Transport::read_some`] waits.
     fn set_read_timeout(&mut self, timeout: Duration) -> io::Result<()>;
+    /// This end may join the board's byte stream in the middle of a frame: the board talks
+    /// before the port is opened (a serial line), so the bytes up to the first delimiter are
+    /// the tail of a frame sent before, not a frame (**Choice 490**). A socket QEMU connects
+    /// before its guest runs starts at a frame's first byte.
+    fn joins_mid_stream(&self) -> bool {
+        false
+    }
 }
 
 /// A read that timed out, as `std` reports it on a socket or serialport on a tty.
@@ -110,5 +117,8 @@ impl Transport for Serial {
     }
     fn set_read_timeout(&mut self, timeout: Duration) -> io::Result<()> {
         self.port.set_timeout(timeout).map_err(io::Error::from)
+    }
+    fn joins_mid_stream(&self) -> bool {
+        true
     }
 }
