@@ -267,16 +267,12 @@ impl Scores {
     }
 }
 
-/// The nearest-rank p-quantile of `xs` (p in (0, 1]); NaN when empty.
+/// The nearest-rank p-quantile of `xs` (p in (0, 1]; [`super::montecarlo::percentile`] of the
+/// sorted values); NaN when empty.
 pub fn quantile(xs: &[f64], p: f64) -> f64 {
     let mut v = xs.to_vec();
     v.sort_by(f64::total_cmp);
-    let n = v.len();
-    if n == 0 {
-        return f64::NAN;
-    }
-    let k = ((p * n as f64).ceil() as usize).clamp(1, n);
-    v[k - 1]
+    super::montecarlo::percentile(&v, p * 100.0)
 }
 
 /// `gains` over `sample` (missions in turn); `Err` on an interrupt or a failing check.
