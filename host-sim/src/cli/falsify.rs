@@ -26,7 +26,7 @@ use crate::output::falsify::{plot_robustness, report_markdown, Written};
 use crate::output::{atomic, OutputDir};
 use crate::scenario::file::ScenarioFile;
 use crate::scenario::navigation::Preset;
-use crate::sim::progress::Progress;
+use crate::sim::progress::{Progress, Unit};
 use crate::studies::falsify::{self, Restart, ShardResult, Spec};
 use crate::studies::mission_space::Reach;
 use crate::studies::preflight::DEFAULT_MARGIN;
@@ -140,7 +140,12 @@ fn search(args: &FalsifyArgs) -> Result<ShardResult> {
         count: n,
     }
     .len();
-    let progress = Progress::start("evaluations", mine * 2 * args.budget as u64, !args.json);
+    let progress = Progress::counting(
+        "falsify",
+        mine * 2 * args.budget as u64,
+        Unit::Evaluations,
+        !args.json,
+    );
     let counter = progress.observer();
     let shard = falsify::run_shard(&spec, i, n, &|| counter.add(1)).map_err(|e| anyhow!(e))?;
     progress.finish();

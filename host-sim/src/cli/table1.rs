@@ -18,7 +18,7 @@ use crate::output::waypoint_plot::mission_plots;
 use crate::output::{self, sections, OutputDir, RealRow, ReportRow};
 use crate::scenario::real_vehicle;
 use crate::scenario::Scenario;
-use crate::sim::progress::Progress;
+use crate::sim::progress::{Progress, Unit};
 use crate::sim::record::RunSummary;
 use crate::sim::RunResult;
 use crate::studies::contract_statistics::{self, PresetStatistics};
@@ -265,9 +265,10 @@ fn fly_all(
 /// The preflight's validation campaign `campaign`, with its progress (a bar unless `json`).
 fn contract(campaign: &Campaign, json: bool) -> Result<(Campaign, Validation)> {
     let missions = campaign.missions()?;
-    let progress = Progress::start(
-        "preflight contract (missions)",
+    let progress = Progress::counting(
+        "preflight contract",
         missions.len() as u64,
+        Unit::Missions,
         !json,
     );
     let counter = progress.observer();
@@ -290,9 +291,10 @@ fn statistics(
     json: bool,
 ) -> Result<(Vec<PresetStatistics>, String)> {
     let presets = &campaign.navigation;
-    let progress = Progress::start(
-        "preflight contract (searched)",
+    let progress = Progress::counting(
+        "preflight contract, searched",
         (presets.len() * contract_statistics::SEARCH_BUDGET) as u64,
+        Unit::Evaluations,
         !json,
     );
     let counter = progress.observer();
@@ -323,9 +325,10 @@ fn main_job_tune(args: &Table1Args, dir: &OutputDir) -> Result<String> {
     }
     let json = args.json;
     let spec = tune::MAIN_JOB_TUNE;
-    let progress = Progress::start(
-        "gain tuning (evaluations)",
+    let progress = Progress::counting(
+        "gain tuning",
         spec.restarts * spec.evaluations_per_restart() as u64,
+        Unit::Evaluations,
         !json,
     );
     let counter = progress.observer();

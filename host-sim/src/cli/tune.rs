@@ -24,7 +24,7 @@ use super::Exit;
 use crate::output::tune::{controller_block, front_csv, plot_front, report_markdown};
 use crate::output::{atomic, OutputDir};
 use crate::scenario::real_vehicle;
-use crate::sim::progress::Progress;
+use crate::sim::progress::{Progress, Unit};
 use crate::studies::preflight::DEFAULT_MARGIN;
 use crate::studies::tune::{self, ShardResult, Spec, Study};
 
@@ -168,9 +168,10 @@ fn search(args: &TuneArgs) -> Result<ShardResult> {
         count: n,
     }
     .len();
-    let progress = Progress::start(
-        "evaluations",
+    let progress = Progress::counting(
+        "tune",
         mine * spec.evaluations_per_restart() as u64,
+        Unit::Evaluations,
         !args.json,
     );
     let counter = progress.observer();

@@ -12,7 +12,7 @@ use super::json::print_json;
 use super::Exit;
 use crate::output::{atomic, OutputDir};
 use crate::scenario::navigation::Preset;
-use crate::sim::progress::Progress;
+use crate::sim::progress::{Progress, Unit};
 use crate::studies::preflight::DEFAULT_MARGIN;
 use crate::studies::validation::{self, Campaign, Measure, DEFAULT_RANDOM, TEAM_MOUNTINGS};
 
@@ -76,7 +76,12 @@ pub fn validate_preflight(args: &ValidateArgs, stdout: &mut dyn Write) -> Result
     };
     let missions = campaign.missions()?;
     let dir = OutputDir::prepare(&args.out)?;
-    let progress = Progress::start("missions", missions.len() as u64, !args.json);
+    let progress = Progress::counting(
+        "validate-preflight",
+        missions.len() as u64,
+        Unit::Missions,
+        !args.json,
+    );
     let counter = progress.observer();
     let v = validation::validate(&missions, args.margin, Measure::Conservativeness, || {
         counter.add(1)

@@ -1,5 +1,6 @@
 //! Progress of long commands, counted in control periods (so that one long run shows progress
-//! inside it, and parallel runs add up).
+//! inside it, and parallel runs add up), or in the whole things a study does ([`Unit`]:
+//! missions checked and flown, evaluations of a search).
 //!
 //! The runs add to a shared counter ([`Progress::observer`], one atomic add a period); a
 //! thread shows it: on a terminal an `indicatif` bar on stderr (hidden with `--json`), and
@@ -21,6 +22,28 @@ use super::record::Sample;
 
 /// Time between two progress lines when stderr is not a terminal.
 pub const LINE_INTERVAL: Duration = Duration::from_secs(5);
+
+/// What a [`Progress`] counts, named in its bar and lines.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Unit {
+    /// Control periods flown (runs count them through [`Progress::observer`]).
+    Periods,
+    /// Missions checked and flown ([`Counter::add`]).
+    Missions,
+    /// Evaluations of a search or a study ([`Counter::add`]).
+    Evaluations,
+}
+
+impl Unit {
+    /// The unit's name in a progress line, plural.
+    pub const fn name(self) -> &'static str {
+        match self {
+            Unit::Periods => "control periods",
+            Unit::Missions => "missions",
+            Unit::Evaluations => "evaluations",
+        }
+    }
+}
 
 /// A running progress display; [`Progress::finish`] ends it.
 pub struct Progress {
@@ -50,6 +73,11 @@ impl Progress {
     /// Starts showing the progress of `what`, `total` control periods in all. `bar`: whether a
     /// terminal may get a bar (false for `--json`).
     pub fn start(what: &str, total: u64, bar: bool) -> Self {
+        Self::counting(what, total, Unit::Periods, bar)
+    }
+
+    /// [`Progress::start`] for `total` of `unit`.
+    pub fn counting(what: &str, total: u64, unit: Unit, bar: bool) -> Self {
         let done = Arc::new(AtomicU64::new(0));
         let stop = Arc::new(AtomicBool::new(false));
         let terminal = std::io::stderr().is_terminal();
@@ -59,10 +87,10 @@ impl Progress {
             .spawn(move || {
                 if terminal {
                     if bar {
-                        show_bar(&what, total, &d, &s);
+                        show_bar(&what, total, unit, &d, &s);
                     }
                 } else {
-                    show_lines(&what, total, &d, &s);
+                    show_lines(&what, total, unit, &d, &s);
                 }
             })
             .ok();
@@ -95,12 +123,13 @@ impl Drop for Progress {
 
 const POLL: Duration = Duration::from_millis(100);
 
-fn show_bar(what: &str, total: u64, done: &AtomicU64, stop: &AtomicBool) {
+fn show_bar(what: &str, total: u64, unit: Unit, done: &AtomicU64, stop: &AtomicBool) {
     let pb = ProgressBar::new(total);
     pb.set_style(
-        ProgressStyle::with_template(
-            "{msg} [{bar:40}] {percent}% of {len} control periods, {elapsed} (eta {eta})",
-        )
+        ProgressStyle::with_template(&format!(
+            "{{msg}} [{{bar:40}}] {{percent}}% of {{len}} {}, {{elapsed}} (eta {{eta}})",
+            unit.name()
+        ))
         .unwrap_or_else(|_| ProgressStyle::default_bar())
         .progress_chars("=> "),
     );
@@ -112,7 +141,7 @@ fn show_bar(what: &str, total: u64, done: &AtomicU64, stop: &AtomicBool) {
     pb.finish_and_clear();
 }
 
-fn show_lines(what: &str, total: u64, done: &AtomicU64, stop: &AtomicBool) {
+fn show_lines(what: &str, total: u64, unit: Unit, done: &AtomicU64, stop: &AtomicBool) {
     let t0 = Instant::now();
     let mut next = LINE_INTERVAL;
     while !stop.load(Ordering::SeqCst) {
@@ -124,13 +153,13 @@ fn show_lines(what: &str, total: u64, done: &AtomicU64, stop: &AtomicBool) {
         next += LINE_INTERVAL;
         eprintln!(
             "{}",
-            line(what, done.load(Ordering::Relaxed), total, elapsed)
+            line(what, done.load(Ordering::Relaxed), total, unit, elapsed)
         );
     }
 }
 
 /// One progress line (see the module doc).
-pub fn line(what: &str, done: u64, total: u64, elapsed: Duration) -> String {
+pub fn line(what: &str, done: u64, total: u64, unit: Unit, elapsed: Duration) -> String {
     let fraction = if total == 0 {
         1.0
     } else {
@@ -146,8 +175,9 @@ pub fn line(what: &str, done: u64, total: u64, elapsed: Duration) -> String {
         )
     };
     format!(
-        "host-sim: {what}: {:.1} % ({done} of {total} control periods), {} elapsed, {left}",
+        "host-sim: {what}: {:.1} % ({done} of {total} {}), {} elapsed, {left}",
         100.0 * fraction,
+        unit.name(),
         duration_text(secs)
     )
 }
@@ -159,5 +189,23 @@ pub fn duration_text(secs: f64) -> String {
         0..60 => format!("{s} s"),
         60..3600 => format!("{} min {:02} s", s / 60, s % 60),
         _ => format!("{} h {:02} min", s / 3600, (s % 3600) / 60),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A line names what it counts, and half done in 10 s leaves about 10 s.
+    #[test]
+    fn a_line_names_its_unit_and_scales_the_time_left() {
+        let l = line("tune", 5, 10, Unit::Evaluations, Duration::from_secs(10));
+        assert_eq!(
+            l,
+            "host-sim: tune: 50.0 % (5 of 10 evaluations), 10 s elapsed, about 10 s left"
+        );
+        let l = line("Table 1", 0, 7, Unit::Periods, Duration::ZERO);
+        assert!(l.contains("(0 of 7 control periods)"), "{l}");
+        assert!(l.ends_with("time left unknown"), "{l}");
     }
 }
