@@ -113,6 +113,49 @@ fn the_dvl_ping_rate_and_latency_are_seen_in_the_solution() {
     assert!((pings as f64 - 8.0 * seconds).abs() <= 1.0, "{pings} pings");
 }
 
+/// A source whose rate does not divide the control rate samples uniformly on the control
+/// ticks: rate·T samples in T seconds (within one), each gap ⌊f_c/f⌋ or ⌈f_c/f⌉ periods, the
+/// ticks taken where the sample count j·f/f_c passes a whole number (Choice 335, Choice 540).
+#[test]
+fn a_source_at_any_rate_arrives_rate_times_t_times_with_gaps_of_whole_periods() {
+    for rate_hz in [2.0, 3.0, 7.5, 8.0, 30.0, 64.0] {
+        let mut m = exact();
+        m.depth.timing = Timing {
+            rate_hz,
+            latency: 0.0,
+            outages: Vec::new(),
+        };
+        let mut nav = NavComputer::new(&m, RATE);
+        assert!(
+            nav.solution().is_none(),
+            "a solution before the first period"
+        );
+        let periods = 5_000u64;
+        let mut ticks = Vec::new();
+        for k in 0..periods {
+            let (eta, nu) = straight(k, 0.5, 0.0, 5.0);
+            if let Some(d) = nav.measure(&eta, &nu).arrived.depth {
+                ticks.push(d.sampled_at);
+            }
+        }
+        // The sample at tick 0 is the one taken before the mission (stamped 0, every source).
+        let expected = rate_hz * periods as f64 / RATE;
+        assert!(
+            (ticks.len() as f64 + 1.0 - expected).abs() <= 1.0,
+            "{rate_hz} Hz: {} samples in {periods} periods",
+            ticks.len() + 1
+        );
+        let (lo, hi) = ((RATE / rate_hz).floor(), (RATE / rate_hz).ceil());
+        for w in ticks.windows(2) {
+            let gap = (w[1] - w[0]) as f64;
+            assert!(
+                lo <= gap && gap <= hi,
+                "{rate_hz} Hz: a gap of {gap} periods"
+            );
+        }
+    }
+}
+
 #[test]
 fn dead_reckoning_under_a_known_velocity_bias_drifts_by_bias_times_t() {
     let mut m = exact();

@@ -166,7 +166,7 @@ impl Clock {
         let j = k.checked_sub(self.latency)?;
         let taken = self.ratio >= 1.0
             || j == 0
-            || (j as f64 * self.ratio).floor() != ((j - 1) as f64 * self.ratio).floor();
+            || whole(j as f64 * self.ratio) != whole((j - 1) as f64 * self.ratio);
         if !taken {
             return None;
         }
@@ -174,6 +174,13 @@ impl Clock {
         let out = self.outages.iter().any(|[a, b]| *a <= t && t < *b);
         (!out).then_some(j)
     }
+}
+
+/// ⌊x⌋ of a sample count 0 ≤ x < 2⁶³ as an integer (**Choice 540**): the conversion truncates,
+/// which for x ≥ 0 is the floor, so the ticks are `f64::floor`'s, without its library call on
+/// a baseline x86-64 (and the signed conversion is one instruction there, the unsigned a few).
+fn whole(x: f64) -> i64 {
+    x as i64
 }
 
 /// A latency in whole control periods (rounded to the nearest).
@@ -308,6 +315,17 @@ impl NavComputer {
 
     /// The solution of the next control period, given the plant's true η, ν at it.
     pub fn step(&mut self, eta: &[f64; 6], nu: &[f64; 6]) -> Solution {
+        *self.measure(eta, nu)
+    }
+
+    /// The solution of the last period stepped ([`NavComputer::step`]), none before the first.
+    pub fn solution(&self) -> Option<&Solution> {
+        (self.k > 0).then_some(&self.out)
+    }
+
+    /// [`NavComputer::step`], the solution kept in place and lent (**Choice 540**: the loop
+    /// reads it where it is, not through two copies of its arrivals a period).
+    pub fn measure(&mut self, eta: &[f64; 6], nu: &[f64; 6]) -> &Solution {
         let k = self.k;
         self.k += 1;
         self.truth.push((*eta, *nu));
@@ -337,7 +355,7 @@ impl NavComputer {
             self.out.nu[i] = v[i];
             self.out.nu[3 + i] = self.rates[i];
         }
-        self.out
+        &self.out
     }
 
     /// One period on: every bias steps, and the velocity error integrates the INS's

@@ -53,7 +53,6 @@ pub const HEADING_REPORT_BOUND: f64 = 4.0 * std::f64::consts::PI;
 /// the same seed (docs/navigation.md#noise-and-navigation).
 pub struct Navigation {
     computer: Option<NavComputer>,
-    last: Option<Solution>,
     noise: Option<SensorNoise>,
     rng: rand::rngs::StdRng,
 }
@@ -63,7 +62,6 @@ impl Navigation {
     pub fn new(noise: Option<&SensorNoise>) -> Self {
         Navigation {
             computer: None,
-            last: None,
             noise: noise.cloned(),
             rng: rand::rngs::StdRng::seed_from_u64(noise.map_or(0, |n| n.seed)),
         }
@@ -81,7 +79,7 @@ impl Navigation {
 
     /// The model's solution of the last period measured (`None` without a model).
     pub fn solution(&self) -> Option<&Solution> {
-        self.last.as_ref()
+        self.computer.as_ref().and_then(NavComputer::solution)
     }
 
     /// The measured η, ν the controller is given, in f32 (one call per control period, in
@@ -89,8 +87,7 @@ impl Navigation {
     pub fn measure(&mut self, state: &PlantState) -> ([f32; 6], [f32; 6]) {
         let (mut eta, mut nu) = (state.eta, state.nu);
         if let Some(c) = &mut self.computer {
-            let s = c.step(&eta.into(), &nu.into());
-            self.last = Some(s);
+            let s = c.measure(&eta.into(), &nu.into());
             eta = s.eta.into();
             nu = s.nu.into();
         }
