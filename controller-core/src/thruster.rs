@@ -30,13 +30,14 @@
 //!
 //! # Square roots in the inverse maps
 //!
-//! The inverse maps call [`crate::math::exact_sqrt`] (libm's `sqrtf`) instead of [`crate::math::sqrt`]. Under the
+//! The inverse maps call [`crate::math::exact_sqrt`] (correctly rounded: the FPU's `vsqrt.f32`
+//! on the board, libm's `sqrtf` on the host) instead of [`crate::math::sqrt`]. Under the
 //! `micromath` feature `math::sqrt` has up to ≈ 6 % relative error; measured through the
 //! inverse maps over the ±24 V range when this choice was made, that is a thrust error of up
 //! to 1.85 N (4.5 %) on the main thruster and 0.46 N (2.3 %) on a tunnel thruster (Cardano's
 //! square root feeds a cancellation), whose whole ±24 V range is only −9.2…+20.1 N. The
 //! reported thrust is the saturation-honesty signal, so it must not depend on the backend; the
-//! cost is five `sqrtf` per tick. With libm the inverse is within 1.2e-5 N of the exact root
+//! cost is five `vsqrt.f32` per tick. With it the inverse is within 1.2e-5 N of the exact root
 //! over ±24 V in every backend (asserted by `tests/thruster.rs`). `cbrt` goes through
 //! [`crate::math::cbrt`]: libm's with `libm-math`, the kernels' otherwise (micromath has none).
 
