@@ -957,18 +957,21 @@ fn times_zero<const N: usize>(x: &[f32; N]) -> f32 {
     zero
 }
 
+/// η and ν finite ([`Fault::NonFiniteInput`] otherwise) and plausible
+/// ([`Fault::InputOutOfRange`]). A plausible value is finite (|x| ≤ a limit is false for NaN
+/// and ±∞), so the plausibility test alone passes every good input and the finiteness test
+/// runs only to name the fault (Choice 524).
 fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {
-    if !eta.iter().chain(nu.iter()).all(|x| x.is_finite()) {
-        return Err(Fault::NonFiniteInput);
-    }
     let plausible = eta[..3].iter().all(|x| x.abs() <= MAX_POSITION)
         && eta[3..].iter().all(|x| x.abs() <= MAX_ANGLE)
         && nu[..3].iter().all(|x| x.abs() <= MAX_LINEAR_SPEED)
         && nu[3..].iter().all(|x| x.abs() <= MAX_ANGULAR_RATE);
     if plausible {
         Ok(())
-    } else {
+    } else if eta.iter().chain(nu.iter()).all(|x| x.is_finite()) {
         Err(Fault::InputOutOfRange)
+    } else {
+        Err(Fault::NonFiniteInput)
     }
 }
 
