@@ -593,7 +593,7 @@ impl Controller {
         let Some((eta, eta_dot)) = state else {
             return Ok(*told);
         };
-        if !eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite()) {
+        if times_zero(&eta) + times_zero(&eta_dot) != 0.0 {
             return Err(Fault::NonFiniteResult);
         }
         let (kin, cos_theta_abs) = self.checked_kinematics(&eta)?;
@@ -947,7 +947,7 @@ fn check_feasible(bounds: &UncertaintyBounds<f32>, beta: f32) -> Result<(), Conf
     Ok(())
 }
 
-/// Σ xᵢ·0: ±0 when every xᵢ is finite, NaN otherwise ([`Output::all_finite`]).
+/// Σ xᵢ·0: ±0 when every xᵢ is finite, NaN otherwise ([`Output::all_finite`], Choice 524).
 #[inline]
 fn times_zero<const N: usize>(x: &[f32; N]) -> f32 {
     let mut zero = 0.0f32;
