@@ -181,18 +181,25 @@ impl Output {
         }
     }
 
+    /// Every field finite. x·0 is ±0 for a finite x and NaN for ±∞ and NaN, and a NaN stays
+    /// NaN through a sum: the sum of every field times 0 is zero exactly when every field is
+    /// finite — two instructions a value on the board where a test and branch each took four
+    /// (Choice 524).
     fn all_finite(&self) -> bool {
-        self.tau
-            .iter()
-            .chain(self.tau_achieved.iter())
-            .chain(self.tau_unallocated.iter())
-            .chain(self.thrust.iter())
-            .chain(self.voltage.iter())
-            .chain(self.eta_d.iter())
-            .chain(self.e1.iter())
-            .chain(self.u.iter())
-            .chain([self.delta, self.w_norm].iter())
-            .all(|x| x.is_finite())
+        let vectors = [
+            &self.tau,
+            &self.tau_achieved,
+            &self.tau_unallocated,
+            &self.eta_d,
+            &self.e1,
+            &self.u,
+        ];
+        let mut zero = (self.delta * 0.0) + (self.w_norm * 0.0);
+        for v in vectors {
+            zero += times_zero(v);
+        }
+        zero += times_zero(&self.thrust) + times_zero(&self.voltage);
+        zero == 0.0
     }
 }
 
@@ -586,7 +593,7 @@ impl Controller {
         let Some((eta, eta_dot)) = state else {
             return Ok(*told);
         };
-        if !eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite()) {
+        if times_zero(&eta) + times_zero(&eta_dot) != 0.0 {
             return Err(Fault::NonFiniteResult);
         }
         let (kin, cos_theta_abs) = self.checked_kinematics(&eta)?;
@@ -794,13 +801,14 @@ impl Controller {
     #[doc(hidden)]
     #[inline]
     pub fn maps_stage(&self, demand: &[f32; THRUSTERS]) -> (Actuation, Vector6<f32>) {
-        let act = thruster::actuate(
+        let act = thruster::actuate_within(
             &self.maps,
             self.config.thrust_unit,
             demand,
             self.config.voltage_limit,
+            self.allocator.envelope(),
         );
-        let tau_achieved = self.allocator.pseudo_inverse().wrench(&act.thrusts);
+        let tau_achieved = self.allocator.wrench(&act.thrusts);
         (act, tau_achieved)
     }
 }
@@ -939,17 +947,66 @@ fn check_feasible(bounds: &UncertaintyBounds<f32>, beta: f32) -> Result<(), Conf
     Ok(())
 }
 
-fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {
-    if !eta.iter().chain(nu.iter()).all(|x| x.is_finite()) {
-        return Err(Fault::NonFiniteInput);
+/// Σ xᵢ·0: ±0 when every xᵢ is finite, NaN otherwise ([`Output::all_finite`], Choice 524).
+#[inline]
+fn times_zero<const N: usize>(x: &[f32; N]) -> f32 {
+    let mut zero = 0.0f32;
+    for v in x {
+        zero += v * 0.0;
     }
+    zero
+}
+
+/// η and ν finite ([`Fault::NonFiniteInput`] otherwise) and plausible
+/// ([`Fault::InputOutOfRange`]). A plausible value is finite (|x| ≤ a limit is false for NaN
+/// and ±∞), so the plausibility test alone passes every good input and the finiteness test
+/// runs only to name the fault (Choice 524).
+fn check_inputs(eta: &[f32; 6], nu: &[f32; 6]) -> Result<(), Fault> {
     let plausible = eta[..3].iter().all(|x| x.abs() <= MAX_POSITION)
         && eta[3..].iter().all(|x| x.abs() <= MAX_ANGLE)
         && nu[..3].iter().all(|x| x.abs() <= MAX_LINEAR_SPEED)
         && nu[3..].iter().all(|x| x.abs() <= MAX_ANGULAR_RATE);
     if plausible {
         Ok(())
-    } else {
+    } else if eta.iter().chain(nu.iter()).all(|x| x.is_finite()) {
         Err(Fault::InputOutOfRange)
+    } else {
+        Err(Fault::NonFiniteInput)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Choice 524: the sum-times-zero check finds a non-finite value in every field and at
+    /// every position, ±∞ and NaN alike, and passes finite values of any size and sign.
+    #[test]
+    fn all_finite_finds_every_non_finite_value() {
+        let finite = Output {
+            tau: [f32::MAX, -f32::MAX, 0.0, -0.0, f32::MIN_POSITIVE, 1.0],
+            ..Output::fail_safe(Fault::NonFiniteResult)
+        };
+        assert!(finite.all_finite());
+        let fields = 6 * 6 + 2 * 5 + 2;
+        for k in 0..fields {
+            for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+                let mut o = finite;
+                let slot = match k {
+                    0..=5 => &mut o.tau[k],
+                    6..=11 => &mut o.tau_achieved[k - 6],
+                    12..=17 => &mut o.tau_unallocated[k - 12],
+                    18..=22 => &mut o.thrust[k - 18],
+                    23..=27 => &mut o.voltage[k - 23],
+                    28..=33 => &mut o.eta_d[k - 28],
+                    34..=39 => &mut o.e1[k - 34],
+                    40..=45 => &mut o.u[k - 40],
+                    46 => &mut o.delta,
+                    _ => &mut o.w_norm,
+                };
+                *slot = bad;
+                assert!(!o.all_finite(), "field slot {k}: {bad}");
+            }
+        }
     }
 }

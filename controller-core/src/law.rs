@@ -186,7 +186,8 @@ pub fn uncertainty_bound(c: &DeltaConstants, x: &DeltaInputs) -> f32 {
 /// literal Eq 7 route and this one in agreement). `jinv_jdot_nu` is
 /// [`Kinematics::jinv_jdot_nu`], passed in because δ(e,t) needs its norm too; `kin` is the
 /// step's one kinematics value. C(ν)ν and D(ν)ν are formed as vectors
-/// ([`model::coriolis_force`], [`model::damping_force`]).
+/// ([`model::coriolis_force_of`], [`model::damping_force`]); `m_hat` is a
+/// [`model::mass_matrix`], whose structure [`model::mass_mul`] multiplies by (Choice 521).
 pub fn body_force<T: RealField + Copy>(
     m_hat: &Matrix6<T>,
     params: &VehicleParams<T>,
@@ -196,8 +197,8 @@ pub fn body_force<T: RealField + Copy>(
     jinv_jdot_nu: &Vector6<T>,
 ) -> Vector6<T> {
     let accel = kin.jinv_mul(u) - jinv_jdot_nu;
-    m_hat * accel
-        + model::coriolis_force(m_hat, nu)
+    model::mass_mul(m_hat, &accel)
+        + model::coriolis_force_of(&model::mass_mul(m_hat, nu), nu)
         + model::damping_force(params, nu)
         + model::restoring(params, &kin.att)
 }

@@ -117,13 +117,15 @@ pub fn sqrt(x: f32) -> f32 {
     }
 }
 
-/// Correctly rounded √x in every backend (libm's `sqrtf`, one `vsqrt.f32` on the M4F), for
-/// what is computed once at configuration time or reported, where micromath's ≈ 6 % error is
-/// not acceptable: the inverse thrust maps, the trajectory's K_d and minimum speed
-/// (docs/numerics.md#the-math-backends, Choice 30).
+/// Correctly rounded √x in every backend, for what is reported or feeds a cancellation, where
+/// micromath's ≈ 6 % error is not acceptable: the inverse thrust maps, the trajectory's K_d and
+/// minimum speed (docs/numerics.md#the-math-backends, Choice 30). It is [`kernels::sqrt`]: the
+/// FPU's `vsqrt.f32` on the M4F (≈ 9 instructions where libm's `sqrtf`, a software loop there,
+/// took ≈ 53: Choice 520), libm's `sqrtf` on the host; both correctly rounded, so the bits are
+/// libm's on every target.
 #[inline]
 pub fn exact_sqrt(x: f32) -> f32 {
-    libm::sqrtf(x)
+    kernels::sqrt(x)
 }
 
 /// ∛x (libm's with `libm-math`, the kernels' otherwise).

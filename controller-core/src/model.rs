@@ -258,6 +258,30 @@ pub fn mass_matrix<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
     rigid_body_mass(p) + added_mass(p)
 }
 
+/// M x for an inertia with [`mass_matrix`]'s structure, M = diag(M) + [[0, −m S(r_G)],
+/// [m S(r_G), 0]]: each row's three structural non-zeros, the diagonal and the two of the skew
+/// block (docs/model.md#parameters-table-2-and-the-inertia-m), 18 products where the dense
+/// product makes 36 (Choice 521).
+///
+/// Each row sums its products in column order, as nalgebra's dense `m * x` does (column by
+/// column), so the result has the dense product's bits: the dense one only adds the exact
+/// zeros 0·xⱼ between, which change no non-zero sum (a sum that is exactly zero may differ in
+/// its sign; `tests/model.rs` checks the bits over random parameters and vectors). Entries off
+/// this structure are not read: call it only with a matrix [`mass_matrix`] built.
+#[inline]
+pub fn mass_mul<T: RealField + Copy>(m: &Matrix6<T>, x: &Vector6<T>) -> Vector6<T> {
+    let row =
+        |i: usize, [a, b, c]: [usize; 3]| m[(i, a)] * x[a] + m[(i, b)] * x[b] + m[(i, c)] * x[c];
+    Vector6::new(
+        row(0, [0, 4, 5]),
+        row(1, [1, 3, 5]),
+        row(2, [2, 3, 4]),
+        row(3, [1, 2, 3]),
+        row(4, [0, 2, 4]),
+        row(5, [0, 1, 5]),
+    )
+}
+
 /// Coriolis–centripetal matrix of a symmetric inertia `m` in Kirchhoff form (docs/model.md#the-coriolis-and-centripetal-matrix):
 /// C(ν) = [[0, −S(a)], [−S(a), −S(b)]] with [a; b] = M ν, so C(ν) ν = [ω × a; v × a + ω × b]
 /// and νᵀ C(ν) ν = 0.

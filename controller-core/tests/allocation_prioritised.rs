@@ -56,6 +56,11 @@ fn reach(a: &PseudoInverse, e: &ThrustEnvelope, thrusters: [usize; 2], r: usize)
     (lo, hi)
 }
 
+/// The same f32 bits, or both zeros of either sign.
+fn same_bits(a: f32, b: f32) -> bool {
+    a.to_bits() == b.to_bits() || (a == 0.0 && b == 0.0)
+}
+
 fn inside(e: &ThrustEnvelope, out: &Allocated) -> bool {
     e.contains(&out.thrusts)
 }
@@ -93,6 +98,25 @@ proptest! {
         prop_assert_eq!(out.thrusts, a.thrusts(&tau));
         prop_assert_eq!(out.saturated, 0);
         prop_assert_eq!(out.unallocated, [0.0; 6]);
+    }
+
+    /// Choice 522: the allocator forms B·T per block row (the voltage maps' achieved wrench);
+    /// on every one of the 32 mountings it has the bits of the dense 6×5 product
+    /// (`PseudoInverse::wrench`, nalgebra's), not merely its values. A zero may differ in its
+    /// sign only.
+    #[test]
+    fn block_wrench_has_the_dense_products_bits(
+        frac in proptest::array::uniform5(0.0f32..1.0),
+        reversed in 0u8..32,
+        unit in unit(),
+    ) {
+        let (al, a) = allocator(reversed, unit, &AxisPriority::default());
+        let e = envelope(unit);
+        let t: [f32; THRUSTERS] = std::array::from_fn(|i| e.min[i] + frac[i] * (e.max[i] - e.min[i]));
+        let (fast, dense) = (al.wrench(&t), a.wrench(&t));
+        for r in 0..6 {
+            prop_assert!(same_bits(fast[r], dense[r]), "row {r}: {} vs {}", fast[r], dense[r]);
+        }
     }
 
     /// Whatever the demand, every thrust is inside its envelope; saturation bits only on

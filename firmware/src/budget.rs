@@ -88,16 +88,18 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "kernels",
         update: 4_000,
-        // kinematics, trajectory, law, allocation, voltage maps. The trajectory stage's 720:
+        // kinematics, trajectory, law, allocation, voltage maps: measured 445, 639, 605, 888,
+        // 424 (Choices 520–524; 499, 639, 682, 888, 1 112 before). The trajectory stage's 720:
         // a waypoint path's sample (two fixed binary searches, the time law's piece and the
-        // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 642 on the survey's golden vectors,
-        // against 468 for the closed forms.
-        stages: [560, 720, 760, 1_000, 1_250],
-        // Measured 6 273 (was 7 200 before Choices 430–431). Issue 28's target is ≤ 4 000,
-        // not met: the law alone is ≈ 3 900 on the same inputs (docs/law.md#the-state-estimator).
-        update_from_solution: 6_600,
-        // solution, filter, estimate, record: measured 443, 1 040, 407, 530.
-        estimator_stages: [500, 1_200, 450, 600],
+        // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
+        // against 445 for the closed forms.
+        stages: [500, 720, 680, 1_000, 480],
+        // Measured 5 183 (6 273 before Choices 520–524, 7 200 before Choices 430–431). Issue
+        // 28's target is ≤ 4 000, not met: the estimator's stages are 2 306 of it and the law
+        // on the estimate ≈ 2 880 (docs/law.md#the-state-estimator).
+        update_from_solution: 5_450,
+        // solution, filter, estimate, record: measured 391, 1 029, 355, 531.
+        estimator_stages: [450, 1_200, 400, 600],
         // Measured 29 160 (the whole patch host-sim sends, protocol 7: its digest covers the
         // estimator's 73 bytes too, and the rebuild checks the box its bounds are of, Choice
         // 363; 21 600–24 120 for one law field), 1 051 160 and 1 218 200.
@@ -110,11 +112,13 @@ pub const BUDGETS: [StepBudget; 3] = [
     // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
     StepBudget {
         backend: "libm",
-        update: 25_000,
-        stages: [8_400, 6_200, 1_000, 1_000, 8_000],
-        // Measured 31 860; solution, filter, estimate, record: 7 592, 1 028, 7 570, 529 (libm's
+        // Measured 15 280 (the SysTick count); stages 7 541, 5 469, 848, 890, 423 (the voltage
+        // maps take no cbrtf since Choice 523, no libm sqrtf since Choice 520).
+        update: 17_000,
+        stages: [8_400, 6_200, 1_000, 1_000, 500],
+        // Measured 24 686; solution, filter, estimate, record: 7 537, 1 025, 7 505, 531 (libm's
         // sinf/cosf in the solution's and the estimate's attitude).
-        update_from_solution: 35_000,
+        update_from_solution: 26_000,
         estimator_stages: [8_400, 1_150, 8_400, 600],
         // Measured 34 720, 1 281 440 and 1 448 480 (libm's cosf in the rebuild, its sin/cos in
         // the waypoint build).
@@ -127,12 +131,13 @@ pub const BUDGETS: [StepBudget; 3] = [
     // micromath takes the kernels' cbrt (it has none), so its maps cost the kernels'.
     StepBudget {
         backend: "micromath",
+        // Measured 3 040 (the SysTick count); stages 377, 570, 618, 890, 431 (the waypoint
+        // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
-        // The waypoint path's trajectory stage: 600 measured (docs/board.md#the-self-test-and-its-budgets).
-        stages: [500, 680, 780, 1_000, 1_250],
-        // Measured 6 151; solution, filter, estimate, record: 398, 1 032, 387, 532.
-        update_from_solution: 6_800,
-        estimator_stages: [450, 1_150, 450, 600],
+        stages: [450, 680, 700, 1_000, 480],
+        // Measured 5 059; solution, filter, estimate, record: 343, 1 030, 321, 532.
+        update_from_solution: 5_350,
+        estimator_stages: [400, 1_150, 380, 600],
         // Measured as the kernels: 29 160, 1 051 200 and 1 218 200.
         work: WorkBudget {
             set_config: 34_000,

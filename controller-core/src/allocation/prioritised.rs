@@ -46,6 +46,7 @@ use crate::allocation::box_solution::{clamp, least_squares, lexicographic};
 use crate::allocation::error::AllocationError;
 use crate::allocation::priority::AxisPriority;
 use crate::allocation::pseudo_inverse::PseudoInverse;
+use crate::axes::ROLL;
 use crate::effectiveness::THRUSTERS;
 use crate::thruster::ThrustEnvelope;
 
@@ -73,6 +74,8 @@ pub struct Allocator {
     envelope: ThrustEnvelope,
     blocks: [Block; THRUSTERS],
     count: usize,
+    /// B's roll row K (not actuated, so in no block; zero for the AUV-150's layout).
+    roll: [f32; THRUSTERS],
 }
 
 impl Allocator {
@@ -98,12 +101,14 @@ impl Allocator {
         if let Some((axis, weight)) = priority.invalid_weight() {
             return Err(AllocationError::Weight { axis, weight });
         }
-        let (blocks, count) = blocks::split(&pseudo_inverse.matrix(), priority)?;
+        let b = pseudo_inverse.matrix();
+        let (blocks, count) = blocks::split(&b, priority)?;
         Ok(Allocator {
             pseudo_inverse: *pseudo_inverse,
             envelope: *envelope,
             blocks,
             count,
+            roll: core::array::from_fn(|t| b[(ROLL, t)]),
         })
     }
 
@@ -138,6 +143,30 @@ impl Allocator {
             self.solve(block, tau, &exact, &mut out);
         }
         out
+    }
+
+    /// The wrench B·T (N, N·m) that `thrusts` (N) give, all six rows: each actuated row from
+    /// its block's gains, the roll row whole (14 products on the AUV-150's layout where the
+    /// dense B·T makes 30). The bits of [`PseudoInverse::wrench`]: a row's products outside its
+    /// block are with exact zeros of B, and the others are summed in thruster order, as the
+    /// dense product sums them (Choice 522).
+    #[inline]
+    pub fn wrench(&self, thrusts: &[f32; THRUSTERS]) -> Vector6<f32> {
+        let t = thrusts;
+        let r = &self.roll;
+        let mut w = Vector6::zeros();
+        w[ROLL] = r[0] * t[0] + r[1] * t[1] + r[2] * t[2] + r[3] * t[3] + r[4] * t[4];
+        for block in &self.blocks[..self.count] {
+            let [i, j] = block.thrusters;
+            let g = &block.g;
+            if block.rule == Rule::Single {
+                w[block.axes[0]] = g[0][0] * t[i];
+            } else {
+                w[block.axes[0]] = g[0][0] * t[i] + g[0][1] * t[j];
+                w[block.axes[1]] = g[1][0] * t[i] + g[1][1] * t[j];
+            }
+        }
+        w
     }
 
     /// One block: keep B₅⁻¹τ if it fits, else solve within the box.
