@@ -73,8 +73,9 @@ impl StepBudget {
 
 /// The deepest the stack may go in the self-test (its `stack high-water mark: N bytes` line),
 /// bytes: a quarter of the STM32F405's 128 KiB of SRAM (memory-stm32f405.x), which the stack
-/// shares with the static RAM. Measured 31 060 B (kernels, libm) and 31 084 B (micromath) with
-/// the 32-waypoint capacity and the estimator's 16-period memory of running sums, several copies
+/// shares with the static RAM. Measured 31 516 B (kernels, libm) and 31 540 B (micromath) with
+/// the 32-waypoint capacity and the estimator's 16-period memory of running sums and its
+/// disturbance state (Choice 510), several copies
 /// of which the self-test holds (Choice 180: every trajectory built in place, the supervisor's
 /// in its one slot, the self-test's circle in static memory); 92 612 B when trajectories of 8.6 kB were built and copied by value,
 /// which this budget refuses.
