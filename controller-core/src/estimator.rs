@@ -16,6 +16,20 @@
 //! the work is fixed: one correction at the solution's stamp and two predictions, each a
 //! difference of running sums of the applied accelerations (Choice 430, [`Estimate`]).
 //!
+//! **Choice 510:** with `disturbance_time` τ_d > 0 each axis carries a third state, the
+//! acceleration dᵢ the nominal model does not explain and that varies slowly (a water current's
+//! drag on the relative velocity, a payload's weight): x = [ηᵢ, η̇ᵢ, dᵢ],
+//!
+//! x⁺ = F x + g aᵢ,  F = [[1, T, T²/2], [0, 1, T], [0, 0, 1]],  g = [T²/2, T, 0],
+//!
+//! d a random walk of variance σₐ²·2T/τ_d per period (a Gauss–Markov process of standard
+//! deviation σₐ and time τ_d, its decay left out so that a steady disturbance leaves no
+//! steady error). Without it a steady current is a constant acceleration the two-state filter
+//! does not know: its estimate lags by a constant offset and the prediction over the
+//! solution's age adds d·(age)²/2. The steady-state gain (3×2) comes from the same doubling
+//! algorithm ([`steady_state_gain_with_disturbance`]); a prediction adds d·Δt²/2 and d·Δt in
+//! closed form (d is constant over it), so the work stays fixed.
+//!
 //! **Choice 341:** the filter's state is kept at the stamp of the newest solution taken (the
 //! delayed horizon), and the estimate the law uses is that state predicted forward to the
 //! current period with the accelerations applied since ([`Estimate::step`]). A solution older
@@ -59,7 +73,15 @@ pub struct EstimatorConfig {
     /// and the applied thrust do not explain (parameter mismatch, current, thruster lag).
     /// Smaller trusts the model more: a smoother estimate that lags a mismatch longer.
     pub accel_sigma: [f32; 6],
+    /// τ_d (s): the time scale of the slowly varying model error the filter estimates as a
+    /// disturbance state per axis (Choice 510; 0: none, the two-state filter). Not a
+    /// scenario key nor on the wire: every board and SIL fly [`DISTURBANCE_TIME`].
+    pub disturbance_time: f32,
 }
+
+/// The disturbance state's time scale (s) every estimator flies (Choice 510): the Gauss–Markov
+/// time of the simulator's current (60 s), the slowest model error the board meets.
+pub const DISTURBANCE_TIME: f32 = 60.0;
 
 impl Default for EstimatorConfig {
     /// Off, with the noise of the shipped campaigns' `[noise]` table (5 mm, 1 mrad;
@@ -71,14 +93,17 @@ impl Default for EstimatorConfig {
             position_sigma: [0.005, 0.005, 0.005, 0.001, 0.001, 0.001],
             velocity_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],
             accel_sigma: [0.02, 0.02, 0.02, 0.004, 0.004, 0.004],
+            disturbance_time: DISTURBANCE_TIME,
         }
     }
 }
 
-/// One axis's steady-state gain K (2×2) and the prior covariance P⁻ it comes from.
+/// One axis's steady-state gain and the prior covariance P⁻ it comes from: K's rows of η and
+/// η̇ (2×2, P⁻'s block of them), and its row of the disturbance (zero without one).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct AxisGain {
     pub k: Matrix2<f32>,
+    pub kd: [f32; 2],
     pub p_prior: Matrix2<f32>,
 }
 
@@ -86,6 +111,7 @@ impl AxisGain {
     /// The gain that takes no measurement (K = 0): an axis of an estimator that is off.
     pub const ZERO: AxisGain = AxisGain {
         k: Matrix2::new(0.0, 0.0, 0.0, 0.0),
+        kd: [0.0; 2],
         p_prior: Matrix2::new(0.0, 0.0, 0.0, 0.0),
     };
 }
@@ -146,6 +172,7 @@ pub fn steady_state_gain(
     if positive && finite {
         Ok(AxisGain {
             k: k.matrix(),
+            kd: [0.0; 2],
             p_prior: p.matrix(),
         })
     } else {
@@ -207,6 +234,127 @@ impl M2 {
     }
 }
 
+/// The steady-state gain of the filter with a disturbance state (Choice 510) for one axis:
+/// as [`steady_state_gain`] on x = [η, η̇, d] with F, g of the module's docs, the measurement
+/// C = [I₂ 0], R = diag(σₚ², σᵥ²) and Q = σₐ² g gᵀ + diag(0, 0, σₐ²·2T/τ_d); the doubling
+/// algorithm from A₀ = Fᵀ, G₀ = Cᵀ R⁻¹ C, H₀ = Q, then K = P⁻Cᵀ(C P⁻ Cᵀ + R)⁻¹ (3×2: rows
+/// η, η̇ in [`AxisGain::k`], d in [`AxisGain::kd`]). `disturbance_time` finite and > 0.
+/// Configuration time only.
+pub fn steady_state_gain_with_disturbance(
+    period: f32,
+    position_sigma: f32,
+    velocity_sigma: f32,
+    accel_sigma: f32,
+    disturbance_time: f32,
+) -> Result<AxisGain, NoSteadyState> {
+    let t = period;
+    let g = [0.5 * t * t, t, 0.0];
+    let qa = accel_sigma * accel_sigma;
+    let mut q = M3(core::array::from_fn(|i| {
+        core::array::from_fn(|j| qa * g[i] * g[j])
+    }));
+    q.0[2][2] = qa * 2.0 * t / disturbance_time;
+    let (rp, rv) = (
+        position_sigma * position_sigma,
+        velocity_sigma * velocity_sigma,
+    );
+    let mut a = M3([[1.0, 0.0, 0.0], [t, 1.0, 0.0], [0.5 * t * t, t, 1.0]]); // Fᵀ
+    let mut gk = M3([[1.0 / rp, 0.0, 0.0], [0.0, 1.0 / rv, 0.0], [0.0, 0.0, 0.0]]);
+    let mut h = q;
+    for _ in 0..DOUBLING_STEPS {
+        let w_inv = M3::IDENTITY
+            .add(&gk.mul(&h))
+            .inverse()
+            .ok_or(NoSteadyState)?;
+        let a_w = a.mul(&w_inv);
+        let a_next = a_w.mul(&a);
+        let g_next = gk.add(&a_w.mul(&gk).mul(&a.transpose()));
+        let h_next = h.add(&a.transpose().mul(&h).mul(&w_inv).mul(&a));
+        a = a_next;
+        gk = g_next;
+        h = h_next;
+    }
+    let p = h.add(&h.transpose()).scale(0.5).0;
+    // S = C P⁻ Cᵀ + R and K = P⁻ Cᵀ S⁻¹.
+    let s = M2([[p[0][0] + rp, p[0][1]], [p[1][0], p[1][1] + rv]])
+        .inverse()
+        .ok_or(NoSteadyState)?;
+    let k: [[f32; 2]; 3] = core::array::from_fn(|i| {
+        core::array::from_fn(|j| p[i][0] * s.0[0][j] + p[i][1] * s.0[1][j])
+    });
+    let block = M2([[p[0][0], p[0][1]], [p[1][0], p[1][1]]]);
+    let positive = p[0][0] > 0.0 && block.det() > 0.0 && M3(p).det() > 0.0;
+    let finite = k
+        .iter()
+        .flatten()
+        .chain(p.iter().flatten())
+        .all(|x| x.is_finite());
+    if positive && finite {
+        Ok(AxisGain {
+            k: M2([k[0], k[1]]).matrix(),
+            kd: k[2],
+            p_prior: block.matrix(),
+        })
+    } else {
+        Err(NoSteadyState)
+    }
+}
+
+/// A 3×3 matrix by rows, as [`M2`] (the disturbance filter's doubling algorithm).
+#[derive(Clone, Copy)]
+struct M3([[f32; 3]; 3]);
+
+impl M3 {
+    const IDENTITY: M3 = M3([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
+
+    fn mul(&self, b: &M3) -> M3 {
+        let (a, b) = (&self.0, &b.0);
+        M3(core::array::from_fn(|i| {
+            core::array::from_fn(|j| a[i][0] * b[0][j] + a[i][1] * b[1][j] + a[i][2] * b[2][j])
+        }))
+    }
+
+    fn add(&self, b: &M3) -> M3 {
+        M3(core::array::from_fn(|i| {
+            core::array::from_fn(|j| self.0[i][j] + b.0[i][j])
+        }))
+    }
+
+    fn scale(&self, s: f32) -> M3 {
+        M3(self.0.map(|row| row.map(|x| x * s)))
+    }
+
+    fn transpose(&self) -> M3 {
+        M3(core::array::from_fn(|i| {
+            core::array::from_fn(|j| self.0[j][i])
+        }))
+    }
+
+    /// The cofactor of (i, j).
+    fn cofactor(&self, i: usize, j: usize) -> f32 {
+        let a = &self.0;
+        let (r0, r1) = ((i + 1) % 3, (i + 2) % 3);
+        let (c0, c1) = ((j + 1) % 3, (j + 2) % 3);
+        a[r0][c0] * a[r1][c1] - a[r0][c1] * a[r1][c0]
+    }
+
+    fn det(&self) -> f32 {
+        (0..3).map(|j| self.0[0][j] * self.cofactor(0, j)).sum()
+    }
+
+    /// The inverse (the adjugate over the determinant), if the determinant is finite and
+    /// not zero.
+    fn inverse(&self) -> Option<M3> {
+        let d = self.det();
+        if d == 0.0 || !d.is_finite() {
+            return None;
+        }
+        Some(M3(core::array::from_fn(|i| {
+            core::array::from_fn(|j| self.cofactor(j, i) / d)
+        })))
+    }
+}
+
 /// The six axes' gains and the period, computed once from an [`EstimatorConfig`].
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorGains {
@@ -216,18 +364,28 @@ pub struct EstimatorGains {
 }
 
 impl EstimatorGains {
-    /// The gains of `config` at `rate_hz`; `Err(axis)` names an axis without a steady state.
+    /// The gains of `config` at `rate_hz`; `Err(axis)` names an axis without a steady state
+    /// (axis 0 also for a `disturbance_time` not finite and ≥ 0).
     pub fn new(config: &EstimatorConfig, rate_hz: u32) -> Result<Self, usize> {
         let period = 1.0 / rate_hz.max(1) as f32;
         let mut axes = [AxisGain::ZERO; 6];
+        let tau_d = config.disturbance_time;
+        if !(tau_d.is_finite() && tau_d >= 0.0) {
+            // No filter of that time scale: the first axis has no gain.
+            return Err(0);
+        }
         for (i, axis) in axes.iter_mut().enumerate() {
-            *axis = steady_state_gain(
-                period,
+            let (sp, sv, sa) = (
                 config.position_sigma[i],
                 config.velocity_sigma[i],
                 config.accel_sigma[i],
-            )
-            .map_err(|_| i)?;
+            );
+            let gain = if tau_d > 0.0 {
+                steady_state_gain_with_disturbance(period, sp, sv, sa, tau_d)
+            } else {
+                steady_state_gain(period, sp, sv, sa)
+            };
+            *axis = gain.map_err(|_| i)?;
         }
         Ok(EstimatorGains { axes, period })
     }
@@ -311,6 +469,8 @@ pub struct Estimate {
     offset: [f32; 6],
     /// η̇ at `stamp`.
     velocity: [f32; 6],
+    /// The disturbance acceleration d (Choice 510; zero without the state).
+    disturbance: [f32; 6],
     stamp: u64,
     valid: bool,
     /// The latest period recorded ([`NONE`]: none). The ring holds every period of
@@ -337,6 +497,7 @@ impl Estimate {
             anchor: [0.0; 6],
             offset: [0.0; 6],
             velocity: [0.0; 6],
+            disturbance: [0.0; 6],
             stamp: 0,
             valid: false,
             last: NONE,
@@ -362,6 +523,11 @@ impl Estimate {
             core::array::from_fn(|i| self.anchor[i] + self.offset[i]),
             self.velocity,
         )
+    }
+
+    /// The disturbance acceleration d the filter holds (Choice 510; zero without the state).
+    pub fn disturbance(&self) -> [f32; 6] {
+        self.disturbance
     }
 
     /// Forgets everything, in place (as [`Estimate::new`]: the ring's sums are read only
@@ -413,8 +579,9 @@ impl Estimate {
     }
 
     /// The state predicted from `from` (the stamp) to `to` with the accelerations applied
-    /// since: the position as its offset from the anchor, and the velocity. Periods older
-    /// than the ring weigh zero. Fixed work (Choice 430).
+    /// since and the disturbance (constant over it, Choice 510): the position as its offset
+    /// from the anchor, and the velocity. Periods older than the ring weigh zero. Fixed work
+    /// (Choice 430).
     fn predicted(&self, gains: &EstimatorGains, from: u64, to: u64) -> ([f32; 6], [f32; 6]) {
         let t = gains.period;
         let dt = periods(to.saturating_sub(from)) * t;
@@ -434,8 +601,9 @@ impl Estimate {
         for i in 0..6 {
             let (sa, sb) = self.sums_at(&s, i);
             let (ea, eb) = self.sums_at(&e, i);
-            p[i] += v[i] * dt + t * t * (eb - sb - n * sa);
-            v[i] += t * (ea - sa);
+            let d = self.disturbance[i];
+            p[i] += (v[i] + 0.5 * d * dt) * dt + t * t * (eb - sb - n * sa);
+            v[i] += d * dt + t * (ea - sa);
         }
         (p, v)
     }
@@ -464,6 +632,7 @@ impl Estimate {
                 self.anchor = *eta;
                 self.offset = [0.0; 6];
                 self.velocity = *eta_dot;
+                self.disturbance = [0.0; 6];
                 self.stamp = stamp;
                 self.valid = true;
             } else if stamp > self.stamp {
@@ -471,6 +640,7 @@ impl Estimate {
                 let (o, v) = self.predicted(gains, self.stamp, stamp);
                 let mut offset = [0.0f32; 6];
                 let mut vel = v;
+                let mut dist = self.disturbance;
                 for i in 0..6 {
                     // z − prior = (z − anchor) − offset: near each other, so exact first.
                     let mut dz = (eta[i] - self.anchor[i]) - o[i];
@@ -482,12 +652,15 @@ impl Estimate {
                     // Posterior − z, with z the new anchor: (prior − z) + K₀·[dz, dv].
                     offset[i] = (k[(0, 0)] - 1.0) * dz + k[(0, 1)] * dv;
                     vel[i] = v[i] + k[(1, 0)] * dz + k[(1, 1)] * dv;
+                    let kd = &gains.axes[i].kd;
+                    dist[i] += kd[0] * dz + kd[1] * dv;
                 }
                 let sum_finite = (0..6).all(|i| (eta[i] + offset[i]).is_finite());
-                if sum_finite && vel.iter().all(|x| x.is_finite()) {
+                if sum_finite && vel.iter().chain(dist.iter()).all(|x| x.is_finite()) {
                     self.anchor = *eta;
                     self.offset = offset;
                     self.velocity = vel;
+                    self.disturbance = dist;
                     self.stamp = stamp;
                 }
             }

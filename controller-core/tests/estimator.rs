@@ -184,12 +184,19 @@ fn the_steady_state_gain_has_the_least_error_variance_of_any_fixed_gain() {
     }
 }
 
+/// The two-state filter's gains (no disturbance state: the closed forms below are of it).
 fn gains(sp: f32, sv: f32, sa: f32) -> EstimatorGains {
+    gains_with(sp, sv, sa, 0.0)
+}
+
+/// The gains with the disturbance state of time scale `tau_d` (0: none, Choice 510).
+fn gains_with(sp: f32, sv: f32, sa: f32, tau_d: f32) -> EstimatorGains {
     let config = EstimatorConfig {
         kind: EstimatorKind::Kalman,
         position_sigma: [sp; 6],
         velocity_sigma: [sv; 6],
         accel_sigma: [sa; 6],
+        disturbance_time: tau_d,
     };
     EstimatorGains::new(&config, 100).unwrap()
 }
@@ -364,6 +371,109 @@ fn a_constant_acceleration_the_model_does_not_know_is_tracked_with_the_closed_fo
         (last.1 / want[1] - 1.0).abs() < 0.02,
         "{last:?} vs {want:?}"
     );
+}
+
+type M3 = [[f64; 3]; 3];
+
+fn mul3(a: &M3, b: &M3) -> M3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| a[i][k] * b[k][j]).sum()))
+}
+
+fn tr3(a: &M3) -> M3 {
+    core::array::from_fn(|i| core::array::from_fn(|j| a[j][i]))
+}
+
+/// The disturbance filter's gain (3×2) after `n` steps of its covariance recursion in f64
+/// from P = diag(σₚ², σᵥ², 1): K = P⁻Cᵀ(C P⁻ Cᵀ + R)⁻¹, P⁺ = (I − K C)P⁻, P⁻ ← F P⁺ Fᵀ + Q
+/// (C = [I₂ 0]; F, g, Q of docs/law.md#the-state-estimator, Choice 510).
+fn riccati_gain_with_disturbance(sp: f64, sv: f64, sa: f64, tau_d: f64, n: usize) -> [[f64; 2]; 3] {
+    let t = 0.01;
+    let f: M3 = [[1.0, t, 0.5 * t * t], [0.0, 1.0, t], [0.0, 0.0, 1.0]];
+    let g = [0.5 * t * t, t, 0.0];
+    let mut q: M3 = core::array::from_fn(|i| core::array::from_fn(|j| sa * sa * g[i] * g[j]));
+    q[2][2] = sa * sa * 2.0 * t / tau_d;
+    let r = [[sp * sp, 0.0], [0.0, sv * sv]];
+    let mut p: M3 = [[sp * sp, 0.0, 0.0], [0.0, sv * sv, 0.0], [0.0, 0.0, 1.0]];
+    let mut k = [[0.0; 2]; 3];
+    for _ in 0..n {
+        let s = inv(&add(&[[p[0][0], p[0][1]], [p[1][0], p[1][1]]], &r));
+        k = core::array::from_fn(|i| {
+            core::array::from_fn(|j| p[i][0] * s[0][j] + p[i][1] * s[1][j])
+        });
+        let ikc: M3 = core::array::from_fn(|i| {
+            core::array::from_fn(|j| {
+                f64::from(u8::from(i == j)) - if j < 2 { k[i][j] } else { 0.0 }
+            })
+        });
+        let post = mul3(&ikc, &p);
+        let fp = mul3(&mul3(&f, &post), &tr3(&f));
+        p = core::array::from_fn(|i| core::array::from_fn(|j| fp[i][j] + q[i][j]));
+    }
+    k
+}
+
+#[test]
+fn the_disturbance_gain_is_the_limit_of_its_riccati_recursion() {
+    for &(sp, sv, sa) in &AXES {
+        for tau_d in [10.0, 60.0] {
+            let got = gains_with(sp as f32, sv as f32, sa as f32, tau_d as f32).axes[0];
+            let want = riccati_gain_with_disturbance(sp, sv, sa, tau_d, 200_000);
+            for (i, row) in want.iter().enumerate() {
+                for (j, &w) in row.iter().enumerate() {
+                    let g = f64::from(if i < 2 { got.k[(i, j)] } else { got.kd[j] });
+                    assert!(
+                        (g - w).abs() <= 2e-3 * w.abs() + 1e-9,
+                        "σ ({sp}, {sv}, {sa}), τ_d {tau_d}: K[{i}][{j}] {g} vs {w}"
+                    );
+                }
+            }
+        }
+    }
+}
+
+/// A steady current is a constant acceleration a₀ the nominal model does not know (its drag
+/// on the relative velocity: the vehicle's velocity through the water is offset by the current
+/// by a constant). Flown on exact solutions `age` periods old, the two-state filter's
+/// prediction keeps a constant error (the closed-form lag of the test above, plus a₀·age²/2
+/// over the age); the disturbance state takes a₀ and the prediction's error goes to zero.
+#[test]
+fn a_steady_current_leaves_no_prediction_error_with_the_disturbance_state() {
+    let (sp, sv, sa) = (0.01f32, 0.005, 0.01);
+    let (t, a0, age) = (0.01f64, 0.05f64, 5u64);
+    let fly = |g: &EstimatorGains| {
+        let mut memory = Estimate::new();
+        let mut last = (0.0, 0.0);
+        for tick in age..12_000u64 {
+            let truth = |k: u64| {
+                let time = k as f64 * t;
+                (0.5 * a0 * time * time, a0 * time)
+            };
+            let (p, v) = truth(tick - age);
+            let (e, ed) = memory
+                .step(
+                    g,
+                    tick,
+                    tick - age,
+                    &[p as f32, 0., 0., 0., 0., 0.],
+                    &[v as f32, 0., 0., 0., 0., 0.],
+                )
+                .unwrap();
+            memory.applied(g, tick, &[0.0; 6]);
+            let (p, v) = truth(tick);
+            last = (p - f64::from(e[0]), v - f64::from(ed[0]));
+        }
+        (last, memory.disturbance()[0])
+    };
+    let (before, _) = fly(&gains(sp, sv, sa));
+    let (after, d) = fly(&gains_with(sp, sv, sa, 60.0));
+    // Before: at least the prediction's share over the age, a₀·(age·T)²/2.
+    let over_age = 0.5 * a0 * (age as f64 * t).powi(2);
+    assert!(before.0 > over_age, "two-state: {before:?}");
+    assert!(before.1 > a0 * age as f64 * t, "two-state: {before:?}");
+    // After: the f32 rounding of positions up to 360 m (ulp 31 µm), not a lag.
+    assert!(after.0.abs() < 1e-4, "with the disturbance: {after:?}");
+    assert!(after.1.abs() < 1e-4, "with the disturbance: {after:?}");
+    assert!(((f64::from(d) - a0) / a0).abs() < 0.01, "d {d} vs a₀ {a0}");
 }
 
 /// The motion the model describes: piecewise-constant accelerations a_t, integrated exactly in

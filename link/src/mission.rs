@@ -196,6 +196,8 @@ impl From<controller_core::EstimatorConfig> for EstimatorSettings {
             position_sigma,
             velocity_sigma,
             accel_sigma,
+            // Not on the wire: every board flies the core's DISTURBANCE_TIME (Choice 510).
+            disturbance_time: _,
         } = e;
         EstimatorSettings {
             kalman: kind == controller_core::EstimatorKind::Kalman,
@@ -223,6 +225,7 @@ impl From<EstimatorSettings> for controller_core::EstimatorConfig {
             position_sigma,
             velocity_sigma,
             accel_sigma,
+            disturbance_time: controller_core::estimator::DISTURBANCE_TIME,
         }
     }
 }

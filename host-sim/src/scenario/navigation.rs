@@ -395,7 +395,7 @@ pub fn real_chain_default(seed: u64) -> Option<NavigationModel> {
 /// The estimator a real-chain scenario flies on when its `[controller]` does not say
 /// `estimator` (**Choice 370**): on, with the survey preset's own figures for what it filters —
 /// σₚ of x y the LBL fix's 0.01 m, σᵥ of x y z the DVL's single ping 0.005 m/s — and a model
-/// error σₐ of 0.01 m/s² on x y z; the other axes keep `EstimatorConfig::default`'s
+/// error σₐ of 0.003 m/s² on x y z (Choice 511); the other axes keep `EstimatorConfig::default`'s
 /// (docs/navigation.md#the-default, measured there).
 pub fn real_chain_estimator() -> controller_core::EstimatorConfig {
     let mut e = controller_core::EstimatorConfig {
@@ -408,8 +408,9 @@ pub fn real_chain_estimator() -> controller_core::EstimatorConfig {
     e
 }
 
-/// The real chain's estimator's model error on x y z (m/s², Choice 370).
-const REAL_CHAIN_ACCEL_SIGMA: f32 = 0.01;
+/// The real chain's estimator's model error on x y z (m/s², Choice 511: 0.003 with the
+/// disturbance state taking the current, Choice 510; 0.01 without it, Choice 370).
+const REAL_CHAIN_ACCEL_SIGMA: f32 = 0.003;
 /// The survey preset's LBL fix σ per horizontal axis (m, Choice 371).
 const SURVEY_FIX_SIGMA: f64 = 0.01;
 /// The survey preset's DVL single-ping σ (m/s, Choice 331).

@@ -171,6 +171,7 @@ fn navigation_and_filter(
         let d = super::navigation::real_chain_estimator();
         let e = &mut config.controller.estimator;
         e.kind = d.kind;
+        e.disturbance_time = d.disturbance_time;
         if !est_keys[1] {
             e.position_sigma = d.position_sigma;
         }
