@@ -10,8 +10,14 @@
 //! - **the pitch offset** — the law has no integrator: the model mismatch in pitch (the
 //!   payload's CG moment, above all) is held by a steady pitch error e_θ = −m/S, with S the
 //!   law's pitch stiffness at zero error, M̂₅₅ (k₁ + p₁₂ δ/μ) inside the boundary layer
-//!   ([`pitch_stiffness`]); the vehicle flies nose-up or -down by e_θ, and at speed the Munk
-//!   moment of that angle of attack is thrust the pair must give.
+//!   ([`axis_stiffness`]); the vehicle flies nose-up or -down by e_θ, and at speed the Munk
+//!   moment of that angle of attack is thrust the pair must give;
+//! - **the yaw offset** — the same in yaw: the law's model has no current, so the current's
+//!   yaw moment (its Munk moment, strongest with the current across the track) and the
+//!   payload's yaw mismatch are held by a steady heading error e_ψ = −n/S_ψ; the vehicle then
+//!   flies at that sideslip to its track, and the sway force and Munk moment of the sideslip
+//!   are thrust the horizontal pair must give — on a reversed thruster's weak side, more than
+//!   the margin leaves (docs/real-vehicle.md#the-attitude-the-vehicle-holds, **Choice 550**).
 
 use controller_core::law::{self, DeltaInputs};
 use controller_core::{Controller, RobustLaw};
@@ -19,9 +25,10 @@ use nalgebra::Vector6;
 
 use crate::plant::{roll_moments, Plant, PlantState};
 
-/// Index of roll and of pitch in η, ν and τ.
+/// Index of roll, pitch and yaw in η, ν and τ.
 const ROLL: usize = 3;
 const PITCH: usize = 4;
+const YAW: usize = 5;
 
 /// The heel (rad) at which the roll row of the force `plant` needs at `state` (with `nu_dot`
 /// and the current `current`) vanishes: one Newton step from the static heel on
@@ -122,20 +129,23 @@ pub fn swing_amplitudes(
     out
 }
 
-/// The law's pitch stiffness at zero error (N m per rad of pitch error) on the reference with
-/// body velocity `nu` and the mission's acceleration bound `accel_bound`: the feedback
-/// acceleration k₁ e plus the robust term's p₁₂ (δ/μ) e inside the boundary layer (Theorem 4;
-/// Theorem 3's discontinuous term has no finite slope and is taken as the boundary layer's
-/// at μ), times the nominal pitch inertia M̂₅₅. δ is the law's own bound at zero error, the
-/// smallest it takes there, so the stiffness is the least the law gives and the pitch offset
-/// the largest (conservative: a larger angle of attack, a larger Munk moment).
-pub fn pitch_stiffness(
+/// The law's stiffness at zero error on the axes that hold a steady error: pitch and yaw
+/// (N m per rad of error), [`axis_stiffness`] of each.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Stiffness {
+    pub pitch: f64,
+    pub yaw: f64,
+}
+
+/// The law's pitch and yaw stiffness on the reference with body velocity `nu`
+/// ([`axis_stiffness`]): δ is formed once, as the law forms it once for every axis.
+pub fn stiffness(
     controller: &Controller,
     nu: &Vector6<f64>,
     jinv_jdot_nu: &Vector6<f64>,
     cos_theta: f64,
     accel_bound: f64,
-) -> f64 {
+) -> Stiffness {
     let c = controller.config();
     let inputs = DeltaInputs {
         accel_bound: accel_bound as f32,
@@ -145,22 +155,53 @@ pub fn pitch_stiffness(
         cos_theta_abs: cos_theta.abs() as f32,
     };
     let delta = law::uncertainty_bound(controller.delta_constants(), &inputs).min(c.delta_max);
+    Stiffness {
+        pitch: axis_stiffness(controller, PITCH, delta),
+        yaw: axis_stiffness(controller, YAW, delta),
+    }
+}
+
+/// The law's stiffness at zero error on `axis` (N m per rad of error): the feedback
+/// acceleration k₁ e plus the robust term's p₁₂ (δ/μ) e inside the boundary layer (Theorem 4;
+/// Theorem 3's discontinuous term has no finite slope and is taken as the boundary layer's at
+/// μ), times the nominal inertia M̂ᵢᵢ. δ is the law's own bound at zero error
+/// ([`stiffness`]), the smallest it takes there, so the stiffness is the least the law gives
+/// and the steady error the largest (conservative: a larger angle of attack or of sideslip, a
+/// larger Munk moment).
+pub fn axis_stiffness(controller: &Controller, axis: usize, delta: f32) -> f64 {
+    let c = controller.config();
     let robust = match (c.robust, c.law) {
         (false, _) => 0.0,
         (true, RobustLaw::BoundaryLayer | RobustLaw::Discontinuous) => {
-            f64::from(controller.lyapunov()[PITCH].p12 * delta / c.mu)
+            f64::from(controller.lyapunov()[axis].p12 * delta / c.mu)
         }
     };
-    let m55 = f64::from(controller.mass_matrix()[(PITCH, PITCH)]);
-    m55 * (f64::from(c.k1[PITCH]) + robust)
+    let m = f64::from(controller.mass_matrix()[(axis, axis)]);
+    m * (f64::from(c.k1[axis]) + robust)
 }
 
-/// The steady pitch error (rad) that holds a pitch-moment mismatch `mismatch` (the moment the
-/// plant needs minus what the law's nominal model gives, N m) against the stiffness `stiffness`.
-pub fn pitch_offset(mismatch: f64, stiffness: f64) -> f64 {
+/// The steady error (rad) that holds a moment mismatch `mismatch` (the moment the plant needs
+/// minus what the law's nominal model gives, N m) against the stiffness `stiffness`: the
+/// pitch offset, and the yaw offset (the heading error that holds the current's yaw moment,
+/// which the law's model does not have).
+pub fn steady_error(mismatch: f64, stiffness: f64) -> f64 {
     if stiffness > 0.0 {
         -mismatch / stiffness
     } else {
         0.0
     }
+}
+
+/// The steady errors (pitch, yaw; rad) that hold the mismatch between the force the plant
+/// `needed` and the one the law's nominal model `modelled` gives, against the law's
+/// `stiffness` ([`steady_error`] per axis): where the preflight evaluates the demand.
+pub fn steady_errors(
+    needed: &Vector6<f64>,
+    modelled: &Vector6<f64>,
+    stiffness: &Stiffness,
+) -> (f64, f64) {
+    (
+        steady_error(needed[PITCH] - modelled[PITCH], stiffness.pitch),
+        steady_error(needed[YAW] - modelled[YAW], stiffness.yaw),
+    )
 }

@@ -14,7 +14,7 @@ use controller_core::{allocation::Allocator, allocation::AxisPriority, axes::NAM
 use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 
-use super::attitude::{self, Swing};
+use super::attitude::{self, Stiffness, Swing};
 use super::period;
 use super::{
     poll, time_scale, CheckError, Engine, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ,
@@ -26,9 +26,10 @@ use fast::{RollConsts, SampleKeys, Shared};
 /// An unallocated part above this (relative to 1 + |τ|) means the axis was given up; below it
 /// is the f32 rounding of an axis met on its bound.
 const GIVEN_UP: f32 = 1.0e-4;
-/// Index of roll and pitch in η.
+/// Index of roll, pitch and yaw in η.
 const ROLL: usize = 3;
 const PITCH: usize = 4;
+const YAW: usize = 5;
 
 /// The reference at one sample of the path, at k = 1.
 pub(super) struct PathSample {
@@ -148,18 +149,19 @@ fn currents(model: &CurrentModel) -> Vec<Vector3<f64>> {
 }
 
 /// The state of the vehicle on the reference sample `smp` at 1/k = `inv_k`, with roll `phi`
-/// and pitch offset `d_theta`: η, ν = J⁻¹(η) η̇_d, ν̇ = J⁻¹(η̈_d − J̇ν) plus the roll
-/// acceleration `p_dot` of a swing.
+/// and the steady errors `offset` (pitch, yaw): η, ν = J⁻¹(η) η̇_d, ν̇ = J⁻¹(η̈_d − J̇ν) plus
+/// the roll acceleration `p_dot` of a swing.
 fn state_at(
     smp: &PathSample,
     inv_k: f64,
     phi: f64,
-    d_theta: f64,
+    offset: (f64, f64),
     p_dot: f64,
 ) -> (PlantState, Vector6<f64>) {
     let mut eta = smp.eta;
     eta[ROLL] = phi;
-    eta[PITCH] += d_theta;
+    eta[PITCH] += offset.0;
+    eta[YAW] += offset.1;
     let att = Attitude::from_eta(&eta);
     let jinv = kinematics::jacobian_inv(&att);
     let nu = jinv * (smp.eta_dot * inv_k);
@@ -558,7 +560,7 @@ impl<'a> Checker<'a> {
     fn at_sample(&self, smp: &PathSample, inv_k: f64) -> AtSample {
         AtSample {
             inv_k,
-            stiffness: self.pitch_stiffness(smp, inv_k),
+            stiffness: self.stiffness(smp, inv_k),
             shared: match self.engine {
                 Engine::Fast => Some(Shared::new(smp, inv_k)),
                 Engine::Exhaustive => None,
@@ -598,12 +600,12 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// The law's pitch stiffness on the reference at sample `smp` ([`attitude::pitch_stiffness`]).
-    fn pitch_stiffness(&self, smp: &PathSample, inv_k: f64) -> f64 {
-        let (state, _) = state_at(smp, inv_k, smp.eta[ROLL], 0.0, 0.0);
+    /// The law's pitch and yaw stiffness on the reference at sample `smp` ([`attitude::stiffness`]).
+    fn stiffness(&self, smp: &PathSample, inv_k: f64) -> Stiffness {
+        let (state, _) = state_at(smp, inv_k, smp.eta[ROLL], (0.0, 0.0), 0.0);
         let att = Attitude::from_eta(&state.eta);
         let jjn = kinematics::jinv_jdot_nu(&att, &state.nu).unwrap_or_else(|_| Vector6::zeros());
-        attitude::pitch_stiffness(
+        attitude::stiffness(
             self.scenario.controller(),
             &state.nu,
             &jjn,
@@ -621,17 +623,17 @@ impl<'a> Checker<'a> {
     fn check_point(&self, at: &Point, full: bool, out: &mut Sweep) {
         let (smp, inv_k, plant, current) = (at.smp, at.inv_k, at.plant, at.current);
         let level = Self::static_heel(plant, smp);
-        let (state, nu_dot) = state_at(smp, inv_k, level, 0.0, 0.0);
+        let (state, nu_dot) = state_at(smp, inv_k, level, (0.0, 0.0), 0.0);
         let heel = attitude::heel(plant, &state, &nu_dot, current).unwrap_or(level);
-        // The pitch error that holds the law's model mismatch in pitch, at the heel.
-        let (state, nu_dot) = state_at(smp, inv_k, heel, 0.0, 0.0);
-        let needed = plant.required_force(&state, &nu_dot, current)[PITCH];
+        // The pitch and yaw errors that hold the law's model mismatch, at the heel.
+        let (state, nu_dot) = state_at(smp, inv_k, heel, (0.0, 0.0), 0.0);
+        let needed = plant.required_force(&state, &nu_dot, current);
         let modelled = self
             .nominal
-            .required_force(&state, &nu_dot, &Vector3::zeros())[PITCH];
-        let d_theta = attitude::pitch_offset(needed - modelled, at.stiffness);
+            .required_force(&state, &nu_dot, &Vector3::zeros());
+        let offset = attitude::steady_errors(&needed, &modelled, &at.stiffness);
         for (phi, p_dot) in at.swing.extremes(heel) {
-            let (state, nu_dot) = state_at(smp, inv_k, phi, d_theta, p_dot);
+            let (state, nu_dot) = state_at(smp, inv_k, phi, offset, p_dot);
             let tau = plant.required_force(&state, &nu_dot, current).cast::<f32>();
             self.judge(at.t, &tau, full, out);
         }
@@ -735,7 +737,7 @@ fn blend_peaks(path: &Trajectory, span: f64) -> Vec<PathSample> {
 }
 
 /// One point of a sweep: a sample, the case's plant and swing there, a current, and the law's
-/// pitch stiffness there.
+/// pitch and yaw stiffness there.
 pub(super) struct Point<'s> {
     pub smp: &'s PathSample,
     pub t: f64,
@@ -743,14 +745,14 @@ pub(super) struct Point<'s> {
     pub plant: &'s Plant,
     pub swing: Swing,
     pub current: &'s Vector3<f64>,
-    pub stiffness: f64,
+    pub stiffness: Stiffness,
 }
 
-/// What every case of one sample shares: 1/k, the law's pitch stiffness there, and the fast
+/// What every case of one sample shares: 1/k, the law's stiffness there, and the fast
 /// engine's [`Shared`].
 struct AtSample {
     inv_k: f64,
-    stiffness: f64,
+    stiffness: Stiffness,
     shared: Option<Shared>,
 }
 

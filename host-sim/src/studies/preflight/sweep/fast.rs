@@ -18,9 +18,10 @@ use super::{CasePlants, Checker, PathSample, Point};
 use crate::plant::{roll_moments, Plant, PlantState};
 use crate::studies::preflight::attitude;
 
-/// Index of roll and pitch in η, ν and τ.
+/// Index of roll, pitch and yaw in η, ν and τ.
 const ROLL: usize = 3;
 const PITCH: usize = 4;
+const YAW: usize = 5;
 
 /// A plant's roll constants: the heeling moment m_y, the righting coefficient k₄, ρ = |(m_y,
 /// k₄)| and the static heel atan2(m_y, k₄) with its sine and cosine
@@ -48,7 +49,9 @@ impl RollConsts {
 
 /// What every case of one sample at one 1/k shares.
 pub(super) struct Shared {
-    /// sin, cos of ψ_d and of θ_d (+ 0, as the reference engine forms it).
+    /// ψ_d and θ_d (+ 0, as the reference engine forms them: the offset 0 added), and the sin,
+    /// cos of each.
+    psi_0: f64,
     psi: (f64, f64),
     theta: f64,
     theta_sin_cos: (f64, f64),
@@ -68,7 +71,8 @@ impl Shared {
     pub(super) fn new(smp: &PathSample, inv_k: f64) -> Self {
         let theta = smp.eta[PITCH] + 0.0;
         Shared {
-            psi: smp.eta[5].sin_cos(),
+            psi_0: smp.eta[YAW] + 0.0,
+            psi: (smp.eta[YAW] + 0.0).sin_cos(),
             theta,
             theta_sin_cos: theta.sin_cos(),
             cos_theta: theta.cos(),
@@ -94,7 +98,7 @@ impl Shared {
         if let Some((_, state, nu_dot)) = seen.iter().find(|e| e.0 == bits) {
             return (*state, *nu_dot, att);
         }
-        let (state, nu_dot) = self.state(smp, level, self.theta, &att, 0.0);
+        let (state, nu_dot) = self.state(smp, level, (self.theta, self.psi_0), &att, 0.0);
         seen.push((bits, state, nu_dot));
         (state, nu_dot, att)
     }
@@ -110,19 +114,20 @@ impl Shared {
         }
     }
 
-    /// The state on the sample with roll `phi`, pitch `theta` (their sines and cosines in
-    /// `att`) and roll acceleration `p_dot`: the reference engine's `state_at`.
+    /// The state on the sample with roll `phi`, pitch and yaw `(theta, psi)` (their sines and
+    /// cosines in `att`) and roll acceleration `p_dot`: the reference engine's `state_at`.
     fn state(
         &self,
         smp: &PathSample,
         phi: f64,
-        theta: f64,
+        (theta, psi): (f64, f64),
         att: &Attitude<f64>,
         p_dot: f64,
     ) -> (PlantState, Vector6<f64>) {
         let mut eta = smp.eta;
         eta[ROLL] = phi;
         eta[PITCH] = theta;
+        eta[YAW] = psi;
         let jinv = kinematics::jacobian_inv(att);
         let nu = jinv * self.eta_dot;
         let jjn = kinematics::jinv_jdot_nu(att, &nu).unwrap_or_else(|_| Vector6::zeros());
@@ -132,8 +137,8 @@ impl Shared {
     }
 }
 
-/// One point (the reference engine's `check_point`): the heel, the pitch offset, the force at
-/// each extreme of the roll swing, each handed to `judge` with its time.
+/// One point (the reference engine's `check_point`): the heel, the pitch and yaw offsets, the
+/// force at each extreme of the roll swing, each handed to `judge` with its time.
 pub(super) fn check_point(
     checker: &Checker,
     at: &Point,
@@ -151,17 +156,23 @@ pub(super) fn check_point(
     let heel = heel(plant, roll, shared, &state, &att, &nu_dot, current).unwrap_or(level);
     // The pitch error that holds the law's model mismatch in pitch, at the heel.
     let att = shared.attitude(heel.sin_cos(), shared.theta_sin_cos);
-    let (state, nu_dot) = shared.state(smp, heel, shared.theta, &att, 0.0);
-    let needed = plant.required_force_at(&state, &att, &nu_dot, current)[PITCH];
+    let (state, nu_dot) = shared.state(smp, heel, (shared.theta, shared.psi_0), &att, 0.0);
+    let needed = plant.required_force_at(&state, &att, &nu_dot, current);
     let modelled = checker
         .nominal()
-        .required_force_at(&state, &att, &nu_dot, &Vector3::zeros())[PITCH];
-    let d_theta = attitude::pitch_offset(needed - modelled, at.stiffness);
+        .required_force_at(&state, &att, &nu_dot, &Vector3::zeros());
+    let (d_theta, d_psi) = attitude::steady_errors(&needed, &modelled, &at.stiffness);
     let theta = smp.eta[PITCH] + d_theta;
     let theta_sc = theta.sin_cos();
+    let psi = smp.eta[YAW] + d_psi;
+    let psi_sc = psi.sin_cos();
     for (phi, p_dot) in at.swing.extremes(heel) {
-        let att = shared.attitude(phi.sin_cos(), theta_sc);
-        let (state, nu_dot) = shared.state(smp, phi, theta, &att, p_dot);
+        let att = Attitude {
+            spsi: psi_sc.0,
+            cpsi: psi_sc.1,
+            ..shared.attitude(phi.sin_cos(), theta_sc)
+        };
+        let (state, nu_dot) = shared.state(smp, phi, (theta, psi), &att, p_dot);
         let tau = plant
             .required_force_at(&state, &att, &nu_dot, current)
             .cast::<f32>();
