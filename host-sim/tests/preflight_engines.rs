@@ -204,6 +204,32 @@ fn the_engines_agree_over_the_whole_box() {
     assert!(verdicts(preflight::Verdict::NeedsTimeScale) > 0);
 }
 
+/// Choices 530–531 on a bisection over the box: the real paths (under their own mounting and
+/// with the vertical pair both pushing up), each cut to its first 30 s so the reference stays
+/// seconds, the first whose box needs a time scale — the doubling, the full sweep at the
+/// bracket's infeasible end, then probes the span screen interpolates — gives the same
+/// `Preflight` as the reference (bit for bit, or its verdicts if checked over one period).
+#[test]
+fn the_engines_agree_on_a_bisection_over_the_whole_box() {
+    let real = real_vehicle::real_scenarios().unwrap();
+    let both_up = real.iter().map(|s| {
+        s.with(|c| c.controller.geometry = ThrusterGeometry::auv150(0b11110))
+            .unwrap()
+    });
+    let needs_scale = real
+        .iter()
+        .cloned()
+        .chain(both_up)
+        .map(|s| s.with(|c| c.duration = c.duration.min(30.0)).unwrap())
+        .find(|s| {
+            let p = preflight::check_with(s, DEFAULT_MARGIN, true, Engine::Fast).unwrap();
+            p.whole_box.map(|b| b.verdict) == Some(preflight::Verdict::NeedsTimeScale)
+        })
+        .expect("a real path whose box needs a time scale");
+    let (fast, reference) = both(&needs_scale, true);
+    agree(&needs_scale, &fast, &reference).unwrap();
+}
+
 /// The speed profile of a waypoint mission (per-part bisections, the check as flown, its
 /// shrink rounds): the shipped short route's first four points (three legs, two turns) under
 /// a constant current (the default: seconds; the whole route below).

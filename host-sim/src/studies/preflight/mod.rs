@@ -593,6 +593,10 @@ fn smallest_time_scale(
     if known.is_none() && hi == max && !feasible_at(max)? {
         return Ok(None);
     }
+    // The spans at the infeasible end, so that the probes between are screened (Choice 531).
+    if hi / lo > 1.0 + TIME_SCALE_TOLERANCE {
+        checker.prime(scope, 1.0 / lo)?;
+    }
     while hi / lo > 1.0 + TIME_SCALE_TOLERANCE {
         let mid = (lo * hi).sqrt();
         if feasible_at(mid)? {

@@ -4,6 +4,7 @@
 //! the board's allocator on the margin envelope.
 
 mod fast;
+mod screen;
 
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 use controller_core::kinematics::{self, Attitude};
@@ -22,6 +23,7 @@ use super::{
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::{InitialAttitude, Scenario};
 use fast::{RollConsts, SampleKeys, Shared};
+use screen::{Screen, Span};
 
 /// An unallocated part above this (relative to 1 + |τ|) means the axis was given up; below it
 /// is the f32 rounding of an axis met on its bound.
@@ -49,6 +51,8 @@ pub(super) struct Sweep {
     pub peaks: Peaks,
     /// Where the first violation was: the next probe of a bisection tries it first.
     at: Option<PointId>,
+    /// The span of the sample being judged, when the box's screen records it (Choice 530).
+    span: Option<Span>,
 }
 
 /// One point of a sweep: a regular sample (`peak` false) or a corner's extreme, the case and
@@ -124,6 +128,8 @@ pub(super) struct Checker<'a> {
     engine: Engine,
     /// Per scope, where the last infeasible probe failed (Choice 392).
     hint: [std::cell::Cell<Option<PointId>>; 2],
+    /// The box's thrust span per sample at the 1/k it was judged at (Choice 530).
+    screen: std::cell::RefCell<Screen>,
 }
 
 /// The currents the check takes (see the module docs of [`super`]).
@@ -242,6 +248,7 @@ impl<'a> Checker<'a> {
         };
         let samples = path_samples(&path, checked)?;
         let corners_peaks = blend_peaks(&path, span);
+        let (n_samples, n_peaks) = (samples.len(), corners_peaks.len());
         let corners = corner_plants(controller.config().uncertainty.cast(f64::from), cfg.trimmed)?;
         let law_model = controller.params().cast(f64::from);
         let nominal = Plant::new(law_model, PlantTerms::default())
@@ -274,6 +281,7 @@ impl<'a> Checker<'a> {
             margin_envelope,
             engine,
             hint: Default::default(),
+            screen: std::cell::RefCell::new(Screen::new(n_samples, n_peaks)),
         })
     }
 
@@ -396,7 +404,7 @@ impl<'a> Checker<'a> {
             .iter()
             .enumerate()
             .filter_map(|(m, &(_, peak))| peak.map(|j| (m, j)));
-        self.sweep_points(&prepared, points, true, inv_k, full, out)
+        self.sweep_points(scope, &prepared, points, true, inv_k, full, out)
     }
 
     /// The regular times at 1/k = `inv_k` and the extremes' merged in time order (each with
@@ -434,6 +442,17 @@ impl<'a> Checker<'a> {
     fn prepare_at<'p>(&'p self, scope: Scope, times: Vec<f64>, owned: &'p [Plant]) -> Prepared<'p> {
         let cases = self.cases(scope, &times, owned);
         Prepared { times, cases }
+    }
+
+    /// Records the box's span at every sample at 1/k = `inv_k` (a full sweep, its verdict
+    /// unused), so that a bisection's later probes between `inv_k` and a feasible 1/k are
+    /// interpolated, not swept (Choice 531). Nothing for the mission as written or the
+    /// reference engine.
+    pub(super) fn prime(&self, scope: Scope, inv_k: f64) -> Result<(), CheckError> {
+        if self.engine == Engine::Fast && scope == Scope::WholeBox {
+            self.sweep(scope, inv_k, true)?;
+        }
+        Ok(())
     }
 
     /// Whether every point of `scope` fits at 1/k = `inv_k` ([`Checker::sweep`]'s verdict
@@ -501,7 +520,7 @@ impl<'a> Checker<'a> {
         let prepared = self.prepare_at(scope, times, &owned);
         let mut out = Sweep::new();
         let points = range.step_by(stride.max(1)).map(|j| (j, j));
-        self.sweep_points(&prepared, points, false, inv_k, full, &mut out)?;
+        self.sweep_points(scope, &prepared, points, false, inv_k, full, &mut out)?;
         Ok(out)
     }
 
@@ -510,8 +529,12 @@ impl<'a> Checker<'a> {
     /// stops at the first violation unless `full`. The fast engine skips a point whose
     /// inputs equal, bit for bit, a point already judged in this sweep (Choice 391): it
     /// would give the same forces, so neither the first violation nor a peak can change.
+    /// Over the box, a verdict-only sweep skips a sample its screen clears and records the
+    /// span of each it judges in full (Choice 530).
+    #[allow(clippy::too_many_arguments)]
     fn sweep_points(
         &self,
+        scope: Scope,
         prepared: &Prepared,
         points: impl Iterator<Item = (usize, usize)>,
         peak: bool,
@@ -520,12 +543,36 @@ impl<'a> Checker<'a> {
         out: &mut Sweep,
     ) -> Result<(), CheckError> {
         let mut seen = SampleKeys::default();
+        // Over the box the fast engine records every sample's span, and skips those its
+        // screen clears when the sweep gives a verdict only.
+        let recording = self.engine == Engine::Fast && scope == Scope::WholeBox;
+        let screening = recording && !full;
         for (m, j) in points {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
             let smp = self.sample(peak, j);
-            if self.engine == Engine::Fast && !seen.insert(smp, inv_k, &prepared.cases, m) {
+            if self.engine == Engine::Fast {
+                if let Some(first) = seen.insert(smp, j, inv_k, &prepared.cases, m) {
+                    // The same inputs: the same span as the sample that had them first.
+                    if recording {
+                        let mut screen = self.screen.borrow_mut();
+                        if let Some(span) = screen.recorded(peak, first, inv_k) {
+                            screen.record(peak, j, inv_k, span);
+                        }
+                    }
+                    continue;
+                }
+            }
+            if screening
+                && self
+                    .screen
+                    .borrow()
+                    .clears(peak, j, inv_k, &self.margin_envelope)
+            {
                 continue;
+            }
+            if recording {
+                out.span = Some(Span::EMPTY);
             }
             let ctx = self.at_sample(smp, inv_k);
             for case in 0..prepared.cases.len() {
@@ -541,9 +588,13 @@ impl<'a> Checker<'a> {
                         out.at = Some(id);
                     }
                     if out.first.is_some() && !full {
+                        out.span = None;
                         return Ok(());
                     }
                 }
+            }
+            if let Some(span) = out.span.take() {
+                self.screen.borrow_mut().record(peak, j, inv_k, span);
             }
         }
         Ok(())
@@ -643,6 +694,9 @@ impl<'a> Checker<'a> {
     /// first violation of the margin envelope.
     fn judge(&self, t: f64, tau: &Vector6<f32>, full: bool, out: &mut Sweep) {
         let allocation = self.scenario.controller().allocation();
+        if let Some(span) = out.span.as_mut() {
+            span.add(&allocation.thrusts(tau));
+        }
         if full {
             let thrusts = allocation.thrusts(tau);
             for (i, p) in out.peaks.iter_mut().enumerate() {
@@ -762,6 +816,7 @@ impl Sweep {
             first: None,
             peaks: [(f64::INFINITY, 0.0, f64::NEG_INFINITY, 0.0); THRUSTERS],
             at: None,
+            span: None,
         }
     }
 }

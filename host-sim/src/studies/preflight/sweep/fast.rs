@@ -9,7 +9,7 @@
 //! it has already judged ([`SampleKeys`]).
 
 use std::cell::RefCell;
-use std::collections::HashSet;
+use std::collections::HashMap;
 
 use controller_core::kinematics::{self, Attitude};
 use nalgebra::{Vector3, Vector6};
@@ -209,18 +209,19 @@ fn heel(
 /// every sample of one attitude is one key, so a straight leg with its speed changes, or a
 /// whole lawn-mower line, is judged once.
 #[derive(Default)]
-pub(super) struct SampleKeys(HashSet<Vec<u64>>);
+pub(super) struct SampleKeys(HashMap<Vec<u64>, usize>);
 
 impl SampleKeys {
-    /// Records the key of sample `smp` at 1/k = `inv_k` and prepared index `m` of `cases`;
-    /// false if it was already there.
+    /// Records the key of sample `smp` (index `j`) at 1/k = `inv_k` and prepared index `m` of
+    /// `cases`; the index of the sample that had it first, if it was already there.
     pub(super) fn insert(
         &mut self,
         smp: &PathSample,
+        j: usize,
         inv_k: f64,
         cases: &[CasePlants<'_>],
         m: usize,
-    ) -> bool {
+    ) -> Option<usize> {
         let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
         key.extend(smp.eta.iter().skip(3).map(|x| x.to_bits()));
         key.extend((smp.eta_dot * inv_k).iter().map(|x| x.to_bits()));
@@ -230,6 +231,12 @@ impl SampleKeys {
             key.push(plant as u64);
             key.push(amplitude.to_bits());
         }
-        self.0.insert(key)
+        match self.0.entry(key) {
+            std::collections::hash_map::Entry::Occupied(e) => Some(*e.get()),
+            std::collections::hash_map::Entry::Vacant(e) => {
+                e.insert(j);
+                None
+            }
+        }
     }
 }
