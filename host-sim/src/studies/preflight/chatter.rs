@@ -11,17 +11,23 @@
 //! estimate's −G x̂, or −G(s + n) flown as told, plus −G w of the period's white noise w), so
 //! var uₖ = c Pₖ cᵀ and cov(uₖ₊₁, uₖ) = c Aₖ Pₖ cᵀ (+ the white noise's terms). Only the draws
 //! (fixes, pings, white noise) enter: a bias moves the solution slowly, which the law follows
-//! as an offset of the path. The covariance is propagated until it repeats with its sources
-//! (the loop settled), and one cycle of it (the least common multiple of the sources' periods)
-//! is kept. Rotational axes take the INS's white attitude and rate noise (no fixes). The axes'
+//! as an offset of the path. The boundary layer's gain is δ/μ with δ the law's own Eq 29 along
+//! the reference at the scale checked (its largest, with ‖e‖ at 3σ of the error the law sees;
+//! at most δ_max), not δ_max: the law flies with the δ it computes (3.3–4 on the shipped
+//! circle against δ_max = 25), and δ_max's gain predicted a noise step 8× the flown one. The
+//! covariance is propagated until it repeats with its sources (the loop settled), and one cycle
+//! of it (the least common multiple of the sources' periods) is kept. Rotational axes take the INS's white attitude and rate noise (no fixes). The axes'
 //! noises are independent, and x and y alike (the larger of the two on surge and sway), so a
 //! thruster's thrust noise is Σₐ c_ja uₐ with c = B⁺ M̂ (the allocation of the nominal mass
 //! matrix's column a): var = Σₐ c_ja² var uₐ, and the same for the lag-1 covariance.
 //!
 //! **The mean command** (Choice 501): along the reference at the time scale checked (its
 //! 20 Hz samples, linear in between at the control rate), the force the plant as written needs
-//! (its payload profile; each current corner of the path-error budget, the worst taken),
-//! through the allocation: what the thrusters are asked for without noise.
+//! at the heel it holds ([`super::attitude::heel`]: roll is not actuated, and the heel turns
+//! the vertical pair's thrust into a sway force the horizontal pair answers) — its payload
+//! profile; each current corner of the path-error budget, the worst taken — through the
+//! allocation: what the thrusters are asked for without noise. The roll swing and the pitch
+//! offset of the force check are not taken.
 //!
 //! **Reversals** (Choice 502). The band's edges are thrusts (the maps of Eqs 31–32 at ±0.5 V
 //! in the scenario's unit). A reversal from below to above crosses the upper edge upwards, one
@@ -44,6 +50,7 @@
 
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
 use controller_core::kinematics::{self, Attitude};
+use controller_core::law::{uncertainty_bound, DeltaInputs};
 use controller_core::thruster::{default_maps, ThrustUnit, ThrusterMap};
 use controller_core::{Mission, Trajectory};
 use nalgebra::{RowVector2, SMatrix, Vector3, Vector6};
@@ -70,6 +77,8 @@ const SETTLE: f64 = 30.0;
 const MAX_CYCLE: u64 = 100_000;
 /// Beyond this many σ of a level, a period's crossing probability is taken as 0 (< 10⁻¹⁵).
 const FAR: f64 = 8.5;
+/// The grid of δ the command noise is computed on: δ rounded up to a power of 1.05 (5 %).
+const DELTA_GRID: f64 = 1.05;
 /// The slowest time scale tried (the trajectory's own limit).
 const MAX_TIME_SCALE: f64 = controller_core::Trajectory::MAX_TIME_SCALE as f64;
 
@@ -327,6 +336,8 @@ pub fn crossing_probability(m: [f64; 2], s: [f64; 2], cov: f64, level: f64) -> f
 struct AxisStats {
     var: Vec<f64>,
     lag: Vec<f64>,
+    /// The largest variance of the error the law sees, position plus velocity (its ‖e‖ in δ).
+    err_var: f64,
 }
 
 impl AxisStats {
@@ -379,19 +390,28 @@ fn axis_stats(lp: &Loop, noise: &AxisNoise) -> AxisStats {
     } = period_maps(lp, noise);
     let g = lp.g();
     let gr = RowVector2::new(lp.gain[0], lp.gain[1]);
-    // u = c X (+ −G w with the estimator off).
+    // u = c X (+ −G w with the estimator off); the error the law sees, e_pos X and e_vel X.
     let mut c = SMatrix::<f64, 1, N>::zeros();
+    let mut e_pos = SMatrix::<f64, 1, N>::zeros();
+    let mut e_vel = SMatrix::<f64, 1, N>::zeros();
     let white = nalgebra::Matrix2::new(noise.white[0].powi(2), 0.0, 0.0, noise.white[1].powi(2));
     let gwg = (gr * white * gr.transpose())[(0, 0)];
     let (w_var, w_lag) = match lp.k {
         Some(_) => {
             c[2] = -gr[0];
             c[3] = -gr[1];
+            e_pos[2] = 1.0;
+            e_vel[3] = 1.0;
             (0.0, 0.0)
         }
         None => {
             for (i, gi) in [(0, 0), (1, 1), (4, 0), (8, 0), (5, 1), (6, 1)] {
                 c[i] = -gr[gi];
+                if gi == 0 {
+                    e_pos[i] = 1.0;
+                } else {
+                    e_vel[i] = 1.0;
+                }
             }
             // cov(uₖ₊₁, uₖ) through sₖ₊₁'s −gG wₖ: (−G g)(G W Gᵀ).
             (gwg, -(gr * g)[(0, 0)] * gwg)
@@ -436,6 +456,11 @@ fn axis_stats(lp: &Loop, noise: &AxisNoise) -> AxisStats {
             let lag = (c * (a * p) * c.transpose())[(0, 0)] + w_lag;
             out.var.push(var.max(0.0));
             out.lag.push(lag);
+            let ev = (e_pos * p * e_pos.transpose())[(0, 0)]
+                + (e_vel * p * e_vel.transpose())[(0, 0)]
+                + noise.white[0].powi(2)
+                + noise.white[1].powi(2);
+            out.err_var = out.err_var.max(ev);
         }
         // Pₙ₊₁, as the path-error budget propagates it.
         p = loop_step * p * loop_step.transpose();
@@ -486,8 +511,14 @@ fn draws(mut noise: AxisNoise) -> AxisNoise {
 pub struct Chatter<'a> {
     scenario: &'a Scenario,
     bound: Bound,
-    /// Per body axis, the command noise over its cycle.
-    stats: [AxisStats; 6],
+    /// Per axis of η, the navigation's draws.
+    noise: [AxisNoise; 6],
+    /// Per δ of the boundary layer (on a grid of [`DELTA_GRID`] steps), per body axis, the
+    /// command noise over its cycle.
+    stats: std::cell::RefCell<Vec<(i32, std::rc::Rc<[AxisStats; 6]>)>>,
+    /// K_d of the path at k = 1, and the ‖e‖ δ takes (3σ of the error the law sees).
+    accel_bound: f64,
+    error_norm: f64,
     /// c_ja²: thruster j's thrust noise per unit variance of body axis a.
     coeff: [[f64; 6]; THRUSTERS],
     /// The band's edges per thruster (N), [at −0.5 V, at +0.5 V].
@@ -511,31 +542,13 @@ impl<'a> Chatter<'a> {
             return Ok(None);
         };
         let controller = scenario.controller();
-        let mut eta_stats: Vec<AxisStats> = Vec::with_capacity(6);
-        for i in 0..6 {
-            let lp = Loop::of(scenario, i)?;
-            let noise = if i < 3 {
+        let noise: [AxisNoise; 6] = std::array::from_fn(|i| {
+            if i < 3 {
                 draws(axis_noise(scenario, i, 0.0))
             } else {
                 rotational_noise(scenario, i)
-            };
-            eta_stats.push(axis_stats(&lp, &noise));
-        }
-        // Surge and sway each take the larger of x and y.
-        let xy = |s: &AxisStats| s.var.iter().copied().fold(0.0, f64::max);
-        let horizontal = if xy(&eta_stats[0]) >= xy(&eta_stats[1]) {
-            eta_stats[0].clone()
-        } else {
-            eta_stats[1].clone()
-        };
-        let stats = [
-            horizontal.clone(),
-            horizontal,
-            eta_stats[2].clone(),
-            eta_stats[3].clone(),
-            eta_stats[4].clone(),
-            eta_stats[5].clone(),
-        ];
+            }
+        });
         let m = controller.mass_matrix();
         let alloc = controller.allocation();
         let mut coeff = [[0.0; 6]; THRUSTERS];
@@ -562,10 +575,13 @@ impl<'a> Chatter<'a> {
         let per = period::period(cfg);
         let checked = per.map_or(span, |p| span.min(p + SAMPLE_PERIOD));
         let (samples, _) = reference_samples(&path, checked)?;
-        Ok(Some(Chatter {
+        let mut out = Chatter {
             scenario,
             bound,
-            stats,
+            noise,
+            stats: std::cell::RefCell::new(Vec::new()),
+            accel_bound: f64::from(path.accel_bound()),
+            error_norm: 0.0,
             coeff,
             band,
             maps,
@@ -574,30 +590,88 @@ impl<'a> Chatter<'a> {
             currents: current_corners(&cfg.current),
             period: per,
             rate_hz: f64::from(cfg.controller.rate_hz),
-        }))
+        };
+        // ‖e‖ in δ: 3σ of the error the law sees, at the δ of the fastest scale (k = 1) with
+        // ‖e‖ = 0 (Choice 500).
+        let (_, delta) = out.mean_thrusts(1.0)?;
+        let stats = out.stats_at(delta)?;
+        out.error_norm = 3.0
+            * [0, 1, 2, 4, 5]
+                .iter()
+                .map(|&a| stats[a].err_var)
+                .sum::<f64>()
+                .sqrt();
+        Ok(Some(out))
+    }
+
+    /// The command noise per body axis with the boundary layer at δ (rounded up to the grid,
+    /// at most δ_max), computed once per grid step.
+    fn stats_at(&self, delta: f64) -> Result<std::rc::Rc<[AxisStats; 6]>, CheckError> {
+        let c = self.scenario.controller().config();
+        let delta_max = f64::from(c.delta_max);
+        let step = (delta.max(1e-3).ln() / DELTA_GRID.ln()).ceil() as i32;
+        let on_grid = DELTA_GRID.powi(step).min(delta_max);
+        if let Some((_, s)) = self.stats.borrow().iter().find(|(k, _)| *k == step) {
+            return Ok(s.clone());
+        }
+        let mut eta_stats: Vec<AxisStats> = Vec::with_capacity(6);
+        for i in 0..6 {
+            let lp = Loop::with_delta(self.scenario, i, on_grid)?;
+            eta_stats.push(axis_stats(&lp, &self.noise[i]));
+        }
+        // Surge and sway each take the larger of x and y.
+        let xy = |s: &AxisStats| s.var.iter().copied().fold(0.0, f64::max);
+        let horizontal = if xy(&eta_stats[0]) >= xy(&eta_stats[1]) {
+            eta_stats[0].clone()
+        } else {
+            eta_stats[1].clone()
+        };
+        let stats = std::rc::Rc::new([
+            horizontal.clone(),
+            horizontal,
+            eta_stats[2].clone(),
+            eta_stats[3].clone(),
+            eta_stats[4].clone(),
+            eta_stats[5].clone(),
+        ]);
+        self.stats.borrow_mut().push((step, stats.clone()));
+        Ok(stats)
     }
 
     /// The mean thrust per thruster at each reference sample at time scale `k`, per current
-    /// corner (module docs, Choice 501).
-    fn mean_thrusts(&self, k: f64) -> Result<Vec<Vec<[f64; THRUSTERS]>>, CheckError> {
+    /// corner (module docs, Choice 501), and the largest δ of Eq 29 along the reference
+    /// (clamped to δ_max) with ‖e‖ the term's error norm.
+    // Long: one pass over the reference forms the state once for the force and for δ.
+    fn mean_thrusts(&self, k: f64) -> Result<(Vec<Vec<[f64; THRUSTERS]>>, f64), CheckError> {
         let cfg = self.scenario.config();
-        let alloc = self.scenario.controller().allocation();
+        let controller = self.scenario.controller();
+        let alloc = controller.allocation();
+        let constants = controller.delta_constants();
+        let mut delta = 0.0f64;
         let mut out = vec![Vec::with_capacity(self.samples.len()); self.currents.len()];
         let mut plant: Option<(controller_core::model::VehicleParams<f64>, Plant)> = None;
         for (j, r) in self.samples.iter().enumerate() {
             if j % 4096 == 0 {
                 super::poll()?;
             }
-            let (v, a) = (r.eta_dot / k, r.eta_ddot / (k * k));
-            let att = Attitude::from_eta(&r.eta);
-            let rot = kinematics::rotation(&att);
-            let lin = rot.transpose() * Vector3::new(v[0], v[1], v[2]);
-            let omega = Vector3::new(v[3], v[4], v[5]);
-            let nu = Vector6::new(lin.x, lin.y, lin.z, omega.x, omega.y, omega.z);
-            let lin_dot = rot.transpose() * Vector3::new(a[0], a[1], a[2]) - omega.cross(&lin);
-            let nu_dot = Vector6::new(lin_dot.x, lin_dot.y, lin_dot.z, a[3], a[4], a[5]);
-            let state = PlantState { eta: r.eta, nu };
             let params = cfg.plant_params_at(r.s * k);
+            // The vehicle holds the heel of its payload (roll is not actuated), as the force
+            // check evaluates it ([`super::attitude::heel`]).
+            let level = crate::plant::static_heel(&params, r.eta[PITCH]).unwrap_or(0.0);
+            let (state, nu_dot) = state_at(r, k, level);
+            let (att, nu) = (Attitude::from_eta(&state.eta), state.nu);
+            let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
+            let d = uncertainty_bound(
+                constants,
+                &DeltaInputs {
+                    accel_bound: (self.accel_bound / (k * k)) as f32,
+                    error_norm: self.error_norm as f32,
+                    nu_norm: nu.norm() as f32,
+                    jinv_jdot_nu_norm: jjn.norm() as f32,
+                    cos_theta_abs: att.ctheta.abs() as f32,
+                },
+            );
+            delta = delta.max(f64::from(d));
             if plant.as_ref().is_some_and(|(had, _)| *had != params) {
                 plant = None;
             }
@@ -610,11 +684,14 @@ impl<'a> Chatter<'a> {
                 )),
             };
             for (c, o) in self.currents.iter().zip(out.iter_mut()) {
+                let heel = super::attitude::heel(truth, &state, &nu_dot, c).unwrap_or(level);
+                let (state, nu_dot) = state_at(r, k, heel);
                 let tau = truth.required_force(&state, &nu_dot, c).cast::<f32>();
                 o.push(alloc.thrusts(&tau).map(f64::from));
             }
         }
-        Ok(out)
+        let delta_max = f64::from(controller.config().delta_max);
+        Ok((out, if delta.is_finite() { delta.min(delta_max) } else { delta_max }))
     }
 
     /// The flight's duration at time scale `k` (s): the same path.
@@ -629,13 +706,14 @@ impl<'a> Chatter<'a> {
     /// # Errors
     /// [`CheckError::Interrupted`]; [`CheckError::Invalid`] for a plant that cannot be built.
     pub fn at(&self, k: f64, noise: f64) -> Result<ChatterPrediction, CheckError> {
-        let means = self.mean_thrusts(k)?;
+        let (means, delta) = self.mean_thrusts(k)?;
+        let stats = self.stats_at(delta)?;
         let duration = self.duration(k);
         let t = 1.0 / self.rate_hz;
         let periods = (duration * self.rate_hz).round().max(1.0) as u64;
         let mut per_corner = Vec::with_capacity(means.len());
         for mean in &means {
-            per_corner.push(self.flown(mean, k, periods, t, noise * noise)?);
+            per_corner.push(self.flown(&stats, mean, k, periods, t, noise * noise)?);
         }
         let thrusters = (0..THRUSTERS)
             .map(|j| {
@@ -689,6 +767,7 @@ impl<'a> Chatter<'a> {
     /// expected total variation (V).
     fn flown(
         &self,
+        stats: &[AxisStats; 6],
         mean: &[[f64; THRUSTERS]],
         k: f64,
         periods: u64,
@@ -718,8 +797,8 @@ impl<'a> Chatter<'a> {
                 super::poll()?;
             }
             let m1 = at(n + 1);
-            let now: [(f64, f64); 6] = std::array::from_fn(|a| self.stats[a].at(n));
-            let next: [(f64, f64); 6] = std::array::from_fn(|a| self.stats[a].at(n + 1));
+            let now: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n));
+            let next: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n + 1));
             for j in 0..THRUSTERS {
                 let c = &self.coeff[j];
                 let v0: f64 = (0..6).map(|a| c[a] * now[a].0).sum::<f64>() * scale2;
@@ -861,6 +940,23 @@ impl<'a> Chatter<'a> {
         }
         s
     }
+}
+
+/// Index of roll and pitch in η.
+const ROLL: usize = 3;
+const PITCH: usize = 4;
+
+/// The vehicle on the reference sample `r` at time scale `k` with roll `phi`: η, ν = J⁻¹η̇,
+/// ν̇ = J⁻¹(η̈ − J̇ν).
+fn state_at(r: &RefSample, k: f64, phi: f64) -> (PlantState, Vector6<f64>) {
+    let mut eta = r.eta;
+    eta[ROLL] = phi;
+    let att = Attitude::from_eta(&eta);
+    let jinv = kinematics::jacobian_inv(&att);
+    let nu = jinv * (r.eta_dot / k);
+    let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
+    let nu_dot = jinv * (r.eta_ddot / (k * k)) - jjn;
+    (PlantState { eta, nu }, nu_dot)
 }
 
 /// E|x| for x ~ N(μ, s²).

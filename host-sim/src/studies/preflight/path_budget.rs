@@ -228,14 +228,26 @@ pub(super) struct Loop {
 
 impl Loop {
     pub(super) fn of(scenario: &Scenario, axis: usize) -> Result<Self, CheckError> {
+        let c = scenario.controller().config();
+        Self::with_robust_gain(scenario, axis, f64::from(c.delta_max / c.mu))
+    }
+
+    /// The loop with the boundary layer's gain at δ = `delta` (δ/μ; [`Loop::of`]: δ_max).
+    pub(super) fn with_delta(
+        scenario: &Scenario,
+        axis: usize,
+        delta: f64,
+    ) -> Result<Self, CheckError> {
+        let c = scenario.controller().config();
+        Self::with_robust_gain(scenario, axis, delta / f64::from(c.mu))
+    }
+
+    /// The loop with the boundary layer's gain δ/μ = `gain` (0 when the law is not robust).
+    fn with_robust_gain(scenario: &Scenario, axis: usize, gain: f64) -> Result<Self, CheckError> {
         let controller = scenario.controller();
         let c = controller.config();
         let lyap = controller.lyapunov();
-        let robust = if c.robust {
-            f64::from(c.delta_max / c.mu)
-        } else {
-            0.0
-        };
+        let robust = if c.robust { gain } else { 0.0 };
         let t = 1.0 / f64::from(c.rate_hz);
         let gain = [
             f64::from(c.k1[axis]) + robust * f64::from(lyap[axis].p12),
