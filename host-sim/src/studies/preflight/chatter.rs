@@ -57,8 +57,8 @@ use nalgebra::{RowVector2, SMatrix, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
 use super::path_budget::{
-    axis_noise, current_corners, period_maps, reference_samples, AxisNoise, Cov, Loop,
-    PeriodMaps, RefSample, N,
+    axis_noise, current_corners, period_maps, reference_samples, AxisNoise, Cov, Loop, PeriodMaps,
+    RefSample, N,
 };
 use super::{period, CheckError, SAMPLE_PERIOD};
 use crate::plant::{Plant, PlantState, PlantTerms};
@@ -490,7 +490,10 @@ fn rotational_noise(scenario: &Scenario, i: usize) -> AxisNoise {
         white = [m.ins.attitude.sigma[i - 3], m.ins.rates.sigma[i - 3]];
     }
     if let Some(n) = &cfg.noise {
-        white = [white[0].hypot(n.eta_sigma[i]), white[1].hypot(n.nu_sigma[i])];
+        white = [
+            white[0].hypot(n.eta_sigma[i]),
+            white[1].hypot(n.nu_sigma[i]),
+        ];
     }
     AxisNoise {
         white,
@@ -691,7 +694,14 @@ impl<'a> Chatter<'a> {
             }
         }
         let delta_max = f64::from(controller.config().delta_max);
-        Ok((out, if delta.is_finite() { delta.min(delta_max) } else { delta_max }))
+        Ok((
+            out,
+            if delta.is_finite() {
+                delta.min(delta_max)
+            } else {
+                delta_max
+            },
+        ))
     }
 
     /// The flight's duration at time scale `k` (s): the same path.
@@ -1015,10 +1025,7 @@ mod tests {
             (-8.0, 6.220_960_574_271_785e-16),
         ] {
             let got = phi(x);
-            assert!(
-                ((got - p) / p).abs() < 1e-12,
-                "Φ({x}) = {got}, table {p}"
-            );
+            assert!(((got - p) / p).abs() < 1e-12, "Φ({x}) = {got}, table {p}");
         }
     }
 
@@ -1026,7 +1033,9 @@ mod tests {
     /// through both of the bivariate routine's branches; ρ = 0 is the product.
     #[test]
     fn the_bivariate_orthant_matches_its_closed_forms() {
-        for r in [-0.999, -0.99, -0.95, -0.5, 0.0, 0.3, 0.9, 0.95, 0.99, 0.9999] {
+        for r in [
+            -0.999, -0.99, -0.95, -0.5, 0.0, 0.3, 0.9, 0.95, 0.99, 0.9999,
+        ] {
             let want = 0.25 + f64::asin(r) / (2.0 * std::f64::consts::PI);
             let got = bvn_upper(0.0, 0.0, r);
             assert!((got - want).abs() < 1e-14, "ρ {r}: {got} vs {want}");
@@ -1042,7 +1051,13 @@ mod tests {
     /// correlations a filtered command has from one period to the next (0.95–0.9999).
     #[test]
     fn the_bivariate_orthant_matches_a_brute_force_integral() {
-        for &(h, k) in &[(0.5, 1.0), (-1.0, 2.0), (2.0, 2.1), (-0.3, -0.2), (1.5, -1.5)] {
+        for &(h, k) in &[
+            (0.5, 1.0),
+            (-1.0, 2.0),
+            (2.0, 2.1),
+            (-0.3, -0.2),
+            (1.5, -1.5),
+        ] {
             for r in [-0.99, -0.93, -0.6, 0.2, 0.8, 0.93, 0.99, 0.999, 0.9999] {
                 let (got, want) = (bvn_upper(h, k, r), brute(h, k, r));
                 assert!(
@@ -1058,8 +1073,8 @@ mod tests {
     /// every T ≪ ℓ, the per-period crossing probability over T tends to it.
     #[test]
     fn crossings_of_a_smooth_process_tend_to_rices_rate() {
-        let (sigma, ell) = (3.0, 0.2);
-        for level in [0.0, 2.0, 6.0] {
+        let (sigma, ell) = (3.0f64, 0.2f64);
+        for level in [0.0f64, 2.0, 6.0] {
             let rice = (-0.5 * (level / sigma).powi(2)).exp() / (std::f64::consts::PI * ell);
             let t = ell / 2000.0;
             let cov = sigma * sigma * (-0.5 * (t / ell).powi(2)).exp();
@@ -1081,7 +1096,8 @@ mod tests {
         let (rho, sigma, n) = (0.97f64, 2.0, 200_000u64);
         let band = [-1.0, 1.5];
         let mean = |k: u64| 3.0 * (k as f64 * 2e-4).sin();
-        let mut x = sigma * StandardNormal.sample(&mut rng) as f64;
+        let z0: f64 = StandardNormal.sample(&mut rng);
+        let mut x = sigma * z0;
         let mut counted = [0u64; 2];
         let mut predicted = [0.0f64; 2];
         let (mut side, mut reversals) = (0i8, 0u64);

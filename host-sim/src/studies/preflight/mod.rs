@@ -352,7 +352,10 @@ impl fmt::Display for Preflight {
                     write!(
                         f,
                         ": chatter {} {r:.1} reversals/s (bound {}), {} {tv:.0} V/s (bound {})",
-                        THRUSTER_NAMES[i], c.max_reversals_per_s, THRUSTER_NAMES[j], c.max_command_tv
+                        THRUSTER_NAMES[i],
+                        c.max_reversals_per_s,
+                        THRUSTER_NAMES[j],
+                        c.max_command_tv
                     )?;
                     if let Some(n) = &c.needs {
                         write!(f, " at every time scale ({n})")?;
