@@ -554,14 +554,12 @@ impl<'a> Chatter<'a> {
         });
         let m = controller.mass_matrix();
         let alloc = controller.allocation();
-        let mut coeff = [[0.0; 6]; THRUSTERS];
-        for a in 0..6 {
+        let columns: [[f32; THRUSTERS]; 6] = std::array::from_fn(|a| {
             let column: Vector6<f32> = m.column(a).into_owned();
-            let thrusts = alloc.thrusts(&column);
-            for (j, x) in thrusts.iter().enumerate() {
-                coeff[j][a] = f64::from(*x).powi(2);
-            }
-        }
+            alloc.thrusts(&column)
+        });
+        let coeff: [[f64; 6]; THRUSTERS] =
+            std::array::from_fn(|j| std::array::from_fn(|a| f64::from(columns[a][j]).powi(2)));
         let maps = default_maps();
         let unit = cfg.controller.thrust_unit;
         let band = maps.map(|map| {
@@ -645,7 +643,7 @@ impl<'a> Chatter<'a> {
     /// corner (module docs, Choice 501), and the largest δ of Eq 29 along the reference
     /// (clamped to δ_max) with ‖e‖ the term's error norm.
     // Long: one pass over the reference forms the state once for the force and for δ.
-    fn mean_thrusts(&self, k: f64) -> Result<(Vec<Vec<[f64; THRUSTERS]>>, f64), CheckError> {
+    fn mean_thrusts(&self, k: f64) -> Result<(MeanThrusts, f64), CheckError> {
         let cfg = self.scenario.config();
         let controller = self.scenario.controller();
         let alloc = controller.allocation();
@@ -951,6 +949,9 @@ impl<'a> Chatter<'a> {
         s
     }
 }
+
+/// Per current corner, per reference sample, the mean thrust per thruster (N).
+type MeanThrusts = Vec<Vec<[f64; THRUSTERS]>>;
 
 /// Index of roll and pitch in η.
 const ROLL: usize = 3;
