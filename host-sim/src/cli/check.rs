@@ -288,6 +288,10 @@ fn preflight_table(p: &Preflight) -> String {
         s.push_str(&b.describe());
         s.push('\n');
     }
+    if let Some(c) = &p.chatter {
+        s.push_str(&c.describe());
+        s.push('\n');
+    }
     if let Some(k) = p.smallest_time_scale {
         s.push_str(&format!(
             "smallest feasible time scale: {k} (the same path then takes {:.1} s)\n",

@@ -49,6 +49,7 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
+pub mod chatter;
 pub mod navigation;
 pub mod path_budget;
 pub mod period;
@@ -260,6 +261,10 @@ pub struct Preflight {
     /// scenario has no bound), Choice 424: a mission whose force fits but whose budget does
     /// not is not feasible at its scale.
     pub path_budget: Option<path_budget::PathBudget>,
+    /// The chatter the mission will show on its navigation, per thruster, against the bound's
+    /// chatter limits (`None`: the scenario has no bound), Choice 504: a mission whose force
+    /// and budget fit but whose chatter does not is not feasible at its scale.
+    pub chatter: Option<chatter::ChatterPrediction>,
 }
 
 impl Preflight {
@@ -338,6 +343,21 @@ impl fmt::Display for Preflight {
                         1e3 * b.bound
                     )?;
                     if let Some(n) = &b.needs {
+                        write!(f, " at every time scale ({n})")?;
+                    }
+                }
+                if let Some(c) = self.chatter.as_ref().filter(|c| !c.fits()) {
+                    let (r, i) = c.worst_reversals();
+                    let (tv, j) = c.worst_tv();
+                    write!(
+                        f,
+                        ": chatter {} {r:.1} reversals/s (bound {}), {} {tv:.0} V/s (bound {})",
+                        THRUSTER_NAMES[i],
+                        c.max_reversals_per_s,
+                        THRUSTER_NAMES[j],
+                        c.max_command_tv
+                    )?;
+                    if let Some(n) = &c.needs {
                         write!(f, " at every time scale ({n})")?;
                     }
                 }
@@ -427,13 +447,20 @@ pub fn check_with(
         true => Some(verdict(&checker, Scope::WholeBox, k)?.0),
         false => None,
     };
-    // Both scopes' verdicts join the budget: the box's too, or its line would call a mission
-    // feasible at a scale whose path error the budget refuses.
-    if let (Some(b), Some(pb)) = (&budget, &path_budget) {
-        with_budget(&checker, Scope::AsWritten, &mut as_written, k, b, pb)?;
-        if let Some(v) = whole_box.as_mut() {
-            with_budget(&checker, Scope::WholeBox, v, k, b, pb)?;
-        }
+    let chatter_model = chatter::Chatter::new(scenario)?;
+    let chatter = match &chatter_model {
+        Some(c) => Some(c.evaluate()?),
+        None => None,
+    };
+    // Both scopes' verdicts join the budget and the chatter term: the box's too, or its line
+    // would call a mission feasible at a scale the budget or the term refuses.
+    let terms = Terms {
+        budget: budget.as_ref().zip(path_budget.as_ref()),
+        chatter: chatter_model.as_ref().zip(chatter.as_ref()),
+    };
+    with_terms(&checker, Scope::AsWritten, &mut as_written, k, &terms)?;
+    if let Some(v) = whole_box.as_mut() {
+        with_terms(&checker, Scope::WholeBox, v, k, &terms)?;
     }
     let envelope = scenario.controller().envelope();
     let thrusters = (0..THRUSTERS)
@@ -477,20 +504,57 @@ pub fn check_with(
         whole_box,
         navigation,
         path_budget,
+        chatter,
     })
 }
 
+/// The terms a force verdict is joined with: the path-error budget (Choice 424) and the chatter
+/// term (Choice 504), each with its model (to evaluate at any scale) and its evaluation.
+struct Terms<'a> {
+    budget: Option<(&'a path_budget::Budget<'a>, &'a path_budget::PathBudget)>,
+    chatter: Option<(&'a chatter::Chatter<'a>, &'a chatter::ChatterPrediction)>,
+}
+
+impl Terms<'_> {
+    /// Each term's smallest fitting scale (`None` inside: that term fits at no scale).
+    fn smallest(&self) -> Vec<Option<f64>> {
+        let mut v = Vec::new();
+        if let Some((_, pb)) = self.budget {
+            v.push(pb.smallest_time_scale);
+        }
+        if let Some((_, c)) = self.chatter {
+            v.push(c.smallest_time_scale);
+        }
+        v
+    }
+
+    /// Every term fits at scale `k`.
+    fn fit_at(&self, k: f64) -> Result<bool, CheckError> {
+        if let Some((b, _)) = self.budget {
+            if !b.fits_at(k)? {
+                return Ok(false);
+            }
+        }
+        if let Some((c, _)) = self.chatter {
+            if !c.fits_at(k)? {
+                return Ok(false);
+            }
+        }
+        Ok(true)
+    }
+}
+
 /// The force verdict `v` over `scope` at the scenario's scale `k` joined with the path-error
-/// budget of the mission as written (Choice 424): feasible only when both fit at `k`; the proposed scale the smallest at which
-/// both fit (the budget's smallest, raised by steps until the force fits too); infeasible when
-/// the budget fits at no scale.
-fn with_budget(
+/// budget (Choice 424) and the chatter term (Choice 504) of the mission as written: feasible
+/// only when all fit at `k`; the proposed scale the smallest at which all fit (the largest of
+/// their smallest, raised by steps until every one fits); infeasible when a term fits at no
+/// scale.
+fn with_terms(
     checker: &Checker,
     scope: Scope,
     v: &mut ScopeVerdict,
     k: f64,
-    budget: &path_budget::Budget,
-    pb: &path_budget::PathBudget,
+    terms: &Terms,
 ) -> Result<(), CheckError> {
     if matches!(
         v.verdict,
@@ -498,25 +562,27 @@ fn with_budget(
     ) {
         return Ok(());
     }
-    let Some(kb) = pb.smallest_time_scale else {
+    let smallest = terms.smallest();
+    if smallest.iter().any(Option::is_none) {
         v.verdict = Verdict::Infeasible;
         v.smallest_time_scale = None;
         return Ok(());
-    };
+    }
     let Some(kf) = v.smallest_time_scale else {
         return Ok(());
     };
-    if kb <= kf && budget.fits_at(kf)? {
+    let kt = smallest.into_iter().flatten().fold(kf, f64::max);
+    if kt <= kf && terms.fit_at(kf)? {
         return Ok(());
     }
     let max = f64::from(Trajectory::MAX_TIME_SCALE);
-    let mut at = kb.max(kf);
+    let mut at = kt;
     let mut found = None;
     for _ in 0..=MAX_ROUNDING_STEPS {
         if at > max {
             break;
         }
-        if checker.feasible(scope, 1.0 / at)? && budget.fits_at(at)? {
+        if checker.feasible(scope, 1.0 / at)? && terms.fit_at(at)? {
             found = Some(at);
             break;
         }

@@ -77,7 +77,7 @@ const MAX_IMPULSE_PERIODS: usize = 60_000;
 const CURRENT_SIGMAS: f64 = super::GAUSS_MARKOV_SIGMAS;
 
 /// The three translational axes.
-const AXES: usize = 3;
+pub(super) const AXES: usize = 3;
 const AXIS_NAMES: [&str; AXES] = ["x", "y", "z"];
 
 /// The budget of one mission at one time scale (see the module docs).
@@ -148,16 +148,16 @@ impl PathBudget {
 
 /// One axis's navigation error sources (module docs), in the η axis's units.
 #[derive(Clone, Debug, Default)]
-struct AxisNoise {
+pub(super) struct AxisNoise {
     /// The position source resetting the drift (fix or pressure depth): σ, bias σ, its
     /// timing.
-    fix: Option<(f64, f64, Timing)>,
+    pub(super) fix: Option<(f64, f64, Timing)>,
     /// DVL ping: σ, bias σ (with the heading's share), timing; `None`: no velocity aiding.
-    ping: Option<(f64, f64, Timing)>,
+    pub(super) ping: Option<(f64, f64, Timing)>,
     /// INS acceleration bias σ (m/s²).
-    accel_bias: f64,
+    pub(super) accel_bias: f64,
     /// White noise per period from `[noise]` (position, velocity).
-    white: [f64; 2],
+    pub(super) white: [f64; 2],
 }
 
 fn steady<const N: usize>(e: &ErrorModel<N>, i: usize) -> f64 {
@@ -165,7 +165,7 @@ fn steady<const N: usize>(e: &ErrorModel<N>, i: usize) -> f64 {
 }
 
 /// The error sources of axis `i` of `scenario` at reference speed `speed` (m/s).
-fn axis_noise(scenario: &Scenario, i: usize, speed: f64) -> AxisNoise {
+pub(super) fn axis_noise(scenario: &Scenario, i: usize, speed: f64) -> AxisNoise {
     let cfg = scenario.config();
     let mut a = AxisNoise::default();
     if let Some(m) = &cfg.navigation {
@@ -220,22 +220,34 @@ fn samples_at(timing: &Timing, k: u64, t_period: f64) -> bool {
 
 /// The law's linear loop on one axis: T, G, and the estimator's K (`None`: off).
 #[derive(Clone, Copy, Debug)]
-struct Loop {
-    t: f64,
-    gain: [f64; 2],
-    k: Option<Matrix2<f64>>,
+pub(super) struct Loop {
+    pub(super) t: f64,
+    pub(super) gain: [f64; 2],
+    pub(super) k: Option<Matrix2<f64>>,
 }
 
 impl Loop {
-    fn of(scenario: &Scenario, axis: usize) -> Result<Self, CheckError> {
+    pub(super) fn of(scenario: &Scenario, axis: usize) -> Result<Self, CheckError> {
+        let c = scenario.controller().config();
+        Self::with_robust_gain(scenario, axis, f64::from(c.delta_max / c.mu))
+    }
+
+    /// The loop with the boundary layer's gain at δ = `delta` (δ/μ; [`Loop::of`]: δ_max).
+    pub(super) fn with_delta(
+        scenario: &Scenario,
+        axis: usize,
+        delta: f64,
+    ) -> Result<Self, CheckError> {
+        let c = scenario.controller().config();
+        Self::with_robust_gain(scenario, axis, delta / f64::from(c.mu))
+    }
+
+    /// The loop with the boundary layer's gain δ/μ = `gain` (0 when the law is not robust).
+    fn with_robust_gain(scenario: &Scenario, axis: usize, gain: f64) -> Result<Self, CheckError> {
         let controller = scenario.controller();
         let c = controller.config();
         let lyap = controller.lyapunov();
-        let robust = if c.robust {
-            f64::from(c.delta_max / c.mu)
-        } else {
-            0.0
-        };
+        let robust = if c.robust { gain } else { 0.0 };
         let t = 1.0 / f64::from(c.rate_hz);
         let gain = [
             f64::from(c.k1[axis]) + robust * f64::from(lyap[axis].p12),
@@ -261,11 +273,11 @@ impl Loop {
         Ok(Loop { t, gain, k })
     }
 
-    fn f(&self) -> Matrix2<f64> {
+    pub(super) fn f(&self) -> Matrix2<f64> {
         Matrix2::new(1.0, self.t, 0.0, 1.0)
     }
 
-    fn g(&self) -> Vector2<f64> {
+    pub(super) fn g(&self) -> Vector2<f64> {
         Vector2::new(0.5 * self.t * self.t, self.t)
     }
 
@@ -303,20 +315,20 @@ impl Loop {
 
 /// The state of the noise propagation: [s₀, s₁, x̂₀, x̂₁, f, h, b_v, b_a, b_p] (module docs:
 /// f the held fix error and its drift, h the held ping error and its drift).
-const N: usize = 9;
-type Cov = SMatrix<f64, N, N>;
+pub(super) const N: usize = 9;
+pub(super) type Cov = SMatrix<f64, N, N>;
 
 /// One period's maps of the noise propagation (module docs): the loop's step, the noise's
 /// drift, the estimator's correction, and the white noise's covariance.
-struct PeriodMaps {
-    loop_step: Cov,
-    drift: Cov,
-    correct: Option<Cov>,
-    q_white: Cov,
+pub(super) struct PeriodMaps {
+    pub(super) loop_step: Cov,
+    pub(super) drift: Cov,
+    pub(super) correct: Option<Cov>,
+    pub(super) q_white: Cov,
 }
 
 /// The maps of one period of the loop `lp` under `noise`.
-fn period_maps(lp: &Loop, noise: &AxisNoise) -> PeriodMaps {
+pub(super) fn period_maps(lp: &Loop, noise: &AxisNoise) -> PeriodMaps {
     let (t, f, g) = (lp.t, lp.f(), lp.g());
     let gr = nalgebra::RowVector2::new(lp.gain[0], lp.gain[1]);
     // The loop's step after the noise (module docs), as a map on the state.
@@ -468,12 +480,12 @@ fn quantile(tail: f64) -> f64 {
 
 /// One sample of the reference at k = 1: η_d, η̇_d, η̈_d and the jerk.
 #[derive(Clone, Copy, Debug)]
-struct RefSample {
-    s: f64,
-    eta: Vector6<f64>,
-    eta_dot: Vector6<f64>,
-    eta_ddot: Vector6<f64>,
-    jerk: Vector6<f64>,
+pub(super) struct RefSample {
+    pub(super) s: f64,
+    pub(super) eta: Vector6<f64>,
+    pub(super) eta_dot: Vector6<f64>,
+    pub(super) eta_ddot: Vector6<f64>,
+    pub(super) jerk: Vector6<f64>,
 }
 
 /// What the budget needs of a mission, computed once; evaluated at any time scale.
@@ -871,7 +883,7 @@ pub fn budget(scenario: &Scenario) -> Result<Option<PathBudget>, CheckError> {
 
 /// The reference at time scale 1 every [`SAMPLE_PERIOD`] over `checked` s of path time, each
 /// sample with its jerk (a finite difference of η̈), and the largest speed per axis.
-fn reference_samples(
+pub(super) fn reference_samples(
     path: &Trajectory,
     checked: f64,
 ) -> Result<(Vec<RefSample>, [f64; AXES]), CheckError> {
@@ -908,7 +920,7 @@ fn reference_samples(
 
 /// The currents the budget flies: the constant one, or a Gauss–Markov one's mean and its
 /// ±[`CURRENT_SIGMAS`]σ corners on x and y.
-fn current_corners(current: &CurrentModel) -> Vec<Vector3<f64>> {
+pub(super) fn current_corners(current: &CurrentModel) -> Vec<Vector3<f64>> {
     match current {
         CurrentModel::None => vec![Vector3::zeros()],
         CurrentModel::Constant(c) => vec![Vector3::from(*c)],

@@ -1,0 +1,1148 @@
+//! The chatter term (docs/real-vehicle.md#the-chatter-term, **Choices 500–504**): per
+//! thruster, the sign reversals per second (through the ±[`DEAD_BAND`] V band of
+//! [`crate::sim::chatter`]) and the command's total variation per second the mission will show
+//! on its navigation, predicted before it flies, against the bound's chatter limits.
+//!
+//! **The command noise** (Choice 500). Per controlled axis the loop is the path-error budget's
+//! ([`super::path_budget`]): the state X = [s, x̂, n] (the vehicle's error, the estimate, the
+//! navigation's held fix and ping errors and their drift) moves one period at a time as
+//! X⁺ = Aₖ X + εₖ (the loop's step, the drift, a fix or a ping replacing its state by a fresh
+//! draw, the estimator's correction), εₖ independent of X. The law's input is u = c X (the
+//! estimate's −G x̂, or −G(s + n) flown as told, plus −G w of the period's white noise w), so
+//! var uₖ = c Pₖ cᵀ and cov(uₖ₊₁, uₖ) = c Aₖ Pₖ cᵀ (+ the white noise's terms). Only the draws
+//! (fixes, pings, white noise) enter: a bias moves the solution slowly, which the law follows
+//! as an offset of the path. The boundary layer's gain is δ/μ with δ the law's own Eq 29 along
+//! the reference at the scale checked (its largest, with ‖e‖ at 3σ of the error the law sees;
+//! at most δ_max), not δ_max: the law flies with the δ it computes (3.3–4 on the shipped
+//! circle against δ_max = 25), and δ_max's gain predicted a noise step 8× the flown one. The
+//! covariance is propagated until it repeats with its sources (the loop settled), and one cycle
+//! of it (the least common multiple of the sources' periods) is kept. Rotational axes take the INS's white attitude and rate noise (no fixes). The axes'
+//! noises are independent, and x and y alike (the larger of the two on surge and sway), so a
+//! thruster's thrust noise is Σₐ c_ja uₐ with c = B⁺ M̂ (the allocation of the nominal mass
+//! matrix's column a): var = Σₐ c_ja² var uₐ, and the same for the lag-1 covariance.
+//!
+//! **The mean command** (Choice 501): along the reference at the time scale checked (its
+//! 20 Hz samples, linear in between at the control rate), the force the plant as written needs
+//! at the heel it holds ([`super::attitude::heel`]: roll is not actuated, and the heel turns
+//! the vertical pair's thrust into a sway force the horizontal pair answers) — its payload
+//! profile; each current corner of the path-error budget, the worst taken — through the
+//! allocation: what the thrusters are asked for without noise. The roll swing and the pitch
+//! offset of the force check are not taken.
+//!
+//! **Reversals** (Choice 502). The band's edges are thrusts (the maps of Eqs 31–32 at ±0.5 V
+//! in the scenario's unit). A reversal from below to above crosses the upper edge upwards, one
+//! back crosses the lower edge downwards, and reversals alternate: over a run,
+//! reversals ≤ min(C₊, C₋) + 2, C± the crossings of each edge (either way). For a Gaussian
+//! command the expected crossings of a level L between two periods is
+//! P(xₖ ≤ L < xₖ₊₁) + P(xₖ₊₁ ≤ L < xₖ), a bivariate normal orthant ([`bvn_upper`]; Rice's
+//! formula is its limit for a smooth process), summed over the flight. The expected count
+//! is raised to a one-sided [`CONFIDENCE_SIGMAS`]σ of a Poisson count (√ of the expectation):
+//! the predicted reversals per second, against `max_reversals_per_s`.
+//!
+//! **Total variation** (Choice 503): E|Vₖ₊₁ − Vₖ| = V′(mₖ)·E|Δ| with Δ Gaussian (the mean's
+//! step and the noise's step variance), summed over the flight per second, against
+//! `max_command_tv`.
+//!
+//! **Joined** (Choice 504, [`super::check_with`]): feasible only when the force, the path-error
+//! budget and this term fit at the scenario's time scale; otherwise the smallest scale where
+//! all three do; infeasible when this term fits at no scale, naming the navigation noise it
+//! needs (the fraction of the navigation's draws at which the mission fits at its own scale).
+
+use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
+use controller_core::kinematics::{self, Attitude};
+use controller_core::law::{uncertainty_bound, DeltaInputs};
+use controller_core::thruster::{default_maps, ThrustUnit, ThrusterMap};
+use controller_core::{Mission, Trajectory};
+use nalgebra::{RowVector2, SMatrix, Vector3, Vector6};
+use serde::{Deserialize, Serialize};
+
+use super::path_budget::{
+    axis_noise, current_corners, period_maps, reference_samples, AxisNoise, Cov, Loop, PeriodMaps,
+    RefSample, N,
+};
+use super::{period, CheckError, SAMPLE_PERIOD};
+use crate::plant::{Plant, PlantState, PlantTerms};
+use crate::scenario::navigation::Timing;
+use crate::scenario::{Bound, Scenario};
+use crate::sim::chatter::DEAD_BAND;
+
+/// The predicted count is its expectation plus this many √(expectation) (a one-sided Poisson
+/// bound at about 1 %), Choice 502.
+pub const CONFIDENCE_SIGMAS: f64 = 2.33;
+/// The longest the covariance is propagated before its cycle is kept (s): the loop and the
+/// estimator settle in seconds.
+const SETTLE: f64 = 30.0;
+/// The longest cycle kept (periods): sources whose periods have no common multiple below it
+/// are taken at the cycle's length.
+const MAX_CYCLE: u64 = 100_000;
+/// Beyond this many σ of a level, a period's crossing probability is taken as 0 (< 10⁻¹⁵).
+const FAR: f64 = 8.5;
+/// The grid of δ the command noise is computed on: δ rounded up to a power of 1.05 (5 %).
+const DELTA_GRID: f64 = 1.05;
+/// The slowest time scale tried (the trajectory's own limit).
+const MAX_TIME_SCALE: f64 = controller_core::Trajectory::MAX_TIME_SCALE as f64;
+
+/// One thruster's predicted chatter at one time scale.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ThrusterPrediction {
+    pub thruster: String,
+    /// The band's edges in thrust (N): the thrusts at −0.5 V and +0.5 V.
+    pub band: [f64; 2],
+    /// The largest σ of the thrust noise over a cycle (N), and of its step from one period to
+    /// the next (N).
+    pub sigma: f64,
+    pub step_sigma: f64,
+    /// Expected sign reversals per second, and the predicted (with the confidence) (1/s).
+    pub expected_reversals_per_s: f64,
+    pub reversals_per_s: f64,
+    /// Expected total variation of the command per second (V/s).
+    pub command_tv: f64,
+}
+
+/// The chatter term of one mission at one time scale (see the module docs).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ChatterPrediction {
+    /// The bound's limits: reversals per second, command total variation (V/s).
+    pub max_reversals_per_s: f64,
+    pub max_command_tv: f64,
+    /// The time scale the figures are at.
+    pub time_scale: f64,
+    /// Per thruster, in the order of `THRUSTER_NAMES`.
+    pub thrusters: Vec<ThrusterPrediction>,
+    /// The smallest time scale at which the term fits (`None`: none up to the slowest).
+    pub smallest_time_scale: Option<f64>,
+    /// When no scale fits: what navigation the mission needs.
+    pub needs: Option<String>,
+}
+
+impl ChatterPrediction {
+    /// The worst thruster's predicted reversals per second and its index.
+    pub fn worst_reversals(&self) -> (f64, usize) {
+        worst(&self.thrusters, |t| t.reversals_per_s)
+    }
+
+    /// The worst thruster's predicted command total variation (V/s) and its index.
+    pub fn worst_tv(&self) -> (f64, usize) {
+        worst(&self.thrusters, |t| t.command_tv)
+    }
+
+    /// Fits the bound's chatter limits at its time scale.
+    pub fn fits(&self) -> bool {
+        self.worst_reversals().0 <= self.max_reversals_per_s
+            && self.worst_tv().0 <= self.max_command_tv
+    }
+
+    /// One line for `check`.
+    pub fn describe(&self) -> String {
+        let (r, ri) = self.worst_reversals();
+        let (tv, ti) = self.worst_tv();
+        let per: Vec<String> = self
+            .thrusters
+            .iter()
+            .map(|t| format!("{:.1}", t.reversals_per_s))
+            .collect();
+        let mut s = format!(
+            "chatter at time scale {}: {} reverses up to {r:.1} times/s through ±{DEAD_BAND} V \
+             (bound {}; per thruster {}), {}'s command varies by up to {tv:.0} V/s (bound {})",
+            self.time_scale,
+            THRUSTER_NAMES[ri],
+            self.max_reversals_per_s,
+            per.join(" / "),
+            THRUSTER_NAMES[ti],
+            self.max_command_tv,
+        );
+        match (self.smallest_time_scale, &self.needs) {
+            (_, Some(n)) => s.push_str(&format!("; no time scale fits: {n}")),
+            (Some(k), None) => s.push_str(&format!("; fits from time scale {k}")),
+            (None, None) => {}
+        }
+        s
+    }
+}
+
+fn worst(t: &[ThrusterPrediction], f: fn(&ThrusterPrediction) -> f64) -> (f64, usize) {
+    t.iter()
+        .enumerate()
+        .fold((0.0, 0), |a, (i, x)| if f(x) > a.0 { (f(x), i) } else { a })
+}
+
+/// P(X > h, Y > k) for standard normals X, Y of correlation r (Genz's BVNU: Drezner and
+/// Wesolowsky's integral of Sheppard's formula for |r| < 0.925, the expansion about r = ±1
+/// beyond), by a 20-point Gauss–Legendre rule: absolute error below 10⁻¹⁴.
+pub fn bvn_upper(h: f64, k: f64, r: f64) -> f64 {
+    use std::f64::consts::PI;
+    let (x, w) = gauss_legendre_20();
+    let hk = h * k;
+    let mut bvn = 0.0;
+    if r.abs() < 0.925 {
+        let hs = 0.5 * (h * h + k * k);
+        let asr = 0.5 * r.asin();
+        for i in 0..20 {
+            let sn = (asr * (1.0 + x[i])).sin();
+            bvn += w[i] * ((sn * hk - hs) / (1.0 - sn * sn)).exp();
+        }
+        bvn = bvn * asr / (2.0 * PI) + phi(-h) * phi(-k);
+        return bvn.clamp(0.0, 1.0);
+    }
+    let (k, hk) = if r < 0.0 { (-k, -hk) } else { (k, hk) };
+    if r.abs() < 1.0 {
+        let a_s = (1.0 - r) * (1.0 + r);
+        let mut a = a_s.sqrt();
+        let bs = (h - k) * (h - k);
+        let c = (4.0 - hk) / 8.0;
+        let d = (12.0 - hk) / 16.0;
+        let asr = -0.5 * (bs / a_s + hk);
+        if asr > -100.0 {
+            bvn = a
+                * asr.exp()
+                * (1.0 - c * (bs - a_s) * (1.0 - d * bs / 5.0) / 3.0 + c * d * a_s * a_s / 5.0);
+        }
+        if hk > -100.0 {
+            let b = bs.sqrt();
+            let sp = (2.0 * PI).sqrt() * phi(-b / a);
+            bvn -= (-0.5 * hk).exp() * sp * b * (1.0 - c * bs * (1.0 - d * bs / 5.0) / 3.0);
+        }
+        a *= 0.5;
+        for i in 0..20 {
+            let xs = (a * (x[i] + 1.0)).powi(2);
+            let rs = (1.0 - xs).sqrt();
+            let asr = -0.5 * (bs / xs + hk);
+            if asr > -100.0 {
+                bvn += a
+                    * w[i]
+                    * asr.exp()
+                    * ((-hk * xs / (2.0 * (1.0 + rs).powi(2))).exp() / rs
+                        - (1.0 + c * xs * (1.0 + d * xs)));
+            }
+        }
+        bvn = -bvn / (2.0 * PI);
+    }
+    if r > 0.0 {
+        bvn += phi(-h.max(k));
+    } else if h >= k {
+        bvn = -bvn;
+    } else {
+        let l = if h < 0.0 {
+            phi(k) - phi(h)
+        } else {
+            phi(-h) - phi(-k)
+        };
+        bvn = l - bvn;
+    }
+    bvn.clamp(0.0, 1.0)
+}
+
+/// The standard normal distribution function Φ(x) (erfc, to double precision).
+pub fn phi(x: f64) -> f64 {
+    0.5 * erfc(-x / std::f64::consts::SQRT_2)
+}
+
+/// erfc(x): 1 − erf(x) by erf's Taylor series below 2, the continued fraction above
+/// (Lentz's method); relative error about 10⁻¹⁴.
+fn erfc(x: f64) -> f64 {
+    if x < 0.0 {
+        return 2.0 - erfc(-x);
+    }
+    if x < 2.0 {
+        // erf by its Taylor series: converges fast for x < 2.
+        let mut sum = x;
+        let mut term = x;
+        let x2 = x * x;
+        let mut n = 0.0;
+        while term.abs() > 1e-17 * sum.abs() {
+            n += 1.0;
+            term *= -x2 / n;
+            sum += term / (2.0 * n + 1.0);
+        }
+        return 1.0 - 2.0 / std::f64::consts::PI.sqrt() * sum;
+    }
+    // Continued fraction (Lentz): erfc x = e^{−x²}/√π · 1/(x + 1/2/(x + 1/(x + 3/2/(x + …)))).
+    let tiny = 1e-300;
+    let mut f = x;
+    let mut c = x;
+    let mut d = 0.0;
+    for i in 1..200 {
+        let a = i as f64 / 2.0;
+        d = x + a * d;
+        d = if d.abs() < tiny { tiny } else { d };
+        c = x + a / c;
+        c = if c.abs() < tiny { tiny } else { c };
+        d = 1.0 / d;
+        let delta = c * d;
+        f *= delta;
+        if (delta - 1.0).abs() < 1e-16 {
+            break;
+        }
+    }
+    (-x * x).exp() / (std::f64::consts::PI.sqrt() * f)
+}
+
+/// The 20-point Gauss–Legendre nodes and weights on [−1, 1] (Newton on P₂₀).
+fn gauss_legendre_20() -> &'static ([f64; 20], [f64; 20]) {
+    static RULE: std::sync::OnceLock<([f64; 20], [f64; 20])> = std::sync::OnceLock::new();
+    RULE.get_or_init(|| {
+        const M: usize = 20;
+        let mut x = [0.0; M];
+        let mut w = [0.0; M];
+        for i in 0..M {
+            let mut z = (std::f64::consts::PI * (i as f64 + 0.75) / (M as f64 + 0.5)).cos();
+            for _ in 0..100 {
+                let (mut p0, mut p1) = (1.0, z);
+                for n in 2..=M {
+                    let n = n as f64;
+                    (p0, p1) = (p1, ((2.0 * n - 1.0) * z * p1 - (n - 1.0) * p0) / n);
+                }
+                let dp = M as f64 * (z * p1 - p0) / (z * z - 1.0);
+                let dz = p1 / dp;
+                z -= dz;
+                if dz.abs() < 1e-16 {
+                    let (mut p0, mut p1) = (1.0, z);
+                    for n in 2..=M {
+                        let n = n as f64;
+                        (p0, p1) = (p1, ((2.0 * n - 1.0) * z * p1 - (n - 1.0) * p0) / n);
+                    }
+                    let dp = M as f64 * (z * p1 - p0) / (z * z - 1.0);
+                    w[i] = 2.0 / ((1.0 - z * z) * dp * dp);
+                    break;
+                }
+            }
+            x[i] = z;
+        }
+        (x, w)
+    })
+}
+
+/// The probability that a Gaussian command crosses `level` (either way) between two periods:
+/// means `m`, σ `s`, covariance `cov` of the two.
+pub fn crossing_probability(m: [f64; 2], s: [f64; 2], cov: f64, level: f64) -> f64 {
+    if s[0] <= 0.0 || s[1] <= 0.0 {
+        // No noise: the mean crosses or it does not.
+        let below = |x: f64| x <= level;
+        return f64::from(u8::from(below(m[0]) != below(m[1])));
+    }
+    let a = (level - m[0]) / s[0];
+    let b = (level - m[1]) / s[1];
+    if a.abs() > FAR && b.abs() > FAR && a.signum() == b.signum() {
+        return 0.0;
+    }
+    let r = (cov / (s[0] * s[1])).clamp(-1.0, 1.0);
+    // P(x₀ ≤ L < x₁) = P(−x₀ ≥ −L, x₁ > L): standardised, −a and b at correlation −r.
+    bvn_upper(-a, b, -r) + bvn_upper(a, -b, -r)
+}
+
+/// One axis's command noise over one cycle of its sources: var u and cov(uₖ₊₁, uₖ) per period,
+/// period k of the flight at index k mod the cycle.
+#[derive(Clone, Debug, Default)]
+struct AxisStats {
+    var: Vec<f64>,
+    lag: Vec<f64>,
+    /// The largest variance of the error the law sees, position plus velocity (its ‖e‖ in δ).
+    err_var: f64,
+}
+
+impl AxisStats {
+    fn at(&self, k: u64) -> (f64, f64) {
+        if self.var.is_empty() {
+            return (0.0, 0.0);
+        }
+        let i = (k % self.var.len() as u64) as usize;
+        (self.var[i], self.lag[i])
+    }
+}
+
+/// Periods between a source's samples (as the navigation model samples it).
+fn every(timing: &Timing, t: f64) -> u64 {
+    (1.0 / (timing.rate_hz * t)).round().max(1.0) as u64
+}
+
+fn gcd(a: u64, b: u64) -> u64 {
+    if b == 0 {
+        a
+    } else {
+        gcd(b, a % b)
+    }
+}
+
+/// The command noise of the loop `lp` under the draws of `noise` (module docs).
+// Long: the propagation of one period is one sequence of steps; split, it would pass the
+// same dozen matrices around.
+fn axis_stats(lp: &Loop, noise: &AxisNoise) -> AxisStats {
+    let t = lp.t;
+    let fix = noise.fix.as_ref().map(|f| (f.0, every(&f.2, t)));
+    let ping = noise.ping.as_ref().map(|p| (p.0, every(&p.2, t)));
+    let quiet = fix.is_none_or(|f| f.0 == 0.0)
+        && ping.is_none_or(|p| p.0 == 0.0)
+        && noise.white.iter().all(|&w| w == 0.0);
+    if quiet || (lp.gain[0] == 0.0 && lp.gain[1] == 0.0) {
+        return AxisStats::default();
+    }
+    let cycle = [fix.map(|f| f.1), ping.map(|p| p.1)]
+        .into_iter()
+        .flatten()
+        .fold(1u64, |c, e| (c / gcd(c, e) * e).min(MAX_CYCLE));
+    let settle_periods = (SETTLE / t).ceil() as u64;
+    let settle = settle_periods.div_ceil(cycle) * cycle;
+    let PeriodMaps {
+        loop_step,
+        drift,
+        correct,
+        q_white,
+    } = period_maps(lp, noise);
+    let g = lp.g();
+    let gr = RowVector2::new(lp.gain[0], lp.gain[1]);
+    // u = c X (+ −G w with the estimator off); the error the law sees, e_pos X and e_vel X.
+    let mut c = SMatrix::<f64, 1, N>::zeros();
+    let mut e_pos = SMatrix::<f64, 1, N>::zeros();
+    let mut e_vel = SMatrix::<f64, 1, N>::zeros();
+    let white = nalgebra::Matrix2::new(noise.white[0].powi(2), 0.0, 0.0, noise.white[1].powi(2));
+    let gwg = (gr * white * gr.transpose())[(0, 0)];
+    let (w_var, w_lag) = match lp.k {
+        Some(_) => {
+            c[2] = -gr[0];
+            c[3] = -gr[1];
+            e_pos[2] = 1.0;
+            e_vel[3] = 1.0;
+            (0.0, 0.0)
+        }
+        None => {
+            for (i, gi) in [(0, 0), (1, 1), (4, 0), (8, 0), (5, 1), (6, 1)] {
+                c[i] = -gr[gi];
+                if gi == 0 {
+                    e_pos[i] = 1.0;
+                } else {
+                    e_vel[i] = 1.0;
+                }
+            }
+            // cov(uₖ₊₁, uₖ) through sₖ₊₁'s −gG wₖ: (−G g)(G W Gᵀ).
+            (gwg, -(gr * g)[(0, 0)] * gwg)
+        }
+    };
+    let mut p = Cov::zeros();
+    if let Some((s, _)) = fix {
+        p[(4, 4)] = s * s;
+    }
+    if let Some((s, _)) = ping {
+        p[(5, 5)] = s * s;
+    }
+    let zero_row = |a: &mut Cov, i: usize| {
+        for j in 0..N {
+            a[(i, j)] = 0.0;
+        }
+    };
+    let reset = |p: &mut Cov, i: usize, var: f64| {
+        for j in 0..N {
+            p[(i, j)] = 0.0;
+            p[(j, i)] = 0.0;
+        }
+        p[(i, i)] = var;
+    };
+    let mut out = AxisStats::default();
+    for n in 0..settle + cycle {
+        // Aₙ: X_{n+1} = Aₙ Xₙ + εₙ.
+        let mut a = drift * loop_step;
+        let fixed = fix.filter(|f| (n + 1).is_multiple_of(f.1));
+        let pinged = ping.filter(|q| (n + 1).is_multiple_of(q.1));
+        if fixed.is_some() {
+            zero_row(&mut a, 4);
+        }
+        if pinged.is_some() {
+            zero_row(&mut a, 5);
+        }
+        if let Some(cc) = &correct {
+            a = cc * a;
+        }
+        if n >= settle {
+            let var = (c * p * c.transpose())[(0, 0)] + w_var;
+            let lag = (c * (a * p) * c.transpose())[(0, 0)] + w_lag;
+            out.var.push(var.max(0.0));
+            out.lag.push(lag);
+            let ev = (e_pos * p * e_pos.transpose())[(0, 0)]
+                + (e_vel * p * e_vel.transpose())[(0, 0)]
+                + noise.white[0].powi(2)
+                + noise.white[1].powi(2);
+            out.err_var = out.err_var.max(ev);
+        }
+        // Pₙ₊₁, as the path-error budget propagates it.
+        p = loop_step * p * loop_step.transpose();
+        if lp.k.is_none() {
+            p += q_white;
+        }
+        p = drift * p * drift.transpose();
+        if let Some((s, _)) = fixed {
+            reset(&mut p, 4, s * s);
+        }
+        if let Some((s, _)) = pinged {
+            reset(&mut p, 5, s * s);
+        }
+        if let Some(cc) = &correct {
+            p = cc * p * cc.transpose() + q_white;
+        }
+    }
+    out
+}
+
+/// The white attitude and rate noise of rotational axis `i` (3..6) of `scenario` (the INS's
+/// and `[noise]`'s), as an [`AxisNoise`] without fixes or pings.
+fn rotational_noise(scenario: &Scenario, i: usize) -> AxisNoise {
+    let cfg = scenario.config();
+    let mut white = [0.0f64; 2];
+    if let Some(m) = &cfg.navigation {
+        white = [m.ins.attitude.sigma[i - 3], m.ins.rates.sigma[i - 3]];
+    }
+    if let Some(n) = &cfg.noise {
+        white = [
+            white[0].hypot(n.eta_sigma[i]),
+            white[1].hypot(n.nu_sigma[i]),
+        ];
+    }
+    AxisNoise {
+        white,
+        ..AxisNoise::default()
+    }
+}
+
+/// The draws of `noise` (its biases zeroed).
+fn draws(mut noise: AxisNoise) -> AxisNoise {
+    noise.accel_bias = 0.0;
+    for src in [&mut noise.fix, &mut noise.ping].into_iter().flatten() {
+        src.1 = 0.0;
+    }
+    noise
+}
+
+/// What the term needs of a mission, computed once; evaluated at any time scale.
+pub struct Chatter<'a> {
+    scenario: &'a Scenario,
+    bound: Bound,
+    /// Per axis of η, the navigation's draws.
+    noise: [AxisNoise; 6],
+    /// Per δ of the boundary layer (on a grid of [`DELTA_GRID`] steps), per body axis, the
+    /// command noise over its cycle.
+    stats: std::cell::RefCell<Vec<(i32, std::rc::Rc<[AxisStats; 6]>)>>,
+    /// K_d of the path at k = 1, and the ‖e‖ δ takes (3σ of the error the law sees).
+    accel_bound: f64,
+    error_norm: f64,
+    /// c_ja²: thruster j's thrust noise per unit variance of body axis a.
+    coeff: [[f64; 6]; THRUSTERS],
+    /// The band's edges per thruster (N), [at −0.5 V, at +0.5 V].
+    band: [[f64; 2]; THRUSTERS],
+    maps: [ThrusterMap; THRUSTERS],
+    unit: ThrustUnit,
+    samples: Vec<RefSample>,
+    currents: Vec<Vector3<f64>>,
+    period: Option<f64>,
+    rate_hz: f64,
+}
+
+impl<'a> Chatter<'a> {
+    /// The term's model of `scenario`; `None` when the scenario has no bound.
+    ///
+    /// # Errors
+    /// [`CheckError::Invalid`] for a loop the term cannot model; [`CheckError::Interrupted`].
+    pub fn new(scenario: &'a Scenario) -> Result<Option<Self>, CheckError> {
+        let cfg = scenario.config();
+        let Some(bound) = cfg.bound() else {
+            return Ok(None);
+        };
+        let controller = scenario.controller();
+        let noise: [AxisNoise; 6] = std::array::from_fn(|i| {
+            if i < 3 {
+                draws(axis_noise(scenario, i, 0.0))
+            } else {
+                rotational_noise(scenario, i)
+            }
+        });
+        let m = controller.mass_matrix();
+        let alloc = controller.allocation();
+        let columns: [[f32; THRUSTERS]; 6] = std::array::from_fn(|a| {
+            let column: Vector6<f32> = m.column(a).into_owned();
+            alloc.thrusts(&column)
+        });
+        let coeff: [[f64; 6]; THRUSTERS] =
+            std::array::from_fn(|j| std::array::from_fn(|a| f64::from(columns[a][j]).powi(2)));
+        let maps = default_maps();
+        let unit = cfg.controller.thrust_unit;
+        let band = maps.map(|map| {
+            let at = |v: f32| f64::from(map.newtons_of_voltage(unit, v));
+            let (lo, hi) = (at(-DEAD_BAND as f32), at(DEAD_BAND as f32));
+            [lo.min(hi), lo.max(hi)]
+        });
+        let path = Trajectory::new(Mission {
+            time_scale: 1.0,
+            ..cfg.mission()
+        })
+        .map_err(|e| CheckError::Invalid(format!("the mission at time scale 1: {e}")))?;
+        let span = cfg.duration / super::time_scale(cfg.time_scale);
+        let per = period::period(cfg);
+        let checked = per.map_or(span, |p| span.min(p + SAMPLE_PERIOD));
+        let (samples, _) = reference_samples(&path, checked)?;
+        let mut out = Chatter {
+            scenario,
+            bound,
+            noise,
+            stats: std::cell::RefCell::new(Vec::new()),
+            accel_bound: f64::from(path.accel_bound()),
+            error_norm: 0.0,
+            coeff,
+            band,
+            maps,
+            unit,
+            samples,
+            currents: current_corners(&cfg.current),
+            period: per,
+            rate_hz: f64::from(cfg.controller.rate_hz),
+        };
+        // ‖e‖ in δ: 3σ of the error the law sees, at the δ of the fastest scale (k = 1) with
+        // ‖e‖ = 0 (Choice 500).
+        let (_, delta) = out.mean_thrusts(1.0)?;
+        let stats = out.stats_at(delta)?;
+        out.error_norm = 3.0
+            * [0, 1, 2, 4, 5]
+                .iter()
+                .map(|&a| stats[a].err_var)
+                .sum::<f64>()
+                .sqrt();
+        Ok(Some(out))
+    }
+
+    /// The command noise per body axis with the boundary layer at δ (rounded up to the grid,
+    /// at most δ_max), computed once per grid step.
+    fn stats_at(&self, delta: f64) -> Result<std::rc::Rc<[AxisStats; 6]>, CheckError> {
+        let c = self.scenario.controller().config();
+        let delta_max = f64::from(c.delta_max);
+        let step = (delta.max(1e-3).ln() / DELTA_GRID.ln()).ceil() as i32;
+        let on_grid = DELTA_GRID.powi(step).min(delta_max);
+        if let Some((_, s)) = self.stats.borrow().iter().find(|(k, _)| *k == step) {
+            return Ok(s.clone());
+        }
+        let mut eta_stats: Vec<AxisStats> = Vec::with_capacity(6);
+        for i in 0..6 {
+            let lp = Loop::with_delta(self.scenario, i, on_grid)?;
+            eta_stats.push(axis_stats(&lp, &self.noise[i]));
+        }
+        // Surge and sway each take the larger of x and y.
+        let xy = |s: &AxisStats| s.var.iter().copied().fold(0.0, f64::max);
+        let horizontal = if xy(&eta_stats[0]) >= xy(&eta_stats[1]) {
+            eta_stats[0].clone()
+        } else {
+            eta_stats[1].clone()
+        };
+        let stats = std::rc::Rc::new([
+            horizontal.clone(),
+            horizontal,
+            eta_stats[2].clone(),
+            eta_stats[3].clone(),
+            eta_stats[4].clone(),
+            eta_stats[5].clone(),
+        ]);
+        self.stats.borrow_mut().push((step, stats.clone()));
+        Ok(stats)
+    }
+
+    /// The mean thrust per thruster at each reference sample at time scale `k`, per current
+    /// corner (module docs, Choice 501), and the largest δ of Eq 29 along the reference
+    /// (clamped to δ_max) with ‖e‖ the term's error norm.
+    // Long: one pass over the reference forms the state once for the force and for δ.
+    fn mean_thrusts(&self, k: f64) -> Result<(MeanThrusts, f64), CheckError> {
+        let cfg = self.scenario.config();
+        let controller = self.scenario.controller();
+        let alloc = controller.allocation();
+        let constants = controller.delta_constants();
+        let mut delta = 0.0f64;
+        let mut out = vec![Vec::with_capacity(self.samples.len()); self.currents.len()];
+        let mut plant: Option<(controller_core::model::VehicleParams<f64>, Plant)> = None;
+        for (j, r) in self.samples.iter().enumerate() {
+            if j % 4096 == 0 {
+                super::poll()?;
+            }
+            let params = cfg.plant_params_at(r.s * k);
+            // The vehicle holds the heel of its payload (roll is not actuated), as the force
+            // check evaluates it ([`super::attitude::heel`]).
+            let level = crate::plant::static_heel(&params, r.eta[PITCH]).unwrap_or(0.0);
+            let (state, nu_dot) = state_at(r, k, level);
+            let (att, nu) = (Attitude::from_eta(&state.eta), state.nu);
+            let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
+            let d = uncertainty_bound(
+                constants,
+                &DeltaInputs {
+                    accel_bound: (self.accel_bound / (k * k)) as f32,
+                    error_norm: self.error_norm as f32,
+                    nu_norm: nu.norm() as f32,
+                    jinv_jdot_nu_norm: jjn.norm() as f32,
+                    cos_theta_abs: att.ctheta.abs() as f32,
+                },
+            );
+            delta = delta.max(f64::from(d));
+            if plant.as_ref().is_some_and(|(had, _)| *had != params) {
+                plant = None;
+            }
+            let (_, truth) = match plant {
+                Some(ref built) => built,
+                None => plant.insert((
+                    params,
+                    Plant::new(params, PlantTerms::default())
+                        .map_err(|e| CheckError::Invalid(format!("the plant: {e}")))?,
+                )),
+            };
+            for (c, o) in self.currents.iter().zip(out.iter_mut()) {
+                let heel = super::attitude::heel(truth, &state, &nu_dot, c).unwrap_or(level);
+                let (state, nu_dot) = state_at(r, k, heel);
+                let tau = truth.required_force(&state, &nu_dot, c).cast::<f32>();
+                o.push(alloc.thrusts(&tau).map(f64::from));
+            }
+        }
+        let delta_max = f64::from(controller.config().delta_max);
+        Ok((
+            out,
+            if delta.is_finite() {
+                delta.min(delta_max)
+            } else {
+                delta_max
+            },
+        ))
+    }
+
+    /// The flight's duration at time scale `k` (s): the same path.
+    fn duration(&self, k: f64) -> f64 {
+        let cfg = self.scenario.config();
+        cfg.duration * k / super::time_scale(cfg.time_scale)
+    }
+
+    /// The term at time scale `k` with the navigation's draws scaled by `noise` (1: as
+    /// configured), without the search.
+    ///
+    /// # Errors
+    /// [`CheckError::Interrupted`]; [`CheckError::Invalid`] for a plant that cannot be built.
+    pub fn at(&self, k: f64, noise: f64) -> Result<ChatterPrediction, CheckError> {
+        let (means, delta) = self.mean_thrusts(k)?;
+        let stats = self.stats_at(delta)?;
+        let duration = self.duration(k);
+        let t = 1.0 / self.rate_hz;
+        let periods = (duration * self.rate_hz).round().max(1.0) as u64;
+        let mut per_corner = Vec::with_capacity(means.len());
+        for mean in &means {
+            per_corner.push(self.flown(&stats, mean, k, periods, t, noise * noise)?);
+        }
+        let thrusters = (0..THRUSTERS)
+            .map(|j| {
+                let mut best: Option<ThrusterPrediction> = None;
+                for c in &per_corner {
+                    let (sigma, step, expected, tv) = c[j];
+                    let predicted = expected + CONFIDENCE_SIGMAS * expected.sqrt() + 2.0;
+                    let p = ThrusterPrediction {
+                        thruster: THRUSTER_NAMES[j].to_string(),
+                        band: self.band[j],
+                        sigma,
+                        step_sigma: step,
+                        expected_reversals_per_s: expected / duration,
+                        reversals_per_s: predicted / duration,
+                        command_tv: tv / duration,
+                    };
+                    let worse = best.as_ref().is_none_or(|b| {
+                        (p.reversals_per_s / self.bound.max_reversals_per_s)
+                            .max(p.command_tv / self.bound.max_command_tv)
+                            > (b.reversals_per_s / self.bound.max_reversals_per_s)
+                                .max(b.command_tv / self.bound.max_command_tv)
+                    });
+                    if worse {
+                        best = Some(p);
+                    }
+                }
+                best.unwrap_or_else(|| ThrusterPrediction {
+                    thruster: THRUSTER_NAMES[j].to_string(),
+                    band: self.band[j],
+                    sigma: 0.0,
+                    step_sigma: 0.0,
+                    expected_reversals_per_s: 0.0,
+                    reversals_per_s: 0.0,
+                    command_tv: 0.0,
+                })
+            })
+            .collect();
+        Ok(ChatterPrediction {
+            max_reversals_per_s: self.bound.max_reversals_per_s,
+            max_command_tv: self.bound.max_command_tv,
+            time_scale: k,
+            thrusters,
+            smallest_time_scale: None,
+            needs: None,
+        })
+    }
+
+    /// Per thruster over a flight of `periods` on the mean profile `mean` (one current
+    /// corner) at scale `k`, the noise's variance scaled by `scale2`: the largest σ, the
+    /// largest step σ, the expected reversals (min of the two edges' crossings) and the
+    /// expected total variation (V).
+    fn flown(
+        &self,
+        stats: &[AxisStats; 6],
+        mean: &[[f64; THRUSTERS]],
+        k: f64,
+        periods: u64,
+        t: f64,
+        scale2: f64,
+    ) -> Result<[(f64, f64, f64, f64); THRUSTERS], CheckError> {
+        let last = mean.len().saturating_sub(1);
+        let span = last.max(1) as f64 * SAMPLE_PERIOD;
+        let at = |n: u64| -> [f64; THRUSTERS] {
+            let mut s = n as f64 * t / k;
+            if let Some(p) = self.period {
+                s %= p;
+            }
+            let x = (s / SAMPLE_PERIOD).min(span / SAMPLE_PERIOD);
+            let j = (x.floor() as usize).min(last);
+            let j1 = (j + 1).min(last);
+            let w = x - j as f64;
+            std::array::from_fn(|i| mean[j][i] * (1.0 - w) + mean[j1][i] * w)
+        };
+        let mut crossings = [[0.0f64; 2]; THRUSTERS];
+        let mut tv = [0.0f64; THRUSTERS];
+        let mut sigma = [0.0f64; THRUSTERS];
+        let mut step = [0.0f64; THRUSTERS];
+        let mut m0 = at(0);
+        for n in 0..periods {
+            if n % 65_536 == 0 {
+                super::poll()?;
+            }
+            let m1 = at(n + 1);
+            let now: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n));
+            let next: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n + 1));
+            for j in 0..THRUSTERS {
+                let c = &self.coeff[j];
+                let v0: f64 = (0..6).map(|a| c[a] * now[a].0).sum::<f64>() * scale2;
+                let v1: f64 = (0..6).map(|a| c[a] * next[a].0).sum::<f64>() * scale2;
+                let cov: f64 = (0..6).map(|a| c[a] * now[a].1).sum::<f64>() * scale2;
+                let s = [v0.sqrt(), v1.sqrt()];
+                let dvar = (v0 + v1 - 2.0 * cov).max(0.0);
+                sigma[j] = sigma[j].max(s[0]);
+                step[j] = step[j].max(dvar.sqrt());
+                for (e, level) in self.band[j].iter().enumerate() {
+                    crossings[j][e] += crossing_probability([m0[j], m1[j]], s, cov, *level);
+                }
+                let dm = m1[j] - m0[j];
+                tv[j] += self.slope(j, m0[j]) * mean_abs(dm, dvar.sqrt());
+            }
+            m0 = m1;
+        }
+        Ok(std::array::from_fn(|j| {
+            (
+                sigma[j],
+                step[j],
+                crossings[j][0].min(crossings[j][1]),
+                tv[j],
+            )
+        }))
+    }
+
+    /// |dV/dT| of thruster `j` at thrust `x` (V/N), 0 where the supply limit clamps it.
+    fn slope(&self, j: usize, x: f64) -> f64 {
+        let h = 0.05;
+        let v = |x: f64| f64::from(self.maps[j].voltage_of_newtons(self.unit, x as f32));
+        let limit = f64::from(self.scenario.config().controller.voltage_limit);
+        if v(x).abs() >= limit {
+            return 0.0;
+        }
+        ((v(x + h) - v(x - h)) / (2.0 * h)).abs()
+    }
+
+    /// Whether the term fits the bound at time scale `k`.
+    ///
+    /// # Errors
+    /// As [`Chatter::at`].
+    pub fn fits_at(&self, k: f64) -> Result<bool, CheckError> {
+        Ok(self.at(k, 1.0)?.fits())
+    }
+
+    /// The term at the scenario's own scale, with the smallest scale that fits and, when none
+    /// does, the navigation noise it needs.
+    ///
+    /// # Errors
+    /// As [`Chatter::at`].
+    pub fn evaluate(&self) -> Result<ChatterPrediction, CheckError> {
+        let k0 = super::time_scale(self.scenario.config().time_scale);
+        let mut out = self.at(k0, 1.0)?;
+        if out.fits() {
+            out.smallest_time_scale = Some(self.smallest(1.0, k0)?);
+            return Ok(out);
+        }
+        let mut hi = k0;
+        let mut found = None;
+        while hi < MAX_TIME_SCALE {
+            let lo = hi;
+            hi = (2.0 * hi).min(MAX_TIME_SCALE);
+            if self.fits_at(hi)? {
+                found = Some(self.smallest(lo, hi)?);
+                break;
+            }
+        }
+        match found {
+            Some(k) => out.smallest_time_scale = Some(k),
+            None => out.needs = Some(self.needs(k0)?),
+        }
+        Ok(out)
+    }
+
+    /// The smallest k in [lo, hi] at which the term fits (it fits at hi), by bisection to
+    /// [`super::TIME_SCALE_TOLERANCE`], rounded up to [`super::TIME_SCALE_STEP`].
+    fn smallest(&self, lo: f64, hi: f64) -> Result<f64, CheckError> {
+        if self.fits_at(lo)? {
+            return Ok(lo);
+        }
+        let (mut lo, mut hi) = (lo, hi);
+        while hi / lo > 1.0 + super::TIME_SCALE_TOLERANCE {
+            let mid = (lo * hi).sqrt();
+            if self.fits_at(mid)? {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let mut k =
+            ((hi / super::TIME_SCALE_STEP).ceil() * super::TIME_SCALE_STEP * 100.0).round() / 100.0;
+        while k < MAX_TIME_SCALE && !self.fits_at(k)? {
+            k = ((k + super::TIME_SCALE_STEP) * 100.0).round() / 100.0;
+        }
+        Ok(k.min(MAX_TIME_SCALE))
+    }
+
+    /// What the navigation must deliver for the term to fit at the scenario's scale `k0`: the
+    /// largest fraction of its draws' σ (fixes, pings, white noise) that fits.
+    fn needs(&self, k0: f64) -> Result<String, CheckError> {
+        let fits = |s: f64| -> Result<bool, CheckError> { Ok(self.at(k0, s)?.fits()) };
+        if !fits(0.0)? {
+            return Ok(
+                "the mean command alone reverses beyond the bound (no navigation helps)"
+                    .to_string(),
+            );
+        }
+        let (mut lo, mut hi) = (0.0, 1.0);
+        while hi - lo > 0.01 {
+            let mid = 0.5 * (lo + hi);
+            if fits(mid)? {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        Ok(self.needs_text(lo))
+    }
+
+    fn needs_text(&self, fraction: f64) -> String {
+        let cfg = self.scenario.config();
+        let mut s = format!(
+            "needs the navigation's noise (fixes, pings, white) at most {:.0} % of the assumed",
+            100.0 * fraction
+        );
+        if let Some(m) = &cfg.navigation {
+            let v = &m.dvl.velocity.sigma;
+            s.push_str(&format!(
+                ": DVL single-ping σ ≤ {:.1} mm/s",
+                1e3 * fraction * v[0].max(v[1])
+            ));
+            if let Some(f) = &m.fix {
+                s.push_str(&format!(
+                    ", fix σ ≤ {:.1} mm",
+                    1e3 * fraction * f.error.sigma[0].max(f.error.sigma[1])
+                ));
+            }
+        }
+        s
+    }
+}
+
+/// Per current corner, per reference sample, the mean thrust per thruster (N).
+type MeanThrusts = Vec<Vec<[f64; THRUSTERS]>>;
+
+/// Index of roll and pitch in η.
+const ROLL: usize = 3;
+const PITCH: usize = 4;
+
+/// The vehicle on the reference sample `r` at time scale `k` with roll `phi`: η, ν = J⁻¹η̇,
+/// ν̇ = J⁻¹(η̈ − J̇ν).
+fn state_at(r: &RefSample, k: f64, phi: f64) -> (PlantState, Vector6<f64>) {
+    let mut eta = r.eta;
+    eta[ROLL] = phi;
+    let att = Attitude::from_eta(&eta);
+    let jinv = kinematics::jacobian_inv(&att);
+    let nu = jinv * (r.eta_dot / k);
+    let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
+    let nu_dot = jinv * (r.eta_ddot / (k * k)) - jjn;
+    (PlantState { eta, nu }, nu_dot)
+}
+
+/// E|x| for x ~ N(μ, s²).
+fn mean_abs(mu: f64, s: f64) -> f64 {
+    if s <= 0.0 {
+        return mu.abs();
+    }
+    let z = mu / s;
+    s * (2.0 / std::f64::consts::PI).sqrt() * (-0.5 * z * z).exp() + mu * (1.0 - 2.0 * phi(-z))
+}
+
+/// The term of `scenario` (module docs); `None` when it has no bound.
+///
+/// # Errors
+/// As [`Chatter::new`] and [`Chatter::evaluate`].
+pub fn chatter(scenario: &Scenario) -> Result<Option<ChatterPrediction>, CheckError> {
+    match Chatter::new(scenario)? {
+        Some(c) => Ok(Some(c.evaluate()?)),
+        None => Ok(None),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::SeedableRng;
+    use rand_distr::{Distribution, StandardNormal};
+
+    /// P(X > h, Y > k) by brute force: ∫_h^∞ φ(x) Φ((ρx − k)/√(1 − ρ²)) dx, Simpson's rule
+    /// on 20 000 intervals out to h + 12.
+    fn brute(h: f64, k: f64, r: f64) -> f64 {
+        let n = 20_000;
+        let (a, b) = (h.max(-12.0), h.max(-12.0) + 24.0);
+        let dx = (b - a) / n as f64;
+        let s = (1.0 - r * r).sqrt();
+        let f = |x: f64| {
+            (-0.5 * x * x).exp() / (2.0 * std::f64::consts::PI).sqrt() * phi((r * x - k) / s)
+        };
+        let mut sum = f(a) + f(b);
+        for i in 1..n {
+            let w = if i % 2 == 1 { 4.0 } else { 2.0 };
+            sum += w * f(a + i as f64 * dx);
+        }
+        sum * dx / 3.0
+    }
+
+    /// Φ at known values (Abramowitz and Stegun's table, and Φ(−8) = 6.22·10⁻¹⁶).
+    #[test]
+    fn the_normal_distribution_function_matches_its_table() {
+        for (x, p) in [
+            (0.0, 0.5),
+            (-1.0, 0.158_655_253_931_457_05),
+            (-1.96, 0.024_997_895_148_220_435),
+            (-3.0, 0.001_349_898_031_630_094_6),
+            (2.5, 0.993_790_334_674_223_7),
+            (-8.0, 6.220_960_574_271_785e-16),
+        ] {
+            let got = phi(x);
+            assert!(((got - p) / p).abs() < 1e-12, "Φ({x}) = {got}, table {p}");
+        }
+    }
+
+    /// The orthant at the origin has the closed form ¼ + asin(ρ)/(2π) (Sheppard), at every ρ,
+    /// through both of the bivariate routine's branches; ρ = 0 is the product.
+    #[test]
+    fn the_bivariate_orthant_matches_its_closed_forms() {
+        for r in [
+            -0.999, -0.99, -0.95, -0.5, 0.0, 0.3, 0.9, 0.95, 0.99, 0.9999,
+        ] {
+            let want = 0.25 + f64::asin(r) / (2.0 * std::f64::consts::PI);
+            let got = bvn_upper(0.0, 0.0, r);
+            assert!((got - want).abs() < 1e-14, "ρ {r}: {got} vs {want}");
+        }
+        for (h, k) in [(1.0, -0.5), (-2.0, 0.7), (2.5, 2.5)] {
+            let got = bvn_upper(h, k, 0.0);
+            let want = phi(-h) * phi(-k);
+            assert!((got - want).abs() < 1e-15, "{got} vs {want}");
+        }
+    }
+
+    /// Away from the origin, against the brute-force integral, in both branches and at the
+    /// correlations a filtered command has from one period to the next (0.95–0.9999).
+    #[test]
+    fn the_bivariate_orthant_matches_a_brute_force_integral() {
+        for &(h, k) in &[
+            (0.5, 1.0),
+            (-1.0, 2.0),
+            (2.0, 2.1),
+            (-0.3, -0.2),
+            (1.5, -1.5),
+        ] {
+            for r in [-0.99, -0.93, -0.6, 0.2, 0.8, 0.93, 0.99, 0.999, 0.9999] {
+                let (got, want) = (bvn_upper(h, k, r), brute(h, k, r));
+                assert!(
+                    (got - want).abs() < 1e-9,
+                    "h {h}, k {k}, ρ {r}: {got} vs {want}"
+                );
+            }
+        }
+    }
+
+    /// Rice's formula: a stationary Gaussian process of σ and autocorrelation e^{−τ²/(2ℓ²)}
+    /// crosses a level L (either way) (1/(πℓ))·e^{−L²/(2σ²)} times per unit time. Sampled
+    /// every T ≪ ℓ, the per-period crossing probability over T tends to it.
+    #[test]
+    fn crossings_of_a_smooth_process_tend_to_rices_rate() {
+        let (sigma, ell) = (3.0f64, 0.2f64);
+        for level in [0.0f64, 2.0, 6.0] {
+            let rice = (-0.5 * (level / sigma).powi(2)).exp() / (std::f64::consts::PI * ell);
+            let t = ell / 2000.0;
+            let cov = sigma * sigma * (-0.5 * (t / ell).powi(2)).exp();
+            let p = crossing_probability([0.0, 0.0], [sigma, sigma], cov, level);
+            let rate = p / t;
+            assert!(
+                (rate / rice - 1.0).abs() < 1e-3,
+                "level {level}: {rate} /s vs Rice {rice} /s"
+            );
+        }
+    }
+
+    /// Counted on a simulated AR(1) command (fixed seed) passing through a band, the
+    /// crossings of each edge are the sum of the per-period probabilities, and the reversals
+    /// through the band (counted as `sim::chatter` counts them) are at most min(C₋, C₊) + 2.
+    #[test]
+    fn simulated_crossings_and_reversals_are_within_the_prediction() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(1);
+        let (rho, sigma, n) = (0.97f64, 2.0, 200_000u64);
+        let band = [-1.0, 1.5];
+        let mean = |k: u64| 3.0 * (k as f64 * 2e-4).sin();
+        let z0: f64 = StandardNormal.sample(&mut rng);
+        let mut x = sigma * z0;
+        let mut counted = [0u64; 2];
+        let mut predicted = [0.0f64; 2];
+        let (mut side, mut reversals) = (0i8, 0u64);
+        for k in 0..n {
+            let e: f64 = StandardNormal.sample(&mut rng);
+            let next = rho * x + sigma * (1.0 - rho * rho).sqrt() * e;
+            let (v0, v1) = (mean(k) + x, mean(k + 1) + next);
+            for (i, level) in band.iter().enumerate() {
+                counted[i] += u64::from((v0 <= *level) != (v1 <= *level));
+                predicted[i] += crossing_probability(
+                    [mean(k), mean(k + 1)],
+                    [sigma, sigma],
+                    rho * sigma * sigma,
+                    *level,
+                );
+            }
+            if v1 > band[1] {
+                reversals += u64::from(side == -1);
+                side = 1;
+            } else if v1 < band[0] {
+                reversals += u64::from(side == 1);
+                side = -1;
+            }
+            x = next;
+        }
+        for i in 0..2 {
+            let (c, p) = (counted[i] as f64, predicted[i]);
+            // A count of crossings of a correlated process: within 5 of its √.
+            assert!((c - p).abs() < 5.0 * p.sqrt(), "edge {i}: {c} vs {p}");
+        }
+        let bound = predicted[0].min(predicted[1]) + 2.0;
+        assert!(
+            (reversals as f64) <= bound + CONFIDENCE_SIGMAS * bound.sqrt(),
+            "{reversals} reversals vs {bound}"
+        );
+        assert!(reversals > 0);
+    }
+
+    /// E|x| of a Gaussian: σ√(2/π) at μ = 0, |μ| when σ → 0.
+    #[test]
+    fn mean_absolute_value_of_a_gaussian() {
+        let s = 1.7;
+        assert!((mean_abs(0.0, s) - s * (2.0 / std::f64::consts::PI).sqrt()).abs() < 1e-15);
+        assert_eq!(mean_abs(-2.0, 0.0), 2.0);
+        assert!((mean_abs(50.0, 1.0) - 50.0).abs() < 1e-12);
+    }
+}
