@@ -285,6 +285,37 @@ fn fmt_violation(v: &Violation) -> String {
     )
 }
 
+impl Preflight {
+    /// The terms beside the force check that do not fit at the scale checked: the path-error
+    /// budget and the chatter term, each with what it needs.
+    fn write_terms_missed(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if let Some(b) = self.path_budget.as_ref().filter(|b| !b.fits()) {
+            write!(
+                f,
+                ": path-error budget {:.1} mm over the {:.0} mm bound",
+                1e3 * b.total,
+                1e3 * b.bound
+            )?;
+            if let Some(n) = &b.needs {
+                write!(f, " at every time scale ({n})")?;
+            }
+        }
+        if let Some(c) = self.chatter.as_ref().filter(|c| !c.fits()) {
+            let (r, i) = c.worst_reversals();
+            let (tv, j) = c.worst_tv();
+            write!(
+                f,
+                ": chatter {} {r:.1} reversals/s (bound {}), {} {tv:.0} V/s (bound {})",
+                THRUSTER_NAMES[i], c.max_reversals_per_s, THRUSTER_NAMES[j], c.max_command_tv
+            )?;
+            if let Some(n) = &c.needs {
+                write!(f, " at every time scale ({n})")?;
+            }
+        }
+        Ok(())
+    }
+}
+
 impl fmt::Display for Preflight {
     /// The one-line verdict, e.g. `preflight real-circular-10R: FEASIBLE at time scale 1 for
     /// this mission (margin 80 %: peak 77 % of vert aft's envelope; smallest feasible time
@@ -335,32 +366,7 @@ impl fmt::Display for Preflight {
                 if let Some(v) = &self.first_violation {
                     write!(f, ": first at t = {:.2} s, {}", v.t, fmt_violation(v))?;
                 }
-                if let Some(b) = self.path_budget.as_ref().filter(|b| !b.fits()) {
-                    write!(
-                        f,
-                        ": path-error budget {:.1} mm over the {:.0} mm bound",
-                        1e3 * b.total,
-                        1e3 * b.bound
-                    )?;
-                    if let Some(n) = &b.needs {
-                        write!(f, " at every time scale ({n})")?;
-                    }
-                }
-                if let Some(c) = self.chatter.as_ref().filter(|c| !c.fits()) {
-                    let (r, i) = c.worst_reversals();
-                    let (tv, j) = c.worst_tv();
-                    write!(
-                        f,
-                        ": chatter {} {r:.1} reversals/s (bound {}), {} {tv:.0} V/s (bound {})",
-                        THRUSTER_NAMES[i],
-                        c.max_reversals_per_s,
-                        THRUSTER_NAMES[j],
-                        c.max_command_tv
-                    )?;
-                    if let Some(n) = &c.needs {
-                        write!(f, " at every time scale ({n})")?;
-                    }
-                }
+                self.write_terms_missed(f)?;
                 match self.smallest_time_scale {
                     Some(k) => write!(f, "; feasible from time scale {k}")?,
                     None => write!(
@@ -417,6 +423,29 @@ pub fn check_as_written(scenario: &Scenario, margin: f64) -> Result<Preflight, C
     check_with(scenario, margin, false, Engine::Fast)
 }
 
+/// Each thruster's peaks over the flight as checked (`peaks`: min, its t, max, its t) against
+/// its envelope.
+fn thruster_demands(
+    envelope: &controller_core::thruster::ThrustEnvelope,
+    peaks: &[(f64, f64, f64, f64); THRUSTERS],
+) -> Vec<ThrusterDemand> {
+    (0..THRUSTERS)
+        .map(|i| {
+            let (min, t_min, max, t_max) = peaks[i];
+            let (lo, hi) = (f64::from(envelope.min[i]), f64::from(envelope.max[i]));
+            ThrusterDemand {
+                thruster: THRUSTER_NAMES[i].to_string(),
+                envelope: [lo, hi],
+                min,
+                t_min,
+                max,
+                t_max,
+                usage: (max / hi).max(min / lo),
+            }
+        })
+        .collect()
+}
+
 /// [`check`] (`whole_box`) or [`check_as_written`] by `engine`: the reference engine
 /// ([`Engine::Exhaustive`]) is what the fast one is tested against.
 ///
@@ -463,21 +492,7 @@ pub fn check_with(
         with_terms(&checker, Scope::WholeBox, v, k, &terms)?;
     }
     let envelope = scenario.controller().envelope();
-    let thrusters = (0..THRUSTERS)
-        .map(|i| {
-            let (min, t_min, max, t_max) = peaks[i];
-            let (lo, hi) = (f64::from(envelope.min[i]), f64::from(envelope.max[i]));
-            ThrusterDemand {
-                thruster: THRUSTER_NAMES[i].to_string(),
-                envelope: [lo, hi],
-                min,
-                t_min,
-                max,
-                t_max,
-                usage: (max / hi).max(min / lo),
-            }
-        })
-        .collect();
+    let thrusters = thruster_demands(envelope, &peaks);
     let mask = cfg.controller.geometry.auv150_reversed();
     let margin_envelope = envelope.scaled(margin as f32);
     let extremes = peaks.map(|(min, _, max, _)| (min, max));

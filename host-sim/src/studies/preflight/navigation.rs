@@ -23,7 +23,7 @@
 //! them as an offset of the path (the navigation's error, not a force), so they take no thrust.
 
 use controller_core::effectiveness::{THRUSTERS, THRUSTER_NAMES};
-use controller_core::estimator::{steady_state_gain, EstimatorKind};
+use controller_core::estimator::EstimatorKind;
 use controller_core::thruster::ThrustEnvelope;
 use nalgebra::{Matrix2, Vector6};
 use serde::{Deserialize, Serialize};
@@ -150,13 +150,7 @@ fn input_sigma(scenario: &Scenario, axis: usize, gain: [f64; 2], sp: f64, sv: f6
             + (gr * r * gr.transpose())[(0, 0)];
         return Some(var.max(0.0).sqrt());
     }
-    let gain_k = steady_state_gain(
-        t as f32,
-        c.estimator.position_sigma[axis],
-        c.estimator.velocity_sigma[axis],
-        c.estimator.accel_sigma[axis],
-    )
-    .ok()?;
+    let gain_k = super::path_budget::board_gain(&c.estimator, c.rate_hz, axis)?;
     let k = gain_k.k.cast::<f64>();
     let i2 = Matrix2::identity();
     let closed = f - g * gr;

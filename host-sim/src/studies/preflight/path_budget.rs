@@ -47,7 +47,7 @@
 //! and a drift over the longer flight change). The budget at k = [`MAX_TIME_SCALE`] is the
 //! mission's speed-independent error: beyond the bound, no time scale helps.
 
-use controller_core::estimator::{steady_state_gain, EstimatorKind};
+use controller_core::estimator::{AxisGain, EstimatorConfig, EstimatorGains, EstimatorKind};
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
 use controller_core::{Mission, Trajectory};
@@ -257,17 +257,14 @@ impl Loop {
         let k = match e.kind {
             EstimatorKind::Off => None,
             EstimatorKind::Kalman => Some(
-                steady_state_gain(
-                    t as f32,
-                    e.position_sigma[axis],
-                    e.velocity_sigma[axis],
-                    e.accel_sigma[axis],
-                )
-                .map_err(|_| {
-                    CheckError::Invalid(format!("the estimator has no steady state on axis {axis}"))
-                })?
-                .k
-                .cast::<f64>(),
+                board_gain(e, c.rate_hz, axis)
+                    .ok_or_else(|| {
+                        CheckError::Invalid(format!(
+                            "the estimator has no steady state on axis {axis}"
+                        ))
+                    })?
+                    .k
+                    .cast::<f64>(),
             ),
         };
         Ok(Loop { t, gain, k })
@@ -311,6 +308,16 @@ impl Loop {
         }
         (s.amax() < 1e-6 * sum).then_some(sum)
     }
+}
+
+/// Axis `axis`'s steady-state gain of the board's own estimator (`EstimatorGains`, the one
+/// `controller_core` flies: with the disturbance state of Choice 510 when `disturbance_time` is
+/// above 0). The loops here take its rows of η and η̇; the disturbance estimate's own path (its
+/// row `kd`, which integrates the innovations) is not modelled (Choice 505).
+pub(super) fn board_gain(e: &EstimatorConfig, rate_hz: u32, axis: usize) -> Option<AxisGain> {
+    EstimatorGains::new(e, rate_hz)
+        .ok()
+        .and_then(|g| g.axes.get(axis).copied())
 }
 
 /// The state of the noise propagation: [s₀, s₁, x̂₀, x̂₁, f, h, b_v, b_a, b_p] (module docs:
