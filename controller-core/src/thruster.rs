@@ -368,13 +368,9 @@ pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
 ///    thrust Eq 32 can give), bit i set;
 /// 3. otherwise V = `maps[i].voltage(c)` (Eq 31/32);
 /// 4. V clamped to [−`v_limit`, +`v_limit`], bit i set if the clamp acted;
-/// 5. reported thrust: what the applied voltage gives, `maps[i].thrust(V)` ·
-///    [`ThrustUnit::newtons`] — also when nothing saturated, so the report is always what the
-///    applied voltage gives — except for a tunnel thruster whose voltage was not clamped, which
-///    reports its command: the thrust its voltage gives to within the f32 rounding of Eq 31
-///    (≤ 4.3 ulps of max(|T|, 1 N) against the f64 root, where the round trip through the
-///    inverse is off by up to ≈ 1e-5 N; Choice 523). A clamped tunnel's is the thrust at the
-///    limit, its envelope's bound.
+/// 5. reported thrust = `maps[i].thrust(V)` · [`ThrustUnit::newtons`] of the clamped voltage —
+///    also when nothing saturated, so the report is always what the applied voltage gives
+///    (within the inverse map's f32 round trip, ~1e-5 polynomial units).
 ///
 /// The controller's commands come from the saturation-aware allocator
 /// ([`crate::allocation::Allocator`]), which keeps them inside the [`ThrustEnvelope`]: then
@@ -390,27 +386,6 @@ pub fn actuate(
     thrust_cmd: &[f32; THRUSTERS],
     v_limit: f32,
 ) -> Actuation {
-    actuate_within(
-        maps,
-        unit,
-        thrust_cmd,
-        v_limit,
-        &ThrustEnvelope::new(maps, unit, v_limit),
-    )
-}
-
-/// [`actuate`] with the envelope of `maps` in `unit` at ±`v_limit` given
-/// ([`ThrustEnvelope::new`], which the controller keeps): a clamped tunnel thruster reports its
-/// bound (the thrust at the limit, the same bits), so the step never evaluates a tunnel's
-/// inverse map (Choice 523).
-#[inline]
-pub fn actuate_within(
-    maps: &[ThrusterMap; THRUSTERS],
-    unit: ThrustUnit,
-    thrust_cmd: &[f32; THRUSTERS],
-    v_limit: f32,
-    envelope: &ThrustEnvelope,
-) -> Actuation {
     if !(v_limit.is_finite() && v_limit > 0.0) {
         return Actuation {
             saturated: ALL_SATURATED,
@@ -419,54 +394,34 @@ pub fn actuate_within(
     }
     let mut out = Actuation::OFF;
     for i in 0..THRUSTERS {
-        let cmd = thrust_cmd[i];
-        let (v, clamp) = command_voltage(maps[i], cmd * unit.per_newton(), v_limit);
+        let (v, t, sat) = actuate_one(maps[i], thrust_cmd[i] * unit.per_newton(), v_limit);
         out.voltages[i] = v;
-        out.thrusts[i] = match (maps[i], clamp) {
-            (_, Clamp::Off) => 0.0,
-            (ThrusterMap::Tunnel, Clamp::None) => cmd,
-            (ThrusterMap::Tunnel, Clamp::Low) => envelope.min[i],
-            (ThrusterMap::Tunnel, Clamp::High) => envelope.max[i],
-            (ThrusterMap::Main, _) => maps[i].thrust(v) * unit.newtons(),
-        };
-        if clamp != Clamp::None {
+        out.thrusts[i] = t * unit.newtons();
+        if sat {
             out.saturated |= 1 << i;
         }
     }
     out
 }
 
-/// How a command's voltage was limited.
-#[derive(Clone, Copy, PartialEq, Eq)]
-enum Clamp {
-    /// Not at all: V is Eq 31/32 of the command.
-    None,
-    /// A non-finite command: 0 V.
-    Off,
-    /// At −v_limit.
-    Low,
-    /// At +v_limit, or the main thruster at its fold.
-    High,
-}
-
-/// The voltage of one thruster's command `cmd` (polynomial units), `v_limit` finite and > 0,
-/// and how it was limited (steps 1–4 of [`actuate`]).
+/// One thruster of [`actuate`], in polynomial units; `v_limit` is finite and > 0.
 #[inline]
-fn command_voltage(map: ThrusterMap, cmd: f32, v_limit: f32) -> (f32, Clamp) {
+fn actuate_one(map: ThrusterMap, cmd: f32, v_limit: f32) -> (f32, f32, bool) {
     if !cmd.is_finite() {
-        return (0.0, Clamp::Off);
+        return (0.0, 0.0, true);
     }
-    let (v, clamp) = match map {
-        ThrusterMap::Main if cmd < MAIN_T_FOLD => (MAIN_V_FOLD, Clamp::High),
-        _ => (map.voltage(cmd), Clamp::None),
+    let (mut v, mut sat) = match map {
+        ThrusterMap::Main if cmd < MAIN_T_FOLD => (MAIN_V_FOLD, true),
+        _ => (map.voltage(cmd), false),
     };
     // voltage() of a finite command is never NaN (Horner steps are inf ∘ finite at worst),
     // and ±∞ is clamped here.
     if v > v_limit {
-        (v_limit, Clamp::High)
+        v = v_limit;
+        sat = true;
     } else if v < -v_limit {
-        (-v_limit, Clamp::Low)
-    } else {
-        (v, clamp)
+        v = -v_limit;
+        sat = true;
     }
+    (v, map.thrust(v), sat)
 }

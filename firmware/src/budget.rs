@@ -89,18 +89,19 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "kernels",
         update: 4_000,
-        // kinematics, trajectory, law, allocation, voltage maps: measured 445, 639, 605, 888,
-        // 424 (Choices 520–524; 499, 639, 682, 888, 1 112 before). The trajectory stage's 720:
+        // kinematics, trajectory, law, allocation, voltage maps: measured 445, 639, 604, 887,
+        // 928 (Choices 520–522 and 524; 499, 639, 682, 888, 1 112 before; the maps keep the
+        // inverse map's Cardano roots, Choice 491). The trajectory stage's 720:
         // a waypoint path's sample (two fixed binary searches, the time law's piece and the
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
         // against 445 for the closed forms.
-        stages: [500, 720, 680, 1_000, 480],
-        // Measured 5 401 (6 492 with the disturbance state, Choice 510, before Choices 520–524;
-        // 6 273 before both, 7 200 before Choices 430–431). Issue 28's target is ≤ 4 000, not
-        // met: the estimator's stages are about 2 400 of it and the law on the estimate ≈ 3 000
+        stages: [500, 720, 680, 1_000, 1_050],
+        // Measured 5 887 (6 492 with the disturbance state, Choice 510, before Choices 520–522 and
+        // 524; 6 273 before both, 7 200 before Choices 430–431). Issue 28's target is ≤ 4 000, not
+        // met: the estimator's stages are about 2 400 of it and the law on the estimate ≈ 3 500
         // (docs/law.md#the-state-estimator).
-        update_from_solution: 5_700,
-        // solution, filter, estimate, record: measured 389, 1 249, 357, 533 (the filter's
+        update_from_solution: 6_200,
+        // solution, filter, estimate, record: measured 389, 1 249, 357, 532 (the filter's
         // disturbance state, Choice 510, adds about 210: its correction and d·Δt²/2, d·Δt in
         // both predictions).
         estimator_stages: [450, 1_350, 400, 600],
@@ -116,13 +117,13 @@ pub const BUDGETS: [StepBudget; 3] = [
     // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
     StepBudget {
         backend: "libm",
-        // Measured 15 280 (the SysTick count); stages 7 541, 5 469, 848, 890, 423 (the voltage
-        // maps take no cbrtf since Choice 523, no libm sqrtf since Choice 520).
-        update: 17_000,
-        stages: [8_400, 6_200, 1_000, 1_000, 500],
-        // Measured 24 913; solution, filter, estimate, record: 7 536, 1 243, 7 504, 531 (libm's
+        // Measured 21 800 (the SysTick count); stages 7 538, 5 469, 847, 888, 7 054 (the voltage
+        // maps' soft-float cbrtf; no libm sqrtf since Choice 520).
+        update: 25_000,
+        stages: [8_400, 6_200, 1_000, 1_000, 8_000],
+        // Measured 31 436; solution, filter, estimate, record: 7 535, 1 247, 7 510, 532 (libm's
         // sinf/cosf in the solution's and the estimate's attitude).
-        update_from_solution: 26_500,
+        update_from_solution: 34_000,
         estimator_stages: [8_400, 1_350, 8_400, 600],
         // Measured 34 720, 1 281 440 and 1 448 480 (libm's cosf in the rebuild, its sin/cos in
         // the waypoint build).
@@ -135,12 +136,12 @@ pub const BUDGETS: [StepBudget; 3] = [
     // micromath takes the kernels' cbrt (it has none), so its maps cost the kernels'.
     StepBudget {
         backend: "micromath",
-        // Measured 3 040 (the SysTick count); stages 377, 570, 618, 890, 431 (the waypoint
-        // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
+        // Measured 3 480 (the SysTick count); stages 376, 568, 617, 889, 929 (the waypoint
+        // path's trajectory stage the 568, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
-        stages: [450, 680, 700, 1_000, 480],
-        // Measured 5 277; solution, filter, estimate, record: 345, 1 248, 319, 533.
-        update_from_solution: 5_600,
+        stages: [450, 680, 700, 1_000, 1_050],
+        // Measured 5 753; solution, filter, estimate, record: 344, 1 249, 324, 530.
+        update_from_solution: 6_100,
         estimator_stages: [400, 1_350, 380, 600],
         // Measured as the kernels: 29 160, 1 051 200 and 1 218 200.
         work: WorkBudget {
