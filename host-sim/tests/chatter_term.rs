@@ -3,17 +3,13 @@
 
 use controller_core::effectiveness::THRUSTER_NAMES;
 use controller_core::EstimatorKind;
-use host_sim::scenario::{real_vehicle, Scenario, SensorNoise};
+use host_sim::scenario::{Scenario, SensorNoise};
 use host_sim::sim::{self, LocalController, Recording, RunResult};
 use host_sim::studies::preflight::chatter::{self, ChatterPrediction};
 
-fn real(name: &str) -> Scenario {
-    real_vehicle::real_scenarios()
-        .unwrap()
-        .into_iter()
-        .find(|s| s.config().name == name)
-        .unwrap()
-}
+mod common;
+
+use common::real_mission as real;
 
 fn predicted(s: &Scenario) -> ChatterPrediction {
     chatter::chatter(s)

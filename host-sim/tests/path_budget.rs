@@ -3,17 +3,13 @@
 
 use controller_core::TrajectoryKind;
 use host_sim::scenario::navigation::{NavigationModel, Preset};
-use host_sim::scenario::{real_vehicle, Scenario};
+use host_sim::scenario::Scenario;
 use host_sim::sim::{self, LocalController, Recording};
 use host_sim::studies::preflight::path_budget::{self, PathBudget};
 
-fn real(name: &str) -> Scenario {
-    real_vehicle::real_scenarios()
-        .unwrap()
-        .into_iter()
-        .find(|s| s.config().name == name)
-        .unwrap()
-}
+mod common;
+
+use common::real_mission as real;
 
 fn budget(s: &Scenario) -> PathBudget {
     path_budget::budget(s)

@@ -8,7 +8,7 @@ pub mod chatter;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 
-use host_sim::scenario::{parse_scenario, ScenarioError};
+use host_sim::scenario::{parse_scenario, real_vehicle, Scenario, ScenarioError};
 
 pub fn host_sim() -> Command {
     Command::new(env!("CARGO_BIN_EXE_host-sim"))
@@ -100,3 +100,12 @@ pub fn toml_error(text: &str) -> String {
 
 /// A one-second circle.
 pub const SHORT: &str = "duration = 1\n[trajectory]\nkind = \"circle\"\nradius = 10\n";
+
+/// The shipped real mission named `name` (its `name` key, e.g. `real-circular-10R`).
+pub fn real_mission(name: &str) -> Scenario {
+    real_vehicle::real_scenarios()
+        .unwrap()
+        .into_iter()
+        .find(|s| s.config().name == name)
+        .unwrap_or_else(|| panic!("no shipped real mission {name}"))
+}

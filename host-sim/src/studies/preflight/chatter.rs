@@ -58,10 +58,10 @@ use serde::{Deserialize, Serialize};
 
 use super::path_budget::{
     axis_noise, current_corners, period_maps, reference_samples, AxisNoise, Cov, Loop, PeriodMaps,
-    RefSample, N,
+    PlantCache, RefSample, N,
 };
 use super::{period, CheckError, SAMPLE_PERIOD};
-use crate::plant::{Plant, PlantState, PlantTerms};
+use crate::plant::PlantState;
 use crate::scenario::navigation::Timing;
 use crate::scenario::{Bound, Scenario};
 use crate::sim::chatter::DEAD_BAND;
@@ -650,7 +650,7 @@ impl<'a> Chatter<'a> {
         let constants = controller.delta_constants();
         let mut delta = 0.0f64;
         let mut out = vec![Vec::with_capacity(self.samples.len()); self.currents.len()];
-        let mut plant: Option<(controller_core::model::VehicleParams<f64>, Plant)> = None;
+        let mut plant = PlantCache::default();
         for (j, r) in self.samples.iter().enumerate() {
             if j % 4096 == 0 {
                 super::poll()?;
@@ -673,17 +673,7 @@ impl<'a> Chatter<'a> {
                 },
             );
             delta = delta.max(f64::from(d));
-            if plant.as_ref().is_some_and(|(had, _)| *had != params) {
-                plant = None;
-            }
-            let (_, truth) = match plant {
-                Some(ref built) => built,
-                None => plant.insert((
-                    params,
-                    Plant::new(params, PlantTerms::default())
-                        .map_err(|e| CheckError::Invalid(format!("the plant: {e}")))?,
-                )),
-            };
+            let truth = plant.at(params)?;
             for (c, o) in self.currents.iter().zip(out.iter_mut()) {
                 let heel = super::attitude::heel(truth, &state, &nu_dot, c).unwrap_or(level);
                 let (state, nu_dot) = state_at(r, k, heel);

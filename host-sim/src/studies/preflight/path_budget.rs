@@ -310,6 +310,26 @@ impl Loop {
     }
 }
 
+/// The plant as written at the latest payload, rebuilt only when the payload changes (a
+/// sweep along the reference meets the same parameters for many samples in a row).
+#[derive(Default)]
+pub(super) struct PlantCache(Option<(VehicleParams<f64>, Plant)>);
+
+impl PlantCache {
+    /// The plant of `params`.
+    pub(super) fn at(&mut self, params: VehicleParams<f64>) -> Result<&Plant, CheckError> {
+        let built = match self.0.take() {
+            Some((had, plant)) if had == params => (had, plant),
+            _ => (
+                params,
+                Plant::new(params, PlantTerms::default())
+                    .map_err(|e| CheckError::Invalid(format!("the plant: {e}")))?,
+            ),
+        };
+        Ok(&self.0.insert(built).1)
+    }
+}
+
 /// Axis `axis`'s steady-state gain of the board's own estimator (`EstimatorGains`, the one
 /// `controller_core` flies: with the disturbance state of Choice 510 when `disturbance_time` is
 /// above 0). The loops here take its rows of η and η̇; the disturbance estimate's own path (its
@@ -572,7 +592,7 @@ impl<'a> Budget<'a> {
         let cfg = self.scenario.config();
         let lag = cfg.thruster_lag.unwrap_or(0.0);
         let mut out = vec![Vec::with_capacity(self.samples.len()); self.currents.len()];
-        let mut plant: Option<(VehicleParams<f64>, Plant)> = None;
+        let mut plant = PlantCache::default();
         for (j, r) in self.samples.iter().enumerate() {
             if j % 4096 == 0 {
                 super::poll()?;
@@ -587,17 +607,7 @@ impl<'a> Budget<'a> {
             let nu_dot = Vector6::new(lin_dot.x, lin_dot.y, lin_dot.z, a[3], a[4], a[5]);
             let state = PlantState { eta: r.eta, nu };
             let params = cfg.plant_params_at(r.s * k);
-            if plant.as_ref().is_some_and(|(had, _)| *had != params) {
-                plant = None;
-            }
-            let (_, true_plant) = match plant {
-                Some(ref built) => built,
-                None => plant.insert((
-                    params,
-                    Plant::new(params, PlantTerms::default())
-                        .map_err(|e| CheckError::Invalid(format!("the plant: {e}")))?,
-                )),
-            };
+            let true_plant = plant.at(params)?;
             // The translational block: a moment the models disagree on is held by the
             // attitude (the heel roll settles at, the pitch and yaw loops), not the path.
             let minv = true_plant
