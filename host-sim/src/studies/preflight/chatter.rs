@@ -57,8 +57,8 @@ use nalgebra::{RowVector2, SMatrix, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
 use super::path_budget::{
-    axis_noise, current_corners, period_maps, reference_samples, AxisNoise, Cov, Loop, PeriodMaps,
-    PlantCache, RefSample, N,
+    axis_noise, current_corners, period_maps, redraw, reference_samples, AxisNoise, Cov, Loop,
+    PeriodMaps, PlantCache, RefSample, N,
 };
 use super::{period, CheckError, SAMPLE_PERIOD};
 use crate::plant::PlantState;
@@ -429,13 +429,6 @@ fn axis_stats(lp: &Loop, noise: &AxisNoise) -> AxisStats {
             a[(i, j)] = 0.0;
         }
     };
-    let reset = |p: &mut Cov, i: usize, var: f64| {
-        for j in 0..N {
-            p[(i, j)] = 0.0;
-            p[(j, i)] = 0.0;
-        }
-        p[(i, i)] = var;
-    };
     let mut out = AxisStats::default();
     for n in 0..settle + cycle {
         // Aₙ: X_{n+1} = Aₙ Xₙ + εₙ.
@@ -469,10 +462,10 @@ fn axis_stats(lp: &Loop, noise: &AxisNoise) -> AxisStats {
         }
         p = drift * p * drift.transpose();
         if let Some((s, _)) = fixed {
-            reset(&mut p, 4, s * s);
+            redraw(&mut p, 4, s * s);
         }
         if let Some((s, _)) = pinged {
-            reset(&mut p, 5, s * s);
+            redraw(&mut p, 5, s * s);
         }
         if let Some(cc) = &correct {
             p = cc * p * cc.transpose() + q_white;

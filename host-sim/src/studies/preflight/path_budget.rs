@@ -422,6 +422,16 @@ pub(super) fn period_maps(lp: &Loop, noise: &AxisNoise) -> PeriodMaps {
     }
 }
 
+/// A held source's new draw: state `i` forgets what it was (its row and column of `p` zeroed)
+/// and takes the variance `var` of a fresh, independent draw (a fix or a DVL ping).
+pub(super) fn redraw(p: &mut Cov, i: usize, var: f64) {
+    for j in 0..N {
+        p[(i, j)] = 0.0;
+        p[(j, i)] = 0.0;
+    }
+    p[(i, i)] = var;
+}
+
 /// σ = maxₜ √P_ee over a flight of `duration` s (module docs), and whether it stayed finite.
 fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> f64 {
     let t = lp.t;
@@ -439,13 +449,6 @@ fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> 
         correct,
         q_white,
     } = period_maps(lp, noise);
-    let reset = |p: &mut Cov, i: usize, var: f64| {
-        for j in 0..N {
-            p[(i, j)] = 0.0;
-            p[(j, i)] = 0.0;
-        }
-        p[(i, i)] = var;
-    };
     // With fixes and no outages the covariance is periodic once the loop has settled.
     let held = noise.fix.as_ref().is_some_and(|f| f.2.outages.is_empty())
         && noise.ping.as_ref().is_none_or(|p| p.2.outages.is_empty());
@@ -471,12 +474,12 @@ fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> 
         p = drift * p * drift.transpose();
         if let Some((_, _, timing)) = &noise.fix {
             if samples_at(timing, n + 1, t) {
-                reset(&mut p, 4, fix_s * fix_s);
+                redraw(&mut p, 4, fix_s * fix_s);
             }
         }
         if let Some((_, _, timing)) = &noise.ping {
             if samples_at(timing, n + 1, t) {
-                reset(&mut p, 5, ping_s * ping_s);
+                redraw(&mut p, 5, ping_s * ping_s);
             }
         }
         if let Some(c) = &correct {
