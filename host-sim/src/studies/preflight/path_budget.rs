@@ -939,23 +939,68 @@ pub(super) fn reference_samples(
 }
 
 /// The currents the budget flies: the constant one, or a Gauss–Markov one's mean and its
-/// ±[`CURRENT_SIGMAS`]σ corners on x and y.
+/// ±[`CURRENT_SIGMAS`]σ corners on each axis whose σ is not zero (x, y and z: a vertical
+/// current's wander changes the heave damping the lag's share is linearised at).
 pub(super) fn current_corners(current: &CurrentModel) -> Vec<Vector3<f64>> {
     match current {
         CurrentModel::None => vec![Vector3::zeros()],
         CurrentModel::Constant(c) => vec![Vector3::from(*c)],
         CurrentModel::GaussMarkov { mean, sigma, .. } => {
+            let offsets = |axis: usize| -> &'static [f64] {
+                if sigma[axis] == 0.0 {
+                    &[0.0]
+                } else {
+                    &[-1.0, 0.0, 1.0]
+                }
+            };
             let mut v = Vec::new();
-            for sx in [-1.0, 0.0, 1.0] {
-                for sy in [-1.0, 0.0, 1.0] {
-                    v.push(Vector3::new(
-                        mean[0] + sx * CURRENT_SIGMAS * sigma[0],
-                        mean[1] + sy * CURRENT_SIGMAS * sigma[1],
-                        mean[2],
-                    ));
+            for sx in offsets(0) {
+                for sy in offsets(1) {
+                    for sz in offsets(2) {
+                        v.push(Vector3::new(
+                            mean[0] + sx * CURRENT_SIGMAS * sigma[0],
+                            mean[1] + sy * CURRENT_SIGMAS * sigma[1],
+                            mean[2] + sz * CURRENT_SIGMAS * sigma[2],
+                        ));
+                    }
                 }
             }
             v
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn gauss_markov(sigma: [f64; 3]) -> CurrentModel {
+        CurrentModel::GaussMarkov {
+            mean: [0.1, -0.05, 0.02],
+            sigma,
+            tau: 300.0,
+            seed: 1,
+        }
+    }
+
+    /// Every axis with a wander is flown at its mean and both ±kσ corners: before, a vertical
+    /// σ was dropped and the heave corners never flew.
+    #[test]
+    fn a_gauss_markov_current_is_cornered_on_every_axis_that_wanders() {
+        for sigma in [[0.05, 0.05, 0.01], [0.0, 0.0, 0.01], [0.05, 0.0, 0.0]] {
+            let corners = current_corners(&gauss_markov(sigma));
+            let wandering = sigma.iter().filter(|s| **s != 0.0).count();
+            assert_eq!(corners.len(), 3usize.pow(wandering as u32), "σ {sigma:?}");
+            for axis in 0..3 {
+                let mean = [0.1, -0.05, 0.02][axis];
+                for k in [-CURRENT_SIGMAS, 0.0, CURRENT_SIGMAS] {
+                    let want = mean + k * sigma[axis];
+                    assert!(
+                        corners.iter().any(|c| (c[axis] - want).abs() < 1e-15),
+                        "σ {sigma:?}: no corner at {want} on axis {axis}"
+                    );
+                }
+            }
         }
     }
 }
