@@ -135,7 +135,7 @@ fn real_chain_currents(c: &mut Criterion) {
     let circle = host_sim::scenario::load_scenario(&circle).expect("the real circle");
     let mut group = c.benchmark_group("current (real chain)");
     group.sample_size(10);
-    for (step, h) in [("1 ms plant", 0.001), ("control-period plant", 0.01)] {
+    for (step, study) in [("1 ms plant", false), ("study-grade plant", true)] {
         for (name, current) in [
             ("constant", CurrentModel::Constant([0.1, 0.05, 0.0])),
             (
@@ -150,7 +150,10 @@ fn real_chain_currents(c: &mut Criterion) {
         ] {
             let s = circle
                 .with(|c| {
-                    c.plant_step = h;
+                    if study {
+                        // Choice 400 with Choice 542: one midpoint step per control period.
+                        host_sim::studies::campaign::PlantStep::ControlPeriod.apply(c);
+                    }
                     c.current = current;
                 })
                 .expect("the circle with a current");

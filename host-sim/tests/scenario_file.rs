@@ -133,6 +133,7 @@ fn every_key(path: TrajectoryKind) -> ScenarioFile {
         table1_case: Some("circular-10R".into()),
         duration: Some(1.0),
         plant_step: Some(1.0),
+        plant_integrator: Some("midpoint".into()),
         ideal_actuators: Some(true),
         initial_offset: Some([0.0; 6]),
         divergence_limit: Some(1.0),
@@ -274,6 +275,10 @@ fn configurations() -> Vec<SimConfig> {
         files.sort();
         out.extend(files.iter().map(|p| load_config(p).unwrap()));
     }
+    // Choice 542: a study-grade configuration (its integrator is written, and read back).
+    let mut study = out[0].clone();
+    study.plant_integrator = host_sim::plant::Integrator::Midpoint;
+    out.push(study);
     for case in Table1Case::ALL {
         out.push(paper::config(case, true));
         out.push(paper::config(case, false));

@@ -191,8 +191,10 @@ pub struct SimConfig {
     /// Simulated time (s). Paper: 70. A waypoint mission without `duration`: its path's time
     /// to the last waypoint ([`crate::scenario::path_time`], Choice 312).
     pub duration: f64,
-    /// Plant RK4 step (s). Default 1 ms.
+    /// Plant step (s). Default 1 ms.
     pub plant_step: f64,
+    /// How the plant is stepped (scenario key `plant_integrator`, **Choice 542**). Default RK4.
+    pub plant_integrator: crate::plant::Integrator,
     /// The controller (its `rate_hz` is the sampled loop's rate; zero-order hold in between).
     pub controller: ControllerConfig,
     pub variation: VariationProfile,
@@ -292,6 +294,7 @@ impl SimConfig {
             speed_limits: None,
             duration: 70.0,
             plant_step: 0.001,
+            plant_integrator: crate::plant::Integrator::Rk4,
             controller: ControllerConfig::default(),
             variation: VariationProfile::None,
             trimmed: false,

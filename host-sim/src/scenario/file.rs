@@ -28,6 +28,9 @@ pub struct ScenarioFile {
     pub duration: Option<f64>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plant_step: Option<f64>,
+    /// An [`Integrator`](crate::plant::Integrator) by name (checked when built).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub plant_integrator: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ideal_actuators: Option<bool>,
     #[serde(
@@ -71,6 +74,7 @@ impl ScenarioFile {
             table1_case: None,
             duration: None,
             plant_step: None,
+            plant_integrator: None,
             ideal_actuators: None,
             initial_offset: None,
             divergence_limit: None,

@@ -17,7 +17,7 @@ use super::file::{
     StepTable, ThrustUnitName, VariationTable,
 };
 use super::{f32_decimal, parse, InitialAttitude, SimConfig, TickRange};
-use crate::plant::{CurrentModel, VariationProfile};
+use crate::plant::{CurrentModel, Integrator, VariationProfile};
 
 /// A configuration a scenario file cannot describe: the field, and why.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -79,6 +79,9 @@ impl TryFrom<&SimConfig> for ScenarioFile {
         file.table1_case = c.case.map(|case| case.name().to_string());
         file.duration = Some(c.duration);
         file.plant_step = Some(c.plant_step);
+        // Written when not the default, so a file of an RK4 run reads as it always did.
+        file.plant_integrator =
+            (c.plant_integrator != Integrator::Rk4).then(|| c.plant_integrator.name().into());
         file.ideal_actuators = Some(c.ideal_actuators);
         file.initial_offset = Some(c.initial_offset);
         file.divergence_limit = Some(c.divergence_limit);

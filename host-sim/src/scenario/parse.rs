@@ -19,7 +19,7 @@ use super::file::{
 use super::paper;
 use super::validate::invalid;
 use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
-use crate::plant::{CurrentModel, VariationProfile};
+use crate::plant::{CurrentModel, Integrator, VariationProfile};
 
 /// Default `seed` of `[noise]`, `[navigation]` and the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;
@@ -98,6 +98,9 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     config.duration = duration(raw.duration, &config)?;
     if let Some(h) = raw.plant_step {
         config.plant_step = h;
+    }
+    if let Some(name) = raw.plant_integrator {
+        config.plant_integrator = integrator(&name)?;
     }
     if let Some(b) = raw.ideal_actuators {
         config.ideal_actuators = b;
@@ -442,4 +445,15 @@ pub(super) fn axis_priority(order: &[String]) -> Res<AxisPriority> {
         priority.rank[axis] = (order.len() - i) as u8;
     }
     Ok(priority)
+}
+
+/// The plant integrator named `name` (`plant_integrator`, Choice 542).
+fn integrator(name: &str) -> Res<Integrator> {
+    Integrator::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = Integrator::ALL.iter().map(|i| i.name()).collect();
+        invalid(
+            "plant_integrator",
+            format!("{name:?} is not one of {}", names.join(", ")),
+        )
+    })
 }

@@ -38,7 +38,7 @@ impl<'a> Vehicle<'a> {
         }
     }
 
-    /// One RK4 step of `h` from time `t` with the body force `tau` held, then the current's.
+    /// One plant step of `h` (the scenario's integrator) from time `t` with the body force `tau` held, then the current's.
     pub fn step(&mut self, t: f64, tau: &Vector6<f64>, h: f64) -> Result<(), PlantError> {
         let params_at = |t: f64| self.config.plant_params_at(t);
         let plant = match &mut self.plant {
@@ -51,7 +51,13 @@ impl<'a> Vehicle<'a> {
                 .plant
                 .insert(Plant::new(params_at(t), PlantTerms::default())?),
         };
-        self.state = plant.rk4_step(&self.state, tau, self.current.velocity(), h)?;
+        self.state = plant.step(
+            self.config.plant_integrator,
+            &self.state,
+            tau,
+            self.current.velocity(),
+            h,
+        )?;
         self.current.step(h);
         Ok(())
     }

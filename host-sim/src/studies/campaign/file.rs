@@ -44,7 +44,7 @@ use controller_core::readable::Readable;
 use serde::{Deserialize, Serialize};
 
 use super::METRIC_NAMES;
-use crate::plant::{CurrentModel, VariationProfile};
+use crate::plant::{CurrentModel, Integrator, VariationProfile};
 use crate::scenario::{
     reversed_mask, Bound, Scenario, ScenarioError, SimConfig, MAX_CURRENT_SPEED,
 };
@@ -154,9 +154,9 @@ impl Default for DrawSpec {
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum PlantStep {
-    /// Study-grade flight: one RK4 step per control period (the thrust is held over the period
-    /// anyway), the step a base gives replaced. Agrees with the 1 ms RK4 within
-    /// [`STUDY_PATH_TOLERANCE`] (tests/study_step.rs).
+    /// Study-grade flight: one explicit-midpoint step per control period (the thrust is held
+    /// over the period anyway; **Choice 542**), the step and integrator a base gives replaced.
+    /// Agrees with the 1 ms RK4 within [`STUDY_PATH_TOLERANCE`] (tests/study_step.rs).
     ControlPeriod,
 }
 
@@ -164,7 +164,10 @@ impl PlantStep {
     /// Sets this step on a run's configuration.
     pub fn apply(self, c: &mut SimConfig) {
         match self {
-            PlantStep::ControlPeriod => c.plant_step = 1.0 / f64::from(c.controller.rate_hz),
+            PlantStep::ControlPeriod => {
+                c.plant_step = 1.0 / f64::from(c.controller.rate_hz);
+                c.plant_integrator = Integrator::Midpoint;
+            }
         }
     }
 }

@@ -287,6 +287,7 @@ impl Campaign {
             let mut c = base.scenario.config().clone();
             step.apply(&mut c);
             file.plant_step = Some(c.plant_step);
+            file.plant_integrator = Some(c.plant_integrator.name().into());
         }
         if self.spec.draw.parameters != ParameterDraw::None {
             file.variation = Some(VariationTable {
