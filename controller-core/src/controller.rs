@@ -801,11 +801,12 @@ impl Controller {
     #[doc(hidden)]
     #[inline]
     pub fn maps_stage(&self, demand: &[f32; THRUSTERS]) -> (Actuation, Vector6<f32>) {
-        let act = thruster::actuate(
+        let act = thruster::actuate_within(
             &self.maps,
             self.config.thrust_unit,
             demand,
             self.config.voltage_limit,
+            self.allocator.envelope(),
         );
         let tau_achieved = self.allocator.wrench(&act.thrusts);
         (act, tau_achieved)
