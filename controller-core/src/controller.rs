@@ -15,6 +15,7 @@ use crate::effectiveness::THRUSTERS;
 use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind};
 use crate::kinematics::{Attitude, Kinematics};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw};
+use crate::math::times_zero;
 use crate::model::{self, VehicleParams};
 use crate::thruster::{self, Actuation, ThrustEnvelope, ThrusterMap};
 use crate::trajectory::{Desired, Trajectory};
@@ -801,11 +802,12 @@ impl Controller {
     #[doc(hidden)]
     #[inline]
     pub fn maps_stage(&self, demand: &[f32; THRUSTERS]) -> (Actuation, Vector6<f32>) {
-        let act = thruster::actuate(
+        let act = thruster::actuate_within(
             &self.maps,
             self.config.thrust_unit,
             demand,
             self.config.voltage_limit,
+            self.allocator.envelope(),
         );
         let tau_achieved = self.allocator.wrench(&act.thrusts);
         (act, tau_achieved)
@@ -944,16 +946,6 @@ fn check_feasible(bounds: &UncertaintyBounds<f32>, beta: f32) -> Result<(), Conf
         });
     }
     Ok(())
-}
-
-/// Σ xᵢ·0: ±0 when every xᵢ is finite, NaN otherwise ([`Output::all_finite`], Choice 524).
-#[inline]
-fn times_zero<const N: usize>(x: &[f32; N]) -> f32 {
-    let mut zero = 0.0f32;
-    for v in x {
-        zero += v * 0.0;
-    }
-    zero
 }
 
 /// η and ν finite ([`Fault::NonFiniteInput`] otherwise) and plausible

@@ -40,6 +40,7 @@ use nalgebra::{Matrix2, Vector6};
 
 use crate::axes::YAW;
 use crate::kinematics::Kinematics;
+use crate::math::times_zero;
 
 /// How many periods of applied acceleration the estimator keeps: the oldest solution it can
 /// correct at its stamp and predict forward (Choice 341: 16 periods, 160 ms at 100 Hz, covers a
@@ -625,7 +626,8 @@ impl Estimate {
             // Time went back: a new mission.
             self.reset();
         }
-        let finite = eta.iter().chain(eta_dot.iter()).all(|x| x.is_finite());
+        // Choice 527: finiteness as Σ x·0 (±0 when all are finite, NaN otherwise).
+        let finite = times_zero(eta) + times_zero(eta_dot) == 0.0;
         let in_window = stamp <= ticks && ticks - stamp <= HORIZON as u64;
         if finite && in_window {
             if !self.valid {
@@ -655,8 +657,8 @@ impl Estimate {
                     let kd = &gains.axes[i].kd;
                     dist[i] += kd[0] * dz + kd[1] * dv;
                 }
-                let sum_finite = (0..6).all(|i| (eta[i] + offset[i]).is_finite());
-                if sum_finite && vel.iter().chain(dist.iter()).all(|x| x.is_finite()) {
+                let posterior: [f32; 6] = core::array::from_fn(|i| eta[i] + offset[i]);
+                if times_zero(&posterior) + times_zero(&vel) + times_zero(&dist) == 0.0 {
                     self.anchor = *eta;
                     self.offset = offset;
                     self.velocity = vel;
@@ -684,7 +686,7 @@ impl Estimate {
     /// board flies); periods the board did not run are recorded as zero accelerations, at
     /// most [`HORIZON`] of them.
     pub fn applied(&mut self, gains: &EstimatorGains, ticks: u64, a: &[f32; 6]) {
-        let finite = a.iter().all(|x| x.is_finite());
+        let finite = times_zero(a) == 0.0;
         if self.last != NONE && ticks <= self.last {
             if ticks == self.last {
                 self.accel = if finite { *a } else { [0.0; 6] };

@@ -368,9 +368,13 @@ pub const ALL_SATURATED: u8 = (1 << THRUSTERS) - 1;
 ///    thrust Eq 32 can give), bit i set;
 /// 3. otherwise V = `maps[i].voltage(c)` (Eq 31/32);
 /// 4. V clamped to [−`v_limit`, +`v_limit`], bit i set if the clamp acted;
-/// 5. reported thrust = `maps[i].thrust(V)` · [`ThrustUnit::newtons`] of the clamped voltage —
-///    also when nothing saturated, so the report is always what the applied voltage gives
-///    (within the inverse map's f32 round trip, ~1e-5 polynomial units).
+/// 5. reported thrust: what the applied voltage gives, `maps[i].thrust(V)` ·
+///    [`ThrustUnit::newtons`] — also when nothing saturated, so the report is always what the
+///    applied voltage gives — except for a tunnel thruster whose voltage was not clamped, which
+///    reports its command: the thrust its voltage gives to within the f32 rounding of Eq 31
+///    (≤ 4.3 ulps of max(|T|, 1 N) against the f64 root, where the round trip through the
+///    inverse is off by up to ≈ 1e-5 N; Choice 526). A clamped tunnel's is the thrust at the
+///    limit, its envelope's bound.
 ///
 /// The controller's commands come from the saturation-aware allocator
 /// ([`crate::allocation::Allocator`]), which keeps them inside the [`ThrustEnvelope`]: then
@@ -386,6 +390,27 @@ pub fn actuate(
     thrust_cmd: &[f32; THRUSTERS],
     v_limit: f32,
 ) -> Actuation {
+    actuate_within(
+        maps,
+        unit,
+        thrust_cmd,
+        v_limit,
+        &ThrustEnvelope::new(maps, unit, v_limit),
+    )
+}
+
+/// [`actuate`] with the envelope of `maps` in `unit` at ±`v_limit` given
+/// ([`ThrustEnvelope::new`], which the controller keeps): a clamped tunnel thruster reports its
+/// bound (the thrust at the limit, the same bits), so the step never evaluates a tunnel's
+/// inverse map (Choice 526).
+#[inline]
+pub fn actuate_within(
+    maps: &[ThrusterMap; THRUSTERS],
+    unit: ThrustUnit,
+    thrust_cmd: &[f32; THRUSTERS],
+    v_limit: f32,
+    envelope: &ThrustEnvelope,
+) -> Actuation {
     if !(v_limit.is_finite() && v_limit > 0.0) {
         return Actuation {
             saturated: ALL_SATURATED,
@@ -394,34 +419,70 @@ pub fn actuate(
     }
     let mut out = Actuation::OFF;
     for i in 0..THRUSTERS {
-        let (v, t, sat) = actuate_one(maps[i], thrust_cmd[i] * unit.per_newton(), v_limit);
+        let cmd = thrust_cmd[i];
+        let (v, clamp) = command_voltage(maps[i], cmd * unit.per_newton(), v_limit);
         out.voltages[i] = v;
-        out.thrusts[i] = t * unit.newtons();
-        if sat {
+        out.thrusts[i] = match (maps[i], clamp) {
+            (_, Clamp::Off) => 0.0,
+            (ThrusterMap::Tunnel, Clamp::None) => cmd,
+            (ThrusterMap::Tunnel, Clamp::Low) => envelope.min[i],
+            (ThrusterMap::Tunnel, Clamp::High) => envelope.max[i],
+            (ThrusterMap::Main, _) => maps[i].thrust(v) * unit.newtons(),
+        };
+        if clamp != Clamp::None {
             out.saturated |= 1 << i;
         }
     }
     out
 }
 
-/// One thruster of [`actuate`], in polynomial units; `v_limit` is finite and > 0.
+/// Whether the thrust [`actuate`] reports for a thruster of map `map`, saturation bit
+/// `saturated` and applied voltage `v` is the inverse map of that voltage to the bit
+/// ([`ThrusterMap::newtons_of_voltage`]): for a voltage other than 0 V (off reports 0 N, the
+/// map its fit's offset), always for the main thruster, for a tunnel only when clamped (it
+/// reports its envelope's bound, the map at the limit). An unclamped tunnel reports its command
+/// (Choice 526).
+///
+/// A simulator that drives its thrusters with the law's report instead of evaluating the
+/// inverse map of the voltage again (host-sim's Choice 402) may do so only where this is true:
+/// a board in the loop is read by its voltages, and the same voltage must give the same thrust
+/// whether the law ran on the host or on the board (PIL = SIL, Choice 525).
 #[inline]
-fn actuate_one(map: ThrusterMap, cmd: f32, v_limit: f32) -> (f32, f32, bool) {
+pub fn reports_inverse_map(map: ThrusterMap, saturated: bool, v: f32) -> bool {
+    v != 0.0 && (map == ThrusterMap::Main || saturated)
+}
+
+/// How a command's voltage was limited.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Clamp {
+    /// Not at all: V is Eq 31/32 of the command.
+    None,
+    /// A non-finite command: 0 V.
+    Off,
+    /// At −v_limit.
+    Low,
+    /// At +v_limit, or the main thruster at its fold.
+    High,
+}
+
+/// The voltage of one thruster's command `cmd` (polynomial units), `v_limit` finite and > 0,
+/// and how it was limited (steps 1–4 of [`actuate`]).
+#[inline]
+fn command_voltage(map: ThrusterMap, cmd: f32, v_limit: f32) -> (f32, Clamp) {
     if !cmd.is_finite() {
-        return (0.0, 0.0, true);
+        return (0.0, Clamp::Off);
     }
-    let (mut v, mut sat) = match map {
-        ThrusterMap::Main if cmd < MAIN_T_FOLD => (MAIN_V_FOLD, true),
-        _ => (map.voltage(cmd), false),
+    let (v, clamp) = match map {
+        ThrusterMap::Main if cmd < MAIN_T_FOLD => (MAIN_V_FOLD, Clamp::High),
+        _ => (map.voltage(cmd), Clamp::None),
     };
     // voltage() of a finite command is never NaN (Horner steps are inf ∘ finite at worst),
     // and ±∞ is clamped here.
     if v > v_limit {
-        v = v_limit;
-        sat = true;
+        (v_limit, Clamp::High)
     } else if v < -v_limit {
-        v = -v_limit;
-        sat = true;
+        (-v_limit, Clamp::Low)
+    } else {
+        (v, clamp)
     }
-    (v, map.thrust(v), sat)
 }

@@ -12,7 +12,7 @@ use controller_core::{HeadingMode, ThrustUnit, TrajectoryKind};
 use host_sim::plant::{self, Plant, PlantState, PlantTerms, VariationProfile};
 use host_sim::scenario::real_vehicle;
 use host_sim::scenario::{load_scenario, parse_scenario, InitialAttitude, Scenario, ScenarioError};
-use host_sim::sim::bound;
+use host_sim::sim::{self, bound, ControlOut, ControlSource, LocalController, Recording, Stop};
 use host_sim::studies::preflight::{self, Verdict, DEFAULT_MARGIN};
 use nalgebra::{Vector3, Vector6};
 
@@ -142,6 +142,52 @@ fn the_real_chain_applies_the_commanded_wrench_in_the_configured_unit() {
             assert!(checked > 150, "{checked} unsaturated periods");
         }
     }
+}
+
+/// The law run on the host as a board runs it: the board's telemetry gives the plant its
+/// voltages, never the thrust the law reported (host_sim::sim::ControlOut::thrust is `None`
+/// from a board).
+struct AsABoard<'a>(LocalController<'a>);
+
+impl ControlSource for AsABoard<'_> {
+    fn control(&mut self, k: u64, eta: &[f32; 6], nu: &[f32; 6]) -> Result<ControlOut, Stop> {
+        let out = self.0.control(k, eta, nu)?;
+        Ok(ControlOut {
+            thrust: None,
+            ..out
+        })
+    }
+}
+
+#[test]
+fn the_plant_gives_a_voltage_one_thrust_whether_the_law_ran_here_or_on_a_board() {
+    // Regression (Choice 525): SIL's plant took the law's reported thrust for a nonzero voltage
+    // (Choice 402), which since Choice 526 (523 before it) is an unclamped tunnel's command, a
+    // few ulps from the inverse map of its voltage that PIL's plant evaluates: PIL differed
+    // from SIL in the last bits (the figure-eight's max path 0.013083055 against 0.013083053 m)
+    // with the same law, the same commands and the same voltages. The same voltages must give
+    // the same flight.
+    let s = real("figure-eight-30x30")
+        .with(|c| c.duration = 3.0)
+        .unwrap();
+    let sil = sim::fly(&s, &mut LocalController::new(&s), &mut (), Recording::Plot);
+    let board = sim::fly(
+        &s,
+        &mut AsABoard(LocalController::new(&s)),
+        &mut (),
+        Recording::Plot,
+    );
+    assert_eq!(sil.samples.len(), board.samples.len());
+    assert!(sil.samples.len() > 100);
+    for (a, b) in sil.samples.iter().zip(&board.samples) {
+        let bits = |x: &[f64]| x.iter().map(|v| v.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&a.thrust), bits(&b.thrust), "thrust at t = {}", a.t);
+        assert_eq!(bits(&a.eta), bits(&b.eta), "η at t = {}", a.t);
+    }
+    assert_eq!(
+        sil.metrics.max_path.to_bits(),
+        board.metrics.max_path.to_bits()
+    );
 }
 
 #[test]

@@ -17,8 +17,9 @@ pub struct ControlOut {
     pub tau: [f32; 6],
     /// Voltages (used by the real actuator chain).
     pub voltage: [f32; THRUSTERS],
-    /// The thrust (N) the law's own maps give for each voltage, when the law ran here: the
-    /// simulated thrusters' inverse map of the same voltage, already computed (**Choice 402**,
+    /// The thrust (N) the law reports for each voltage, when the law ran here: the inverse map
+    /// of the voltage, or an unclamped tunnel's command (Choice 526). The simulated thrusters
+    /// take it where it is that map, already computed (**Choice 402**, Choice 525,
     /// [`Thrusters::target`](super::thrusters::Thrusters::target)). `None` from a board.
     pub thrust: Option<[f32; THRUSTERS]>,
     pub saturated: u8,

@@ -65,11 +65,14 @@ impl<'a> Thrusters<'a> {
         let mut t = [0.0; THRUSTERS];
         for (i, t) in t.iter_mut().enumerate() {
             let v = out.voltage[i];
+            let clamped = out.saturated & (1 << i) != 0;
             *t = match out.thrust {
-                // Choice 402: the law's maps are these maps in this unit, and for a voltage
-                // other than 0 V its thrust is newtons_of_voltage(v), the same f32 operations.
-                // At 0 V the law reports 0 N (power off), the map its fit's offset.
-                Some(law) if v != 0.0 => law[i],
+                // Choice 402: the law's maps are these maps in this unit; where the law reports
+                // the inverse map of the voltage (Choice 525: not at 0 V, the law's power-off
+                // 0 N, nor an unclamped tunnel's command, Choice 526) its thrust is
+                // newtons_of_voltage(v), the same f32 operations. Elsewhere, and from a board
+                // (read by its voltages alone), the map is evaluated here: PIL = SIL.
+                Some(law) if thruster::reports_inverse_map(self.maps[i], clamped, v) => law[i],
                 _ => self.maps[i].newtons_of_voltage(self.unit, v),
             } as f64;
         }
