@@ -532,6 +532,10 @@ pub struct Budget<'a> {
     latency: f64,
     /// The reference's period (s of path time), when it repeats.
     period: Option<f64>,
+    /// Every budget evaluated, by the bits of its time scale and duration (Choice 532): the
+    /// check's search, the joined verdicts of both scopes and their rounding ask for the same
+    /// scale more than once, and each is a propagation over the whole flight.
+    memo: std::cell::RefCell<Vec<([u64; 2], PathBudget)>>,
 }
 
 impl<'a> Budget<'a> {
@@ -586,6 +590,7 @@ impl<'a> Budget<'a> {
             speed,
             latency,
             period: period::period(cfg),
+            memo: std::cell::RefCell::new(Vec::new()),
         }))
     }
 
@@ -690,8 +695,20 @@ impl<'a> Budget<'a> {
         Ok(self.at(k)?.fits())
     }
 
-    /// The budget at time scale `k` over a flight of `duration` s.
+    /// The budget at time scale `k` over a flight of `duration` s: evaluated once per pair
+    /// (the same bits in, the same budget out).
     fn at_for(&self, k: f64, duration: f64) -> Result<PathBudget, CheckError> {
+        let key = [k.to_bits(), duration.to_bits()];
+        if let Some((_, b)) = self.memo.borrow().iter().find(|m| m.0 == key) {
+            return Ok(b.clone());
+        }
+        let b = self.evaluate_at_for(k, duration)?;
+        self.memo.borrow_mut().push((key, b.clone()));
+        Ok(b)
+    }
+
+    /// [`Budget::at_for`], evaluated.
+    fn evaluate_at_for(&self, k: f64, duration: f64) -> Result<PathBudget, CheckError> {
         let d = self.mismatch(k)?;
         let mismatch: [f64; AXES] = std::array::from_fn(|i| {
             d.iter()
