@@ -432,23 +432,11 @@ pub(super) fn redraw(p: &mut Cov, i: usize, var: f64) {
     p[(i, i)] = var;
 }
 
-/// σ = maxₜ √P_ee over a flight of `duration` s (module docs), and whether it stayed finite.
-fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> f64 {
+/// The periods of a flight of `duration` s over which [`noise_sigma`] propagates the
+/// covariance of `noise` on the loop `lp`: the whole flight, or until it repeats with its
+/// fixes.
+fn propagation_steps(lp: &Loop, noise: &AxisNoise, duration: f64) -> u64 {
     let t = lp.t;
-    let (fix_s, fix_b) = noise.fix.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
-    let (ping_s, ping_b) = noise.ping.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
-    let mut p = Cov::zeros();
-    p[(4, 4)] = fix_s * fix_s;
-    p[(5, 5)] = ping_s * ping_s;
-    p[(6, 6)] = ping_b * ping_b;
-    p[(7, 7)] = noise.accel_bias * noise.accel_bias;
-    p[(8, 8)] = fix_b * fix_b;
-    let PeriodMaps {
-        loop_step,
-        drift,
-        correct,
-        q_white,
-    } = period_maps(lp, noise);
     // With fixes and no outages the covariance is periodic once the loop has settled.
     let held = noise.fix.as_ref().is_some_and(|f| f.2.outages.is_empty())
         && noise.ping.as_ref().is_none_or(|p| p.2.outages.is_empty());
@@ -464,7 +452,27 @@ fn noise_sigma(lp: &Loop, noise: &AxisNoise, duration: f64, stop_above: f64) -> 
     } else {
         duration
     };
-    let steps = (span.min(MAX_PROPAGATION) / t).ceil() as u64;
+    (span.min(MAX_PROPAGATION) / t).ceil() as u64
+}
+
+/// σ = maxₜ √P_ee over `steps` periods of the loop `lp` ([`propagation_steps`], module
+/// docs), stopping once above `stop_above`.
+fn noise_sigma(lp: &Loop, noise: &AxisNoise, steps: u64, stop_above: f64) -> f64 {
+    let t = lp.t;
+    let (fix_s, fix_b) = noise.fix.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
+    let (ping_s, ping_b) = noise.ping.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
+    let mut p = Cov::zeros();
+    p[(4, 4)] = fix_s * fix_s;
+    p[(5, 5)] = ping_s * ping_s;
+    p[(6, 6)] = ping_b * ping_b;
+    p[(7, 7)] = noise.accel_bias * noise.accel_bias;
+    p[(8, 8)] = fix_b * fix_b;
+    let PeriodMaps {
+        loop_step,
+        drift,
+        correct,
+        q_white,
+    } = period_maps(lp, noise);
     let mut worst = 0.0f64;
     for n in 0..steps {
         p = loop_step * p * loop_step.transpose();
@@ -532,6 +540,15 @@ pub struct Budget<'a> {
     latency: f64,
     /// The reference's period (s of path time), when it repeats.
     period: Option<f64>,
+    /// Every budget evaluated, by the bits of its time scale and duration (Choice 532): the
+    /// check's search, the joined verdicts of both scopes and their rounding ask for the same
+    /// scale more than once, and each is a propagation over the whole flight.
+    memo: std::cell::RefCell<Vec<([u64; 2], PathBudget)>>,
+    /// Every σ propagated, by its axis and the bits of what it reads (Choice 535): the
+    /// draws' σ does not depend on the time scale (a ping's error, not the heading's share of
+    /// the speed), and with fixes the propagation stops where the covariance repeats, so every
+    /// scale of a search past that length asks for the same one.
+    sigmas: std::cell::RefCell<std::collections::HashMap<Vec<u64>, f64>>,
 }
 
 impl<'a> Budget<'a> {
@@ -586,6 +603,8 @@ impl<'a> Budget<'a> {
             speed,
             latency,
             period: period::period(cfg),
+            memo: std::cell::RefCell::new(Vec::new()),
+            sigmas: std::cell::RefCell::new(std::collections::HashMap::new()),
         }))
     }
 
@@ -690,8 +709,48 @@ impl<'a> Budget<'a> {
         Ok(self.at(k)?.fits())
     }
 
-    /// The budget at time scale `k` over a flight of `duration` s.
+    /// [`noise_sigma`] of axis `i` under `noise` over a flight of `duration` s, propagated
+    /// once per distinct input (the same bits in, the same σ out).
+    fn noise_sigma(&self, i: usize, noise: &AxisNoise, duration: f64, stop: f64) -> f64 {
+        let lp = &self.loops[i];
+        let steps = propagation_steps(lp, noise, duration);
+        let source = |s: &Option<(f64, f64, Timing)>| -> Vec<u64> {
+            match s {
+                None => vec![0],
+                Some((sigma, bias, timing)) => [1.0, *sigma, *bias, timing.rate_hz]
+                    .into_iter()
+                    .chain(timing.outages.iter().flatten().copied())
+                    .map(f64::to_bits)
+                    .chain([timing.outages.len() as u64])
+                    .collect(),
+            }
+        };
+        let mut key = vec![i as u64, steps, stop.to_bits(), noise.accel_bias.to_bits()];
+        key.extend(noise.white.map(f64::to_bits));
+        key.extend(source(&noise.fix));
+        key.extend(source(&noise.ping));
+        if let Some(&sigma) = self.sigmas.borrow().get(&key) {
+            return sigma;
+        }
+        let sigma = noise_sigma(lp, noise, steps, stop);
+        self.sigmas.borrow_mut().insert(key, sigma);
+        sigma
+    }
+
+    /// The budget at time scale `k` over a flight of `duration` s: evaluated once per pair
+    /// (the same bits in, the same budget out).
     fn at_for(&self, k: f64, duration: f64) -> Result<PathBudget, CheckError> {
+        let key = [k.to_bits(), duration.to_bits()];
+        if let Some((_, b)) = self.memo.borrow().iter().find(|m| m.0 == key) {
+            return Ok(b.clone());
+        }
+        let b = self.evaluate_at_for(k, duration)?;
+        self.memo.borrow_mut().push((key, b.clone()));
+        Ok(b)
+    }
+
+    /// [`Budget::at_for`], evaluated.
+    fn evaluate_at_for(&self, k: f64, duration: f64) -> Result<PathBudget, CheckError> {
         let d = self.mismatch(k)?;
         let mismatch: [f64; AXES] = std::array::from_fn(|i| {
             d.iter()
@@ -739,8 +798,8 @@ impl<'a> Budget<'a> {
             let q = quantile(MISS_PROBABILITY / (AXES as f64 * fixes));
             // σ beyond the bound: the budget cannot fit (q > 1), no need to fly further.
             let stop = self.bound;
-            let sigma = noise_sigma(&self.loops[i], &draws, duration, stop);
-            let bias = noise_sigma(&self.loops[i], &biases, duration, stop);
+            let sigma = self.noise_sigma(i, &draws, duration, stop);
+            let bias = self.noise_sigma(i, &biases, duration, stop);
             out.quantile[i] = q;
             out.noise_sigma[i] = sigma;
             out.bias_sigma[i] = bias;
