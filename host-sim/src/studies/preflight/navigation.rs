@@ -152,20 +152,28 @@ fn input_sigma(scenario: &Scenario, axis: usize, gain: [f64; 2], sp: f64, sv: f6
     }
     let gain_k = super::path_budget::board_gain(&c.estimator, c.rate_hz, axis)?;
     let k = gain_k.k.cast::<f64>();
-    let i2 = Matrix2::identity();
-    let closed = f - g * gr;
-    // X = [s; x̂]: X⁺ = A X + B n⁺.
-    let mut a = nalgebra::DMatrix::<f64>::zeros(4, 4);
-    a.view_mut((0, 0), (2, 2)).copy_from(&f);
-    a.view_mut((0, 2), (2, 2)).copy_from(&(-(g * gr)));
-    a.view_mut((2, 0), (2, 2)).copy_from(&(k * f));
-    a.view_mut((2, 2), (2, 2))
-        .copy_from(&((i2 - k) * closed - k * g * gr));
-    let mut b = nalgebra::DMatrix::<f64>::zeros(4, 2);
+    let kd = nalgebra::RowVector2::new(f64::from(gain_k.kd[0]), f64::from(gain_k.kd[1]));
+    // X = [s; x̂; d̂]: X⁺ = A X + B n⁺ (Choice 512: the prior x̂⁻ = (F − gG)x̂ + g d̂, the
+    // innovation ν = s⁺ + n⁺ − x̂⁻, x̂⁺ = x̂⁻ + Kν, d̂⁺ = d̂ + kd·ν).
+    let mut next = nalgebra::SMatrix::<f64, 2, 5>::zeros();
+    next.fixed_view_mut::<2, 2>(0, 0).copy_from(&f);
+    next.fixed_view_mut::<2, 2>(0, 2).copy_from(&(-(g * gr)));
+    let mut prior = nalgebra::SMatrix::<f64, 2, 5>::zeros();
+    prior.fixed_view_mut::<2, 2>(0, 2).copy_from(&(f - g * gr));
+    prior.fixed_view_mut::<2, 1>(0, 4).copy_from(&g);
+    let innovation = next - prior;
+    let mut a = nalgebra::DMatrix::<f64>::zeros(5, 5);
+    a.view_mut((0, 0), (2, 5)).copy_from(&next);
+    a.view_mut((2, 0), (2, 5))
+        .copy_from(&(prior + k * innovation));
+    a.view_mut((4, 0), (1, 5)).copy_from(&(kd * innovation));
+    a[(4, 4)] += 1.0;
+    let mut b = nalgebra::DMatrix::<f64>::zeros(5, 2);
     b.view_mut((2, 0), (2, 2)).copy_from(&k);
+    b.view_mut((4, 0), (1, 2)).copy_from(&kd);
     let rd = dm(&r);
     let p = fix(a, &b * rd * b.transpose())?;
-    let mut cu = nalgebra::DMatrix::<f64>::zeros(1, 4);
+    let mut cu = nalgebra::DMatrix::<f64>::zeros(1, 5);
     cu[(0, 2)] = -gain[0];
     cu[(0, 3)] = -gain[1];
     let var = (&cu * p * cu.transpose())[(0, 0)];

@@ -8,9 +8,13 @@
 //! s = [e, ė] moves as s⁺ = F s + g(u + d) (F = [[1, T], [0, 1]], g = [T²/2, T]), d the
 //! acceleration the law's nominal model does not explain; the law's input is u = −G ŝ with
 //! G = [K₁ + (δ_max/μ)p₁₂, K₂ + (δ_max/μ)p₂₂] (Eq 17, and Δu of Eq 30 inside its boundary
-//! layer), ŝ the solution as told (s + n) or the estimator's posterior
-//! x̂⁺ = (I − K)(F − gG)x̂ + K(s⁺ + n⁺) (the steady-state gain K of
-//! `controller_core::estimator`; its prediction uses u, so d is what it does not know).
+//! layer), ŝ the solution as told (s + n) or the estimator's posterior. The estimator is the
+//! board's own (the steady-state gain of `controller_core::estimator`, its rows K of η, η̇ and
+//! kd of the disturbance estimate d̂, **Choice 512**): its prior is x̂⁻ = (F − gG)x̂ + g d̂ (its
+//! prediction uses u and d̂, so d − d̂ is what it does not know), its innovation
+//! ν = s⁺ + n⁺ − x̂⁻, and x̂⁺ = x̂⁻ + Kν, d̂⁺ = d̂ + kd·ν: d̂ integrates the innovations, so a
+//! steady d leaves the estimate without a lag, and the noise reaches u through d̂ too. With
+//! the two-state filter kd = 0 and d̂ stays 0. The law itself does not use d̂.
 //!
 //! **Navigation error n** (Choice 421): not white. Its position part is the last fix's error
 //! (σ_f, a new draw at each fix, held in between) plus its bias, plus the dead reckoning's
@@ -20,7 +24,7 @@
 //! n_v⁺ = n_v + T b_a. For z the fixes are the pressure depths. Fixes and pings come at their
 //! sources' rates, none in their outages; with no fixes the position drifts for the whole
 //! mission. The scenario's `[noise]` adds white noise per period. The covariance of the whole
-//! state [s, x̂, n] is propagated period by period over the flight (P⁺ = A P Aᵀ + Q, a fix or
+//! state [s, x̂, n, d̂] is propagated period by period over the flight (P⁺ = A P Aᵀ + Q, a fix or
 //! ping replacing its state's row by a fresh draw), and σᵢ = maxₜ √P_ee(t).
 //!
 //! **Confidence** (Choice 422): a mission's largest error per axis is over N = D·f_fix
@@ -51,7 +55,7 @@ use controller_core::estimator::{AxisGain, EstimatorConfig, EstimatorGains, Esti
 use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
 use controller_core::{Mission, Trajectory};
-use nalgebra::{Matrix2, SMatrix, Vector2, Vector3, Vector6};
+use nalgebra::{Matrix2, RowVector2, SMatrix, Vector2, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
 use super::{period, CheckError, SAMPLE_PERIOD};
@@ -218,12 +222,21 @@ fn samples_at(timing: &Timing, k: u64, t_period: f64) -> bool {
     k.is_multiple_of(every) && !timing.outages.iter().any(|o| t >= o[0] && t < o[1])
 }
 
-/// The law's linear loop on one axis: T, G, and the estimator's K (`None`: off).
+/// The law's linear loop on one axis: T, G, and the estimator's K (`None`: off) with its row
+/// kd of the disturbance estimate (zero without the disturbance state or the estimator).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Loop {
     pub(super) t: f64,
     pub(super) gain: [f64; 2],
     pub(super) k: Option<Matrix2<f64>>,
+    pub(super) kd: RowVector2<f64>,
+}
+
+/// The estimator's state in the loop's linear model: x̂ = [ê, ê̇] and d̂ (module docs).
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct LoopEstimate {
+    pub(super) x: Vector2<f64>,
+    pub(super) d: f64,
 }
 
 impl Loop {
@@ -254,20 +267,45 @@ impl Loop {
             f64::from(c.k2[axis]) + robust * f64::from(lyap[axis].p22),
         ];
         let e = &scenario.config().controller.estimator;
-        let k = match e.kind {
-            EstimatorKind::Off => None,
-            EstimatorKind::Kalman => Some(
-                board_gain(e, c.rate_hz, axis)
-                    .ok_or_else(|| {
-                        CheckError::Invalid(format!(
-                            "the estimator has no steady state on axis {axis}"
-                        ))
-                    })?
-                    .k
-                    .cast::<f64>(),
-            ),
+        let (k, kd) = match e.kind {
+            EstimatorKind::Off => (None, RowVector2::zeros()),
+            EstimatorKind::Kalman => {
+                let b = board_gain(e, c.rate_hz, axis).ok_or_else(|| {
+                    CheckError::Invalid(format!("the estimator has no steady state on axis {axis}"))
+                })?;
+                (
+                    Some(b.k.cast::<f64>()),
+                    RowVector2::new(f64::from(b.kd[0]), f64::from(b.kd[1])),
+                )
+            }
         };
-        Ok(Loop { t, gain, k })
+        Ok(Loop { t, gain, k, kd })
+    }
+
+    /// The law's input u = −G ŝ on the estimate (the estimator on) or on `s` (off).
+    pub(super) fn input(&self, s: &Vector2<f64>, est: &LoopEstimate) -> f64 {
+        let gr = RowVector2::new(self.gain[0], self.gain[1]);
+        let on = if self.k.is_some() { est.x } else { *s };
+        -(gr * on)[0]
+    }
+
+    /// One period of the board's estimator (module docs): from `est` with the input `u`
+    /// applied, corrected on the measured `z` (the error s⁺, plus the navigation's error).
+    pub(super) fn estimate_step(
+        &self,
+        est: &LoopEstimate,
+        u: f64,
+        z: &Vector2<f64>,
+    ) -> LoopEstimate {
+        let Some(k) = self.k else {
+            return *est;
+        };
+        let prior = self.f() * est.x + self.g() * (u + est.d);
+        let innovation = z - prior;
+        LoopEstimate {
+            x: prior + k * innovation,
+            d: est.d + (self.kd * innovation)[0],
+        }
     }
 
     pub(super) fn f(&self) -> Matrix2<f64> {
@@ -282,27 +320,21 @@ impl Loop {
     /// the position error e; `None` when the loop is unstable.
     fn lag_gain(&self) -> Option<f64> {
         let (f, g) = (self.f(), self.g());
-        let gr = nalgebra::RowVector2::new(self.gain[0], self.gain[1]);
         let mut s = g;
-        let mut xh = match self.k {
-            Some(k) => k * g,
-            None => Vector2::zeros(),
-        };
+        // The period of the impulse: the estimate, from zero, corrected on it.
+        let mut est = self.estimate_step(&LoopEstimate::default(), 0.0, &s);
         let mut sum = 0.0;
         for n in 0..MAX_IMPULSE_PERIODS {
             sum += s[0].abs();
-            let est = if self.k.is_some() { xh } else { s };
-            let u = -(gr * est)[0];
+            let u = self.input(&s, &est);
             let s_next = f * s + g * u;
-            if let Some(k) = self.k {
-                xh = (Matrix2::identity() - k) * (f * xh + g * u) + k * s_next;
-            }
+            est = self.estimate_step(&est, u, &s_next);
             s = s_next;
             if !s.iter().all(|x| x.is_finite()) {
                 return None;
             }
-            if n > 100 && s.amax() < 1e-15 * sum.max(1e-300) && xh.amax() < 1e-15 * sum.max(1e-300)
-            {
+            let small = 1e-15 * sum.max(1e-300);
+            if n > 100 && s.amax() < small && est.x.amax() < small && est.d.abs() < small {
                 return Some(sum);
             }
         }
@@ -332,17 +364,20 @@ impl PlantCache {
 
 /// Axis `axis`'s steady-state gain of the board's own estimator (`EstimatorGains`, the one
 /// `controller_core` flies: with the disturbance state of Choice 510 when `disturbance_time` is
-/// above 0). The loops here take its rows of η and η̇; the disturbance estimate's own path (its
-/// row `kd`, which integrates the innovations) is not modelled (Choice 505).
+/// above 0). The loops here take all its rows: η and η̇ (Choice 505) and the disturbance
+/// estimate's `kd`, which integrates the innovations (Choice 512).
 pub(super) fn board_gain(e: &EstimatorConfig, rate_hz: u32, axis: usize) -> Option<AxisGain> {
     EstimatorGains::new(e, rate_hz)
         .ok()
         .and_then(|g| g.axes.get(axis).copied())
 }
 
-/// The state of the noise propagation: [s₀, s₁, x̂₀, x̂₁, f, h, b_v, b_a, b_p] (module docs:
-/// f the held fix error and its drift, h the held ping error and its drift).
-pub(super) const N: usize = 9;
+/// The state of the noise propagation: [s₀, s₁, x̂₀, x̂₁, f, h, b_v, b_a, b_p, d̂] (module
+/// docs: f the held fix error and its drift, h the held ping error and its drift, d̂ the
+/// estimator's disturbance estimate).
+pub(super) const N: usize = 10;
+/// d̂'s index in the noise propagation's state.
+pub(super) const D_HAT: usize = 9;
 pub(super) type Cov = SMatrix<f64, N, N>;
 
 /// One period's maps of the noise propagation (module docs): the loop's step, the noise's
@@ -389,31 +424,42 @@ pub(super) fn period_maps(lp: &Loop, noise: &AxisNoise) -> PeriodMaps {
     drift[(4, 5)] = t;
     drift[(4, 6)] = t;
     drift[(5, 7)] = t;
-    // The estimator's correction with the new noise: x̂⁺ = (I−K)(F−gG)x̂ + K(s + m).
+    // The estimator's correction with the new noise (module docs): the prior
+    // x̂⁻ = (F−gG)x̂ + g d̂, the innovation ν = s + m − x̂⁻, x̂⁺ = x̂⁻ + Kν, d̂⁺ = d̂ + kd·ν.
     let correct = lp.k.map(|k| {
+        // ν as a map on the state: s + m − (F−gG)x̂ − g d̂, with m = [f + b_p, h + b_v].
+        let mut nu = SMatrix::<f64, 2, N>::zeros();
+        nu.fixed_view_mut::<2, 2>(0, 0)
+            .copy_from(&Matrix2::identity());
+        nu.fixed_view_mut::<2, 2>(0, 2).copy_from(&(-(f - ggr)));
+        nu[(0, 4)] = 1.0;
+        nu[(0, 8)] = 1.0;
+        nu[(1, 5)] = 1.0;
+        nu[(1, 6)] = 1.0;
+        nu.fixed_view_mut::<2, 1>(0, D_HAT).copy_from(&(-g));
+        let mut prior = SMatrix::<f64, 2, N>::zeros();
+        prior.fixed_view_mut::<2, 2>(0, 2).copy_from(&(f - ggr));
+        prior.fixed_view_mut::<2, 1>(0, D_HAT).copy_from(&g);
         let mut c = Cov::identity();
-        let a = (Matrix2::identity() - k) * (f - ggr);
-        c.fixed_view_mut::<2, 2>(2, 2).copy_from(&a);
-        c.fixed_view_mut::<2, 2>(2, 0).copy_from(&k);
-        // m = [f + b_p, h + b_v].
-        for r in 0..2 {
-            c[(2 + r, 4)] = k[(r, 0)];
-            c[(2 + r, 8)] = k[(r, 0)];
-            c[(2 + r, 5)] = k[(r, 1)];
-            c[(2 + r, 6)] = k[(r, 1)];
+        c.fixed_view_mut::<2, N>(2, 0).copy_from(&(prior + k * nu));
+        let d_row = lp.kd * nu;
+        for j in 0..N {
+            c[(D_HAT, j)] += d_row[j];
         }
         c
     });
     let white = Matrix2::new(noise.white[0].powi(2), 0.0, 0.0, noise.white[1].powi(2));
-    // White measurement noise enters through −gG (off) or K (estimator).
-    let mut q_white = Cov::zeros();
-    let wb = match lp.k {
-        Some(k) => (2, k),
-        None => (0, -ggr),
-    };
-    q_white
-        .fixed_view_mut::<2, 2>(wb.0, wb.0)
-        .copy_from(&(wb.1 * white * wb.1.transpose()));
+    // White measurement noise enters through −gG on s (off), or K on x̂ and kd on d̂
+    // (the estimator).
+    let mut wb = SMatrix::<f64, N, 2>::zeros();
+    match lp.k {
+        Some(k) => {
+            wb.fixed_view_mut::<2, 2>(2, 0).copy_from(&k);
+            wb.fixed_view_mut::<1, 2>(D_HAT, 0).copy_from(&lp.kd);
+        }
+        None => wb.fixed_view_mut::<2, 2>(0, 0).copy_from(&(-ggr)),
+    }
+    let q_white = wb * white * wb.transpose();
     PeriodMaps {
         loop_step,
         drift,
@@ -660,7 +706,6 @@ impl<'a> Budget<'a> {
     fn lag_response(&self, i: usize, d: &[[f64; AXES]], k: f64, duration: f64) -> f64 {
         let lp = &self.loops[i];
         let (f, g) = (lp.f(), lp.g());
-        let gr = nalgebra::RowVector2::new(lp.gain[0], lp.gain[1]);
         let span_samples = d.len().saturating_sub(1).max(1) as f64 * SAMPLE_PERIOD;
         let at = |t: f64| -> f64 {
             let mut s = t / k;
@@ -674,15 +719,12 @@ impl<'a> Budget<'a> {
             d[j][i] * (1.0 - w) + d[j1][i] * w
         };
         let steps = (duration.min(MAX_PROPAGATION) / lp.t).ceil() as u64;
-        let (mut s, mut xh) = (Vector2::zeros(), Vector2::zeros());
+        let (mut s, mut est) = (Vector2::zeros(), LoopEstimate::default());
         let mut worst = 0.0f64;
         for n in 0..steps {
-            let est = if lp.k.is_some() { xh } else { s };
-            let u = -(gr * est)[0];
+            let u = lp.input(&s, &est);
             let s_next = f * s + g * (u + at(n as f64 * lp.t));
-            if let Some(kk) = lp.k {
-                xh = (Matrix2::identity() - kk) * (f * xh + g * u) + kk * s_next;
-            }
+            est = lp.estimate_step(&est, u, &s_next);
             s = s_next;
             worst = worst.max(s[0].abs());
         }
@@ -1061,5 +1103,45 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// The board's estimator with its disturbance state (Choice 510) is unbiased under a
+    /// steady unexplained acceleration d: d̂ → d, and the loop settles where the law's input on
+    /// the true error cancels it, u = −G s = −d with ė = 0, so e = d/G₁ (closed form). The
+    /// loop's model must carry d̂'s integration (Choice 512) to show it: with the rows of η and
+    /// η̇ alone the estimate lags d and the error settles elsewhere (regression: it did).
+    #[test]
+    fn a_steady_disturbance_settles_at_the_closed_form_error() {
+        let e = crate::scenario::navigation::real_chain_estimator();
+        let b = board_gain(&e, 100, 0).expect("the real chain's estimator has a gain");
+        assert!(
+            b.kd.iter().any(|&x| x != 0.0),
+            "the disturbance state is on"
+        );
+        let c = controller_core::ControllerConfig::default();
+        let gain = [f64::from(c.k1[0]), f64::from(c.k2[0])];
+        let lp = Loop {
+            t: 0.01,
+            gain,
+            k: Some(b.k.cast::<f64>()),
+            kd: RowVector2::new(f64::from(b.kd[0]), f64::from(b.kd[1])),
+        };
+        let d = 0.05;
+        let (mut s, mut est) = (Vector2::zeros(), LoopEstimate::default());
+        // 20 min: d̂'s own time constant is tens of seconds at σₐ 0.004, τ_d 60 s.
+        for _ in 0..120_000 {
+            let u = lp.input(&s, &est);
+            let s_next = lp.f() * s + lp.g() * (u + d);
+            est = lp.estimate_step(&est, u, &s_next);
+            s = s_next;
+        }
+        let want = d / gain[0];
+        assert!(
+            (s[0] - want).abs() < 1e-6 * want,
+            "e {} vs d/G₁ {want}",
+            s[0]
+        );
+        assert!(s[1].abs() < 1e-9, "ė {}", s[1]);
+        assert!((est.d - d).abs() < 1e-6 * d, "d̂ {} vs d {d}", est.d);
     }
 }
