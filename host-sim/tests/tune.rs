@@ -6,7 +6,7 @@ use host_sim::scenario::real_vehicle;
 use host_sim::studies::tune::nsga2::{
     crowding_distance, dominates, non_dominated_sort, survivors, Scored,
 };
-use host_sim::studies::tune::{self, admissible, Gains, Refusal, Spec};
+use host_sim::studies::tune::{self, admissible, Candidate, Gains, Refusal, Scores, Spec};
 use rand::rngs::ChaCha8Rng;
 use rand::{RngExt, SeedableRng};
 
@@ -197,10 +197,23 @@ fn tiny() -> Spec {
     }
 }
 
+/// Deb's constrained domination written out from the scores (not the library's `dominates`):
+/// fewer missions refused or failed wins; as many, `a` is no worse on every p95 and better on
+/// one.
+fn beats(a: &Scores, b: &Scores) -> bool {
+    let (va, vb) = (a.refused + a.failed, b.refused + b.failed);
+    if va != vb {
+        return va < vb;
+    }
+    let pairs = a.p95.iter().zip(&b.p95);
+    pairs.clone().all(|(x, y)| x <= y) && pairs.clone().any(|(x, y)| x < y)
+}
+
 #[test]
 fn a_study_is_deterministic_and_shards_merge_to_one_run() {
     let spec = tiny();
-    let one = tune::merge(&[tune::run_shard(&spec, 0, 1, &|| ()).unwrap()]).unwrap();
+    let whole = tune::run_shard(&spec, 0, 1, &|| ()).unwrap();
+    let one = tune::merge(std::slice::from_ref(&whole)).unwrap();
     let a = tune::run_shard(&spec, 0, 2, &|| ()).unwrap();
     let b = tune::run_shard(&spec, 1, 2, &|| ()).unwrap();
     let merged = tune::merge(&[b, a]).unwrap();
@@ -211,10 +224,23 @@ fn a_study_is_deterministic_and_shards_merge_to_one_run() {
     assert_eq!(one.evaluations, merged.evaluations);
     assert_eq!(one.evaluations, 2 * spec.evaluations_per_restart());
     assert!(one.missing.is_empty());
-    // Each restart's first member is the shipped gains; nothing on the front is dominated by
-    // them.
-    let shipped = one.shipped.scores.scored();
+    // The front against every candidate the study flew, by brute force: each member was
+    // flown with the scores it reports, no flown candidate beats it, and every flown candidate
+    // that nothing flown beats is on it.
+    let flown: Vec<&Candidate> = whole.restarts.iter().flat_map(|r| &r.evaluated).collect();
+    assert_eq!(flown.len(), one.evaluations);
+    assert!(flown.iter().any(|c| c.x == one.shipped.x));
     for c in &one.front {
-        assert!(!dominates(&shipped, &c.scores.scored()));
+        assert!(flown.iter().any(|f| f.x == c.x && f.scores == c.scores));
+        assert!(
+            !flown.iter().any(|f| beats(&f.scores, &c.scores)),
+            "{:?}",
+            c.gains
+        );
+    }
+    for f in &flown {
+        let beaten = flown.iter().any(|g| beats(&g.scores, &f.scores));
+        let on_front = one.front.iter().any(|c| c.x == f.x);
+        assert_eq!(on_front, !beaten, "{:?}: {:?}", f.gains, f.scores);
     }
 }

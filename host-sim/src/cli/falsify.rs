@@ -3,7 +3,8 @@
 //!
 //! ```text
 //! host-sim falsify [--budget B] [--restarts R] [--seed S] [--margin M] [--duration D]
-//!                  [--reach contract|realities] [--navigation PRESET] [--shard I/N] [--json]
+//!                  [--reach contract|realities] [--navigation PRESET] [--refused graded|flat]
+//!                  [--shard I/N] [--json]
 //!                  --out DIR
 //! host-sim falsify --merge DIR… --out DIR
 //! ```
@@ -27,7 +28,7 @@ use crate::output::{atomic, OutputDir};
 use crate::scenario::file::ScenarioFile;
 use crate::scenario::navigation::Preset;
 use crate::sim::progress::{Progress, Unit};
-use crate::studies::falsify::{self, Restart, ShardResult, Spec};
+use crate::studies::falsify::{self, Refused, Restart, ShardResult, Spec};
 use crate::studies::mission_space::Reach;
 use crate::studies::preflight::DEFAULT_MARGIN;
 
@@ -55,6 +56,11 @@ pub struct FalsifyArgs {
     /// low-cost); default: the contract's exact state, or a drawn preset for the realities.
     #[arg(long, value_parser = super::validate::parse_preset)]
     pub navigation: Option<Preset>,
+    /// What a candidate the preflight refuses scores for the search: graded (how far its check
+    /// is from feasible, above every flown robustness) or flat (+∞, the search learns nothing
+    /// from it).
+    #[arg(long, value_enum, default_value_t = Refused::Graded)]
+    pub refused: Refused,
     #[command(flatten)]
     pub shards: RestartShards,
     #[arg(long)]
@@ -133,6 +139,7 @@ fn search(args: &FalsifyArgs) -> Result<ShardResult> {
         budget: args.budget,
         restarts: args.restarts,
         navigation: args.navigation,
+        refused: args.refused,
     };
     let mine = crate::studies::campaign::Shard {
         runs: args.restarts,

@@ -12,7 +12,7 @@
 //! host-sim monte-carlo --runs N --seed S [--scenario FILE] [--current V] [--json] [--out DIR]
 //! host-sim check --scenario FILE.toml [--margin 0.8] [--json]
 //! host-sim validate-preflight [--mountings team|all] [--random N] [--seed S] [--margin 0.8] [--json] [--out DIR] [--allow-long-run]
-//! host-sim falsify [--budget B] [--restarts R] [--seed S] [--margin M] [--duration D] [--reach contract|realities] [--shard I/N] --out DIR | --merge DIR… --out DIR
+//! host-sim falsify [--budget B] [--restarts R] [--seed S] [--margin M] [--duration D] [--reach contract|realities] [--navigation PRESET] [--refused graded|flat] [--shard I/N] --out DIR | --merge DIR… --out DIR
 //! host-sim tune [--missions M] [--duration D] [--population P] [--generations G] [--restarts R] [--seed S] [--shard I/N] --out DIR | --merge DIR… --out DIR
 //! host-sim campaign plan FILE [--workers N] | run FILE [--shard I/N] --out DIR | merge DIR… --out DIR
 //! host-sim import-plan FILE.plan [--speed 0.5] [--name NAME]    # the scenario TOML on stdout

@@ -40,6 +40,7 @@ pub fn search_spec(preset: Preset) -> Spec {
         budget: SEARCH_BUDGET,
         restarts: 1,
         navigation: Some(preset),
+        refused: falsify::Refused::Graded,
     }
 }
 

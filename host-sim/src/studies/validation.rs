@@ -354,6 +354,18 @@ pub fn check_and_fly(
     base: &Scenario,
     margin: f64,
 ) -> Result<Option<(MissionResult, Option<Flown>)>, CheckFlyError> {
+    Ok(check_and_fly_report(base, margin)?.map(|(_, result, flown)| (result, flown)))
+}
+
+/// [`check_and_fly`], with the check's own report (what a refused mission missed by: the
+/// falsifier's graded score, docs/search.md#refused-candidates).
+///
+/// # Errors
+/// As [`check_and_fly`].
+pub fn check_and_fly_report(
+    base: &Scenario,
+    margin: f64,
+) -> Result<Option<(preflight::Preflight, MissionResult, Option<Flown>)>, CheckFlyError> {
     let p = match preflight::check_as_written(base, margin) {
         Ok(p) => p,
         Err(CheckError::Interrupted) => return Ok(None),
@@ -386,7 +398,7 @@ pub fn check_and_fly(
         sampled: false,
     };
     let Some(k) = proposed else {
-        return Ok(Some((out, None)));
+        return Ok(Some((p, out, None)));
     };
     let scenario = at_scale(base, k).map_err(|error| CheckFlyError::AtScale { scale: k, error })?;
     let (within, metrics) = flies(&scenario);
@@ -396,6 +408,7 @@ pub fn check_and_fly(
         Some(within),
     );
     Ok(Some((
+        p,
         out,
         Some(Flown {
             scenario,

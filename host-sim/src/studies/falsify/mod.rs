@@ -5,7 +5,9 @@
 //! of how far the flight stayed inside each limit normalised by that limit
 //! ([`bound::robustness`], Choice 412). Negative: the preflight called the mission feasible at
 //! a scale at which it missed — **false feasible**. A candidate the preflight refuses (no
-//! scale proposed) or the core does not accept does not count (it cannot be false feasible).
+//! scale proposed) or the core does not accept does not count (it cannot be false feasible);
+//! a refused one scores, for the search, how far its check is from feasible ([`refusal`],
+//! Choice 551), above every flown robustness.
 //!
 //! Two searches at the same budget of evaluations, each in restarts (one restart per shard
 //! index, Choice 414): the cross-entropy method ([`cross_entropy`], Choice 413) and uniform
@@ -24,6 +26,28 @@ use crate::scenario::{real_vehicle, Bound, Scenario, ScenarioError};
 use crate::sim::bound;
 
 pub mod cross_entropy;
+pub mod refusal;
+
+/// What a candidate the preflight refuses scores for the search (**Choice 551**,
+/// docs/search.md#refused-candidates).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize, clap::ValueEnum)]
+#[serde(rename_all = "kebab-case")]
+pub enum Refused {
+    /// [`refusal::REFUSED_BASE`] plus how far its check is from feasible
+    /// ([`refusal::excess`]): the search is pulled towards the feasibility boundary.
+    #[default]
+    Graded,
+    /// +∞: never an elite, the search learns nothing from it (what a shard written without
+    /// this field did; the tests' comparison).
+    Flat,
+}
+
+impl Refused {
+    /// A shard written without the field scored refusals +∞.
+    fn unrecorded() -> Self {
+        Refused::Flat
+    }
+}
 
 /// What every candidate of a search shares.
 #[derive(Clone, Debug)]
@@ -38,6 +62,8 @@ pub struct Setup {
     /// Every candidate told its state through this preset (`None`: as the reach has it — the
     /// exact state for the contract's, a drawn preset for the realities).
     pub navigation: Option<Preset>,
+    /// What a refused candidate scores.
+    pub refused: Refused,
 }
 
 impl Setup {
@@ -50,7 +76,13 @@ impl Setup {
             margin,
             duration,
             navigation: None,
+            refused: Refused::default(),
         })
+    }
+
+    /// The same candidates, a refused one scored as `refused` says.
+    pub fn with_refused(self, refused: Refused) -> Self {
+        Setup { refused, ..self }
     }
 
     /// The same candidates, each told its state through `preset` (Choice 470): the realities'
@@ -118,6 +150,10 @@ pub struct Evaluation {
     pub terms: Option<[f64; 4]>,
     /// Completed outside the real vehicle's bound at the proposed scale.
     pub falsified: bool,
+    /// Refused by the preflight and scored graded: how far its check is from feasible
+    /// ([`refusal::Excess::distance`]).
+    #[serde(default)]
+    pub refusal: Option<f64>,
 }
 
 impl Evaluation {
@@ -135,9 +171,14 @@ impl Evaluation {
         robustness.is_sign_negative()
     }
 
-    /// What a minimiser sees: the robustness, +∞ when it does not count.
+    /// What a minimiser sees: the robustness; for a refused candidate scored graded,
+    /// [`refusal::REFUSED_BASE`] plus its distance from feasible; +∞ otherwise.
     pub fn score(&self) -> f64 {
-        self.robustness().unwrap_or(f64::INFINITY)
+        match (self.robustness(), self.refusal) {
+            (Some(r), _) => r,
+            (None, Some(d)) => refusal::REFUSED_BASE + d,
+            (None, None) => f64::INFINITY,
+        }
     }
 }
 
@@ -149,13 +190,14 @@ pub fn evaluate(setup: &Setup, x: &[f64]) -> Result<Evaluation, String> {
         proposed: None,
         terms: None,
         falsified: false,
+        refusal: None,
     };
     let mission = match setup.mission(x, "candidate") {
         Ok(m) => m,
         Err(ScenarioError::Invalid { .. }) => return Ok(not_counted),
         Err(e) => return Err(e.to_string()),
     };
-    let (result, flown) = match validation::check_and_fly(&mission, setup.margin) {
+    let (check, result, flown) = match validation::check_and_fly_report(&mission, setup.margin) {
         Ok(Some(r)) => r,
         Ok(None) => return Err("interrupted".to_string()),
         // The core refuses the proposed scale: nothing flies, nothing counts.
@@ -163,6 +205,14 @@ pub fn evaluate(setup: &Setup, x: &[f64]) -> Result<Evaluation, String> {
         Err(e) => return Err(e.to_string()),
     };
     Ok(match flown {
+        None if setup.refused == Refused::Graded => Evaluation {
+            refusal: Some(
+                refusal::excess(&mission, &check)
+                    .map_err(|e| e.to_string())?
+                    .distance(),
+            ),
+            ..not_counted
+        },
         None => not_counted,
         Some(f) => Evaluation {
             proposed: result.proposed,
@@ -254,13 +304,11 @@ fn evaluate_batch(
         if e.falsified && restart.first_falsified.is_none() {
             restart.first_falsified = Some(restart.trace.len());
         }
-        let s = e.score();
-        scores.push(s);
-        if s < restart
-            .worst
-            .as_ref()
-            .map_or(f64::INFINITY, Evaluation::score)
-        {
+        scores.push(e.score());
+        // The worst is of the candidates that count (a refused one's score is not a
+        // robustness).
+        let least = restart.min_robustness().unwrap_or(f64::INFINITY);
+        if e.robustness().is_some_and(|r| r < least) {
             restart.worst = Some(e);
         }
     }
@@ -334,12 +382,17 @@ pub struct Spec {
     /// The navigation preset every candidate is told its state through ([`Setup::navigation`]).
     #[serde(default)]
     pub navigation: Option<Preset>,
+    /// What a refused candidate scores ([`Setup::refused`]).
+    #[serde(default = "Refused::unrecorded")]
+    pub refused: Refused,
 }
 
 impl Spec {
     /// Its candidates' setup.
     pub fn setup(&self) -> Result<Setup, ScenarioError> {
-        Ok(Setup::new(self.reach, self.margin, self.duration)?.with_navigation(self.navigation))
+        Ok(Setup::new(self.reach, self.margin, self.duration)?
+            .with_navigation(self.navigation)
+            .with_refused(self.refused))
     }
 }
 

@@ -329,11 +329,15 @@ pub struct Candidate {
     pub scores: Scores,
 }
 
-/// One NSGA-II restart: its last population.
+/// One NSGA-II restart: its last population, and every candidate it flew.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Restart {
     pub index: u64,
     pub population: Vec<Candidate>,
+    /// Every candidate flown, in order (the first population, then each generation's
+    /// children): what the front is checked against (tests/tune.rs).
+    #[serde(default)]
+    pub evaluated: Vec<Candidate>,
     /// Candidates evaluated (flown over the sample).
     pub evaluations: usize,
     /// Candidates the constraint filter refused (drawn again, never flown).
@@ -413,6 +417,7 @@ pub fn run_restart(
     let mut restart = Restart {
         index,
         population: Vec::new(),
+        evaluated: Vec::new(),
         evaluations: 0,
         refused_by_law: 0,
         partial: false,
@@ -426,6 +431,7 @@ pub fn run_restart(
         Err(e) => return Err(e),
     }
     restart.evaluations = restart.population.len();
+    restart.evaluated.clone_from(&restart.population);
     for _ in 0..spec.generations {
         if crate::interrupt::requested() {
             restart.partial = true;
@@ -458,6 +464,7 @@ pub fn run_restart(
             Err(e) => return Err(e),
         };
         restart.evaluations += children.len();
+        restart.evaluated.extend(children.iter().cloned());
         let mut all = std::mem::take(&mut restart.population);
         all.extend(children);
         let scored: Vec<nsga2::Scored> = all.iter().map(|c| c.scores.scored()).collect();
