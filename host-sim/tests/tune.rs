@@ -140,14 +140,12 @@ fn quantile_is_the_nearest_rank() {
 fn the_constraint_filter_takes_the_laws_conditions() {
     let base = real_vehicle::real_scenarios().unwrap().swap_remove(0);
     let shipped = Gains::of(&base.config().controller);
-    // The shipped (paper's) gains: K = 4, μ = 0.1, δ_max = 25.
-    assert_eq!(
-        shipped.0,
-        [4.0, 4.0, 4.0, 4.0, 4.0, 4.0, 0.1f32 as f64, 25.0, 1.0]
-    );
+    // The shipped gains: the paper's K = 4 and δ_max = 25, the real chain's μ (Choice 507).
+    let mu = f64::from(host_sim::scenario::navigation::REAL_CHAIN_MU);
+    assert_eq!(shipped.0, [4.0, 4.0, 4.0, 4.0, 4.0, 4.0, mu, 25.0, 1.0]);
     // Eq 40 at δ_max with Q = I: √(μ δ_max / 2).
     let limit = tune::ball_at_delta_max(&base.config().controller);
-    assert!((limit - (0.1f32 as f64 * 25.0 / 2.0).sqrt()).abs() < 1e-9);
+    assert!((limit - (mu * 25.0 / 2.0).sqrt()).abs() < 1e-9);
     assert!(admissible(&base, &shipped, limit).is_ok());
 
     // Theorem 4's ball: μ = 0.4, δ_max = 25 → √5 > √1.25.

@@ -14,7 +14,7 @@ use controller_core::effectiveness::THRUSTER_NAMES;
 use super::file::{
     spelled, AttitudeName, BBoundName, ControllerTable, CurrentName, CurrentTable, Delta,
     EstimatorName, HeadingName, LawName, LinkFaultsTable, ProfileName, ScenarioFile,
-    ThrustUnitName, VariationTable,
+    ThrustUnitName, TrajectoryTable, VariationTable,
 };
 use super::paper;
 use super::validate::invalid;
@@ -67,21 +67,28 @@ fn required<T: Copy>(key: &str, value: Option<T>, what: &str) -> Res<T> {
     value.ok_or_else(|| invalid(key, format!("required with {what}")))
 }
 
-/// The configuration a file describes; a file without `name` is called `default_name`.
-pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
-    let name = raw.name.unwrap_or_else(|| default_name.to_string());
-    let mut config = SimConfig::new(name, raw.trajectory.path);
-    if let Some(h) = raw.trajectory.heading {
+/// The configuration of a file's `[trajectory]` table: its path, heading, origin, speed limits
+/// and time scale.
+fn trajectory(raw: TrajectoryTable, name: String) -> Res<SimConfig> {
+    let mut config = SimConfig::new(name, raw.path);
+    if let Some(h) = raw.heading {
         config.heading = match h {
             HeadingName::Paper => HeadingMode::Paper,
             HeadingName::Tangent => HeadingMode::Tangent,
         };
     }
-    config.origin = raw.trajectory.origin;
-    config.speed_limits = raw.trajectory.speed_limits;
-    if let Some(k) = raw.trajectory.time_scale {
+    config.origin = raw.origin;
+    config.speed_limits = raw.speed_limits;
+    if let Some(k) = raw.time_scale {
         config.time_scale = to_f32("trajectory.time_scale", k)?;
     }
+    Ok(config)
+}
+
+/// The configuration a file describes; a file without `name` is called `default_name`.
+pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
+    let name = raw.name.unwrap_or_else(|| default_name.to_string());
+    let mut config = trajectory(raw.trajectory, name)?;
     if let Some(case) = raw.table1_case {
         config.case = Some(Table1Case::from_name(&case).ok_or_else(|| {
             let names: Vec<&str> = Table1Case::ALL.iter().map(|c| c.name()).collect();

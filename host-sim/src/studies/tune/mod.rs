@@ -575,9 +575,20 @@ pub fn merge(shards: &[ShardResult]) -> Result<Study, MergeError> {
             .filter(|r| r.partial)
             .map(|r| format!("restart {} (interrupted)", r.index)),
     );
+    // The front is over every candidate a restart flew, not only its last population: NSGA-II's
+    // crowding truncation drops non-dominated candidates when the first front outgrows the
+    // population, and a dropped one is still a point the study measured (tests/tune.rs checks
+    // the front against every flown candidate by brute force). A shard file written before
+    // `evaluated` existed gives its population.
     let all: Vec<Candidate> = restarts
         .iter()
-        .flat_map(|r| r.population.iter().cloned())
+        .flat_map(|r| {
+            if r.evaluated.is_empty() {
+                r.population.iter().cloned()
+            } else {
+                r.evaluated.iter().cloned()
+            }
+        })
         .collect();
     let scored: Vec<nsga2::Scored> = all.iter().map(|c| c.scores.scored()).collect();
     let first_front = nsga2::non_dominated_sort(&scored)
