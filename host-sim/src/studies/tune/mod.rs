@@ -22,9 +22,9 @@
 //!   scale (a refused mission counts as [`Trajectory::MAX_TIME_SCALE`]); each as p95 (nearest
 //!   rank) and worst. The search minimises the five p95s; a refused mission and a flight with
 //!   a metric not a number are constraint violations (Deb's rule: fewer first).
-//! - The search ([`nsga2`], Choice 441) in restarts, the shards' unit (**Choice 445**): restart
+//! - The search ([`nsga2`], Choice 441) in restarts, the shards' unit (**Choice 496**): restart
 //!   r is its own stream of the seed, its first member the shipped gains; the merge takes the
-//!   non-dominated set of every restart's last population.
+//!   non-dominated set of every candidate the restarts flew (Choice 496).
 //! - The chosen point ([`choose`], **Choice 446**): of the feasible front, the one whose worst
 //!   ratio to the shipped gains' score over the five objectives is least.
 
@@ -178,15 +178,15 @@ impl Spec {
     }
 }
 
-/// The main job's study (**Choice 447**, docs/tune.md#in-the-main-job): small and fixed-seed,
-/// its cost bounded (measured in docs/tune.md).
+/// The main job's study (**Choices 447 and 495**, docs/tune.md#in-the-main-job): small and
+/// fixed-seed, its cost bounded (measured in docs/tune.md): 12 evaluations of 6 missions.
 pub const MAIN_JOB_TUNE: Spec = Spec {
     seed: 1,
-    missions: 6,
+    missions: 3,
     duration: 20.0,
     margin: crate::studies::preflight::DEFAULT_MARGIN,
-    population: 12,
-    generations: 6,
+    population: 6,
+    generations: 1,
     restarts: 1,
 };
 
@@ -527,7 +527,7 @@ pub fn run_shard(
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct Study {
     pub spec: Spec,
-    /// The non-dominated candidates of every restart's last population, by their first
+    /// The non-dominated candidates of every candidate the restarts flew, by their first
     /// objective (ties by the coordinates).
     pub front: Vec<Candidate>,
     pub shipped: Candidate,
@@ -551,7 +551,7 @@ pub enum MergeError {
     Twice(u64),
 }
 
-/// The shards as one study (Choice 445).
+/// The shards as one study (Choice 496).
 pub fn merge(shards: &[ShardResult]) -> Result<Study, MergeError> {
     let first = shards.first().ok_or(MergeError::Empty)?;
     let spec = first.spec.clone();
