@@ -140,8 +140,8 @@ fn quantile_is_the_nearest_rank() {
 fn the_constraint_filter_takes_the_laws_conditions() {
     let base = real_vehicle::real_scenarios().unwrap().swap_remove(0);
     let shipped = Gains::of(&base.config().controller);
-    // The shipped gains: the paper's K = 4 and δ_max = 25, the real chain's μ (Choice 507).
-    let mu = f64::from(host_sim::scenario::navigation::REAL_CHAIN_MU);
+    // The shipped (paper's) gains: K = 4, μ = 0.1, δ_max = 25 (Choice 497: the link carries no μ).
+    let mu = 0.1f32 as f64;
     assert_eq!(shipped.0, [4.0, 4.0, 4.0, 4.0, 4.0, 4.0, mu, 25.0, 1.0]);
     // Eq 40 at δ_max with Q = I: √(μ δ_max / 2).
     let limit = tune::ball_at_delta_max(&base.config().controller);

@@ -419,13 +419,6 @@ pub fn real_chain_estimator() -> controller_core::EstimatorConfig {
 /// noise. Measured on the `real-circle` campaign: σₐ 0.003 on x y z (Choice 511) reversed the
 /// vertical pair over 2 /s on a payload whose mean command sits in the ±0.5 V band.
 const REAL_CHAIN_ACCEL_SIGMA: [(usize, f32); 4] = [(0, 0.004), (1, 0.004), (2, 0.001), (5, 0.002)];
-/// The boundary layer μ of the law a real-chain scenario flies when its `[controller]` does not
-/// say `mu` (**Choice 507**, docs/law.md#the-state-estimator): 0.15, the paper's 0.1 on the
-/// ideal actuators (Table 1 bit for bit). Inside the layer the robust term's gain on w is δ/μ:
-/// the wider layer passes a third less of the estimate's noise to the thrusters for a few
-/// millimetres of path under a current (the `real-circle` campaign: 99.13 % → 99.37 % within
-/// bound over its first 3 000 runs).
-pub const REAL_CHAIN_MU: f32 = 0.15;
 /// The survey preset's LBL fix σ per horizontal axis (m, Choice 371).
 const SURVEY_FIX_SIGMA: f64 = 0.01;
 /// The survey preset's DVL single-ping σ (m/s, Choice 331).

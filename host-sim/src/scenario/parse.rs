@@ -99,7 +99,6 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
         })?);
     }
     let est_keys = raw.controller.as_ref().map_or([false; 4], estimator_keys);
-    let mu_given = raw.controller.as_ref().is_some_and(|c| c.mu.is_some());
     if let Some(raw) = raw.controller {
         config.controller = build_controller(&raw)?;
     }
@@ -149,10 +148,6 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
         });
     }
     navigation_and_filter(&mut config, raw.navigation.as_ref(), est_keys)?;
-    if !mu_given && !config.ideal_actuators {
-        // The real chain's boundary layer (Choice 507); the ideal actuators keep the paper's.
-        config.controller.mu = super::navigation::REAL_CHAIN_MU;
-    }
     if let Some(raw) = raw.link_faults {
         config.link_faults = build_link_faults(&raw)?;
     }
