@@ -438,18 +438,19 @@ pub fn actuate_within(
 
 /// Whether the thrust [`actuate`] reports for a thruster of map `map`, saturation bit
 /// `saturated` and applied voltage `v` is the inverse map of that voltage to the bit
-/// ([`ThrusterMap::newtons_of_voltage`]): for a voltage other than 0 V (off reports 0 N, the
-/// map its fit's offset), always for the main thruster, for a tunnel only when clamped (it
-/// reports its envelope's bound, the map at the limit). An unclamped tunnel reports its command
-/// (Choice 526).
+/// ([`ThrusterMap::newtons_of_voltage`]) for a simulator to take: for a voltage other than 0 V
+/// (off reports 0 N, the map its fit's offset), on the main thruster only (Choice 498). An
+/// unclamped tunnel reports its command (Choice 526); a clamped one its envelope's bound, and
+/// a saturation mask that flags a tunnel (the law's `saturated`) does not say its voltage map
+/// clamped it, so a tunnel is never taken.
 ///
 /// A simulator that drives its thrusters with the law's report instead of evaluating the
 /// inverse map of the voltage again (host-sim's Choice 402) may do so only where this is true:
 /// a board in the loop is read by its voltages, and the same voltage must give the same thrust
 /// whether the law ran on the host or on the board (PIL = SIL, Choice 525).
 #[inline]
-pub fn reports_inverse_map(map: ThrusterMap, saturated: bool, v: f32) -> bool {
-    v != 0.0 && (map == ThrusterMap::Main || saturated)
+pub fn reports_inverse_map(map: ThrusterMap, _saturated: bool, v: f32) -> bool {
+    v != 0.0 && map == ThrusterMap::Main
 }
 
 /// How a command's voltage was limited.

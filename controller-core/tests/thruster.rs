@@ -627,3 +627,30 @@ fn an_unclamped_tunnel_voltage_gives_its_command_closer_than_the_round_trip() {
         "{command} vs {round_trip} ulps"
     );
 }
+
+/// Where [`reports_inverse_map`] says the report is the inverse map, it is the thrust a
+/// simulator evaluates from the voltage alone, `newtons_of_voltage` in the unit the law flies,
+/// to the bit, for commands that clamp every thruster at either limit, in newtons and in kgf
+/// (the property test above draws newtons only). The defect of Choice 498 (a tunnel the law's
+/// mask flagged, taken by SIL) is held by CI's PIL replay of the campaign's worst case.
+#[test]
+fn where_the_report_is_the_inverse_map_a_voltage_gives_it_in_every_unit() {
+    let maps = default_maps();
+    for unit in [ThrustUnit::Newton, ThrustUnit::Kgf] {
+        for cmd in [1e4f32, -1e4, 50.0, -50.0, 0.5] {
+            let a = actuate(&maps, unit, &[cmd; THRUSTERS], DEFAULT_V_LIMIT);
+            for (i, map) in maps.iter().enumerate() {
+                let v = a.voltages[i];
+                if reports_inverse_map(*map, a.is_saturated(i), v) {
+                    let want = map.newtons_of_voltage(unit, v);
+                    assert_eq!(
+                        a.thrusts[i].to_bits(),
+                        want.to_bits(),
+                        "{unit:?}, thruster {i}, command {cmd}: {} vs {want}",
+                        a.thrusts[i]
+                    );
+                }
+            }
+        }
+    }
+}

@@ -69,7 +69,7 @@ impl<'a> Thrusters<'a> {
             *t = match out.thrust {
                 // Choice 402: the law's maps are these maps in this unit; where the law reports
                 // the inverse map of the voltage (Choice 525: not at 0 V, the law's power-off
-                // 0 N, nor an unclamped tunnel's command, Choice 526) its thrust is
+                // 0 N, nor a tunnel's report, Choice 498) its thrust is
                 // newtons_of_voltage(v), the same f32 operations. Elsewhere, and from a board
                 // (read by its voltages alone), the map is evaluated here: PIL = SIL.
                 Some(law) if thruster::reports_inverse_map(self.maps[i], clamped, v) => law[i],
