@@ -6,9 +6,10 @@
 /// Highest loop rate (Hz) the board accepts.
 ///
 /// **Choice:** 200 Hz. One period must carry a telemetry frame out and a state frame in; the
-/// largest frame (`auv_link::MAX_FRAME` = 179 bytes, signed, protocol 6) takes 3.9 ms at the
-/// STM32 board's 460 800 baud ([`crate::serial::LINK_BAUD`]), so the link alone allows at most
-/// ≈ 257 Hz, and
+/// largest telemetry frame (179 bytes, signed) takes 3.9 ms at the STM32 board's 460 800 baud
+/// ([`crate::serial::LINK_BAUD`]), so the link alone allows at most ≈ 257 Hz, and the largest
+/// frame of all (`auv_link::MAX_FRAME` = 225 bytes, a whole signed `SetConfig`, protocol 8,
+/// sent disarmed) still fits a period at this rate (4.9 ms, tested below); and
 /// 200 Hz (5 ms) leaves room for the update and the state frame's own latency. The core's
 /// `update` costs ≈ 0.2 ms on the 168 MHz M4F (firmware/README.md). Before this limit the
 /// board accepted 4 294 967 295 Hz.

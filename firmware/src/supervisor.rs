@@ -561,7 +561,10 @@ impl Supervisor {
     /// so the core revalidates all of it (the envelope and the allocator's blocks are rebuilt
     /// by `Controller::rebuild`, which keeps the suprema over the parameter box computed
     /// at boot: Choice 225) before anything is applied. A rebuild is the period's long job
-    /// (Choice 226).
+    /// (Choice 226). The law's settings (protocol 8, Choice 508: K₁, K₂, Q, β, μ, the robust
+    /// law, the ‖b‖ bound, the pitch limit) go through the same rebuild: whatever the core
+    /// refuses (β below β̂, Theorem 2, the loop-rate rule, a gain that is not finite and > 0)
+    /// is [`Refusal::ControllerConfig`], and nothing changes.
     fn configure(&mut self, p: &ConfigPatch) -> Result<(), Refusal> {
         if self.armed {
             return Err(Refusal::WhileArmed);
@@ -593,6 +596,11 @@ impl Supervisor {
         }
         if let Some(e) = p.estimator {
             cfg.estimator = e.into();
+        }
+        // Protocol 8 (Choice 508): the law's settings, validated below by the core's own
+        // checks in the rebuild (Assumption 2, Theorem 2, the loop-rate rule).
+        if let Some(law) = p.law {
+            law.apply(&mut cfg);
         }
         let stale_periods = p.stale_periods.unwrap_or(self.stale_periods);
         let lockstep = p.lockstep.unwrap_or(self.lockstep);

@@ -147,13 +147,14 @@ fn a_peer_stamping_the_last_timestamp_is_refused_and_the_board_flies_on() {
 /// Found by the fuzz target (with this harness): raw bytes that are a signed `Arm` of
 /// timestamp 1 — libFuzzer learnt its MAC from the comparison that checks it. The harness now
 /// treats a raw chunk that verifies with the key as a key holder's frame. (The frame's bytes
-/// are protocol 7's: the same `Arm`, seq 1, timestamp 1, signed with the harness's key.)
+/// are protocol 8's: the same `Arm`, seq 1, timestamp 1, signed with the harness's key; the
+/// version byte moves the MAC and the CRC.)
 #[test]
 fn raw_bytes_that_verify_with_the_key_are_a_key_holders_frame() {
     let mut v = vec![0xA9, OP_RAW, 29, 0x7A];
     v.extend([0; 7]);
     v.extend([
-        4, 7, 1, 1, 1, 2, 1, 1, 1, 1, 1, 9, 69, 181, 148, 188, 119, 219, 191, 248, 0,
+        4, 8, 1, 1, 1, 2, 1, 1, 1, 1, 1, 9, 206, 88, 206, 115, 194, 194, 67, 117, 0,
     ]);
     assert_eq!(v.len(), 3 + 29);
     let s = run(&v);

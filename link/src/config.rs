@@ -14,16 +14,21 @@
 //! little-endian bytes), `stale_periods` (1 byte), `lockstep` (0 or 1), the thrust unit (its
 //! wire index: 0 kgf, 1 newton), `reversed_thrusters` (1 byte), then the priority's six ranks
 //! (1 byte each) and six weights (f32 each), then the estimator's (protocol 7): on (0 or 1),
-//! σₚ, σᵥ, σₐ (six f32 each): 120 bytes. Written field by field, not through postcard, so that
-//! the board carries no serializer for a message it only receives.
+//! σₚ, σᵥ, σₐ (six f32 each), then the law's (protocol 8): K₁, K₂ (six f32 each), q₁, q₂, β,
+//! μ (f32 each), the robust law's and the ‖b‖ bound's wire index (1 byte each: 0 Theorem 3,
+//! 1 Theorem 4; 0 controlled rows, 1 literal) and the pitch limit (f32): 190 bytes. Written
+//! field by field, not through postcard, so that the board carries no serializer for a message
+//! it only receives.
 
 use controller_core::ControllerConfig;
 
-use crate::msg::{ConfigPatch, Telemetry, ThrustUnit, NOT_AUV150};
+use crate::msg::{BBound, ConfigPatch, LawSettings, RobustLaw, Telemetry, ThrustUnit, NOT_AUV150};
 use crate::upload::CRC32;
 
 /// Bytes the digest covers (module docs).
-const DIGEST_BYTES: usize = 4 + 1 + 4 + 4 + 1 + 1 + 1 + 1 + 6 + 6 * 4 + 1 + 18 * 4;
+const DIGEST_BYTES: usize = 4 + 1 + 4 + 4 + 1 + 1 + 1 + 1 + 6 + 6 * 4 + 1 + 18 * 4 + LAW_BYTES;
+/// The law's bytes of the digest (protocol 8).
+const LAW_BYTES: usize = 16 * 4 + 1 + 1 + 4;
 
 /// The thruster mounting a board that flies `config` reports: the AUV-150 layout's
 /// reversed-thruster mask ([`Telemetry::reversed_thrusters`]), or [`NOT_AUV150`] for a geometry
@@ -48,6 +53,7 @@ impl ConfigPatch {
             reversed_thrusters: Some(mounting_of(config)),
             priority: Some(config.priority.into()),
             estimator: Some(config.estimator.into()),
+            law: Some(LawSettings::of(config)),
         }
     }
 
@@ -71,6 +77,7 @@ impl ConfigPatch {
             Some(mounting),
             Some(priority),
             Some(estimator),
+            Some(law),
         ) = (
             self.rate_hz,
             self.robust,
@@ -82,6 +89,7 @@ impl ConfigPatch {
             self.reversed_thrusters,
             self.priority,
             self.estimator,
+            self.law,
         )
         else {
             return None;
@@ -111,6 +119,7 @@ impl ConfigPatch {
         for (i, x) in sigmas.into_iter().flatten().enumerate() {
             bytes[48 + 4 * i..52 + 4 * i].copy_from_slice(&x.to_le_bytes());
         }
+        law_bytes(&law, &mut bytes[DIGEST_BYTES - LAW_BYTES..]);
         Some(CRC32.checksum(&bytes))
     }
 
@@ -144,6 +153,26 @@ impl ConfigPatch {
         }
         Ok(())
     }
+}
+
+/// The law's bytes of the digest (module docs) into `out` (`LAW_BYTES` long).
+fn law_bytes(law: &LawSettings, out: &mut [u8]) {
+    let scalars = [law.beta, law.mu];
+    let floats = law.k1.iter().chain(&law.k2).chain(&law.q).chain(&scalars);
+    let mut n = 0;
+    for x in floats {
+        out[n..n + 4].copy_from_slice(&x.to_le_bytes());
+        n += 4;
+    }
+    out[n] = match law.law {
+        RobustLaw::Discontinuous => 0,
+        RobustLaw::BoundaryLayer => 1,
+    };
+    out[n + 1] = match law.b_bound {
+        BBound::ControlledRows => 0,
+        BBound::Literal => 1,
+    };
+    out[n + 2..n + 6].copy_from_slice(&law.pitch_limit.to_le_bytes());
 }
 
 /// Why a board's telemetry does not confirm a configuration ([`ConfigPatch::confirm`]).

@@ -401,7 +401,7 @@ mod tests {
         use std::string::ToString;
         assert_eq!(
             LinkError::Version { got: 1 }.to_string(),
-            "protocol version 1, expected 7"
+            "protocol version 1, expected 8"
         );
         assert_eq!(
             LinkError::Overflow.to_string(),

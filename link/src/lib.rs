@@ -29,13 +29,14 @@
 //!   bytes, `c < 0xFF` implying a zero after them. The stuffed frame contains no `0x00`; a
 //!   single `0x00` ends each frame. A sender may also send a `0x00` before a frame (e.g. after
 //!   reset): empty frames are ignored.
-//! - **Size:** at most [`MAX_FRAME`] = 179 bytes on the wire, delimiter included
-//!   ([`Envelope::MAX_SIZE`] = 162 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
-//!   code byte + 1 delimiter; a telemetry frame is the largest message, a state frame is at
-//!   most 80 bytes signed, a command at most 80). At 460 800 baud (46 080 bytes/s, the STM32
-//!   board's link) the largest frame takes 3.9 ms, so a State frame in one direction and a
-//!   Telemetry frame in the other fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz
-//!   uses 39 % of the board's transmit bandwidth); 115 200 baud (14.1 ms) would not.
+//! - **Size:** at most [`MAX_FRAME`] = 225 bytes on the wire, delimiter included
+//!   ([`Envelope::MAX_SIZE`] = 208 postcard bytes + 13 signature bytes + 2 CRC bytes + 1 COBS
+//!   code byte + 1 delimiter; a whole `SetConfig` is the largest message since protocol 8,
+//!   sent during the set-up; a telemetry frame is at most 179 bytes signed, a state frame at
+//!   most 80). At 460 800 baud (46 080 bytes/s, the STM32 board's link) the largest telemetry
+//!   frame takes 3.9 ms, so a State frame in one direction and a Telemetry frame in the other
+//!   fit in a 10 ms (100 Hz) control period (telemetry at 100 Hz uses 39 % of the board's
+//!   transmit bandwidth); 115 200 baud (14.1 ms) would not. The largest frame takes 4.9 ms.
 //!
 //! # Receiving
 //!
@@ -108,9 +109,9 @@ pub use frame::{
 };
 pub use heading::Heading;
 pub use msg::{
-    AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings, FailSafeReason,
-    MissionPlan, MissionSpec, Msg, StateFrame, Telemetry, ThrustUnit, DEFAULT_STALE_PERIODS,
-    NOT_AUV150, PROTOCOL_VERSION,
+    AxisPriority, BBound, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings,
+    FailSafeReason, LawSettings, MissionPlan, MissionSpec, Msg, RobustLaw, StateFrame, Telemetry,
+    ThrustUnit, DEFAULT_STALE_PERIODS, NOT_AUV150, PROTOCOL_VERSION,
 };
 pub use refusal::Refusal;
 pub use upload::{

@@ -20,7 +20,10 @@
 use controller_core::{trajectory, HeadingMode, Mission, TrajectoryKind};
 
 use crate::heading::Heading;
-use crate::msg::{AxisPriority, EstimatorSettings, MissionPlan, MissionSpec, ThrustUnit};
+use crate::msg::{
+    AxisPriority, BBound, EstimatorSettings, LawSettings, MissionPlan, MissionSpec, RobustLaw,
+    ThrustUnit,
+};
 use crate::refusal::Refusal;
 use crate::upload::{MissionUpload, UploadBuffer};
 
@@ -128,6 +131,13 @@ macro_rules! variant_for_variant {
 
 variant_for_variant!(Heading, HeadingMode, Paper, Tangent);
 variant_for_variant!(ThrustUnit, controller_core::ThrustUnit, Kgf, Newton);
+variant_for_variant!(
+    RobustLaw,
+    controller_core::law::RobustLaw,
+    Discontinuous,
+    BoundaryLayer
+);
+variant_for_variant!(BBound, controller_core::BBound, ControlledRows, Literal);
 
 impl From<Mission> for MissionPlan {
     /// A waypoint path is named by the CRC of this mission's upload (its heading and time
@@ -227,5 +237,70 @@ impl From<EstimatorSettings> for controller_core::EstimatorConfig {
             accel_sigma,
             disturbance_time: controller_core::estimator::DISTURBANCE_TIME,
         }
+    }
+}
+
+impl LawSettings {
+    /// The law's settings of `c`, field for field (every `f32` keeps its bits).
+    pub fn of(c: &controller_core::ControllerConfig) -> Self {
+        // Every field named, so that a law setting added to the core is a compile error here
+        // until the link carries it or says why not.
+        let controller_core::ControllerConfig {
+            k1,
+            k2,
+            q,
+            beta,
+            mu,
+            law,
+            b_bound,
+            pitch_limit,
+            // Carried by `ConfigPatch`'s own fields (protocols 1–7).
+            robust: _,
+            delta_max: _,
+            rate_hz: _,
+            voltage_limit: _,
+            thrust_unit: _,
+            priority: _,
+            estimator: _,
+            // The mounting crosses as `ConfigPatch::reversed_thrusters`; the positions, the
+            // nominal model and its box are the vehicle's, built into the board (Choices 49,
+            // 225, 363).
+            geometry: _,
+            params: _,
+            uncertainty: _,
+        } = *c;
+        LawSettings {
+            k1,
+            k2,
+            q,
+            beta,
+            mu,
+            law: law.into(),
+            b_bound: b_bound.into(),
+            pitch_limit,
+        }
+    }
+
+    /// `c` with these law settings; the rest of `c` unchanged. Does not validate (the
+    /// receiver builds the controller, which does).
+    pub fn apply(self, c: &mut controller_core::ControllerConfig) {
+        let LawSettings {
+            k1,
+            k2,
+            q,
+            beta,
+            mu,
+            law,
+            b_bound,
+            pitch_limit,
+        } = self;
+        c.k1 = k1;
+        c.k2 = k2;
+        c.q = q;
+        c.beta = beta;
+        c.mu = mu;
+        c.law = law.into();
+        c.b_bound = b_bound.into();
+        c.pitch_limit = pitch_limit;
     }
 }

@@ -36,7 +36,13 @@ use crate::upload::{UploadChunk, UploadPart, UploadStatus, CHUNK_WORDS};
 /// 7: `SetConfig` carries the state estimator's settings ([`ConfigPatch::estimator`],
 /// [`EstimatorSettings`]), which the digest covers; the board computes the gains from them
 /// while disarmed (Choice 361).
-pub const PROTOCOL_VERSION: u8 = 7;
+///
+/// 8: `SetConfig` carries the law's settings ([`ConfigPatch::law`], [`LawSettings`]: K₁,
+/// K₂, Q, β, μ, Theorem 3 or 4, the ‖b‖ bound, the pitch limit), which the digest covers; the
+/// board validates them with the core's checks and applies them in its disarmed rebuild, so a
+/// board flies the law the host's SIL flies (Choice 508). A whole `SetConfig` is now the
+/// largest message.
+pub const PROTOCOL_VERSION: u8 = 8;
 
 // Worst-case postcard sizes of the primitives: u8 and bool are one byte, f32 is four bytes
 // little-endian, u16/u32/u64 are unsigned LEB128 varints (7 bits per byte), `Option` is a
@@ -341,6 +347,74 @@ pub struct ConfigPatch {
     /// The state estimator the law flies on and its noise settings (refused while armed, and
     /// when the core refuses a setting: [`Refusal::ControllerConfig`]).
     pub estimator: Option<EstimatorSettings>,
+    // Protocol 8: appended field.
+    /// The law's settings (refused while armed, and when the core refuses a setting or the
+    /// configuration they make: Assumption 2 β̂ ≤ β, Theorem 2, the loop-rate rule;
+    /// [`Refusal::ControllerConfig`]).
+    pub law: Option<LawSettings>,
+}
+
+/// The wire form of the law's settings of `controller_core::ControllerConfig`, field for field
+/// (docs/law.md): the gains of Eq (17), the Lyapunov weights of Theorem 3, β of Assumption 2
+/// and Eq (29), the boundary layer μ of Eq (30), which robust law, which ‖b‖ bound enters δ,
+/// and the pitch limit. Convert with [`LawSettings::of`] and [`LawSettings::apply`]
+/// ([`crate::mission`]); the receiver validates the configuration they make with
+/// `controller_core::Controller::new`'s checks.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub struct LawSettings {
+    /// K₁ = diag(ω²ᵢ) of Eq (17), rows x y z φ θ ψ (roll must be 0).
+    pub k1: [f32; 6],
+    /// K₂ = diag(2ωᵢ) of Eq (17) (roll must be 0).
+    pub k2: [f32; 6],
+    /// Q = diag(q₁, q₂) of the per-axis Lyapunov equation (Theorem 3).
+    pub q: [f32; 2],
+    /// β of Assumption 2 and Eq (29).
+    pub beta: f32,
+    /// Boundary-layer width μ of Eq (30).
+    pub mu: f32,
+    /// Theorem 3 (Eq 26) or Theorem 4 (Eq 30).
+    pub law: RobustLaw,
+    /// Which bound on ‖b‖ enters δ (Eq 29).
+    pub b_bound: BBound,
+    /// |θ| beyond which the law faults (rad).
+    pub pitch_limit: f32,
+}
+
+impl LawSettings {
+    /// Worst-case postcard size of a `LawSettings` (bytes).
+    pub const MAX_SIZE: usize =
+        6 * F32 + 6 * F32 + 2 * F32 + F32 + F32 + RobustLaw::MAX_SIZE + BBound::MAX_SIZE + F32;
+}
+
+/// The wire form of `controller_core::law::RobustLaw` (variant order is the wire format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum RobustLaw {
+    /// Theorem 3, Eq (26): Δu = −δ w/‖w‖.
+    Discontinuous,
+    /// Theorem 4, Eq (30): the boundary layer of width μ.
+    BoundaryLayer,
+}
+
+impl RobustLaw {
+    /// Worst-case postcard size of a `RobustLaw` (bytes).
+    pub const MAX_SIZE: usize = TAG;
+}
+
+/// The wire form of `controller_core::BBound` (variant order is the wire format).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[cfg_attr(feature = "defmt", derive(defmt::Format))]
+pub enum BBound {
+    /// c_b · max(1, 1/|cos θ|) over the controlled rows (the default).
+    ControlledRows,
+    /// The literal ‖M̄⁻¹‖ bound.
+    Literal,
+}
+
+impl BBound {
+    /// Worst-case postcard size of a `BBound` (bytes).
+    pub const MAX_SIZE: usize = TAG;
 }
 
 /// The wire form of `controller_core::EstimatorConfig` (docs/law.md#the-state-estimator):
@@ -396,7 +470,43 @@ impl ConfigPatch {
         + option(ThrustUnit::MAX_SIZE)
         + option(U8)
         + option(AxisPriority::MAX_SIZE)
-        + option(EstimatorSettings::MAX_SIZE);
+        + option(EstimatorSettings::MAX_SIZE)
+        + option(LawSettings::MAX_SIZE);
+
+    /// The patch of the longest encoding: every field `Some`, every varint at its maximum,
+    /// every f32 at its largest magnitude. Its `SetConfig` in an envelope with
+    /// `seq = u16::MAX` is [`Envelope::MAX_SIZE`] bytes and, signed, the longest frame,
+    /// `MAX_FRAME` (protocol 8; the link's tests check both).
+    pub const LARGEST: ConfigPatch = ConfigPatch {
+        rate_hz: Some(u32::MAX),
+        robust: Some(true),
+        delta_max: Some(f32::MAX),
+        voltage_limit: Some(f32::MAX),
+        stale_periods: Some(u8::MAX),
+        lockstep: Some(true),
+        thrust_unit: Some(ThrustUnit::Newton),
+        reversed_thrusters: Some(u8::MAX),
+        priority: Some(AxisPriority {
+            rank: [u8::MAX; 6],
+            weight: [f32::MAX; 6],
+        }),
+        estimator: Some(EstimatorSettings {
+            kalman: true,
+            position_sigma: [f32::MAX; 6],
+            velocity_sigma: [f32::MAX; 6],
+            accel_sigma: [f32::MAX; 6],
+        }),
+        law: Some(LawSettings {
+            k1: [f32::MAX; 6],
+            k2: [f32::MAX; 6],
+            q: [f32::MAX; 2],
+            beta: f32::MAX,
+            mu: f32::MAX,
+            law: RobustLaw::BoundaryLayer,
+            b_bound: BBound::Literal,
+            pitch_limit: f32::MAX,
+        }),
+    };
 
     /// Changes nothing.
     pub const EMPTY: ConfigPatch = ConfigPatch {
@@ -410,6 +520,7 @@ impl ConfigPatch {
         reversed_thrusters: None,
         priority: None,
         estimator: None,
+        law: None,
     };
 }
 
@@ -498,9 +609,10 @@ pub struct Telemetry {
 
 impl Telemetry {
     /// The report of the longest encoding: every varint at its maximum, every f32 at its largest
-    /// magnitude, every `Option` `Some`. Its envelope with `seq = u16::MAX` is
-    /// [`Envelope::MAX_SIZE`] bytes and, signed, the longest frame, `MAX_FRAME` (the link's
-    /// tests check both); the board's self-test times its encoding as the worst case.
+    /// magnitude, every `Option` `Some`: the longest frame the board sends (the link's tests
+    /// check its size, [`Telemetry::MAX_SIZE`]); the board's self-test times its encoding as the
+    /// worst case. Since protocol 8 the longest message is a whole `SetConfig`
+    /// ([`ConfigPatch::LARGEST`]).
     pub const LARGEST: Telemetry = Telemetry {
         tick: u64::MAX,
         status: BoardStatus::FailSafe(FailSafeReason::Overrun),

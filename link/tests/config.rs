@@ -4,7 +4,8 @@
 //! sent from one that does not, naming what differs where telemetry can tell.
 
 use auv_link::{
-    AxisPriority, ConfigMismatch, ConfigPatch, EstimatorSettings, Telemetry, ThrustUnit,
+    AxisPriority, BBound, ConfigMismatch, ConfigPatch, EstimatorSettings, LawSettings, RobustLaw,
+    Telemetry, ThrustUnit,
 };
 use controller_core::ControllerConfig;
 
@@ -35,6 +36,7 @@ fn the_whole_configuration_sets_every_field_from_the_core_and_the_board() {
     );
     assert_eq!(w.priority, Some(AxisPriority::from(c.priority)));
     assert_eq!(w.estimator, Some(EstimatorSettings::from(c.estimator)));
+    assert_eq!(w.law, Some(LawSettings::of(&c)));
     // Any field unset: not whole.
     for unset in [
         ConfigPatch { rate_hz: None, ..w },
@@ -46,6 +48,7 @@ fn the_whole_configuration_sets_every_field_from_the_core_and_the_board() {
             estimator: None,
             ..w
         },
+        ConfigPatch { law: None, ..w },
         ConfigPatch {
             lockstep: None,
             ..w
@@ -82,8 +85,30 @@ fn the_digest_is_the_crc32_of_the_documented_bytes() {
     {
         bytes.extend_from_slice(&x.to_le_bytes());
     }
-    assert_eq!(bytes.len(), 120);
+    // Protocol 8: the law's K₁, K₂, q₁, q₂, β, μ, then Theorem 4 (1), the controlled rows (0),
+    // then the pitch limit.
+    for x in c.k1.iter().chain(&c.k2).chain(&c.q).chain(&[c.beta, c.mu]) {
+        bytes.extend_from_slice(&x.to_le_bytes());
+    }
+    bytes.extend_from_slice(&[1, 0]);
+    bytes.extend_from_slice(&c.pitch_limit.to_le_bytes());
+    assert_eq!(bytes.len(), 190);
     assert_eq!(w.digest(), Some(crc32_by_hand(&bytes)));
+    // Theorem 3 is the law's wire index 0, the literal bound the bound's 1 (bytes 184, 185).
+    let mut other = w.law.unwrap();
+    other.law = RobustLaw::Discontinuous;
+    other.b_bound = BBound::Literal;
+    let mut other_bytes = bytes.clone();
+    other_bytes[184] = 0;
+    other_bytes[185] = 1;
+    assert_eq!(
+        ConfigPatch {
+            law: Some(other),
+            ..w
+        }
+        .digest(),
+        Some(crc32_by_hand(&other_bytes))
+    );
     // Newton is the unit's wire index 1.
     let newton = ConfigPatch {
         thrust_unit: Some(ThrustUnit::Newton),
@@ -114,7 +139,42 @@ fn every_field_moves_the_digest() {
     };
     let mut sigma = w.estimator.unwrap();
     sigma.accel_sigma[5] = 0.005;
-    let changed = [
+    // Protocol 8: each law setting, changed alone.
+    let law = w.law.unwrap();
+    let laws = [
+        LawSettings { mu: 0.15, ..law },
+        LawSettings { beta: 0.7, ..law },
+        LawSettings {
+            pitch_limit: 1.0,
+            ..law
+        },
+        LawSettings {
+            q: [1.0, 2.0],
+            ..law
+        },
+        LawSettings {
+            law: RobustLaw::Discontinuous,
+            ..law
+        },
+        LawSettings {
+            b_bound: BBound::Literal,
+            ..law
+        },
+        LawSettings {
+            k1: [5.0, 4.0, 4.0, 0.0, 4.0, 4.0],
+            ..law
+        },
+        LawSettings {
+            k2: [4.0, 4.0, 4.0, 0.0, 4.0, 3.0],
+            ..law
+        },
+        // The same value as K₁'s change, in K₂: the digest tells the fields apart.
+        LawSettings {
+            k2: [5.0, 4.0, 4.0, 0.0, 4.0, 4.0],
+            ..law
+        },
+    ];
+    let mut changed = vec![
         ConfigPatch {
             estimator: Some(on),
             ..w
@@ -160,12 +220,14 @@ fn every_field_moves_the_digest() {
             ..w
         },
     ];
+    changed.extend(laws.map(|l| ConfigPatch { law: Some(l), ..w }));
     let mut digests: Vec<u32> = changed.iter().filter_map(ConfigPatch::digest).collect();
     digests.extend(w.digest());
     let n = digests.len();
     digests.sort_unstable();
     digests.dedup();
-    assert_eq!(digests.len(), n, "ten configurations, ten digests");
+    assert_eq!(n, 21);
+    assert_eq!(digests.len(), n, "21 configurations, 21 digests");
     // The same configuration, the same digest (a copy, and the same fields rebuilt).
     assert_eq!(defaults().digest(), w.digest());
 }
@@ -232,5 +294,45 @@ fn confirm_accepts_the_board_that_flies_what_was_sent_and_names_what_differs() {
     assert_eq!(
         partial.confirm(&telemetry_of(&sent)),
         Err(ConfigMismatch::NotWhole)
+    );
+}
+
+/// Protocol 8: the law's settings cross field for field, every f32 keeping its bits, and
+/// `apply` changes the law's fields of a configuration and nothing else.
+#[test]
+fn the_law_settings_cross_field_for_field() {
+    let mut c = ControllerConfig {
+        mu: 0.15,
+        beta: 0.7,
+        q: [1.0, 2.0],
+        pitch_limit: 1.0,
+        law: controller_core::RobustLaw::Discontinuous,
+        b_bound: controller_core::BBound::Literal,
+        ..ControllerConfig::default()
+    };
+    c.k1[0] = 5.0;
+    c.k2[5] = f32::from_bits(0x7FC0_1234); // a NaN with a payload
+    let law = LawSettings::of(&c);
+    assert_eq!(law.law, RobustLaw::Discontinuous);
+    assert_eq!(law.b_bound, BBound::Literal);
+    let mut back = ControllerConfig {
+        rate_hz: 50,
+        delta_max: 12.5,
+        ..ControllerConfig::default()
+    };
+    law.apply(&mut back);
+    assert_eq!(back.k2[5].to_bits(), 0x7FC0_1234);
+    // Everything but what the law does not carry is `c`'s; that is `back`'s own.
+    back.k2[5] = c.k2[5];
+    assert_eq!(
+        format!("{back:?}"),
+        format!(
+            "{:?}",
+            ControllerConfig {
+                rate_hz: 50,
+                delta_max: 12.5,
+                ..c
+            }
+        )
     );
 }

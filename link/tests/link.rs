@@ -3,10 +3,10 @@
 
 use auv_link::sign::SIGNATURE_LEN;
 use auv_link::{
-    decode_frame, encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope,
-    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, StateFrame,
-    Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, CRC_LEN, MAX_BODY, MAX_FRAME,
-    PROTOCOL_VERSION,
+    decode_frame, encode, BBound, BoardStatus, Command, ConfigPatch, Envelope, FailSafeReason,
+    FrameDecoder, Heading, LawSettings, LinkError, MissionPlan, MissionSpec, Msg, RobustLaw,
+    StateFrame, Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, CRC_LEN, MAX_BODY,
+    MAX_FRAME, PROTOCOL_VERSION,
 };
 use controller_core::TrajectoryKind;
 
@@ -17,7 +17,8 @@ mod envelopes;
 #[path = "common/frames.rs"]
 mod frames;
 use envelopes::{
-    decode_chunked, decode_stream, every_kind, frame, largest, postcard_len, reference_frame,
+    decode_chunked, decode_stream, every_kind, frame, largest, largest_telemetry, postcard_len,
+    reference_frame,
 };
 
 // ---------------------------------------------------------------------------------------------
@@ -86,7 +87,7 @@ fn empty_frames_are_ignored() {
 
 #[test]
 fn max_sizes_are_exact() {
-    let Msg::Telemetry(t) = largest().msg else {
+    let Msg::Telemetry(t) = largest_telemetry().msg else {
         unreachable!()
     };
     assert_eq!(postcard_len(&t), Telemetry::MAX_SIZE);
@@ -115,26 +116,12 @@ fn max_sizes_are_exact() {
     };
     assert_eq!(postcard_len(&plan), MissionPlan::MAX_SIZE);
     assert_eq!(postcard_len(&ThrustUnit::Newton), ThrustUnit::MAX_SIZE);
-    let p = ConfigPatch {
-        rate_hz: Some(u32::MAX),
-        robust: Some(true),
-        delta_max: Some(f32::MAX),
-        voltage_limit: Some(f32::MAX),
-        stale_periods: Some(u8::MAX),
-        lockstep: Some(true),
-        thrust_unit: Some(ThrustUnit::Newton),
-        reversed_thrusters: Some(u8::MAX),
-        priority: Some(AxisPriority {
-            rank: [u8::MAX; 6],
-            weight: [f32::MAX; 6],
-        }),
-        estimator: Some(auv_link::EstimatorSettings {
-            kalman: true,
-            position_sigma: [f32::MAX; 6],
-            velocity_sigma: [f32::MAX; 6],
-            accel_sigma: [f32::MAX; 6],
-        }),
-    };
+    let p = ConfigPatch::LARGEST;
+    assert!(p.is_whole());
+    let law = p.law.unwrap();
+    assert_eq!(postcard_len(&law), LawSettings::MAX_SIZE);
+    assert_eq!(postcard_len(&law.law), RobustLaw::MAX_SIZE);
+    assert_eq!(postcard_len(&law.b_bound), BBound::MAX_SIZE);
     assert_eq!(postcard_len(&p), ConfigPatch::MAX_SIZE);
     let begin = UploadHeader {
         points: u8::MAX,
@@ -156,10 +143,15 @@ fn max_sizes_are_exact() {
     assert_eq!(
         postcard_len(&Command::SetConfig(p)),
         Command::MAX_SIZE,
-        "a whole SetConfig is the largest command (protocol 7)"
+        "a whole SetConfig is the largest command (protocols 7 and 8)"
     );
     assert!(postcard_len(&Command::Upload(UploadPart::Chunk(chunk))) < Command::MAX_SIZE);
-    assert_eq!(postcard_len(&Msg::Telemetry(t)), Msg::MAX_SIZE);
+    // Protocol 8: a whole SetConfig is the largest message, longer than any telemetry.
+    assert_eq!(
+        postcard_len(&Msg::Command(Command::SetConfig(p))),
+        Msg::MAX_SIZE
+    );
+    assert!(postcard_len(&Msg::Telemetry(t)) < Msg::MAX_SIZE);
     assert_eq!(postcard_len(&largest()), Envelope::MAX_SIZE);
     // Every other kind is no larger.
     for env in every_kind() {
@@ -172,18 +164,25 @@ fn largest_message_fits_max_frame_exactly() {
     // Protocol 3's commands, by hand from the layout: a full ConfigPatch is 6 + 2 + 5 + 5 + 2
     // + 2 (protocol 2) + 2 (unit) + 2 (mask) + 31 (priority: 6 ranks, 6 weights) bytes; a
     // StartMission is its tag, the path (17), the heading (1) and the time scale (4).
-    // Protocol 7 adds the estimator's settings: a tag, a bool and 18 f32 (74 bytes).
-    assert_eq!(ConfigPatch::MAX_SIZE, 57 + 74);
+    // Protocol 7 adds the estimator's settings: a tag, a bool and 18 f32 (74 bytes); protocol 8
+    // the law's: a tag, K₁ and K₂ (12 f32), q (2), β, μ, the law's and the bound's variant
+    // bytes and the pitch limit (1 + 64 + 2 + 4 = 71 bytes).
+    assert_eq!(ConfigPatch::MAX_SIZE, 57 + 74 + 71);
     assert_eq!(MissionPlan::MAX_SIZE + 1, 23);
     // Protocol 5's upload chunk (the command's tag, the part's tag, the index, 32 words: 131
-    // bytes) was the largest command; protocol 7's whole SetConfig is one byte more.
-    assert_eq!(Command::MAX_SIZE, 1 + 57 + 74);
-    // Protocol 4's telemetry counter is one u32 varint more (at most 5 bytes); protocol 5's
-    // upload status is a u32 and a u32 varint, a u8 and a bool (12 bytes); protocol 6's
-    // configuration digest one u32 varint more (5 bytes).
-    assert_eq!(Envelope::MAX_SIZE, 145 + 12 + 5);
-    assert_eq!(MAX_BODY, 160 + 12 + 5);
-    assert_eq!(MAX_FRAME, 162 + 12 + 5);
+    // bytes) was the largest command; protocol 7's whole SetConfig was one byte more, and
+    // protocol 8's is 72 more than that.
+    assert_eq!(Command::MAX_SIZE, 1 + 57 + 74 + 71);
+    // Until protocol 7 the largest message was a telemetry frame (157 postcard bytes; its
+    // envelope 162 with protocol 4's counter, protocol 5's upload status and protocol 6's
+    // digest). Protocol 8's whole SetConfig is longer: the envelope's version and seq (1 + 3
+    // bytes), the message's tag and the command.
+    assert_eq!(Telemetry::MAX_SIZE, 145 + 12 + 5 - 5);
+    assert_eq!(Envelope::MAX_SIZE, 1 + 3 + 1 + Command::MAX_SIZE);
+    assert_eq!(Envelope::MAX_SIZE, 208);
+    assert_eq!(MAX_BODY, 208 + 13 + 2);
+    // COBS adds one code byte per 254 (one here) and the delimiter one more.
+    assert_eq!(MAX_FRAME, 225);
     // Unsigned, the largest frame is the signature's length short of MAX_FRAME (the signed one
     // is exactly MAX_FRAME: tests/sign.rs).
     let env = largest();
@@ -260,7 +259,7 @@ fn a_new_wire_variant_comes_with_a_new_protocol_version() {
     // commands). A board refuses a tag past its own variants, so a variant added to
     // `MissionSpec` or `Command` is a new protocol: this fails until PROTOCOL_VERSION is
     // bumped and its row added here.
-    const CARRIED: [(u8, usize, usize); 3] = [(5, 5, 6), (6, 5, 6), (7, 5, 6)];
+    const CARRIED: [(u8, usize, usize); 4] = [(5, 5, 6), (6, 5, 6), (7, 5, 6), (8, 5, 6)];
     let now = (
         PROTOCOL_VERSION,
         TrajectoryKind::EXAMPLES.len(),

@@ -52,7 +52,7 @@ fn any_single_byte_corruption_is_caught_and_the_stream_recovers() {
 
 #[test]
 fn wrong_version_is_rejected_before_parsing() {
-    for version in [0u8, 1, 2, 3, 4, 5, 6, 8, 0x7F, 0xFF] {
+    for version in [0u8, 1, 2, 3, 4, 5, 6, 7, 9, 0x7F, 0xFF] {
         let env = Envelope {
             version,
             ..Envelope::new(5, Msg::Command(Command::Arm))
@@ -69,30 +69,30 @@ fn wrong_version_is_rejected_before_parsing() {
         );
     }
     // A future version whose body this version cannot parse: still a Version error.
-    let wire = frame_from_body(&[8, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
+    let wire = frame_from_body(&[9, 0xFF, 0xFF, 0xFF, 0x7F, 0xEE]);
     assert_eq!(
         decode_stream(&wire),
-        vec![Err(LinkError::Version { got: 8 })]
+        vec![Err(LinkError::Version { got: 9 })]
     );
 }
 
 #[test]
 fn hand_made_frames_match_the_documented_format() {
-    // Envelope { version 7, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
-    assert_eq!(PROTOCOL_VERSION, 7);
-    let wire = frame_from_body(&[7, 0xAC, 0x02, 0x01, 0x00]);
+    // Envelope { version 8, seq 300 (varint AC 02), Command(Arm) } built from the docs alone.
+    assert_eq!(PROTOCOL_VERSION, 8);
+    let wire = frame_from_body(&[8, 0xAC, 0x02, 0x01, 0x00]);
     let env = Envelope::new(300, Msg::Command(Command::Arm));
     assert_eq!(wire, frame(&env));
     // A body with a byte left over (or 12, or 14: not a signature), or a bad variant, or cut
     // short: Deserialize.
     for body in [
-        &[7, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
-        &[&[7, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
-        &[&[7, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
-        &[7, 0x00, 0x03][..],
-        &[7, 0x00, 0x01, 0x06][..],
-        &[7, 0x00, 0x00, 0x01][..],
-        &[7][..],
+        &[8, 0xAC, 0x02, 0x01, 0x00, 0x00][..],
+        &[&[8, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN - 1]].concat()[..],
+        &[&[8, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN + 1]].concat()[..],
+        &[8, 0x00, 0x03][..],
+        &[8, 0x00, 0x01, 0x06][..],
+        &[8, 0x00, 0x00, 0x01][..],
+        &[8][..],
     ] {
         assert_eq!(
             decode_stream(&frame_from_body(body)),
@@ -101,7 +101,7 @@ fn hand_made_frames_match_the_documented_format() {
         );
     }
     // Exactly a signature's length left over: a signed frame, which an unsigned link refuses.
-    let signed = [&[7, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
+    let signed = [&[8, 0xAC, 0x02, 0x01, 0x00][..], &[7; SIGNATURE_LEN]].concat();
     assert_eq!(
         decode_stream(&frame_from_body(&signed)),
         vec![Err(LinkError::Auth(AuthError::SigningOff))]

@@ -3,10 +3,10 @@
 //! never panic.
 
 use auv_link::{
-    decode_frame, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings,
-    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, MissionSpec, Msg, Refusal,
-    StateFrame, Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, UploadStatus,
-    MAX_FRAME, PROTOCOL_VERSION,
+    decode_frame, AxisPriority, BBound, BoardStatus, Command, ConfigPatch, Envelope,
+    EstimatorSettings, FailSafeReason, FrameDecoder, Heading, LawSettings, LinkError, MissionPlan,
+    MissionSpec, Msg, Refusal, RobustLaw, StateFrame, Telemetry, ThrustUnit, UploadChunk,
+    UploadHeader, UploadPart, UploadStatus, MAX_FRAME, PROTOCOL_VERSION,
 };
 use controller_core::TrajectoryKind;
 use proptest::prelude::*;
@@ -153,6 +153,7 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
         any::<Option<u8>>(),
         proptest::option::of(any_priority()),
         proptest::option::of(any_estimator()),
+        proptest::option::of(any_law()),
     )
         .prop_map(
             |(
@@ -166,6 +167,7 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
                 reversed_thrusters,
                 priority,
                 estimator,
+                law,
             )| ConfigPatch {
                 rate_hz,
                 robust,
@@ -177,6 +179,40 @@ fn any_patch() -> BoxedStrategy<ConfigPatch> {
                 reversed_thrusters,
                 priority,
                 estimator,
+                law,
+            },
+        )
+        .boxed()
+}
+
+/// Any law settings (protocol 8): every f32 bit pattern, both laws and both bounds.
+fn any_law() -> BoxedStrategy<LawSettings> {
+    (
+        prop::array::uniform6(any_f32()),
+        prop::array::uniform6(any_f32()),
+        prop::array::uniform2(any_f32()),
+        (any_f32(), any_f32(), any_f32()),
+        any::<bool>(),
+        any::<bool>(),
+    )
+        .prop_map(
+            |(k1, k2, q, (beta, mu, pitch_limit), theorem4, literal)| LawSettings {
+                k1,
+                k2,
+                q,
+                beta,
+                mu,
+                law: if theorem4 {
+                    RobustLaw::BoundaryLayer
+                } else {
+                    RobustLaw::Discontinuous
+                },
+                b_bound: if literal {
+                    BBound::Literal
+                } else {
+                    BBound::ControlledRows
+                },
+                pitch_limit,
             },
         )
         .boxed()

@@ -9,8 +9,8 @@ use auv_link::sign::{
     RESERVE, SIGNATURE_LEN, TIMESTAMP_LEN, UNITS_PER_SECOND,
 };
 use auv_link::{
-    decode_frame, decode_frame_signed, encode, encode_signed, Command, Envelope, FrameDecoder,
-    LinkError, Msg, StateFrame, Telemetry, MAX_FRAME,
+    decode_frame, decode_frame_signed, encode, encode_signed, Command, ConfigPatch, Envelope,
+    FrameDecoder, LinkError, Msg, StateFrame, Telemetry, MAX_FRAME,
 };
 use frames::{crc16, stuff};
 use hmac::{Hmac, KeyInit, Mac};
@@ -41,9 +41,9 @@ fn arm(seq: u16) -> Envelope {
 
 #[test]
 fn a_signed_frame_is_the_documented_layout() {
-    // postcard(Envelope{7, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
+    // postcard(Envelope{8, seq 300, Command(Arm)}) ‖ link id 0 ‖ timestamp 5 (6 bytes LE) ‖
     // the first 6 bytes of HMAC-SHA-256(key, everything before the MAC) ‖ CRC-16 of it all.
-    let covered = [7u8, 0xAC, 0x02, 0x01, 0x00];
+    let covered = [8u8, 0xAC, 0x02, 0x01, 0x00];
     let id_time = [0u8, 5, 0, 0, 0, 0, 0];
     let mut mac = <Hmac<Sha256> as KeyInit>::new_from_slice(&KEY).unwrap();
     mac.update(&covered);
@@ -61,10 +61,22 @@ fn a_signed_frame_is_the_documented_layout() {
 
 #[test]
 fn the_largest_signed_frame_is_max_frame() {
+    // Protocol 8: a whole SetConfig, to the board.
+    let env = Envelope::new(
+        u16::MAX,
+        Msg::Command(Command::SetConfig(ConfigPatch::LARGEST)),
+    );
+    let mut to_board = Signer::new(&key(), Direction::ToBoard);
+    let wire = signed(&env, &mut to_board);
+    assert_eq!(wire.len(), MAX_FRAME);
+    let mut dec = FrameDecoder::signed(Verifier::new(&key(), Direction::ToBoard));
+    assert_eq!(push_all(&mut dec, &wire), vec![Ok(env)]);
+    // The largest telemetry, signed: the longest frame the board sends, 179 bytes (the
+    // longest frame of every protocol before 8).
     let env = Envelope::new(u16::MAX, Msg::Telemetry(Telemetry::LARGEST));
     let mut signer = Signer::new(&key(), Direction::FromBoard);
     let wire = signed(&env, &mut signer);
-    assert_eq!(wire.len(), MAX_FRAME);
+    assert_eq!(wire.len(), 179);
     let mut dec = FrameDecoder::signed(Verifier::new(&key(), Direction::FromBoard));
     assert_eq!(push_all(&mut dec, &wire), vec![Ok(env)]);
     // The largest state frame, signed: what the navigation computer sends every period.

@@ -5,9 +5,10 @@
 #![allow(dead_code)]
 
 use auv_link::{
-    encode, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings,
-    FailSafeReason, FrameDecoder, Heading, LinkError, MissionPlan, Msg, Refusal, StateFrame,
-    Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart, UploadStatus, MAX_FRAME,
+    encode, AxisPriority, BBound, BoardStatus, Command, ConfigPatch, Envelope, EstimatorSettings,
+    FailSafeReason, FrameDecoder, Heading, LawSettings, LinkError, MissionPlan, Msg, Refusal,
+    RobustLaw, StateFrame, Telemetry, ThrustUnit, UploadChunk, UploadHeader, UploadPart,
+    UploadStatus, MAX_FRAME,
 };
 use controller_core::TrajectoryKind;
 
@@ -148,6 +149,16 @@ pub fn every_kind() -> Vec<Envelope> {
                 velocity_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],
                 accel_sigma: [f32::MAX, 0.02, -0.0, 0.004, f32::MIN_POSITIVE, 1e-30],
             }),
+            law: Some(LawSettings {
+                k1: [5.0, 4.0, 4.0, 0.0, 4.0, 4.0],
+                k2: [4.0, 4.0, 4.0, -0.0, 4.0, 3.0],
+                q: [1.0, f32::MIN_POSITIVE],
+                beta: 0.605,
+                mu: 0.15,
+                law: RobustLaw::Discontinuous,
+                b_bound: BBound::Literal,
+                pitch_limit: 1.3962634,
+            }),
         })),
         Msg::Command(Command::SetConfig(ConfigPatch {
             delta_max: Some(10.0),
@@ -166,8 +177,17 @@ pub fn every_kind() -> Vec<Envelope> {
         .collect()
 }
 
-/// The largest message: every varint at its maximum, every f32 at f32::MAX, every Option Some.
+/// The largest message (protocol 8: a whole `SetConfig`): every varint at its maximum, every
+/// f32 at f32::MAX, every Option Some.
 pub fn largest() -> Envelope {
+    Envelope::new(
+        u16::MAX,
+        Msg::Command(Command::SetConfig(ConfigPatch::LARGEST)),
+    )
+}
+
+/// The largest telemetry: the longest frame the board sends.
+pub fn largest_telemetry() -> Envelope {
     Envelope::new(u16::MAX, Msg::Telemetry(Telemetry::LARGEST))
 }
 

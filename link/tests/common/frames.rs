@@ -171,7 +171,22 @@ pub fn same_command(a: &Command, b: &Command) -> bool {
                 reversed_thrusters,
                 priority,
                 estimator,
+                law,
             } = a;
+            let same_law = match (law, &b.law) {
+                (None, None) => true,
+                (Some(l), Some(m)) => {
+                    fs(&l.k1, &m.k1)
+                        && fs(&l.k2, &m.k2)
+                        && fs(&l.q, &m.q)
+                        && f(l.beta, m.beta)
+                        && f(l.mu, m.mu)
+                        && l.law == m.law
+                        && l.b_bound == m.b_bound
+                        && f(l.pitch_limit, m.pitch_limit)
+                }
+                _ => false,
+            };
             let same_estimator = match (estimator, &b.estimator) {
                 (None, None) => true,
                 (Some(e), Some(g)) => {
@@ -189,6 +204,7 @@ pub fn same_command(a: &Command, b: &Command) -> bool {
             };
             same_priority
                 && same_estimator
+                && same_law
                 && *thrust_unit == b.thrust_unit
                 && *reversed_thrusters == b.reversed_thrusters
                 && *rate_hz == b.rate_hz

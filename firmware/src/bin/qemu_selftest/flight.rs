@@ -21,7 +21,8 @@ use core::ptr::{read_volatile, write_volatile};
 use auv_link::sign::{Direction, LinkKey, Signer};
 use auv_link::{
     encode, encode_signed, AxisPriority, BoardStatus, Command, ConfigPatch, Envelope, Heading,
-    MissionPlan, MissionSpec, MissionUpload, Msg, StateFrame, ThrustUnit, UploadPart, MAX_FRAME,
+    LawSettings, MissionPlan, MissionSpec, MissionUpload, Msg, StateFrame, ThrustUnit, UploadPart,
+    MAX_FRAME,
 };
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::trajectory::{SpeedList, WaypointList, MAX_PARTS, MAX_WAYPOINTS};
@@ -372,9 +373,19 @@ fn one(set: fn(&mut ConfigPatch)) -> ConfigPatch {
     p
 }
 
+/// Law settings other than the defaults (a rebuild): μ = 0.15 and changed K₁, K₂ (protocol
+/// 8, Choice 508).
+fn other_law() -> LawSettings {
+    let mut law = LawSettings::of(&ControllerConfig::default());
+    law.mu = 0.15;
+    law.k1[0] = 5.0;
+    law.k2[5] = 3.0;
+    law
+}
+
 /// Each field the link sets, changed alone from the defaults, and the whole patch host-sim's
-/// set-up sends (with the rate, unit, mounting and priority changed).
-fn field_patches(defaults: ConfigPatch) -> [(&'static str, ConfigPatch); 10] {
+/// set-up sends (with the rate, unit, mounting, priority and law changed).
+fn field_patches(defaults: ConfigPatch) -> [(&'static str, ConfigPatch); 11] {
     [
         ("rate_hz", one(|p| p.rate_hz = Some(200))),
         ("robust", one(|p| p.robust = Some(false))),
@@ -388,6 +399,7 @@ fn field_patches(defaults: ConfigPatch) -> [(&'static str, ConfigPatch); 10] {
         ("priority", one(|p| p.priority = Some(other_priority()))),
         ("stale_periods", one(|p| p.stale_periods = Some(3))),
         ("lockstep", one(|p| p.lockstep = Some(true))),
+        ("law", one(|p| p.law = Some(other_law()))),
         (
             "whole",
             ConfigPatch {
@@ -395,6 +407,7 @@ fn field_patches(defaults: ConfigPatch) -> [(&'static str, ConfigPatch); 10] {
                 thrust_unit: Some(ThrustUnit::Newton),
                 reversed_thrusters: Some(0),
                 priority: Some(other_priority()),
+                law: Some(other_law()),
                 ..defaults
             },
         ),
@@ -426,7 +439,7 @@ fn config_costs(syst: &mut SYST) -> Option<u32> {
     let mut seq = 0u16;
     let defaults = ConfigPatch::whole(&cfg, auv_link::DEFAULT_STALE_PERIODS, false);
     let fields = field_patches(defaults);
-    let mut costs = [0u32; 10];
+    let mut costs = [0u32; 11];
     for ((_, p), cost) in fields.iter().zip(costs.iter_mut()) {
         *cost = set_config_cost(&mut sup, &mut link, &mut seq, *p);
         sup.step(false, &|| 0);

@@ -166,8 +166,10 @@ pub(super) fn patch(input: &mut Bytes) -> ConfigPatch {
         }),
         reversed_thrusters: (present & 128 != 0).then(|| input.u8()),
         priority: None,
-        // Protocol 7's estimator stays unset too (tests/estimator.rs flies it).
+        // Protocol 7's estimator stays unset too (tests/estimator.rs flies it), and protocol
+        // 8's law (tests/law_settings.rs: the board takes a law exactly when the core does).
         estimator: None,
+        law: None,
     }
 }
 
