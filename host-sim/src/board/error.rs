@@ -101,10 +101,6 @@ pub enum Error {
     /// The scenario's thruster geometry is not one the link carries.
     #[error("the board's link carries the thruster geometry as the AUV-150 layout with some thrusters reversed; this scenario's geometry is another one, which PIL cannot fly")]
     Geometry,
-    /// The scenario's law settings differ from the board's built-in ones where the link
-    /// carries none (Choice 497): the board would fly another law than the simulator.
-    #[error("the board's link carries no {}: this scenario sets {} other than the board's built-in law, which PIL and HIL cannot fly (remove the keys, or fly it in SIL)", .fields.join(", "), if .fields.len() == 1 { "it" } else { "them" })]
-    LawNotCarried { fields: Vec<&'static str> },
     /// The board refused a command of the set-up, with its reason.
     #[error("the board refused the set-up: {}", reason.map_or("(no reason)", Refusal::as_str))]
     Refused { reason: Option<Refusal> },
@@ -171,8 +167,7 @@ impl From<Error> for Stop {
             | Error::Refused { .. }
             | Error::UploadNotVerified { .. }
             | Error::NotArmed { .. }
-            | Error::Geometry
-            | Error::LawNotCarried { .. } => BoardLoss::Misconfigured,
+            | Error::Geometry => BoardLoss::Misconfigured,
             Error::LinkIo { .. }
             | Error::Encode(_)
             | Error::ElfUnreadable { .. }

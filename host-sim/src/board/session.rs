@@ -17,7 +17,6 @@ use super::pacing::Pacing;
 use super::stats::{FailSafeEvent, FailSafeEventKind, UploadStats};
 use super::upload::upload;
 use crate::scenario::Scenario;
-use controller_core::ControllerConfig;
 
 /// The longest the set-up waits for the board to report itself armed, whatever telemetry
 /// keeps coming.
@@ -53,16 +52,14 @@ pub(super) struct SetUp {
 impl Session {
     /// The session of `scenario`'s validated controller and mission, paced by `pacing`.
     /// Refuses a thruster geometry the link cannot carry. The whole configuration is sent
-    /// (`ConfigPatch::whole`: the law's settings, the thruster chain and the state estimator's
-    /// settings, from which the board computes its gains, Choice 361).
+    /// (`ConfigPatch::whole`: the law's settings — K₁, K₂, Q, β, μ, the robust law, the ‖b‖
+    /// bound, the pitch limit since protocol 8, Choice 508 — the thruster chain and the state
+    /// estimator's settings, from which the board computes its gains, Choice 361), so the
+    /// board flies the law the scenario sets, as SIL does.
     pub(super) fn new(scenario: &Scenario, pacing: Pacing) -> Result<Self, Error> {
         let c = scenario.controller().config();
         // The link carries the geometry as the AUV-150 layout's reversed-thruster mask.
         let mounting = c.geometry.auv150_reversed().ok_or(Error::Geometry)?;
-        let fields = law_not_carried(c);
-        if !fields.is_empty() {
-            return Err(Error::LawNotCarried { fields });
-        }
         let thrust_unit = ThrustUnit::from(c.thrust_unit);
         let mission = scenario.trajectory().mission();
         Ok(Session {
@@ -219,56 +216,5 @@ fn refuse_if(t: &Telemetry, before: u32) -> Result<(), Error> {
         })
     } else {
         Ok(())
-    }
-}
-
-/// The law settings of `c` the link does not carry (`ConfigPatch` has no field for them) that
-/// differ from the board's built-in law, `ControllerConfig::default()` (Choice 497). The
-/// model, its box and the geometry are checked elsewhere (the rebuild's box, Choice 363;
-/// [`Error::Geometry`]).
-pub(super) fn law_not_carried(c: &ControllerConfig) -> Vec<&'static str> {
-    let board = ControllerConfig::default();
-    let mut out = Vec::new();
-    let mut differs = |name: &'static str, same: bool| {
-        if !same {
-            out.push(name);
-        }
-    };
-    differs("k1", c.k1 == board.k1);
-    differs("k2", c.k2 == board.k2);
-    differs("q", c.q == board.q);
-    differs("beta", c.beta == board.beta);
-    differs("mu", c.mu == board.mu);
-    differs("law", c.law == board.law);
-    differs("b_bound", c.b_bound == board.b_bound);
-    differs("pitch_limit", c.pitch_limit == board.pitch_limit);
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A law setting the link cannot carry is named, not flown silently: before, a scenario's
-    /// μ = 0.15 reached SIL while the board flew its built-in 0.1 (the real figure-eight's 3 s,
-    /// 0.016140 m against 0.015972 m).
-    #[test]
-    fn a_law_setting_the_link_cannot_carry_is_named() {
-        assert!(law_not_carried(&ControllerConfig::default()).is_empty());
-        let mut c = ControllerConfig {
-            mu: 0.15,
-            ..Default::default()
-        };
-        assert_eq!(law_not_carried(&c), ["mu"]);
-        c.k1[0] = 5.0;
-        c.k2[5] = 3.0;
-        assert_eq!(law_not_carried(&c), ["k1", "k2", "mu"]);
-        // What the link carries is not a difference.
-        let c = ControllerConfig {
-            delta_max: 20.0,
-            robust: false,
-            ..Default::default()
-        };
-        assert!(law_not_carried(&c).is_empty());
     }
 }

@@ -1,6 +1,8 @@
 //! Processor in the loop: the QEMU flying image flies the simulated vehicle through
-//! `host-sim pil`. Six checks: a short lawn-mower mission must equal SIL bit for bit, on an
-//! unsigned and on a signed link (the public CI test key, [`CI_TEST_KEY`]); a waypoint mission
+//! `host-sim pil`. Seven checks: a short lawn-mower mission must equal SIL bit for bit, on an
+//! unsigned and on a signed link (the public CI test key, [`CI_TEST_KEY`]); the real-chain
+//! mission with a tuned law ([`TUNED_LAW`]: μ, K₁, K₂ other than the board's built-in ones,
+//! protocol 8) must equal SIL bit for bit; a waypoint mission
 //! uploaded over a link that loses one chunk ([`WAYPOINTS`]) must equal SIL bit for bit with
 //! the chunk resent once; a short real-chain
 //! mission (kgf, tangent heading, time scale > 1, the real actuator chain, the real vehicle's
@@ -32,6 +34,14 @@ pub const CI_TEST_KEY: &str = "firmware/ci-test-link-key.hex";
 const REAL_CHAIN: &str = "host-sim/scenarios/real/figure-eight-30x30.toml";
 /// Seconds of the real-chain mission: 300 periods, a few seconds of QEMU.
 const REAL_CHAIN_SECONDS: &str = "3";
+
+/// The law keys added to [`REAL_CHAIN`]'s `[controller]` for the tuned-law case (written to
+/// the scratch folder as `pil-tuned-law.toml`): μ = 0.15 (the real-circle campaign's better
+/// layer) and other K₁ (surge) and K₂ (yaw) than the paper's. The board boots on the paper's
+/// law, so it flies these only if the link carries them (protocol 8, Choice 508): with μ alone
+/// and no law on the link the board flew 0.015972 m against SIL's 0.016140 m.
+const TUNED_LAW: &str =
+    "mu = 0.15\nk1 = [5.0, 4.0, 4.0, 0.0, 4.0, 4.0]\nk2 = [4.0, 4.0, 4.0, 0.0, 4.0, 3.0]\n";
 
 /// The waypoint mission PIL flies (workspace-relative, docs/ci.md#the-board-in-ci): uploaded in two
 /// chunks, the second lost on its first sending ([`WAYPOINTS_LOST_CHUNK`]), so the board's
@@ -69,7 +79,7 @@ pub fn build_host_sim(ci: &mut Ci) -> Option<PathBuf> {
 /// check and the report cannot disagree on a field.
 pub fn checks(ci: &mut Ci, host_sim: &Path, elf: &Path) {
     ci.step(
-        "processor in the loop: a short mission unsigned and signed, a short real-chain mission (PIL must equal SIL), a link-fault case, and a campaign's worst case replayed on the board",
+        "processor in the loop: a short mission unsigned and signed, a short real-chain mission and the same with a tuned law (PIL must equal SIL), a link-fault case, and a campaign's worst case replayed on the board",
     );
     let pil = Pil { host_sim, elf };
     same_as_sil(ci, &pil);
@@ -149,6 +159,17 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
     let signed = [&short[..3], &["5", "--link-key-file", &key]].concat();
     let real = ["--scenario", REAL_CHAIN, "--duration", REAL_CHAIN_SECONDS];
     let real_chain = real_chain_scenario(ci);
+    let tuned_file = tuned_law_scenario(ci);
+    let tuned_path = tuned_file
+        .as_ref()
+        .map(|p| p.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let tuned = [
+        "--scenario",
+        tuned_path.as_str(),
+        "--duration",
+        REAL_CHAIN_SECONDS,
+    ];
     let waypoints = [
         "--scenario",
         WAYPOINTS,
@@ -159,8 +180,12 @@ fn same_as_sil(ci: &mut Ci, pil: &Pil) {
         ("short", &short[..], false),
         ("short-signed", &signed[..], true),
         ("real-chain", &real[..], false),
+        ("tuned-law", &tuned[..], false),
         ("waypoints", &waypoints[..], false),
     ] {
+        if name == "tuned-law" && tuned_file.is_none() {
+            continue;
+        }
         let want_chain = if name == "real-chain" {
             match &real_chain {
                 Some(c) => Some(c),
@@ -480,6 +505,33 @@ fn campaign_worst_case(ci: &mut Ci, pil: &Pil) {
 /// The real-chain scenario's thrust unit name and reversed-thruster mask, after checking that
 /// it is a real-chain mission as [`REAL_CHAIN`] says (kgf, tangent heading, time scale > 1,
 /// the real actuator chain); `None` (and a CI failure) otherwise.
+/// [`REAL_CHAIN`] with [`TUNED_LAW`] in its `[controller]`, written to the scratch folder.
+fn tuned_law_scenario(ci: &mut Ci) -> Option<PathBuf> {
+    let text = match std::fs::read_to_string(ci.root.join(REAL_CHAIN)) {
+        Ok(t) if t.contains("\n[controller]\n") => t,
+        other => {
+            ci.fail(format!(
+                "PIL tuned-law: {REAL_CHAIN} must have a [controller] table to add the law to ({:?})",
+                other.err()
+            ));
+            return None;
+        }
+    };
+    let tuned = text.replacen(
+        "\n[controller]\n",
+        &format!("\n[controller]\n{TUNED_LAW}"),
+        1,
+    );
+    let path = ci.scratch().join("pil-tuned-law.toml");
+    match std::fs::write(&path, tuned) {
+        Ok(()) => Some(path),
+        Err(e) => {
+            ci.fail(format!("PIL tuned-law: writing {}: {e}", path.display()));
+            None
+        }
+    }
+}
+
 fn real_chain_scenario(ci: &mut Ci) -> Option<(&'static str, u8)> {
     let path = ci.root.join(REAL_CHAIN);
     let s = match host_sim::scenario::load_scenario(&path) {
