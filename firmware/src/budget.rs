@@ -106,11 +106,13 @@ pub const BUDGETS: [StepBudget; 3] = [
         // before Choice 527's finiteness sums; the filter's disturbance state, Choice 510,
         // adds about 210: its correction and d·Δt²/2, d·Δt in both predictions).
         estimator_stages: [450, 1_280, 410, 600],
-        // Measured 29 160 (the whole patch host-sim sends, protocol 7: its digest covers the
-        // estimator's 73 bytes too, and the rebuild checks the box its bounds are of, Choice
-        // 363; 21 600–24 120 for one law field), 1 051 160 and 1 218 200.
+        // Measured 35 960 (the whole patch host-sim sends, protocol 8: 71 bytes of the law's
+        // settings more to decode, a digest over 190 bytes, 120 before, and the rebuild's
+        // Lyapunov solve and loop-rate rule on the law sent, Choice 508; 29 160 with protocol
+        // 7's; 23 920–28 480 for one field, the law alone the 28 480), 1 051 160 and
+        // 1 218 200.
         work: WorkBudget {
-            set_config: 34_000,
+            set_config: 41_000,
             build: 1_200_000,
             period: 1_400_000,
         },
@@ -126,10 +128,10 @@ pub const BUDGETS: [StepBudget; 3] = [
         // sinf/cosf in the solution's and the estimate's attitude).
         update_from_solution: 26_500,
         estimator_stages: [8_400, 1_280, 8_400, 600],
-        // Measured 34 720, 1 281 440 and 1 448 480 (libm's cosf in the rebuild, its sin/cos in
-        // the waypoint build).
+        // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
+        // cosf in the rebuild, its sin/cos in the waypoint build).
         work: WorkBudget {
-            set_config: 48_000,
+            set_config: 55_000,
             build: 1_450_000,
             period: 1_650_000,
         },
@@ -144,9 +146,9 @@ pub const BUDGETS: [StepBudget; 3] = [
         // Measured 5 124; solution, filter, estimate, record: 345, 1 107, 319, 520.
         update_from_solution: 5_400,
         estimator_stages: [400, 1_280, 380, 600],
-        // Measured as the kernels: 29 160, 1 051 200 and 1 218 200.
+        // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
         work: WorkBudget {
-            set_config: 34_000,
+            set_config: 41_000,
             build: 1_200_000,
             period: 1_400_000,
         },
