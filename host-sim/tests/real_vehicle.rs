@@ -326,6 +326,32 @@ fn the_compiled_real_missions_are_the_folders_files_and_fly_the_paths_of_table_1
     }
 }
 
+/// Choices 543–544: every shipped real mission is one its own check calls feasible as written,
+/// on the navigation it ships with (survey-grade), the path-error budget and the chatter term
+/// included, and each closed form at the smallest scale the check proposes (the file says so).
+/// Before, the files sat at the scales the force check alone proposed (the circle at 1, the
+/// survey's legs at 2.11 m/s), which the budget and the term refuse: INFEASIBLE.
+#[test]
+fn every_shipped_real_mission_is_feasible_by_its_own_check_at_its_own_scale() {
+    let real = real_vehicle::real_scenarios().unwrap();
+    let surveys = real_vehicle::waypoint_scenarios().unwrap();
+    for s in real.iter().chain(&surveys) {
+        let c = s.config();
+        let p = preflight::check_as_written(s, DEFAULT_MARGIN).unwrap();
+        assert_eq!(p.verdict, Verdict::Feasible, "{}: {p}", c.name);
+        assert!(p.path_budget.is_some() && p.chatter.is_some(), "{}", c.name);
+        if matches!(c.trajectory, TrajectoryKind::Waypoints { .. }) {
+            continue;
+        }
+        assert_eq!(
+            p.smallest_time_scale,
+            Some(f64::from(c.time_scale) * 1e6).map(|k| k.round() / 1e6),
+            "{}: {p}",
+            c.name
+        );
+    }
+}
+
 #[test]
 fn the_static_demand_is_the_closed_form_of_weight_and_cg_moment() {
     // Untrimmed Table-3 payload (held constant), started in trim: the vehicle floats at its

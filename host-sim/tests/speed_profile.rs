@@ -5,12 +5,20 @@ use controller_core::trajectory::SpeedList;
 use controller_core::TrajectoryKind;
 use host_sim::scenario::real_vehicle;
 use host_sim::sim::{self, bound};
-use host_sim::studies::preflight::profile;
-use host_sim::studies::preflight::DEFAULT_MARGIN;
+use host_sim::studies::preflight::{self, profile, Verdict, DEFAULT_MARGIN};
 
 /// The shipped survey's vehicle on a short path: a 90 m leg, a 90° turn, a 20 m leg, a 90° turn,
-/// a 90 m leg back (constant speed 0.5 m/s; five parts... three legs and two turns).
+/// a 90 m leg back (constant speed 0.5 m/s; three legs and two turns), told the exact state:
+/// the force's search (steps 1–3 of the profile) alone decides it.
 fn short_survey() -> host_sim::scenario::Scenario {
+    navigated_short_survey()
+        .with(|c| c.navigation = None)
+        .unwrap()
+}
+
+/// [`short_survey`] on the navigation the survey ships with (survey-grade, filtered): the
+/// path-error budget and the chatter term join the search (step 4, Choice 543).
+fn navigated_short_survey() -> host_sim::scenario::Scenario {
     let base = real_vehicle::waypoint_scenarios().unwrap().remove(0);
     base.with(|c| {
         let points = controller_core::WaypointList::new(&[
@@ -30,6 +38,54 @@ fn short_survey() -> host_sim::scenario::Scenario {
         c.duration = 400.0;
     })
     .unwrap()
+}
+
+/// `s` with the profile `p` pinned (its speeds, speed change and duration).
+fn pinned(
+    s: &host_sim::scenario::Scenario,
+    p: &profile::SpeedProfile,
+) -> host_sim::scenario::Scenario {
+    let speeds: Vec<f32> = p.speeds.iter().map(|&v| v as f32).collect();
+    s.with(|c| {
+        if let TrajectoryKind::Waypoints {
+            speeds: ref mut sp,
+            speed_change: ref mut a,
+            ..
+        } = c.trajectory
+        {
+            *sp = Some(SpeedList::new(&speeds).unwrap());
+            *a = Some(p.speed_change as f32);
+        }
+        c.duration = p.total_time;
+    })
+    .unwrap()
+}
+
+/// Choice 543: on its navigation, the profile the thrusters allow is one the path-error budget
+/// refuses (the check as written calls it INFEASIBLE, which is what `check` printed to pin
+/// before); the proposal caps the parts the budget limits, names it, and its own check calls
+/// the pinned mission FEASIBLE.
+#[test]
+fn on_its_navigation_the_profile_is_one_its_own_check_calls_feasible() {
+    let force_only = profile::propose(&short_survey(), DEFAULT_MARGIN)
+        .unwrap()
+        .expect("a waypoint mission");
+    let s = navigated_short_survey();
+    let before = preflight::check_as_written(&pinned(&s, &force_only), DEFAULT_MARGIN).unwrap();
+    assert_ne!(before.verdict, Verdict::Feasible, "{before}");
+    let p = profile::propose(&s, DEFAULT_MARGIN)
+        .unwrap()
+        .expect("a waypoint mission");
+    assert!(
+        p.parts.iter().any(|t| t.limiting == profile::BUDGET),
+        "{p:?}"
+    );
+    // Only lowered: no part faster than the force allows.
+    for (v, f) in p.speeds.iter().zip(&force_only.speeds) {
+        assert!(v <= f, "{p:?} vs {force_only:?}");
+    }
+    let after = preflight::check_as_written(&pinned(&s, &p), DEFAULT_MARGIN).unwrap();
+    assert_eq!(after.verdict, Verdict::Feasible, "{after}");
 }
 
 #[test]
@@ -54,21 +110,7 @@ fn the_profile_beats_the_uniform_scale_and_flies_within_the_bound() {
         p.total_time
     );
     // Flown as pinned: within the real vehicle's bound.
-    let speeds: Vec<f32> = p.speeds.iter().map(|&v| v as f32).collect();
-    let pinned = s
-        .with(|c| {
-            if let TrajectoryKind::Waypoints {
-                speeds: ref mut sp,
-                speed_change: ref mut a,
-                ..
-            } = c.trajectory
-            {
-                *sp = Some(SpeedList::new(&speeds).unwrap());
-                *a = Some(p.speed_change as f32);
-            }
-            c.duration = p.total_time;
-        })
-        .unwrap();
+    let pinned = pinned(&s, &p);
     let run = sim::run(&pinned);
     assert!(bound::within_bound(&run), "{:?}", run.metrics);
     assert!(!run.missed(), "{}", run.outcome);

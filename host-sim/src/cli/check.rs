@@ -124,7 +124,9 @@ fn checked(args: &CheckArgs, stdout: &mut dyn Write) -> Result<Checked> {
     // cannot be flown even slowly over the box cannot be flown as written either).
     match profile::propose(&scenario, args.margin) {
         Ok(s) => out.speed_profile = s,
-        Err(e @ CheckError::NoProfile { .. }) => out.no_speed_profile = Some(e.to_string()),
+        Err(e @ (CheckError::NoProfile { .. } | CheckError::NoProfileTerm { .. })) => {
+            out.no_speed_profile = Some(e.to_string())
+        }
         Err(CheckError::Interrupted) => {
             eprintln!("host-sim: check: interrupted before the speed profile");
             out.interrupted = true;
@@ -307,7 +309,7 @@ fn preflight_table(p: &Preflight) -> String {
 fn profile_table(path: TrajectoryKind, p: &SpeedProfile) -> Result<String> {
     let mut s = format!(
         "speed profile over the whole box (margin envelope, speed changes at {} m/s²):\n\
-         {:<12} {:>10} {:>12} {:>10}  limited by (thruster, cap or changes)\n",
+         {:<12} {:>10} {:>12} {:>10}  limited by (thruster, cap, changes, path budget or chatter)\n",
         Readable(p.speed_change),
         "part",
         "length (m)",

@@ -93,6 +93,13 @@ pub enum CheckError {
         /// The thruster out of its envelope.
         thruster: String,
     },
+    /// A waypoint mission with no speed profile its own check passes (Choice 543): the
+    /// path-error budget or the chatter term refuses it at every speed the search tries, or
+    /// the check as flown still refuses it after the search's rounds.
+    NoProfileTerm {
+        /// What refuses it, as a clause.
+        why: String,
+    },
 }
 
 impl fmt::Display for CheckError {
@@ -105,6 +112,7 @@ impl fmt::Display for CheckError {
                 "no speed profile: {part} cannot be flown over the whole box even at {} m/s ({thruster} beyond its envelope)",
                 profile::MIN_PROFILE_SPEED
             ),
+            CheckError::NoProfileTerm { why } => write!(f, "no speed profile: {why}"),
         }
     }
 }

@@ -57,12 +57,21 @@ pub const VERIFY_SHRINK: f64 = 0.97;
 pub const MAX_VERIFY_ROUNDS: usize = 8;
 /// The slowest speed the search considers (m/s): a part infeasible there is infeasible.
 pub const MIN_PROFILE_SPEED: f64 = 0.02;
+/// The slowest common speed step 4 caps the parts at (m/s): the navigation's terms hardly
+/// change below it, and a vehicle this slow has little steerage (Choice 543).
+pub const MIN_TERM_SPEED: f64 = 0.1;
+/// The factor step 4 lowers its cap by before its bisection (Choice 543).
+pub const TERM_STEP: f64 = 0.8;
 /// What the report names as the limit of a leg its cap bound (`trajectory.speed_limits`).
 pub const CAP: &str = "cap";
 /// What the report names as the limit of a part that step 2 slowed below its own speed (and
 /// below its cap): too short to reach it and come back with the speed changes at
 /// `speed_change` (**Choice 171**).
 pub const CHANGES: &str = "changes";
+/// What the report names as the limit of a part the path-error budget capped (Choice 543).
+pub const BUDGET: &str = "path budget";
+/// What the report names as the limit of a part the chatter term capped (Choice 543).
+pub const CHATTER: &str = "chatter";
 
 /// One part of the path as the profile flies it.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -156,19 +165,65 @@ pub fn propose_with(
         accel: super::time_scale(speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
     };
     let checker = Checker::new(&constant, margin, engine)?;
-    let (fastest, limiting) = per_part_speeds(&checker, &parts)?;
-    let uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
-    let mut speeds = fastest.clone();
-    for round in 0..=MAX_VERIFY_ROUNDS {
-        let rounded = round_down(&speeds);
+    let (fastest, mut limiting) = per_part_speeds(&checker, &parts)?;
+    let mut uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
+    let flown = |speeds: &[f64]| -> Result<(Vec<f64>, Vec<f64>, Scenario), CheckError> {
+        let rounded = round_down(speeds);
         let fitted = fit_changes(&parts, &rounded);
-        let flown = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
+        let scenario = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
+        Ok((rounded, fitted, scenario))
+    };
+    // Step 4 (Choice 543): the path-error budget and the chatter term as flown. A profile the
+    // force allows may still be one the mission's navigation cannot fly within its bound (the
+    // boundary layer's gain grows with the reference's speed): every part is then capped at
+    // the fastest common speed at which both terms fit.
+    let capped = |c: f64| -> Vec<f64> { fastest.iter().map(|&v| v.min(c)).collect() };
+    let mut speeds = fastest.clone();
+    if let Some(term) = terms_miss(&flown(&speeds)?.2)? {
+        // Down from the fastest part in steps of TERM_STEP to the first cap that fits, then
+        // bisection between it and the step above: the terms are not monotone at the slow
+        // end (a longer flight meets more fixes, and drifts longer without them), so the
+        // search keeps to the fastest cap that fits.
+        let mut hi = fastest.iter().copied().fold(0.0, f64::max);
+        let mut lo = hi * TERM_STEP;
+        while terms_miss(&flown(&capped(lo))?.2)?.is_some() {
+            if lo <= MIN_TERM_SPEED {
+                return Err(CheckError::NoProfileTerm {
+                    why: format!("the {term} refuses the route at every common speed from {:.2} down to {MIN_TERM_SPEED} m/s", fastest.iter().copied().fold(0.0, f64::max)),
+                });
+            }
+            hi = lo;
+            lo = (lo * TERM_STEP).max(MIN_TERM_SPEED);
+        }
+        let mut limit = term;
+        while hi / lo > 1.0 + SPEED_TOLERANCE {
+            let mid = (lo * hi).sqrt();
+            match terms_miss(&flown(&capped(mid))?.2)? {
+                None => lo = mid,
+                Some(t) => {
+                    hi = mid;
+                    limit = t;
+                }
+            }
+        }
+        for (l, &v) in limiting.iter_mut().zip(&fastest) {
+            if v > lo {
+                *l = limit.to_string();
+            }
+        }
+        speeds = capped(lo);
+        // The fastest uniform speed is capped alike: the terms refuse any faster.
+        uniform_speed = uniform_speed.min(lo);
+    }
+    for round in 0..=MAX_VERIFY_ROUNDS {
+        let (rounded, fitted, flown) = flown(&speeds)?;
         let checker = Checker::new(&flown, margin, engine)?;
         // The mission as written first: one case against the box's 2⁹, and a round it
-        // refuses needs no sweep of the box (Choice 533).
-        let ok =
-            checker.feasible(Scope::AsWritten, 1.0)? && checker.feasible(Scope::WholeBox, 1.0)?;
-        if ok || round == MAX_VERIFY_ROUNDS {
+        // refuses needs no sweep of the box (Choice 533); then the terms (Choice 543).
+        let ok = checker.feasible(Scope::AsWritten, 1.0)?
+            && checker.feasible(Scope::WholeBox, 1.0)?
+            && terms_miss(&flown)?.is_none();
+        if ok {
             // A part step 2 slowed is limited by the changes, not by what bounded its search.
             let limiting = limiting
                 .iter()
@@ -189,7 +244,28 @@ pub fn propose_with(
         }
         speeds.iter_mut().for_each(|v| *v *= VERIFY_SHRINK);
     }
-    unreachable!("the loop returns in its last round")
+    // Choice 543: no profile is proposed that its own check refuses.
+    Err(CheckError::NoProfileTerm {
+        why: format!(
+            "the check as flown still refuses it with every speed lowered {MAX_VERIFY_ROUNDS} times by {VERIFY_SHRINK}"
+        ),
+    })
+}
+
+/// The term that refuses the mission `flown` at its own time scale (the path-error budget
+/// first, then the chatter term), or `None` when both fit (or it has no bound).
+fn terms_miss(flown: &Scenario) -> Result<Option<&'static str>, CheckError> {
+    if let Some(b) = super::path_budget::Budget::new(flown)? {
+        if !b.fits_at(1.0)? {
+            return Ok(Some(BUDGET));
+        }
+    }
+    if let Some(c) = super::chatter::Chatter::new(flown)? {
+        if !c.fits_at(1.0)? {
+            return Ok(Some(CHATTER));
+        }
+    }
+    Ok(None)
 }
 
 /// `cfg` with the time law `speeds` (per part; `None`: constant speed), time scale 1 and a
