@@ -77,6 +77,59 @@ fn unit() -> impl Strategy<Value = ThrustUnit> {
     prop_oneof![Just(ThrustUnit::Kgf), Just(ThrustUnit::Newton)]
 }
 
+/// [`Allocator::allocate`] on a layout of the AUV-150's blocks with lexicographic rules: each
+/// block's higher axis met exactly when feasible (else at the nearest end of its reach), the
+/// lower then no worse than a brute-force grid on the segment that gives the higher.
+fn lexicographic_optimum(
+    al: &Allocator,
+    a: &PseudoInverse,
+    e: &ThrustEnvelope,
+    tau: &[f32; 6],
+) -> Result<(), TestCaseError> {
+    let out = al.allocate(&Vector6::from(*tau));
+    // (block, high axis, low axis)
+    for (thrusters, high, low) in [(BLOCKS[0].0, M, Z), (BLOCKS[1].0, N, Y)] {
+        let (lo, hi) = reach(a, e, thrusters, high);
+        let want = (tau[high] as f64).clamp(lo, hi);
+        let got = row(a, high, &out.thrusts);
+        let tol = 1e-4 * (hi - lo);
+        prop_assert!(
+            (got - want).abs() <= tol,
+            "axis {}: achieved {} but {} is reachable ({} … {})",
+            high,
+            got,
+            want,
+            lo,
+            hi
+        );
+        // Brute force on the segment {g_high·T = want}: a fine grid of the first thruster,
+        // the second from the segment's equation; the best lower-axis residual there.
+        let b = a.matrix();
+        let [p, q] = thrusters;
+        let (gp, gq) = (b[(high, p)] as f64, b[(high, q)] as f64);
+        let mut best = f64::INFINITY;
+        for k in 0..=4000 {
+            let tp = e.min[p] as f64 + (e.max[p] - e.min[p]) as f64 * k as f64 / 4000.0;
+            let tq = (want - gp * tp) / gq;
+            if tq < e.min[q] as f64 - 1e-9 || tq > e.max[q] as f64 + 1e-9 {
+                continue;
+            }
+            let r = tau[low] as f64 - (b[(low, p)] as f64 * tp + b[(low, q)] as f64 * tq);
+            best = best.min(r.abs());
+        }
+        let mine = (tau[low] as f64 - row(a, low, &out.thrusts)).abs();
+        let step = (e.max[p] - e.min[p]) as f64 / 4000.0 * 4.0;
+        prop_assert!(
+            mine <= best + step + 1e-4 * (tau[low].abs() as f64).max(1.0),
+            "axis {}: residual {} but the segment allows {}",
+            low,
+            mine,
+            best
+        );
+    }
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(2000))]
 
@@ -156,36 +209,22 @@ proptest! {
     #[test]
     fn higher_priority_axis_is_met_when_feasible(tau in wrench(), reversed in 0u8..32, unit in unit()) {
         let (al, a) = allocator(reversed, unit, &AxisPriority::default());
-        let e = envelope(unit);
-        let out = al.allocate(&Vector6::from(tau));
-        // (block, high axis, low axis)
-        for (thrusters, high, low) in [(BLOCKS[0].0, M, Z), (BLOCKS[1].0, N, Y)] {
-            let (lo, hi) = reach(&a, &e, thrusters, high);
-            let want = (tau[high] as f64).clamp(lo, hi);
-            let got = row(&a, high, &out.thrusts);
-            let tol = 1e-4 * (hi - lo);
-            prop_assert!((got - want).abs() <= tol,
-                "axis {}: achieved {} but {} is reachable ({} … {})", high, got, want, lo, hi);
-            // Brute force on the segment {g_high·T = want}: a fine grid of the first thruster,
-            // the second from the segment's equation; the best lower-axis residual there.
-            let b = a.matrix();
-            let [p, q] = thrusters;
-            let (gp, gq) = (b[(high, p)] as f64, b[(high, q)] as f64);
-            let mut best = f64::INFINITY;
-            for k in 0..=4000 {
-                let tp = e.min[p] as f64 + (e.max[p] - e.min[p]) as f64 * k as f64 / 4000.0;
-                let tq = (want - gp * tp) / gq;
-                if tq < e.min[q] as f64 - 1e-9 || tq > e.max[q] as f64 + 1e-9 {
-                    continue;
-                }
-                let r = tau[low] as f64 - (b[(low, p)] as f64 * tp + b[(low, q)] as f64 * tq);
-                best = best.min(r.abs());
-            }
-            let mine = (tau[low] as f64 - row(&a, low, &out.thrusts)).abs();
-            let step = (e.max[p] - e.min[p]) as f64 / 4000.0 * 4.0;
-            prop_assert!(mine <= best + step + 1e-4 * (tau[low].abs() as f64).max(1.0),
-                "axis {}: residual {} but the segment allows {}", low, mine, best);
-        }
+        lexicographic_optimum(&al, &a, &envelope(unit), &tau)?;
+    }
+
+    /// The same on a layout whose aft thrusters sit further aft than the fore ones are forward
+    /// (2.2 m against 1.8 m): each block's larger gain on its higher axis (pitch, yaw) is its
+    /// second thruster's, which the allocator takes first (Choice 493).
+    #[test]
+    fn higher_priority_axis_is_met_with_unequal_arms(tau in wrench(), reversed in 0u8..32, unit in unit()) {
+        let mut g = ThrusterGeometry::auv150(reversed);
+        g.position[2][0] = -2.2;
+        g.position[4][0] = -2.2;
+        let b = g.effectiveness().expect("a valid layout");
+        prop_assert!(b[(M, 2)].abs() > b[(M, 1)].abs() && b[(N, 4)].abs() > b[(N, 3)].abs());
+        let a = PseudoInverse::new(&g).expect("a block layout");
+        let al = Allocator::new(&a, &envelope(unit), &AxisPriority::default()).expect("blocks");
+        lexicographic_optimum(&al, &a, &envelope(unit), &tau)?;
     }
 
     /// Equal priority within each block: the weighted least-squares optimum over the box is no

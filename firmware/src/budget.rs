@@ -89,20 +89,21 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "kernels",
         update: 4_000,
-        // kinematics, trajectory, law, allocation, voltage maps: measured 448, 640, 606, 891,
-        // 427 (Choices 520–522, 524 and 526; 499, 639, 682, 888, 1 112 before; an unclamped
-        // tunnel reports its command, no Cardano root on the step). The trajectory stage's 720:
+        // kinematics, trajectory, law, allocation, voltage maps: measured 444, 640, 605, 811,
+        // 424 (the allocation 891 before Choice 493; Choices 520–522, 524 and 526 took them
+        // from 499, 639, 682, 888, 1 112; an unclamped tunnel reports its command, no Cardano
+        // root on the step). The trajectory stage's 720:
         // a waypoint path's sample (two fixed binary searches, the time law's piece and the
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
         // against 445 for the closed forms.
-        stages: [500, 720, 680, 1_000, 480],
-        // Measured 5 245 (5 887 with the inverse map's roots, Choice 491, and the estimator's
-        // finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
+        stages: [500, 720, 680, 930, 480],
+        // Measured 5 164 (5 245 before Choice 493; 5 887 with the inverse map's roots, Choice
+        // 491, and the estimator's finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
         // 510, before Choices 520–522 and 524; 6 273 before both, 7 200 before Choices
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
-        // 2 250 of it and the law on the estimate ≈ 3 000 (docs/law.md#the-state-estimator).
-        update_from_solution: 5_500,
-        // solution, filter, estimate, record: measured 390, 1 108, 356, 521 (1 249 and 532
+        // 2 250 of it and the law on the estimate ≈ 2 900 (docs/law.md#the-state-estimator).
+        update_from_solution: 5_450,
+        // solution, filter, estimate, record: measured 390, 1 106, 353, 518 (1 249 and 532
         // before Choice 527's finiteness sums; the filter's disturbance state, Choice 510,
         // adds about 210: its correction and d·Δt²/2, d·Δt in both predictions).
         estimator_stages: [450, 1_280, 410, 600],
@@ -123,10 +124,11 @@ pub const BUDGETS: [StepBudget; 3] = [
         // Measured 15 240 (the SysTick count); stages 7 540, 5 471, 849, 890, 423 (the voltage
         // maps take no cbrtf since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
-        stages: [8_400, 6_200, 1_000, 1_000, 500],
-        // Measured 24 757; solution, filter, estimate, record: 7 537, 1 102, 7 503, 518 (libm's
+        stages: [8_400, 6_200, 1_000, 930, 500],
+        // Measured 24 683 (24 757 before Choice 493); solution, filter, estimate, record: 7 535,
+        // 1 101, 7 504, 518 (libm's
         // sinf/cosf in the solution's and the estimate's attitude).
-        update_from_solution: 26_500,
+        update_from_solution: 26_000,
         estimator_stages: [8_400, 1_280, 8_400, 600],
         // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
         // cosf in the rebuild, its sin/cos in the waypoint build).
@@ -142,9 +144,10 @@ pub const BUDGETS: [StepBudget; 3] = [
         // Measured 3 000 (the SysTick count); stages 377, 570, 618, 890, 422 (the waypoint
         // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
-        stages: [450, 680, 700, 1_000, 480],
-        // Measured 5 124; solution, filter, estimate, record: 345, 1 107, 319, 520.
-        update_from_solution: 5_400,
+        stages: [450, 680, 700, 930, 480],
+        // Measured 5 047 (5 124 before Choice 493); solution, filter, estimate, record: 343,
+        // 1 107, 321, 518.
+        update_from_solution: 5_300,
         estimator_stages: [400, 1_280, 380, 600],
         // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
         work: WorkBudget {

@@ -161,16 +161,21 @@ fn two_block(
     if !(det.is_finite() && det != 0.0) {
         return Err(AllocationError::Singular);
     }
+    let (mut thrusters, mut g) = (thrusters, g);
     let rule = if priority.rank[axes[0]] == priority.rank[axes[1]] {
         Rule::LeastSquares([priority.weight[axes[0]], priority.weight[axes[1]]])
     } else {
-        let p = if g[0][0].abs() >= g[0][1].abs() { 0 } else { 1 };
-        let q = 1 - p;
-        let ratio = g[0][q] / g[0][p];
-        let alpha = g[1][q] - g[1][p] * ratio;
+        // Choice 493: the thruster with the larger gain on the higher axis (p) is the block's
+        // first, so the step indexes nothing by p. Every value the step forms from the pair is
+        // a two-term sum or a product, which the order leaves bit for bit.
+        if g[0][0].abs() < g[0][1].abs() {
+            thrusters.swap(0, 1);
+            g = [[g[0][1], g[0][0]], [g[1][1], g[1][0]]];
+        }
+        let ratio = g[0][1] / g[0][0];
+        let alpha = g[1][1] - g[1][0] * ratio;
         Rule::Lexicographic(Segment {
-            p,
-            inv_gap: 1.0 / g[0][p],
+            inv_gap: 1.0 / g[0][0],
             ratio,
             inv_alpha: 1.0 / alpha,
         })

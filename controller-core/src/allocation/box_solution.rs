@@ -3,13 +3,11 @@
 //! least squares over the box's edges and corners ([`super::Allocator`] says when each applies).
 
 /// The constants of the lexicographic solution, precomputed. With `p` the thruster whose
-/// gain on axis a is the larger in magnitude and `q` the other, the segment g_a·T = c is
+/// gain on axis a is the larger in magnitude, the block's first (Choice 493), and `q` the other, the segment g_a·T = c is
 /// T_p = (c − g_aq T_q)/g_ap, and along it τ_b = α T_q + β with α = g_bq − g_bp g_aq/g_ap
 /// (= det G / g_ap ≠ 0) and β = g_bp c/g_ap.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct Segment {
-    /// Index (0 or 1) of `p` within the block.
-    pub(super) p: usize,
     /// 1/g_ap.
     pub(super) inv_gap: f32,
     /// g_aq/g_ap.
@@ -51,7 +49,8 @@ pub(super) fn lexicographic(
     lo: [f32; 2],
     hi: [f32; 2],
 ) -> [f32; 2] {
-    let (p, q) = (seg.p, 1 - seg.p);
+    // p is the block's first thruster (Choice 493).
+    let (p, q) = (0, 1);
     let (r_lo, r_hi) = reach(g[0], lo, hi);
     let c = clamp(ta, r_lo, r_hi);
     // T_q such that T_p = (c − g_aq T_q)/g_ap lies in [lo_p, hi_p], and T_q in its own box.
