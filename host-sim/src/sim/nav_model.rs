@@ -72,7 +72,8 @@ impl NoiseDraws {
 /// scheme: ChaCha12 (`StdRng`) or Xoshiro256++ (about a fifth of ChaCha12's cost a draw).
 #[derive(Debug)]
 pub enum Normals {
-    ChaCha(StdRng),
+    /// Boxed: its 320 bytes of state would size every generator.
+    ChaCha(Box<StdRng>),
     Xoshiro(Xoshiro256PlusPlus),
 }
 
@@ -80,16 +81,16 @@ impl Normals {
     /// The generator of `draws` seeded from `seed`.
     pub fn new(draws: NoiseDraws, seed: u64) -> Self {
         match draws {
-            NoiseDraws::EveryPeriod => Normals::ChaCha(StdRng::seed_from_u64(seed)),
+            NoiseDraws::EveryPeriod => Normals::ChaCha(Box::new(StdRng::seed_from_u64(seed))),
             NoiseDraws::AtSamples => Normals::Xoshiro(Xoshiro256PlusPlus::seed_from_u64(seed)),
         }
     }
 
     /// The next standard normal.
     #[inline]
-    pub fn next(&mut self) -> f64 {
+    pub fn normal(&mut self) -> f64 {
         match self {
-            Normals::ChaCha(r) => StandardNormal.sample(r),
+            Normals::ChaCha(r) => StandardNormal.sample(r.as_mut()),
             Normals::Xoshiro(r) => StandardNormal.sample(r),
         }
     }
@@ -173,7 +174,7 @@ impl<const N: usize> Stream<N> {
         let mut gm = [0.0; N];
         for (g, s) in gm.iter_mut().zip(model.bias_sigma) {
             if !(sparse && s == 0.0) {
-                *g = s * rng.next();
+                *g = s * rng.normal();
             }
         }
         Stream {
@@ -205,17 +206,17 @@ impl<const N: usize> Stream<N> {
             for i in 0..N {
                 self.gm[i] *= a;
                 if sb[i] != 0.0 {
-                    self.gm[i] += sb[i] * self.rng.next();
+                    self.gm[i] += sb[i] * self.rng.normal();
                 }
                 if sw[i] != 0.0 {
-                    self.walk[i] += sw[i] * self.rng.next();
+                    self.walk[i] += sw[i] * self.rng.normal();
                 }
             }
             return;
         }
         for i in 0..N {
-            let n1 = self.rng.next();
-            let n2 = self.rng.next();
+            let n1 = self.rng.normal();
+            let n2 = self.rng.normal();
             self.gm[i] = a * self.gm[i] + sb[i] * n1;
             self.walk[i] += sw[i] * n2;
         }
@@ -239,7 +240,7 @@ impl<const N: usize> Stream<N> {
             let white = if self.sparse && s == 0.0 {
                 0.0
             } else {
-                s * self.rng.next()
+                s * self.rng.normal()
             };
             *e = self.model.bias[i] + self.gm[i] + self.walk[i] + white;
         }
@@ -675,7 +676,7 @@ mod tests {
             NoiseDraws::AtSamples,
             3u64.wrapping_add(5u64.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
         );
-        assert_eq!(s.rng.next().to_bits(), fresh.next().to_bits());
+        assert_eq!(s.rng.normal().to_bits(), fresh.normal().to_bits());
         // Every period, the same source draws one normal at the start and two per step.
         let mut e = Stream::new(m, 3, 5, NoiseDraws::EveryPeriod);
         e.advance(0.01);
@@ -684,9 +685,9 @@ mod tests {
             3u64.wrapping_add(5u64.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
         );
         for _ in 0..3 {
-            chacha.next();
+            chacha.normal();
         }
-        assert_eq!(e.rng.next().to_bits(), chacha.next().to_bits());
+        assert_eq!(e.rng.normal().to_bits(), chacha.normal().to_bits());
     }
 
     #[test]

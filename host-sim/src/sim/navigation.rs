@@ -96,8 +96,8 @@ impl Navigation {
         eta[5] = reported_heading(eta[5]);
         if let Some(n) = &self.noise {
             for i in 0..6 {
-                let a = self.rng.next();
-                let b = self.rng.next();
+                let a = self.rng.normal();
+                let b = self.rng.normal();
                 eta[i] += n.eta_sigma[i] * a;
                 nu[i] += n.nu_sigma[i] * b;
             }
