@@ -68,12 +68,25 @@ fn missions(c: &mut Criterion) {
         spec,
         campaign.bases.clone(),
     );
+    // Its noise drawn every period from ChaCha12 (before Choice 536) beside the study-grade
+    // draws it declares.
+    let mut spec = campaign.spec.clone();
+    spec.noise_draws = None;
+    let every_period = host_sim::studies::campaign::Campaign::new(
+        campaign.text.clone(),
+        spec,
+        campaign.bases.clone(),
+    );
     let mut group = c.benchmark_group("campaign");
     group.sample_size(20);
     for (name, campaign) in [
         (
             "real-circle run (70 s, real chain, drawn Δp, current, noise), study-grade step",
             &campaign,
+        ),
+        (
+            "real-circle run (70 s, real chain, drawn Δp, current, noise), study-grade step, noise drawn every period",
+            &every_period,
         ),
         (
             "real-circle run (70 s, real chain, drawn Δp, current, noise), 1 ms step",

@@ -134,6 +134,7 @@ fn every_key(path: TrajectoryKind) -> ScenarioFile {
         duration: Some(1.0),
         plant_step: Some(1.0),
         plant_integrator: Some("midpoint".into()),
+        noise_draws: Some("at-samples".into()),
         ideal_actuators: Some(true),
         initial_offset: Some([0.0; 6]),
         divergence_limit: Some(1.0),
@@ -278,6 +279,9 @@ fn configurations() -> Vec<SimConfig> {
     // Choice 542: a study-grade configuration (its integrator is written, and read back).
     let mut study = out[0].clone();
     study.plant_integrator = host_sim::plant::Integrator::Midpoint;
+    out.push(study.clone());
+    // Choice 536: study-grade noise draws (written, and read back).
+    study.noise_draws = host_sim::sim::nav_model::NoiseDraws::AtSamples;
     out.push(study);
     for case in Table1Case::ALL {
         out.push(paper::config(case, true));

@@ -134,6 +134,7 @@ fn other_bad_values_name_their_keys() {
         ("plant_step = 0.02\n", "plant_step"), // > the 10 ms control period
         ("plant_step = 0.003\n", "plant_step"), // does not divide 10 ms
         ("plant_integrator = \"euler\"\n", "plant_integrator"),
+        ("noise_draws = \"sometimes\"\n", "noise_draws"),
         ("divergence_limit = 0\n", "divergence_limit"),
         ("thruster_lag = 0\n", "thruster_lag"),
         (

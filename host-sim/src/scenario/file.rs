@@ -31,6 +31,9 @@ pub struct ScenarioFile {
     /// An [`Integrator`](crate::plant::Integrator) by name (checked when built).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plant_integrator: Option<String>,
+    /// A [`NoiseDraws`](crate::sim::nav_model::NoiseDraws) by name (checked when built).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_draws: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]
     pub ideal_actuators: Option<bool>,
     #[serde(
@@ -75,6 +78,7 @@ impl ScenarioFile {
             duration: None,
             plant_step: None,
             plant_integrator: None,
+            noise_draws: None,
             ideal_actuators: None,
             initial_offset: None,
             divergence_limit: None,

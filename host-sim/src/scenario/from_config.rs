@@ -18,6 +18,7 @@ use super::file::{
 };
 use super::{f32_decimal, parse, InitialAttitude, SimConfig, TickRange};
 use crate::plant::{CurrentModel, Integrator, VariationProfile};
+use crate::sim::nav_model::NoiseDraws;
 
 /// A configuration a scenario file cannot describe: the field, and why.
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -82,6 +83,8 @@ impl TryFrom<&SimConfig> for ScenarioFile {
         // Written when not the default, so a file of an RK4 run reads as it always did.
         file.plant_integrator =
             (c.plant_integrator != Integrator::Rk4).then(|| c.plant_integrator.name().into());
+        file.noise_draws =
+            (c.noise_draws != NoiseDraws::EveryPeriod).then(|| c.noise_draws.name().into());
         file.ideal_actuators = Some(c.ideal_actuators);
         file.initial_offset = Some(c.initial_offset);
         file.divergence_limit = Some(c.divergence_limit);

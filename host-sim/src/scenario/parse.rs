@@ -20,6 +20,7 @@ use super::paper;
 use super::validate::invalid;
 use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
 use crate::plant::{CurrentModel, Integrator, VariationProfile};
+use crate::sim::nav_model::NoiseDraws;
 
 /// Default `seed` of `[noise]`, `[navigation]` and the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;
@@ -108,6 +109,9 @@ pub(super) fn build(raw: ScenarioFile, default_name: &str) -> Res<SimConfig> {
     }
     if let Some(name) = raw.plant_integrator {
         config.plant_integrator = integrator(&name)?;
+    }
+    if let Some(name) = raw.noise_draws {
+        config.noise_draws = noise_draws(&name)?;
     }
     if let Some(b) = raw.ideal_actuators {
         config.ideal_actuators = b;
@@ -452,6 +456,17 @@ pub(super) fn axis_priority(order: &[String]) -> Res<AxisPriority> {
         priority.rank[axis] = (order.len() - i) as u8;
     }
     Ok(priority)
+}
+
+/// The noise draws named `name` (`noise_draws`, Choice 536).
+fn noise_draws(name: &str) -> Res<NoiseDraws> {
+    NoiseDraws::from_name(name).ok_or_else(|| {
+        let names: Vec<&str> = NoiseDraws::ALL.iter().map(|d| d.name()).collect();
+        invalid(
+            "noise_draws",
+            format!("{name:?} is not one of {}", names.join(", ")),
+        )
+    })
 }
 
 /// The plant integrator named `name` (`plant_integrator`, Choice 542).

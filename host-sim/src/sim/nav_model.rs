@@ -15,14 +15,86 @@
 //!
 //! Everything is f64 and deterministic: each source draws from its own generator, seeded from
 //! the model's seed and the source, so changing one source does not change another's noise.
+//! How the errors are drawn is the scenario's `noise_draws` ([`NoiseDraws`]): every bias
+//! stepped every period from ChaCha12 (the default), or each error drawn only when its source
+//! samples, from Xoshiro256++ (study-grade flight).
 
 use std::collections::VecDeque;
 
 use rand::rngs::StdRng;
 use rand::SeedableRng;
 use rand_distr::{Distribution, StandardNormal};
+use rand_xoshiro::Xoshiro256PlusPlus;
 
 use crate::scenario::navigation::{ErrorModel, NavigationModel, Timing};
+
+/// How a run draws its navigation errors and `[noise]` (scenario key `noise_draws`).
+///
+/// **Choice 536** (docs/navigation.md#the-noise-draws): `every-period` is the default and what
+/// Table 1 and the shipped missions fly — each source's error process drawn from ChaCha12
+/// (`StdRng`) and every bias stepped every control period, sampled or not (two normals per
+/// axis a period, a zero σ drawn and multiplied by 0). `at-samples` is the study-grade
+/// scheme a campaign declares with `noise_draws = "at-samples"`: Xoshiro256++ generators
+/// (the same ziggurat normal), each source's bias stepped only when the source samples, over
+/// the periods since its last sample by the exact transition (Eq N1:
+/// b ← a^n·b + σ_b·√(1 − a^(2n))·w₁, walk ← walk + σ_w·√(n·dt)·w₂, a = e^(−dt/τ)), and
+/// no normal drawn for a zero σ. Both are the same processes at every sample (the n-step
+/// transition is the composition of n one-step ones), not the same realisations.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoiseDraws {
+    /// ChaCha12, every bias stepped every period (today's streams, bit for bit).
+    #[default]
+    EveryPeriod,
+    /// Xoshiro256++, each error drawn at its source's samples only.
+    AtSamples,
+}
+
+impl NoiseDraws {
+    /// Every scheme, in the order the scenario key lists them.
+    pub const ALL: [NoiseDraws; 2] = [NoiseDraws::EveryPeriod, NoiseDraws::AtSamples];
+
+    /// The scenario key's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            NoiseDraws::EveryPeriod => "every-period",
+            NoiseDraws::AtSamples => "at-samples",
+        }
+    }
+
+    /// The scheme named `name`, if any.
+    pub fn from_name(name: &str) -> Option<NoiseDraws> {
+        NoiseDraws::ALL.into_iter().find(|d| d.name() == name)
+    }
+}
+
+/// A seeded generator of standard normals (the ziggurat of `rand_distr`) of a [`NoiseDraws`]
+/// scheme: ChaCha12 (`StdRng`) or Xoshiro256++ (about a fifth of ChaCha12's cost a draw).
+#[derive(Debug)]
+pub enum Normals {
+    /// Boxed: its 320 bytes of state would size every generator.
+    ChaCha(Box<StdRng>),
+    Xoshiro(Xoshiro256PlusPlus),
+}
+
+impl Normals {
+    /// The generator of `draws` seeded from `seed`.
+    pub fn new(draws: NoiseDraws, seed: u64) -> Self {
+        match draws {
+            NoiseDraws::EveryPeriod => Normals::ChaCha(Box::new(StdRng::seed_from_u64(seed))),
+            NoiseDraws::AtSamples => Normals::Xoshiro(Xoshiro256PlusPlus::seed_from_u64(seed)),
+        }
+    }
+
+    /// The next standard normal.
+    #[inline]
+    pub fn normal(&mut self) -> f64 {
+        match self {
+            Normals::ChaCha(r) => StandardNormal.sample(r.as_mut()),
+            Normals::Xoshiro(r) => StandardNormal.sample(r),
+        }
+    }
+}
 
 /// What the navigation computer reports for one control period.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -78,7 +150,11 @@ pub struct Ping {
 /// A source's error process: its generator and its bias's current value.
 struct Stream<const N: usize> {
     model: ErrorModel<N>,
-    rng: StdRng,
+    rng: Normals,
+    /// [`NoiseDraws::AtSamples`]: no normal is drawn for a zero σ.
+    sparse: bool,
+    /// The control tick the bias was last stepped to ([`Stream::advance_to`]).
+    at: u64,
     gm: [f64; N],
     walk: [f64; N],
     /// The step [`Stream::advance`] formed its factors for, and the factors: e^(−dt/τ),
@@ -88,18 +164,24 @@ struct Stream<const N: usize> {
 }
 
 impl<const N: usize> Stream<N> {
-    fn new(model: ErrorModel<N>, seed: u64, source: u64) -> Self {
+    fn new(model: ErrorModel<N>, seed: u64, source: u64, draws: NoiseDraws) -> Self {
         // Distinct streams per source (a golden-ratio step between their seeds).
-        let mut rng =
-            StdRng::seed_from_u64(seed.wrapping_add(source.wrapping_mul(0x9E37_79B9_7F4A_7C15)));
+        let mut rng = Normals::new(
+            draws,
+            seed.wrapping_add(source.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+        );
+        let sparse = draws == NoiseDraws::AtSamples;
         let mut gm = [0.0; N];
         for (g, s) in gm.iter_mut().zip(model.bias_sigma) {
-            let n: f64 = StandardNormal.sample(&mut rng);
-            *g = s * n;
+            if !(sparse && s == 0.0) {
+                *g = s * rng.normal();
+            }
         }
         Stream {
             model,
             rng,
+            sparse,
+            at: 0,
             gm,
             walk: [0.0; N],
             step: None,
@@ -120,11 +202,33 @@ impl<const N: usize> Stream<N> {
                 (a, sb, sw)
             }
         };
+        if self.sparse {
+            for i in 0..N {
+                self.gm[i] *= a;
+                if sb[i] != 0.0 {
+                    self.gm[i] += sb[i] * self.rng.normal();
+                }
+                if sw[i] != 0.0 {
+                    self.walk[i] += sw[i] * self.rng.normal();
+                }
+            }
+            return;
+        }
         for i in 0..N {
-            let n1: f64 = StandardNormal.sample(&mut self.rng);
-            let n2: f64 = StandardNormal.sample(&mut self.rng);
+            let n1 = self.rng.normal();
+            let n2 = self.rng.normal();
             self.gm[i] = a * self.gm[i] + sb[i] * n1;
             self.walk[i] += sw[i] * n2;
+        }
+    }
+
+    /// [`NoiseDraws::AtSamples`]: steps the bias from its last tick to tick `k` in one step of
+    /// (k − last)·dt (Eq N1), nothing if it is there.
+    fn advance_to(&mut self, k: u64, dt: f64) {
+        let n = k.saturating_sub(self.at);
+        if n > 0 {
+            self.at = k;
+            self.advance(n as f64 * dt);
         }
     }
 
@@ -132,8 +236,13 @@ impl<const N: usize> Stream<N> {
     fn sample(&mut self) -> [f64; N] {
         let mut e = [0.0; N];
         for (i, e) in e.iter_mut().enumerate() {
-            let n: f64 = StandardNormal.sample(&mut self.rng);
-            *e = self.model.bias[i] + self.gm[i] + self.walk[i] + self.model.sigma[i] * n;
+            let s = self.model.sigma[i];
+            let white = if self.sparse && s == 0.0 {
+                0.0
+            } else {
+                s * self.rng.normal()
+            };
+            *e = self.model.bias[i] + self.gm[i] + self.walk[i] + white;
         }
         e
     }
@@ -234,6 +343,8 @@ fn rotate(att: &[f64; 3], v: &[f64; 3]) -> [f64; 3] {
 /// The navigation computer of one run.
 pub struct NavComputer {
     model: NavigationModel,
+    /// [`NoiseDraws::AtSamples`]: each stream is stepped when its source samples.
+    at_samples: bool,
     dt: f64,
     k: u64,
     ins: (Clock, Stream<3>, Stream<3>),
@@ -253,8 +364,15 @@ pub struct NavComputer {
 }
 
 impl NavComputer {
-    /// The computer of `model` on a control loop at `rate_hz`.
+    /// The computer of `model` on a control loop at `rate_hz`, its errors drawn every period
+    /// ([`NoiseDraws::EveryPeriod`]).
     pub fn new(model: &NavigationModel, rate_hz: f64) -> Self {
+        Self::with_draws(model, rate_hz, NoiseDraws::EveryPeriod)
+    }
+
+    /// The computer of `model` on a control loop at `rate_hz`, its errors drawn as `draws`
+    /// says.
+    pub fn with_draws(model: &NavigationModel, rate_hz: f64, draws: NoiseDraws) -> Self {
         let seed = model.seed;
         let ins = Clock::new(&model.ins.timing, rate_hz);
         let dvl = Clock::new(&model.dvl.timing, rate_hz);
@@ -262,7 +380,7 @@ impl NavComputer {
         let fix = model.fix.as_ref().map(|f| {
             (
                 Clock::new(&f.timing, rate_hz),
-                Stream::new(f.error, seed, 6),
+                Stream::new(f.error, seed, 6, draws),
             )
         });
         let longest = [&ins, &dvl, &depth]
@@ -273,16 +391,17 @@ impl NavComputer {
             .unwrap_or(0);
         let keep = (longest + ins.latency + 2) as usize;
         NavComputer {
+            at_samples: draws == NoiseDraws::AtSamples,
             dt: 1.0 / rate_hz,
             k: 0,
             ins: (
                 ins,
-                Stream::new(model.ins.attitude, seed, 1),
-                Stream::new(model.ins.rates, seed, 2),
+                Stream::new(model.ins.attitude, seed, 1, draws),
+                Stream::new(model.ins.rates, seed, 2, draws),
             ),
-            accel: Stream::new(model.ins.accel, seed, 3),
-            dvl: (dvl, Stream::new(model.dvl.velocity, seed, 4)),
-            depth: (depth, Stream::new(model.depth.error, seed, 5)),
+            accel: Stream::new(model.ins.accel, seed, 3, draws),
+            dvl: (dvl, Stream::new(model.dvl.velocity, seed, 4, draws)),
+            depth: (depth, Stream::new(model.depth.error, seed, 5, draws)),
             fix,
             truth: History::new(keep),
             dr: History::new(keep),
@@ -362,6 +481,16 @@ impl NavComputer {
     /// acceleration error (reset only by a ping).
     fn advance(&mut self) {
         let dt = self.dt;
+        if self.at_samples {
+            // Only the acceleration error is integrated every period; the other sources' biases
+            // are stepped when they sample (Choice 536).
+            self.accel.advance_to(self.k - 1, dt);
+            let a = self.accel.sample();
+            for (e, a) in self.e_v.iter_mut().zip(a) {
+                *e += a * dt;
+            }
+            return;
+        }
         self.ins.1.advance(dt);
         self.ins.2.advance(dt);
         self.accel.advance(dt);
@@ -379,6 +508,10 @@ impl NavComputer {
     /// The INS sample of tick `j`: attitude and rates; the solution now holds at `j`.
     fn ins_sample(&mut self, j: u64) {
         let (te, tn) = self.truth.at(j);
+        if self.at_samples {
+            self.ins.1.advance_to(self.k - 1, self.dt);
+            self.ins.2.advance_to(self.k - 1, self.dt);
+        }
         let ea = self.ins.1.sample();
         let er = self.ins.2.sample();
         for i in 0..3 {
@@ -404,6 +537,9 @@ impl NavComputer {
         self.out.bottom_lock = self.lock(te[2]);
         let mut velocity = None;
         if self.out.bottom_lock {
+            if self.at_samples {
+                self.dvl.1.advance_to(self.k - 1, self.dt);
+            }
             self.e_v = self.dvl.1.sample();
             self.out.velocity_at = Some(j);
             velocity = Some(std::array::from_fn(|i| tn[i] + self.e_v[i]));
@@ -433,7 +569,11 @@ impl NavComputer {
     /// that it passes through them at their time.
     fn anchor(&mut self, k: u64) {
         let ins_latency = self.ins.0.latency;
+        let (at_samples, dt) = (self.at_samples, self.dt);
         if let Some(j) = self.depth.0.arrival(k).filter(|&j| j > 0) {
+            if at_samples {
+                self.depth.1.advance_to(k, dt);
+            }
             let z = self.truth.at(j).0[2] + self.depth.1.sample()[0];
             self.offset[2] = z - self.dr.at((j + ins_latency).min(k))[2];
             self.out.arrived.depth = Some(Measured {
@@ -443,6 +583,9 @@ impl NavComputer {
         }
         if let Some((clock, stream)) = &mut self.fix {
             if let Some(j) = clock.arrival(k).filter(|&j| j > 0) {
+                if at_samples {
+                    stream.advance_to(k, dt);
+                }
                 let e = stream.sample();
                 let (te, _) = self.truth.at(j);
                 let at = self.dr.at((j + ins_latency).min(k));
@@ -455,5 +598,104 @@ impl NavComputer {
                 });
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn model(sigma: f64, bias_sigma: f64, tau: f64, walk: f64) -> ErrorModel<1> {
+        ErrorModel {
+            sigma: [sigma],
+            bias: [0.0],
+            bias_sigma: [bias_sigma],
+            bias_tau: tau,
+            bias_walk: [walk],
+        }
+    }
+
+    /// Eq N1: a Gauss–Markov bias stepped only at its source's samples (every 12 or 13
+    /// periods, as an 8 Hz DVL on a 100 Hz loop) has the process's steady σ_b² at the
+    /// samples and its autocorrelation e^(−n·dt/τ) between them.
+    #[test]
+    fn a_bias_stepped_at_its_samples_keeps_the_gauss_markov_statistics() {
+        let (sb, tau, dt) = (0.5, 0.3, 0.01);
+        let mut s = Stream::new(model(0.0, sb, tau, 0.0), 7, 4, NoiseDraws::AtSamples);
+        let (mut k, mut xs) = (0u64, Vec::new());
+        for i in 0..100_000u64 {
+            k += 12 + i % 2;
+            s.advance_to(k, dt);
+            xs.push(s.sample()[0]);
+        }
+        let n = xs.len() as f64;
+        let mean = xs.iter().sum::<f64>() / n;
+        let var = xs.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / n;
+        assert!((var / (sb * sb) - 1.0).abs() < 0.03, "variance {var}");
+        // Lag-one correlation against the mean of e^(−12dt/τ) and e^(−13dt/τ).
+        let rho = xs
+            .windows(2)
+            .map(|w| (w[0] - mean) * (w[1] - mean))
+            .sum::<f64>()
+            / (n * var);
+        let expected = 0.5 * ((-0.12f64 / tau).exp() + (-0.13f64 / tau).exp());
+        assert!((rho - expected).abs() < 0.01, "{rho} vs {expected}");
+    }
+
+    /// Eq N1: a random walk stepped at irregular samples has the variance σ_w²·t of one
+    /// stepped every period.
+    #[test]
+    fn a_walk_stepped_at_its_samples_has_variance_sigma_squared_t() {
+        let (sw, dt) = (0.2, 0.01);
+        let ends: Vec<f64> = (0..4000u64)
+            .map(|seed| {
+                let mut s = Stream::new(model(0.0, 0.0, 600.0, sw), seed, 1, NoiseDraws::AtSamples);
+                let mut k = 0;
+                while k < 100 {
+                    k = (k + 1 + (k * 7 + seed) % 13).min(100);
+                    s.advance_to(k, dt);
+                }
+                s.sample()[0]
+            })
+            .collect();
+        let var = ends.iter().map(|x| x * x).sum::<f64>() / ends.len() as f64;
+        // t = 1 s; the estimate's standard error is √(2/4000) ≈ 2.2 %.
+        assert!((var / (sw * sw) - 1.0).abs() < 0.08, "variance {var}");
+    }
+
+    /// At samples, a zero σ draws nothing: a source without white noise or bias leaves its
+    /// generator where it was, so its error is exactly its constant bias.
+    #[test]
+    fn a_zero_sigma_draws_no_normal_at_samples() {
+        let mut m = model(0.0, 0.0, 600.0, 0.0);
+        m.bias = [0.25];
+        let mut s = Stream::new(m, 3, 5, NoiseDraws::AtSamples);
+        s.advance_to(40, 0.01);
+        assert_eq!(s.sample(), [0.25]);
+        let mut fresh = Normals::new(
+            NoiseDraws::AtSamples,
+            3u64.wrapping_add(5u64.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+        );
+        assert_eq!(s.rng.normal().to_bits(), fresh.normal().to_bits());
+        // Every period, the same source draws one normal at the start and two per step.
+        let mut e = Stream::new(m, 3, 5, NoiseDraws::EveryPeriod);
+        e.advance(0.01);
+        let mut chacha = Normals::new(
+            NoiseDraws::EveryPeriod,
+            3u64.wrapping_add(5u64.wrapping_mul(0x9E37_79B9_7F4A_7C15)),
+        );
+        for _ in 0..3 {
+            chacha.normal();
+        }
+        assert_eq!(e.rng.normal().to_bits(), chacha.normal().to_bits());
+    }
+
+    #[test]
+    fn the_scenario_key_names_each_scheme() {
+        for d in NoiseDraws::ALL {
+            assert_eq!(NoiseDraws::from_name(d.name()), Some(d));
+        }
+        assert_eq!(NoiseDraws::default(), NoiseDraws::EveryPeriod);
+        assert_eq!(NoiseDraws::from_name("sometimes"), None);
     }
 }

@@ -4,10 +4,7 @@
 //! rounded to f32 as it crosses to the controller. The same values go to the law wherever it
 //! runs (SIL, PIL, HIL: [`super::ControlSource`]), so PIL = SIL holds with navigation on.
 
-use rand::SeedableRng;
-use rand_distr::{Distribution, StandardNormal};
-
-use super::nav_model::{NavComputer, Solution};
+use super::nav_model::{NavComputer, NoiseDraws, Normals, Solution};
 use crate::plant::PlantState;
 use crate::scenario::{SensorNoise, SimConfig};
 
@@ -54,26 +51,31 @@ pub const HEADING_REPORT_BOUND: f64 = 4.0 * std::f64::consts::PI;
 pub struct Navigation {
     computer: Option<NavComputer>,
     noise: Option<SensorNoise>,
-    rng: rand::rngs::StdRng,
+    rng: Normals,
 }
 
 impl Navigation {
     /// A navigation with `noise` (seeded from it) over the exact state.
     pub fn new(noise: Option<&SensorNoise>) -> Self {
+        Self::with_draws(noise, NoiseDraws::EveryPeriod)
+    }
+
+    /// [`Navigation::new`] with the noise's generator of `draws` (Choice 536).
+    fn with_draws(noise: Option<&SensorNoise>, draws: NoiseDraws) -> Self {
         Navigation {
             computer: None,
             noise: noise.cloned(),
-            rng: rand::rngs::StdRng::seed_from_u64(noise.map_or(0, |n| n.seed)),
+            rng: Normals::new(draws, noise.map_or(0, |n| n.seed)),
         }
     }
 
-    /// The navigation of a run of `cfg`: its `[navigation]` model and its `[noise]`.
+    /// The navigation of a run of `cfg`: its `[navigation]` model and its `[noise]`, drawn as
+    /// its `noise_draws` says.
     pub fn of(cfg: &SimConfig) -> Self {
-        let mut n = Navigation::new(cfg.noise.as_ref());
-        n.computer = cfg
-            .navigation
-            .as_ref()
-            .map(|m| NavComputer::new(m, f64::from(cfg.controller.rate_hz)));
+        let mut n = Navigation::with_draws(cfg.noise.as_ref(), cfg.noise_draws);
+        n.computer = cfg.navigation.as_ref().map(|m| {
+            NavComputer::with_draws(m, f64::from(cfg.controller.rate_hz), cfg.noise_draws)
+        });
         n
     }
 
@@ -94,8 +96,8 @@ impl Navigation {
         eta[5] = reported_heading(eta[5]);
         if let Some(n) = &self.noise {
             for i in 0..6 {
-                let a: f64 = StandardNormal.sample(&mut self.rng);
-                let b: f64 = StandardNormal.sample(&mut self.rng);
+                let a = self.rng.normal();
+                let b = self.rng.normal();
                 eta[i] += n.eta_sigma[i] * a;
                 nu[i] += n.nu_sigma[i] * b;
             }

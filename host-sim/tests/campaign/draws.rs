@@ -72,15 +72,29 @@ fn drawn_values_lie_in_their_boxes() {
 /// navigation seed, so `run` on it flies the campaign's run bit for bit.
 #[test]
 fn each_run_draws_its_navigation_noise_and_replays_it_from_its_file() {
+    // Study-grade, as the shipped campaign flies (Choice 400): the file keeps its step.
+    draws_and_replays("navigation-seed", "plant_step = \"control-period\"\n");
+}
+
+/// Choice 536: a campaign of study-grade noise (`noise_draws = "at-samples"`) writes the key
+/// into each run's file, so `run` (and `pil`, which flies the same navigation) replays it bit
+/// for bit; without it the file flew the default draws, other noise.
+#[test]
+fn a_run_of_study_grade_noise_replays_it_from_its_file() {
+    draws_and_replays(
+        "at-samples",
+        "plant_step = \"control-period\"\nnoise_draws = \"at-samples\"\n",
+    );
+}
+
+fn draws_and_replays(name: &str, keys: &str) {
     use host_sim::plant::PlantState;
     use host_sim::scenario::parse_scenario;
     use host_sim::sim::navigation::Navigation;
     use nalgebra::Vector6;
 
-    let dir = tempdir("navigation-seed");
-    // Study-grade, as the shipped campaign flies (Choice 400): the file keeps its step.
-    let text =
-        campaign_text(2, 3).replace("metrics =", "plant_step = \"control-period\"\nmetrics =");
+    let dir = tempdir(name);
+    let text = campaign_text(2, 3).replace("metrics =", &format!("{keys}metrics ="));
     let file = write_campaign(&dir, &text);
     let c = Campaign::load(&file).unwrap();
     let told = |i: u64| {
@@ -114,6 +128,11 @@ fn each_run_draws_its_navigation_noise_and_replays_it_from_its_file() {
         assert_eq!(
             replay.config().navigation,
             flown.config().navigation,
+            "run {i}"
+        );
+        assert_eq!(
+            replay.config().noise_draws,
+            flown.config().noise_draws,
             "run {i}"
         );
         let record = c.fly(i).unwrap();

@@ -10,8 +10,10 @@
 //!                              # flies base ⌊i·B/runs⌋ (B bases: equal blocks of indices)
 //! metrics = ["max_path", "rms_path"]  # reported metrics, the first is "the error" of the
 //!                              # scatter plots; default all (METRIC_NAMES)
-//! plant_step = "control-period"  # study-grade flight (Choice 400): one RK4 step per control
-//!                              # period instead of each base's plant_step; default: the base's
+//! plant_step = "control-period"  # study-grade flight (Choice 400): one midpoint step per
+//!                              # control period instead of each base's plant_step; default: the base's
+//! noise_draws = "at-samples"   # study-grade noise (Choice 536): each navigation error drawn at
+//!                              # its source's samples, Xoshiro256++; default: the base's
 //!
 //! [draw]                       # what each run draws; a key left out draws nothing
 //! parameters = "uniform"       # "uniform" in the Table-3 box | "corners" of it | "none"
@@ -48,6 +50,7 @@ use crate::plant::{CurrentModel, Integrator, VariationProfile};
 use crate::scenario::{
     reversed_mask, Bound, Scenario, ScenarioError, SimConfig, MAX_CURRENT_SPEED,
 };
+use crate::sim::nav_model::NoiseDraws;
 
 /// Most runs of one campaign: 10⁹ (a run's index is recorded exactly, and a campaign of more is
 /// more likely a typo than a plan).
@@ -204,6 +207,10 @@ pub struct CampaignSpec {
     /// Absent: each base's plant step (a campaign without the key hashes as before).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub plant_step: Option<PlantStep>,
+    /// Absent: each base's own `noise_draws` (Choice 536; a campaign without the key hashes
+    /// as before).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise_draws: Option<NoiseDraws>,
     #[serde(default)]
     pub draw: DrawSpec,
     pub bound: Option<BoundSpec>,

@@ -192,6 +192,9 @@ impl Campaign {
                 // Choice 400: study-grade flight.
                 step.apply(c);
             }
+            if let Some(draws) = spec.noise_draws {
+                c.noise_draws = draws;
+            }
             if spec.draw.parameters != ParameterDraw::None {
                 c.variation = VariationProfile::Constant(ParamVariation::from_array(d.variation));
             }
@@ -288,6 +291,10 @@ impl Campaign {
             step.apply(&mut c);
             file.plant_step = Some(c.plant_step);
             file.plant_integrator = Some(c.plant_integrator.name().into());
+        }
+        if let Some(draws) = self.spec.noise_draws {
+            // Choice 536: a run of study-grade noise replays with its draws.
+            file.noise_draws = Some(draws.name().into());
         }
         if self.spec.draw.parameters != ParameterDraw::None {
             file.variation = Some(VariationTable {
