@@ -305,44 +305,15 @@ pub fn phi(x: f64) -> f64 {
     0.5 * erfc(-x / std::f64::consts::SQRT_2)
 }
 
-/// erfc(x): 1 − erf(x) by erf's Taylor series below 2, the continued fraction above
-/// (Lentz's method); relative error about 10⁻¹⁴.
+/// erfc(x) by FreeBSD's rational approximations (the `libm` crate's port, within about an
+/// ulp: one or two exp and a few polynomials), Choice 518; for x < 0 as 2 − erfc(−x), so
+/// that [`phi_pair`]'s two values are [`phi`]'s bit for bit. The term's series below 2 and
+/// continued fraction above (30–200 iterations, relative error 10⁻¹⁴) were 60 % of its time.
 fn erfc(x: f64) -> f64 {
     if x < 0.0 {
         return 2.0 - erfc(-x);
     }
-    if x < 2.0 {
-        // erf by its Taylor series: converges fast for x < 2.
-        let mut sum = x;
-        let mut term = x;
-        let x2 = x * x;
-        let mut n = 0.0;
-        while term.abs() > 1e-17 * sum.abs() {
-            n += 1.0;
-            term *= -x2 / n;
-            sum += term / (2.0 * n + 1.0);
-        }
-        return 1.0 - 2.0 / std::f64::consts::PI.sqrt() * sum;
-    }
-    // Continued fraction (Lentz): erfc x = e^{−x²}/√π · 1/(x + 1/2/(x + 1/(x + 3/2/(x + …)))).
-    let tiny = 1e-300;
-    let mut f = x;
-    let mut c = x;
-    let mut d = 0.0;
-    for i in 1..200 {
-        let a = i as f64 / 2.0;
-        d = x + a * d;
-        d = if d.abs() < tiny { tiny } else { d };
-        c = x + a / c;
-        c = if c.abs() < tiny { tiny } else { c };
-        d = 1.0 / d;
-        let delta = c * d;
-        f *= delta;
-        if (delta - 1.0).abs() < 1e-16 {
-            break;
-        }
-    }
-    (-x * x).exp() / (std::f64::consts::PI.sqrt() * f)
+    libm::erfc(x)
 }
 
 /// The 20-point Gauss–Legendre nodes and weights on [−1, 1] (Newton on P₂₀).
@@ -1187,6 +1158,74 @@ mod tests {
             sum += w * f(a + i as f64 * dx);
         }
         sum * dx / 3.0
+    }
+
+    /// The term's erfc before Choice 518: erf's Taylor series below 2, the continued
+    /// fraction above (Lentz), relative error about 10⁻¹⁴.
+    fn erfc_series(x: f64) -> f64 {
+        if x < 0.0 {
+            return 2.0 - erfc_series(-x);
+        }
+        if x < 2.0 {
+            // erf by its Taylor series: converges fast for x < 2.
+            let mut sum = x;
+            let mut term = x;
+            let x2 = x * x;
+            let mut n = 0.0;
+            while term.abs() > 1e-17 * sum.abs() {
+                n += 1.0;
+                term *= -x2 / n;
+                sum += term / (2.0 * n + 1.0);
+            }
+            return 1.0 - 2.0 / std::f64::consts::PI.sqrt() * sum;
+        }
+        // Continued fraction (Lentz): erfc x = e^{−x²}/√π · 1/(x + 1/2/(x + 1/(x + 3/2/(x + …)))).
+        let tiny = 1e-300;
+        let mut f = x;
+        let mut c = x;
+        let mut d = 0.0;
+        for i in 1..200 {
+            let a = i as f64 / 2.0;
+            d = x + a * d;
+            d = if d.abs() < tiny { tiny } else { d };
+            c = x + a / c;
+            c = if c.abs() < tiny { tiny } else { c };
+            d = 1.0 / d;
+            let delta = c * d;
+            f *= delta;
+            if (delta - 1.0).abs() < 1e-16 {
+                break;
+            }
+        }
+        (-x * x).exp() / (std::f64::consts::PI.sqrt() * f)
+    }
+
+    /// The erfc of Choice 518 is the series and continued fraction it replaced within
+    /// 5·10⁻¹³ (relative) over the arguments the term's Φ takes (|x| ≤ 8.5/√2 and beyond), on
+    /// both sides of the series' edge at 2 and the rational pieces' at 0.84375, 1.25 and
+    /// 1/0.35. The difference is the series' own error where 1 − erf cancels below 2:
+    /// 2.2·10⁻¹³ at 1.956 against a 40-digit erfc, where the new one is within 10⁻¹⁶.
+    #[test]
+    fn the_erfc_is_the_series_it_replaced_to_its_precision() {
+        let mut worst = 0.0f64;
+        for i in -4000..=4000 {
+            let x = f64::from(i) * 2e-3 + 1e-7;
+            let (new, old) = (erfc(x), erfc_series(x));
+            worst = worst.max(((new - old) / old).abs());
+        }
+        for x in [
+            0.84375,
+            1.25,
+            2.0,
+            1.0 / 0.35,
+            6.0,
+            8.5 / std::f64::consts::SQRT_2,
+        ] {
+            for y in [x, -x, x * (1.0 + 1e-12), x * (1.0 - 1e-12)] {
+                worst = worst.max(((erfc(y) - erfc_series(y)) / erfc_series(y)).abs());
+            }
+        }
+        assert!(worst < 5e-13, "{worst:e}");
     }
 
     /// Φ at known values (Abramowitz and Stegun's table, and Φ(−8) = 6.22·10⁻¹⁶).
