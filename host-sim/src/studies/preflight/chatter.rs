@@ -845,12 +845,7 @@ impl<'a> Chatter<'a> {
     /// The prediction at scale `k` from each current corner's flight (per thruster: σ, step
     /// σ, expected count, total variation): per thruster the corner with the largest share of
     /// the bound.
-    fn assemble(
-        &self,
-        k: f64,
-        duration: f64,
-        per_corner: &[[(f64, f64, f64, f64); THRUSTERS]],
-    ) -> ChatterPrediction {
+    fn assemble(&self, k: f64, duration: f64, per_corner: &[Flown]) -> ChatterPrediction {
         let thrusters = (0..THRUSTERS)
             .map(|j| {
                 let mut best: Option<ThrusterPrediction> = None;
@@ -909,7 +904,7 @@ impl<'a> Chatter<'a> {
         k: f64,
         scale2: f64,
         stop: Option<f64>,
-    ) -> Result<Option<[(f64, f64, f64, f64); THRUSTERS]>, CheckError> {
+    ) -> Result<Option<Flown>, CheckError> {
         let t = 1.0 / self.rate_hz;
         let periods = (self.duration(k) * self.rate_hz).round().max(1.0) as u64;
         let last = mean.len().saturating_sub(1);
@@ -1095,6 +1090,10 @@ impl<'a> Chatter<'a> {
         s
     }
 }
+
+/// One current corner's flight, per thruster: the largest σ and step σ, the expected
+/// reversals and the total variation ([`Chatter::flown`]).
+type Flown = [(f64, f64, f64, f64); THRUSTERS];
 
 /// Per current corner, per reference sample, the mean thrust per thruster (N).
 type MeanThrusts = Vec<Vec<[f64; THRUSTERS]>>;
