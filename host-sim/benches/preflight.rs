@@ -1,14 +1,18 @@
 //! Preflight benchmarks (docs/real-vehicle.md#how-the-check-is-made): `host-sim check`'s work —
 //! the verdict over both scopes and, for a waypoint mission, the speed profile's search — on
 //! the shipped survey, a 32-point route (a payload staircase, a current) and a day-long
-//! circle. `cargo bench --profile host -p host-sim --bench preflight`; one thread.
+//! circle; and the chatter term alone (its prediction and its search, Choices 500–504 and
+//! 516–517) on the survey and on the tuning study's main-job sample (`tune::MAIN_JOB_TUNE`:
+//! refused missions ask it up to scale 100). `cargo bench --profile host -p host-sim --bench
+//! preflight`; one thread.
 
 use std::hint::black_box;
 use std::path::Path;
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use host_sim::scenario::{load_scenario, Scenario};
-use host_sim::studies::preflight::{self, profile, Engine, DEFAULT_MARGIN};
+use host_sim::studies::preflight::{self, chatter, profile, Engine, DEFAULT_MARGIN};
+use host_sim::studies::tune;
 
 fn scenario(path: &str) -> Scenario {
     load_scenario(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).expect("the scenario")
@@ -31,6 +35,21 @@ fn bench(c: &mut Criterion) {
         let s = scenario(path);
         group.bench_function(name, |b| b.iter(|| check(black_box(&s), Engine::Fast)));
     }
+    group.finish();
+    let mut group = c.benchmark_group("chatter");
+    group.sample_size(10);
+    let survey = scenario("scenarios/real/survey-200x100.toml");
+    group.bench_function("survey-200x100", |b| {
+        b.iter(|| chatter::chatter(black_box(&survey)).expect("the term"))
+    });
+    let sample = tune::sample(&tune::MAIN_JOB_TUNE).expect("the sample");
+    group.bench_function("tune-sample", |b| {
+        b.iter(|| {
+            for s in &sample.missions {
+                chatter::chatter(black_box(s)).expect("the term");
+            }
+        })
+    });
     group.finish();
 }
 

@@ -3,9 +3,11 @@
 
 use controller_core::effectiveness::THRUSTER_NAMES;
 use controller_core::EstimatorKind;
+use host_sim::scenario::navigation::Preset;
 use host_sim::scenario::{Scenario, SensorNoise};
 use host_sim::sim::{self, LocalController, Recording, RunResult};
-use host_sim::studies::preflight::chatter::{self, ChatterPrediction};
+use host_sim::studies::preflight::chatter::{self, Chatter, ChatterPrediction};
+use host_sim::studies::validation::Campaign;
 
 mod common;
 
@@ -91,4 +93,65 @@ fn white_noise_flown_as_told_is_refused_at_every_scale() {
         run.metrics.reversals_per_s
     );
     assert!(run.metrics.reversals_per_s > p.max_reversals_per_s);
+}
+
+/// The search's decision (Choice 516) stops a pass over the flight once a partial sum is past
+/// the bound; it answers what the full prediction answers, at every scale and noise fraction
+/// asked: on the shipped circle (fits from 1.32), the white noise flown as told (refused at
+/// every scale), and the tuning sample's disturbed missions on `survey` (a Gauss–Markov
+/// current on half: several current corners, the first past the bound stops the decision).
+/// And the prediction a finished decision keeps is the fresh one, bit for bit.
+#[test]
+fn the_stopping_decision_answers_what_the_full_prediction_answers() {
+    let white = real("real-circular-10R")
+        .with(|c| {
+            c.navigation = None;
+            c.controller.estimator.kind = EstimatorKind::Off;
+            c.noise = Some(SensorNoise {
+                eta_sigma: [0.005, 0.005, 0.005, 0.001, 0.001, 0.001],
+                nu_sigma: [0.002, 0.002, 0.002, 0.0005, 0.0005, 0.0005],
+                seed: 1,
+            });
+        })
+        .unwrap();
+    let campaign = Campaign {
+        masks: Vec::new(),
+        random: 4,
+        seed: 1,
+        navigation: vec![Preset::Survey],
+        disturbed: true,
+    };
+    let all = campaign.missions().unwrap();
+    let mut missions = vec![real("real-circular-10R"), white];
+    for i in 0..all.len() {
+        missions.push(all.get(i).unwrap().with(|c| c.duration = 20.0).unwrap());
+    }
+    let (mut stopped, mut kept) = (0, 0);
+    for s in &missions {
+        let name = &s.config().name;
+        let deciding = Chatter::new(s).unwrap().unwrap();
+        for (k, noise) in [
+            (1.0, 1.0),
+            (1.25, 1.0),
+            (1.7, 1.0),
+            (3.1, 1.0),
+            (8.0, 1.0),
+            (1.0, 0.5),
+            (1.0, 0.1),
+            (1.0, 0.0),
+        ] {
+            let full = Chatter::new(s).unwrap().unwrap().at(k, noise).unwrap();
+            let fits = deciding.fits_with(k, noise).unwrap();
+            assert_eq!(fits, full.fits(), "{name} at {k}, noise {noise}");
+            // A decision that fits flew the whole flight and kept it.
+            let again = deciding.at(k, noise).unwrap();
+            assert_eq!(again, full, "{name} at {k}, noise {noise}");
+            match fits {
+                true => kept += 1,
+                false => stopped += 1,
+            }
+        }
+    }
+    // Both answers were given.
+    assert!(stopped > 5 && kept > 5, "{stopped} refused, {kept} fit");
 }
