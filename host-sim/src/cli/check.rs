@@ -322,14 +322,18 @@ fn profile_table(path: TrajectoryKind, p: &SpeedProfile) -> Result<String> {
             part.name, part.length, part.speed, part.time, part.limiting
         ));
     }
+    let saved = 1.0 - p.total_time / p.uniform_time;
+    let compared = if saved > 0.0 {
+        format!("{:.1} % less with the profile", 100.0 * saved)
+    } else {
+        // Every part held at one cap (Choice 543): the profile's own speed changes and its
+        // rounding down make it no faster than the uniform speed.
+        "no faster with the profile: its parts are held at one cap".to_string()
+    };
     s.push_str(&format!(
         "total {:.1} s with the profile; {:.1} s at the fastest uniform speed {:.3} m/s \
-         ({:.1} % less with the profile); {:.1} s at the file's speed\n",
-        p.total_time,
-        p.uniform_time,
-        p.uniform_speed,
-        100.0 * (1.0 - p.total_time / p.uniform_time),
-        p.nominal_time
+         ({compared}); {:.1} s at the file's speed\n",
+        p.total_time, p.uniform_time, p.uniform_speed, p.nominal_time
     ));
     if p.shrink_rounds > 0 {
         s.push_str(&format!(
