@@ -178,15 +178,15 @@ impl Spec {
     }
 }
 
-/// The main job's study (**Choices 447 and 495**, docs/tune.md#in-the-main-job): small and
-/// fixed-seed, its cost bounded (measured in docs/tune.md): 12 evaluations of 6 missions.
+/// The main job's study (**Choices 447 and 545**, docs/tune.md#in-the-main-job): small and
+/// fixed-seed, its cost bounded (measured in docs/tune.md): 24 evaluations of 12 missions.
 pub const MAIN_JOB_TUNE: Spec = Spec {
     seed: 1,
-    missions: 3,
+    missions: 6,
     duration: 20.0,
     margin: crate::studies::preflight::DEFAULT_MARGIN,
-    population: 6,
-    generations: 1,
+    population: 8,
+    generations: 2,
     restarts: 1,
 };
 
