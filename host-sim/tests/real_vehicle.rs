@@ -390,7 +390,13 @@ fn the_static_demand_is_the_closed_form_of_weight_and_cg_moment() {
     // (the heel turns part of the turn's centripetal force into heave, the pitch offset brings
     // a Munk moment: docs/real-vehicle.md#the-attitude-the-vehicle-holds).
     let at_rest = moment * heel.cos() / 3.6;
-    let r = exact("circular-10R");
+    // The circle at the paper's pace (time scale 1; the file ships slower, Choice 544).
+    let r = exact("circular-10R")
+        .with(|c| {
+            c.time_scale = 1.0;
+            c.duration = 70.0;
+        })
+        .unwrap();
     // At k = 40 the circle's 2 m/s are 0.05 m/s (the tangent heading needs 0.02): the
     // velocity terms are 1/1600 of the mission's.
     let slow = r.with(|c| {
