@@ -43,6 +43,10 @@ fn the_both_up_circle_is_refused_at_its_speed_and_flies_at_the_proposed_scale() 
     let both_up = real_vehicle::real_scenarios().unwrap()[1]
         .with(|c| {
             c.controller.geometry = ThrusterGeometry::auv150(0b11110);
+            // At the paper's pace (the file ships at the scale its own check proposes on its
+            // navigation, Choice 544).
+            c.time_scale = 1.0;
+            c.duration = 70.0;
             // On the exact state, as when it was found (on `survey` the navigation's share
             // leaves this mounting no margin even at rest: statically infeasible).
             c.navigation = None;
