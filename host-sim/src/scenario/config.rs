@@ -197,7 +197,7 @@ pub struct SimConfig {
     pub plant_integrator: crate::plant::Integrator,
     /// How the navigation errors and `[noise]` are drawn (scenario key `noise_draws`,
     /// **Choice 536**). Default every period from ChaCha12.
-    pub noise_draws: crate::sim::nav_model::NoiseDraws,
+    pub noise_draws: crate::scenario::navigation::NoiseDraws,
     /// The controller (its `rate_hz` is the sampled loop's rate; zero-order hold in between).
     pub controller: ControllerConfig,
     pub variation: VariationProfile,
@@ -298,7 +298,7 @@ impl SimConfig {
             duration: 70.0,
             plant_step: 0.001,
             plant_integrator: crate::plant::Integrator::Rk4,
-            noise_draws: crate::sim::nav_model::NoiseDraws::EveryPeriod,
+            noise_draws: crate::scenario::navigation::NoiseDraws::EveryPeriod,
             controller: ControllerConfig::default(),
             variation: VariationProfile::None,
             trimmed: false,

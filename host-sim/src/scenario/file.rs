@@ -31,7 +31,7 @@ pub struct ScenarioFile {
     /// An [`Integrator`](crate::plant::Integrator) by name (checked when built).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub plant_integrator: Option<String>,
-    /// A [`NoiseDraws`](crate::sim::nav_model::NoiseDraws) by name (checked when built).
+    /// A [`NoiseDraws`](crate::scenario::navigation::NoiseDraws) by name (checked when built).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub noise_draws: Option<String>,
     #[serde(skip_serializing_if = "Option::is_none")]

@@ -18,7 +18,7 @@ use super::file::{
 };
 use super::{f32_decimal, parse, InitialAttitude, SimConfig, TickRange};
 use crate::plant::{CurrentModel, Integrator, VariationProfile};
-use crate::sim::nav_model::NoiseDraws;
+use crate::scenario::navigation::NoiseDraws;
 
 /// A configuration a scenario file cannot describe: the field, and why.
 #[derive(Clone, Debug, PartialEq, Eq)]

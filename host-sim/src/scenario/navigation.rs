@@ -649,3 +649,43 @@ pub fn validate(m: &NavigationModel) -> Res<()> {
     }
     Ok(())
 }
+
+/// How a run draws its navigation errors and `[noise]` (scenario key `noise_draws`).
+///
+/// **Choice 536** (docs/navigation.md#the-noise-draws): `every-period` is the default and what
+/// Table 1 and the shipped missions fly — each source's error process drawn from ChaCha12
+/// (`StdRng`) and every bias stepped every control period, sampled or not (two normals per
+/// axis a period, a zero σ drawn and multiplied by 0). `at-samples` is the study-grade
+/// scheme a campaign declares with `noise_draws = "at-samples"`: Xoshiro256++ generators
+/// (the same ziggurat normal), each source's bias stepped only when the source samples, over
+/// the periods since its last sample by the exact transition (Eq N1:
+/// b ← a^n·b + σ_b·√(1 − a^(2n))·w₁, walk ← walk + σ_w·√(n·dt)·w₂, a = e^(−dt/τ)), and
+/// no normal drawn for a zero σ. Both are the same processes at every sample (the n-step
+/// transition is the composition of n one-step ones), not the same realisations.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum NoiseDraws {
+    /// ChaCha12, every bias stepped every period (today's streams, bit for bit).
+    #[default]
+    EveryPeriod,
+    /// Xoshiro256++, each error drawn at its source's samples only.
+    AtSamples,
+}
+
+impl NoiseDraws {
+    /// Every scheme, in the order the scenario key lists them.
+    pub const ALL: [NoiseDraws; 2] = [NoiseDraws::EveryPeriod, NoiseDraws::AtSamples];
+
+    /// The scenario key's value.
+    pub fn name(self) -> &'static str {
+        match self {
+            NoiseDraws::EveryPeriod => "every-period",
+            NoiseDraws::AtSamples => "at-samples",
+        }
+    }
+
+    /// The scheme named `name`, if any.
+    pub fn from_name(name: &str) -> Option<NoiseDraws> {
+        NoiseDraws::ALL.into_iter().find(|d| d.name() == name)
+    }
+}

@@ -20,7 +20,7 @@ use super::paper;
 use super::validate::invalid;
 use super::{Bound, InitialAttitude, LinkFaults, ScenarioError, SensorNoise, SimConfig, TickRange};
 use crate::plant::{CurrentModel, Integrator, VariationProfile};
-use crate::sim::nav_model::NoiseDraws;
+use crate::scenario::navigation::NoiseDraws;
 
 /// Default `seed` of `[noise]`, `[navigation]` and the Gauss–Markov current.
 pub const DEFAULT_SEED: u64 = 1;

@@ -119,6 +119,29 @@ struct Parts {
     caps: Vec<Option<f64>>,
 }
 
+impl Parts {
+    /// The parts of `constant` (the mission of `cfg` at its constant `speed`), with the legs'
+    /// caps and the speed change.
+    fn of(cfg: &SimConfig, constant: &Scenario, speed: f32, speed_change: Option<f32>) -> Self {
+        let route = *constant.trajectory().route();
+        let n_parts = route.segment_part(route.segment_count() - 1) + 1;
+        // Part 2j is leg j (the turns between).
+        let caps = (0..n_parts)
+            .map(|p| match (p % 2, &cfg.speed_limits) {
+                (0, Some(c)) => c.get(p / 2).copied(),
+                _ => None,
+            })
+            .collect();
+        Parts {
+            route,
+            caps,
+            speed: f64::from(speed),
+            // The f32 as the decimal it was written as (0.05, not 0.0500000007).
+            accel: super::time_scale(speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
+        }
+    }
+}
+
 /// The speed profile of `scenario` at `margin`, if it is a waypoint mission (`None` otherwise).
 ///
 /// # Errors
@@ -148,22 +171,7 @@ pub fn propose_with(
         return Ok(None);
     };
     let constant = with_law(cfg, None, None, 1.0)?;
-    let route = *constant.trajectory().route();
-    let n_parts = route.segment_part(route.segment_count() - 1) + 1;
-    // Part 2j is leg j (the turns between).
-    let caps = (0..n_parts)
-        .map(|p| match (p % 2, &cfg.speed_limits) {
-            (0, Some(c)) => c.get(p / 2).copied(),
-            _ => None,
-        })
-        .collect();
-    let parts = Parts {
-        route,
-        caps,
-        speed: f64::from(speed),
-        // The f32 as the decimal it was written as (0.05, not 0.0500000007).
-        accel: super::time_scale(speed_change.unwrap_or(DEFAULT_SPEED_CHANGE)),
-    };
+    let parts = Parts::of(cfg, &constant, speed, speed_change);
     let checker = Checker::new(&constant, margin, engine)?;
     let (fastest, mut limiting) = per_part_speeds(&checker, &parts)?;
     let mut uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
@@ -173,47 +181,17 @@ pub fn propose_with(
         let scenario = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
         Ok((rounded, fitted, scenario))
     };
-    // Step 4 (Choice 543): the path-error budget and the chatter term as flown. A profile the
-    // force allows may still be one the mission's navigation cannot fly within its bound (the
-    // boundary layer's gain grows with the reference's speed): every part is then capped at
-    // the fastest common speed at which both terms fit.
-    let capped = |c: f64| -> Vec<f64> { fastest.iter().map(|&v| v.min(c)).collect() };
+    // Step 4 (Choice 543): the path-error budget and the chatter term as flown.
     let mut speeds = fastest.clone();
-    if let Some(term) = terms_miss(&flown(&speeds)?.2)? {
-        // Down from the fastest part in steps of TERM_STEP to the first cap that fits, then
-        // bisection between it and the step above: the terms are not monotone at the slow
-        // end (a longer flight meets more fixes, and drifts longer without them), so the
-        // search keeps to the fastest cap that fits.
-        let mut hi = fastest.iter().copied().fold(0.0, f64::max);
-        let mut lo = hi * TERM_STEP;
-        while terms_miss(&flown(&capped(lo))?.2)?.is_some() {
-            if lo <= MIN_TERM_SPEED {
-                return Err(CheckError::NoProfileTerm {
-                    why: format!("the {term} refuses the route at every common speed from {:.2} down to {MIN_TERM_SPEED} m/s", fastest.iter().copied().fold(0.0, f64::max)),
-                });
-            }
-            hi = lo;
-            lo = (lo * TERM_STEP).max(MIN_TERM_SPEED);
-        }
-        let mut limit = term;
-        while hi / lo > 1.0 + SPEED_TOLERANCE {
-            let mid = (lo * hi).sqrt();
-            match terms_miss(&flown(&capped(mid))?.2)? {
-                None => lo = mid,
-                Some(t) => {
-                    hi = mid;
-                    limit = t;
-                }
-            }
-        }
+    if let Some((cap, term)) = terms_cap(&fastest, &flown)? {
         for (l, &v) in limiting.iter_mut().zip(&fastest) {
-            if v > lo {
-                *l = limit.to_string();
+            if v > cap {
+                *l = term.to_string();
             }
         }
-        speeds = capped(lo);
+        speeds = fastest.iter().map(|&v| v.min(cap)).collect();
         // The fastest uniform speed is capped alike: the terms refuse any faster.
-        uniform_speed = uniform_speed.min(lo);
+        uniform_speed = uniform_speed.min(cap);
     }
     for round in 0..=MAX_VERIFY_ROUNDS {
         let (rounded, fitted, flown) = flown(&speeds)?;
@@ -250,6 +228,56 @@ pub fn propose_with(
             "the check as flown still refuses it with every speed lowered {MAX_VERIFY_ROUNDS} times by {VERIFY_SHRINK}"
         ),
     })
+}
+
+/// Step 4 (Choice 543): when the path-error budget or the chatter term refuses the profile
+/// `fastest` as flown (`flown` pins a profile and returns the scenario as its third part), the
+/// common cap on every part's speed at which both pass, and the term that bounds it; `None`
+/// when the profile passes as it is. A profile the force allows may still be one the
+/// mission's navigation cannot fly within its bound (the boundary layer's gain grows with the
+/// reference's speed, and with it the navigation noise the vehicle follows).
+///
+/// # Errors
+/// [`CheckError::NoProfileTerm`] when no cap down to [`MIN_TERM_SPEED`] passes; as
+/// [`propose`] otherwise.
+fn terms_cap<F>(fastest: &[f64], flown: &F) -> Result<Option<(f64, &'static str)>, CheckError>
+where
+    F: Fn(&[f64]) -> Result<(Vec<f64>, Vec<f64>, Scenario), CheckError>,
+{
+    let capped = |c: f64| -> Vec<f64> { fastest.iter().map(|&v| v.min(c)).collect() };
+    let Some(term) = terms_miss(&flown(fastest)?.2)? else {
+        return Ok(None);
+    };
+    // Down from the fastest part in steps of TERM_STEP to the first cap that fits, then
+    // bisection between it and the step above: the terms are not monotone at the slow end (a
+    // longer flight meets more fixes, and drifts longer without them), so the search keeps to
+    // the fastest cap that fits.
+    let top = fastest.iter().copied().fold(0.0, f64::max);
+    let mut hi = top;
+    let mut lo = hi * TERM_STEP;
+    while terms_miss(&flown(&capped(lo))?.2)?.is_some() {
+        if lo <= MIN_TERM_SPEED {
+            return Err(CheckError::NoProfileTerm {
+                why: format!(
+                    "the {term} refuses the route at every common speed from {top:.2} down to {MIN_TERM_SPEED} m/s"
+                ),
+            });
+        }
+        hi = lo;
+        lo = (lo * TERM_STEP).max(MIN_TERM_SPEED);
+    }
+    let mut limit = term;
+    while hi / lo > 1.0 + SPEED_TOLERANCE {
+        let mid = (lo * hi).sqrt();
+        match terms_miss(&flown(&capped(mid))?.2)? {
+            None => lo = mid,
+            Some(t) => {
+                hi = mid;
+                limit = t;
+            }
+        }
+    }
+    Ok(Some((lo, limit)))
 }
 
 /// The term that refuses the mission `flown` at its own time scale (the path-error budget
