@@ -8,9 +8,10 @@
 //! supervisor on a host thread, whose UART takes one frame a period (real time's period 0).
 //! (The QEMU boards, and a QEMU port that goes away mid-mission, are flown by `cargo xtask pil`.)
 
-use std::collections::VecDeque;
+#[path = "common/soft_board.rs"]
+mod soft_board;
+
 use std::io::{Read, Write};
-use std::os::fd::AsRawFd;
 use std::path::PathBuf;
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicBool, Ordering};
@@ -22,14 +23,12 @@ use auv_link::{
     encode, encode_signed, BoardStatus, Command as LinkCommand, Envelope, FrameDecoder, Msg,
     Refusal, Telemetry, ThrustUnit, UploadStatus, MAX_FRAME, PROTOCOL_VERSION,
 };
-use controller_core::{Controller, ControllerConfig};
-use firmware::board::{receive, LinkBuffers};
-use firmware::supervisor::{BoardInfo, Supervisor};
 use host_sim::board::{self, BoardComparison, BoardInTheLoop, Pacing};
 use host_sim::cli::Cases;
 use host_sim::scenario::{load_scenario, LinkFaults, Scenario};
 use host_sim::sim::{self, BoardLoss, Outcome, Recording};
 use serialport::{SerialPort, TTYPort};
+use soft_board::{pty, SoftBoard};
 
 /// The reply timeout the tests give `hil` (s).
 const REPLY_TIMEOUT: &str = "0.5";
@@ -75,21 +74,6 @@ fn hil_kept(
 
 fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()
-}
-
-/// A pty pair: the master (the test's end, the "board") and the slave's path, free for
-/// `hil` to open (the pair's own slave handle is closed: it holds the port exclusively).
-fn pty() -> (TTYPort, String) {
-    let (master, slave) = TTYPort::pair().expect("a pseudo-terminal pair");
-    // Not inherited by the `host-sim` processes the tests start (this test's or another's): a
-    // board that hangs up must close the master's last copy.
-    // SAFETY: fcntl(2) on a descriptor the pair owns.
-    unsafe {
-        libc::fcntl(master.as_raw_fd(), libc::F_SETFD, libc::FD_CLOEXEC);
-    }
-    let path = slave.name().expect("the slave's path");
-    drop(slave);
-    (master, path)
 }
 
 /// The one-second lawn-mower mission the tests fly.
@@ -191,39 +175,17 @@ fn noise_on_the_line_is_counted_and_named() {
 
 /// The board: every period of its own timer, the bytes of at most one whole frame (up to its
 /// `0x00` delimiter) go to the supervisor, then one supervisor step and its telemetry.
-fn one_frame_a_period_board(mut port: TTYPort, stop: Arc<AtomicBool>) {
-    let controller = Controller::new(ControllerConfig::default()).expect("default config");
-    let info = BoardInfo {
-        supply_voltage: controller_core::DEFAULT_V_LIMIT,
-        signing: false,
-    };
-    let mut sup = Supervisor::new(controller, info);
-    let mut bufs = LinkBuffers::new();
-    let _ = port.set_timeout(Duration::from_millis(1));
-    let mut inbox: VecDeque<u8> = VecDeque::new();
-    let mut chunk = [0u8; 256];
+fn one_frame_a_period_board(port: TTYPort, stop: Arc<AtomicBool>) {
+    let mut board = SoftBoard::new(port);
     let mut next = Instant::now();
     while !stop.load(Ordering::Relaxed) {
         // Until the boundary, the "UART" fills the inbox.
         while Instant::now() < next {
-            match port.read(&mut chunk) {
-                Ok(n) => inbox.extend(&chunk[..n]),
-                // A master reads EIO while no one holds the slave (before `hil` opens it).
-                Err(_) => std::thread::sleep(Duration::from_millis(1)),
-            }
+            board.listen();
         }
-        next += Duration::from_secs_f64(1.0 / f64::from(sup.rate_hz().max(1)));
-        // One frame's bytes, if a whole one is there.
-        if let Some(end) = inbox.iter().position(|&b| b == 0) {
-            let frame: Vec<u8> = inbox.drain(..=end).collect();
-            receive(&mut sup, &mut bufs, &frame);
-        }
-        let step = sup.step(false, &|| 0);
-        let env = sup.envelope(step.telemetry);
-        if let Ok(frame) = bufs.encode(&env) {
-            // Nobody listening yet (or any more): the frame is lost, as on a real line.
-            let _ = port.write_all(frame);
-        }
+        next += board.period();
+        board.take_frame();
+        board.step_and_answer();
     }
 }
 

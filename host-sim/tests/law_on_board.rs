@@ -6,21 +6,19 @@
 //! gains (the real figure-eight's 3 s: 0.015972 m on the board against 0.016140 in SIL).
 //! (The QEMU board flies the same case in `cargo xtask pil`.)
 
-use std::collections::VecDeque;
-use std::io::{Read, Write};
-use std::os::fd::AsRawFd;
+#[path = "common/soft_board.rs"]
+mod soft_board;
+
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::sync::Arc;
-use std::time::{Duration, Instant};
+use std::time::Instant;
 
-use controller_core::{Controller, ControllerConfig};
-use firmware::board::{receive, LinkBuffers};
-use firmware::supervisor::{BoardInfo, Supervisor};
 use host_sim::board::BoardComparison;
 use host_sim::cli::Cases;
-use serialport::{SerialPort, TTYPort};
+use serialport::TTYPort;
+use soft_board::{pty, SoftBoard};
 
 /// The real-chain mission (the one `cargo xtask pil` flies on the real chain).
 const REAL: &str = "scenarios/real/figure-eight-30x30.toml";
@@ -55,40 +53,17 @@ fn scenario(dir: &Path, name: &str, law: &str) -> PathBuf {
     path
 }
 
-/// A pty pair: the master (the board's end) and the slave's path, free for `hil` to open.
-fn pty() -> (TTYPort, String) {
-    let (master, slave) = TTYPort::pair().expect("a pseudo-terminal pair");
-    // SAFETY: fcntl(2) on a descriptor the pair owns (not inherited by `host-sim`).
-    unsafe {
-        libc::fcntl(master.as_raw_fd(), libc::F_SETFD, libc::FD_CLOEXEC);
-    }
-    let path = slave.name().expect("the slave's path");
-    drop(slave);
-    (master, path)
-}
-
 /// The board as `firmware::board::period` runs it in lock-step: it decodes whole frames until
 /// a state frame is fresh or its period's timer passes, then runs one supervisor step and
 /// sends its telemetry. It boots on the core's defaults, as the flying images do: every law
 /// setting it flies comes over the link.
-fn lockstep_board(mut port: TTYPort, stop: Arc<AtomicBool>) {
-    let controller = Controller::new(ControllerConfig::default()).expect("default config");
-    let info = BoardInfo {
-        supply_voltage: controller_core::DEFAULT_V_LIMIT,
-        signing: false,
-    };
-    let mut sup = Supervisor::new(controller, info);
-    let mut bufs = LinkBuffers::new();
-    let _ = port.set_timeout(Duration::from_millis(1));
-    let mut inbox: VecDeque<u8> = VecDeque::new();
-    let mut chunk = [0u8; 256];
+fn lockstep_board(port: TTYPort, stop: Arc<AtomicBool>) {
+    let mut board = SoftBoard::new(port);
     let mut next = Instant::now();
     while !stop.load(Ordering::Relaxed) {
         loop {
-            if let Some(end) = inbox.iter().position(|&b| b == 0) {
-                let frame: Vec<u8> = inbox.drain(..=end).collect();
-                receive(&mut sup, &mut bufs, &frame);
-                if sup.lockstep() && sup.state_fresh() {
+            if board.take_frame() {
+                if board.sup.lockstep() && board.sup.state_fresh() {
                     break;
                 }
                 continue;
@@ -96,18 +71,10 @@ fn lockstep_board(mut port: TTYPort, stop: Arc<AtomicBool>) {
             if Instant::now() >= next || stop.load(Ordering::Relaxed) {
                 break;
             }
-            match port.read(&mut chunk) {
-                Ok(n) => inbox.extend(&chunk[..n]),
-                // A master reads EIO while no one holds the slave (before `hil` opens it).
-                Err(_) => std::thread::sleep(Duration::from_millis(1)),
-            }
+            board.listen();
         }
-        next = Instant::now() + Duration::from_secs_f64(1.0 / f64::from(sup.rate_hz().max(1)));
-        let step = sup.step(false, &|| 0);
-        let env = sup.envelope(step.telemetry);
-        if let Ok(frame) = bufs.encode(&env) {
-            let _ = port.write_all(frame);
-        }
+        next = Instant::now() + board.period();
+        board.step_and_answer();
     }
 }
 
