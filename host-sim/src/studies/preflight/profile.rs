@@ -176,14 +176,19 @@ pub fn propose_with(
     let (fastest, mut limiting) = per_part_speeds(&checker, &parts)?;
     let mut uniform_speed = fastest.iter().copied().fold(f64::INFINITY, f64::min);
     let flown = |speeds: &[f64]| -> Result<(Vec<f64>, Vec<f64>, Scenario), CheckError> {
-        let rounded = round_down(speeds);
-        let fitted = fit_changes(&parts, &rounded);
-        let scenario = with_law(cfg, Some(&fitted), Some(parts.accel), 1.0)?;
+        let (rounded, fitted, accel) = pinned(&parts, speeds);
+        let scenario = with_law(cfg, Some(&fitted), Some(accel), 1.0)?;
         Ok((rounded, fitted, scenario))
+    };
+    // The terms' verdict per profile as flown, kept by its pinned speeds (Choice 519).
+    let mut memo = TermsMemo::default();
+    let mut miss = |speeds: &[f64]| -> Result<Option<&'static str>, CheckError> {
+        let (_, fitted, _) = pinned(&parts, speeds);
+        memo.get_or(&fitted, || terms_miss(&flown(speeds)?.2))
     };
     // Step 4 (Choice 543): the path-error budget and the chatter term as flown.
     let mut speeds = fastest.clone();
-    if let Some((cap, term)) = terms_cap(&fastest, &flown)? {
+    if let Some((cap, term)) = terms_cap(&fastest, &mut miss)? {
         for (l, &v) in limiting.iter_mut().zip(&fastest) {
             if v > cap {
                 *l = term.to_string();
@@ -200,7 +205,7 @@ pub fn propose_with(
         // refuses needs no sweep of the box (Choice 533); then the terms (Choice 543).
         let ok = checker.feasible(Scope::AsWritten, 1.0)?
             && checker.feasible(Scope::WholeBox, 1.0)?
-            && terms_miss(&flown)?.is_none();
+            && miss(&speeds)?.is_none();
         if ok {
             // A part step 2 slowed is limited by the changes, not by what bounded its search.
             let limiting = limiting
@@ -240,12 +245,12 @@ pub fn propose_with(
 /// # Errors
 /// [`CheckError::NoProfileTerm`] when no cap down to [`MIN_TERM_SPEED`] passes; as
 /// [`propose`] otherwise.
-fn terms_cap<F>(fastest: &[f64], flown: &F) -> Result<Option<(f64, &'static str)>, CheckError>
+fn terms_cap<F>(fastest: &[f64], miss: &mut F) -> Result<Option<(f64, &'static str)>, CheckError>
 where
-    F: Fn(&[f64]) -> Result<(Vec<f64>, Vec<f64>, Scenario), CheckError>,
+    F: FnMut(&[f64]) -> Result<Option<&'static str>, CheckError>,
 {
     let capped = |c: f64| -> Vec<f64> { fastest.iter().map(|&v| v.min(c)).collect() };
-    let Some(term) = terms_miss(&flown(fastest)?.2)? else {
+    let Some(term) = miss(fastest)? else {
         return Ok(None);
     };
     // Down from the fastest part in steps of TERM_STEP to the first cap that fits, then
@@ -255,7 +260,7 @@ where
     let top = fastest.iter().copied().fold(0.0, f64::max);
     let mut hi = top;
     let mut lo = hi * TERM_STEP;
-    while terms_miss(&flown(&capped(lo))?.2)?.is_some() {
+    while miss(&capped(lo))?.is_some() {
         if lo <= MIN_TERM_SPEED {
             return Err(CheckError::NoProfileTerm {
                 why: format!(
@@ -269,7 +274,7 @@ where
     let mut limit = term;
     while hi / lo > 1.0 + SPEED_TOLERANCE {
         let mid = (lo * hi).sqrt();
-        match terms_miss(&flown(&capped(mid))?.2)? {
+        match miss(&capped(mid))? {
             None => lo = mid,
             Some(t) => {
                 hi = mid;
@@ -278,6 +283,40 @@ where
         }
     }
     Ok(Some((lo, limit)))
+}
+
+/// The speeds a profile pins for `speeds` (per part): rounded down to [`SPEED_STEP`], then
+/// fitted to the speed changes (steps 2–3), and the changes' |σ̈|. The mission flown is a
+/// function of these alone ([`with_law`] of the file's configuration).
+fn pinned(parts: &Parts, speeds: &[f64]) -> (Vec<f64>, Vec<f64>, f64) {
+    let rounded = round_down(speeds);
+    let fitted = fit_changes(parts, &rounded);
+    (rounded, fitted, parts.accel)
+}
+
+/// The terms' verdict ([`terms_miss`]) per profile as flown, by the bits of its pinned speeds
+/// (**Choice 519**): the mission flown is a function of them alone, so a profile pinned the
+/// same as one already judged has the same verdict. Step 4's bisection asks caps 1 % apart
+/// that round to the same 0.01 m/s, and step 3's first round asks the profile step 4 ended
+/// on; each was a new budget and a new chatter pass over the whole flight.
+#[derive(Default)]
+struct TermsMemo(std::collections::HashMap<Vec<u64>, Option<&'static str>>);
+
+impl TermsMemo {
+    /// The verdict kept for `fitted`, or `judge`'s, kept.
+    fn get_or(
+        &mut self,
+        fitted: &[f64],
+        judge: impl FnOnce() -> Result<Option<&'static str>, CheckError>,
+    ) -> Result<Option<&'static str>, CheckError> {
+        let key: Vec<u64> = fitted.iter().map(|v| v.to_bits()).collect();
+        if let Some(&kept) = self.0.get(&key) {
+            return Ok(kept);
+        }
+        let verdict = judge()?;
+        self.0.insert(key, verdict);
+        Ok(verdict)
+    }
 }
 
 /// The term that refuses the mission `flown` at its own time scale (the path-error budget
@@ -518,5 +557,39 @@ fn report(
         length,
         nominal_time: length / parts.speed,
         shrink_rounds,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Choice 519: a profile pinned the same as one already judged is not judged again (its
+    /// kept verdict, refused or not, is returned); one pinned differently, even in the last
+    /// bit of one speed, is judged.
+    #[test]
+    fn the_terms_are_judged_once_per_pinned_profile() {
+        let mut memo = TermsMemo::default();
+        let judged = std::cell::Cell::new(0);
+        let ask = |memo: &mut TermsMemo, speeds: &[f64], verdict: Option<&'static str>| {
+            memo.get_or(speeds, || {
+                judged.set(judged.get() + 1);
+                Ok(verdict)
+            })
+            .unwrap()
+        };
+        assert_eq!(ask(&mut memo, &[0.36, 0.3], Some(BUDGET)), Some(BUDGET));
+        // The same pinned speeds: the kept verdict, whatever a new judgement would say.
+        assert_eq!(ask(&mut memo, &[0.36, 0.3], None), Some(BUDGET));
+        assert_eq!(ask(&mut memo, &[0.35, 0.3], None), None);
+        assert_eq!(ask(&mut memo, &[0.35, 0.3], Some(CHATTER)), None);
+        let next = f64::from_bits(0.3f64.to_bits() + 1);
+        assert_eq!(ask(&mut memo, &[0.35, next], Some(CHATTER)), Some(CHATTER));
+        assert_eq!(judged.get(), 3);
+        // An error is not kept: the next ask judges again.
+        let failed = memo.get_or(&[0.2], || Err(CheckError::Interrupted));
+        assert_eq!(failed, Err(CheckError::Interrupted));
+        assert_eq!(ask(&mut memo, &[0.2], None), None);
+        assert_eq!(judged.get(), 4);
     }
 }

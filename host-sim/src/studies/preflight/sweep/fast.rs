@@ -65,6 +65,23 @@ pub(super) struct Shared {
     /// 451): the box's 2⁹ corners have at most 8 static heels (only Δm, Δy_G and Δz_G move
     /// it), so the state at each is formed once per sample, not once per corner.
     level: RefCell<Vec<(u64, PlantState, Vector6<f64>)>>,
+    /// What the heels met so far on this sample give, by the heel's bits (Choice 528): the
+    /// attitude and state at the heel and the law's nominal force there, which depend on the
+    /// corner only through the heel. Corners that differ only in what the heel's roll row
+    /// does not read meet the same heel bit for bit (ΔI_x, ΔI_y, ΔI_z multiply p, q and ṗ,
+    /// exact zeros where the state at the static heel neither rolls nor pitches), and its
+    /// state and nominal force are formed once per sample.
+    heels: RefCell<HashMap<u64, AtHeel>>,
+}
+
+/// The attitude and state at one heel on a sample, and the law's nominal force there
+/// ([`Shared::at_heel`]).
+#[derive(Clone, Copy)]
+struct AtHeel {
+    att: Attitude<f64>,
+    state: PlantState,
+    nu_dot: Vector6<f64>,
+    modelled: Vector6<f64>,
 }
 
 impl Shared {
@@ -80,7 +97,29 @@ impl Shared {
             eta_dot: smp.eta_dot * inv_k,
             eta_ddot: smp.eta_ddot * (inv_k * inv_k),
             level: RefCell::new(Vec::new()),
+            heels: RefCell::new(HashMap::new()),
         }
+    }
+
+    /// The attitude and state on the sample at roll `heel` (the sample's pitch and yaw, no
+    /// roll acceleration) and the law's `nominal` force there without a current: formed once
+    /// per distinct `heel` (its bits: the same inputs, the same state and force).
+    fn at_heel(&self, smp: &PathSample, heel: f64, nominal: &Plant) -> AtHeel {
+        let bits = heel.to_bits();
+        if let Some(kept) = self.heels.borrow().get(&bits) {
+            return *kept;
+        }
+        let att = self.attitude(heel.sin_cos(), self.theta_sin_cos);
+        let (state, nu_dot) = self.state(smp, heel, (self.theta, self.psi_0), &att, 0.0);
+        let modelled = nominal.required_force_at(&state, &att, &nu_dot, &Vector3::zeros());
+        let out = AtHeel {
+            att,
+            state,
+            nu_dot,
+            modelled,
+        };
+        self.heels.borrow_mut().insert(bits, out);
+        out
     }
 
     /// [`Shared::state`] at roll `level` (a static heel, sines and cosines `level_sc`), the
@@ -155,13 +194,9 @@ pub(super) fn check_point(
     let (state, nu_dot, att) = shared.level_state(smp, level, level_sc);
     let heel = heel(plant, roll, shared, &state, &att, &nu_dot, current).unwrap_or(level);
     // The pitch error that holds the law's model mismatch in pitch, at the heel.
-    let att = shared.attitude(heel.sin_cos(), shared.theta_sin_cos);
-    let (state, nu_dot) = shared.state(smp, heel, (shared.theta, shared.psi_0), &att, 0.0);
-    let needed = plant.required_force_at(&state, &att, &nu_dot, current);
-    let modelled = checker
-        .nominal()
-        .required_force_at(&state, &att, &nu_dot, &Vector3::zeros());
-    let (d_theta, d_psi) = attitude::steady_errors(&needed, &modelled, &at.stiffness);
+    let h = shared.at_heel(smp, heel, checker.nominal());
+    let needed = plant.required_force_at(&h.state, &h.att, &h.nu_dot, current);
+    let (d_theta, d_psi) = attitude::steady_errors(&needed, &h.modelled, &at.stiffness);
     let theta = smp.eta[PITCH] + d_theta;
     let theta_sc = theta.sin_cos();
     let psi = smp.eta[YAW] + d_psi;
