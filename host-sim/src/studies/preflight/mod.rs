@@ -50,6 +50,7 @@ use crate::scenario::Scenario;
 
 pub mod attitude;
 pub mod chatter;
+pub mod lag;
 pub mod navigation;
 pub mod path_budget;
 pub mod period;
