@@ -36,7 +36,9 @@
 //!
 //! **Choices** (docs/real-vehicle.md#preflight-feasibility): the box is the controller's `uncertainty` box; the margin
 //! is 80 %; the path is sampled at 20 Hz of its own time; Gauss–Markov currents are taken at
-//! ±3σ; the attitude model is [`attitude`]'s (**Choice 104**).
+//! ±3σ; the attitude model is [`attitude`]'s (**Choice 104**). Beside the navigation's share
+//! ([`navigation`], Choice 372) each thruster's margin envelope keeps the thrusters' lag's
+//! share ([`lag`], Choice 509): the start transient's overshoot through a lagged thruster.
 
 use std::fmt;
 
@@ -50,6 +52,7 @@ use crate::scenario::Scenario;
 
 pub mod attitude;
 pub mod chatter;
+pub mod lag;
 pub mod navigation;
 pub mod path_budget;
 pub mod period;
