@@ -1023,7 +1023,7 @@ impl<'a> Chatter<'a> {
             m0 = m1;
         }
         // A long mission's window: the repeating part's sums extrapolated at their mean per
-        // period over the rest of the flight (Eq 38.2).
+        // period over the rest of the flight (Eq L2).
         if flown < periods {
             let factor = (periods - from) as f64 / (flown - from) as f64;
             for j in 0..THRUSTERS {

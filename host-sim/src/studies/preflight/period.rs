@@ -28,7 +28,7 @@
 //!   [`LEVELS`] constant levels s = 0, ¼, ½, ¾, 1, every one with the largest roll swing the
 //!   payload can drive ([`swing_bound`]). At a fixed attitude Eq (1) is affine in Δp (M, C, g
 //!   are linear in the mass, the CG and the inertia), so the demand at any s lies between its
-//!   values at s = 0 and s = 1 (Eq 38.1); the heel, the trim and the swing bend it slightly,
+//!   values at s = 0 and s = 1 (Eq L1); the heel, the trim and the swing bend it slightly,
 //!   which the three inner levels catch. A superset of every time of the mission (tight when the
 //!   periods are incommensurate); a violation's time is that of its path phase in the first
 //!   period, and the payload there is the level's, not the one the mission flies at that time.
@@ -36,7 +36,7 @@
 //! Short missions (the contract's: one to three periods) keep the sweep of the payload as
 //! written, so their verdicts do not move. The chatter term and the path budget of a long mission
 //! ([`Reduction::window`], **Choice 539**) fly the first whole periods past the staircase's last
-//! step that last [`WINDOW`] s, and extrapolate the rest at the window's mean (Eq 38.2).
+//! step that last [`WINDOW`] s, and extrapolate the rest at the window's mean (Eq L2).
 
 use controller_core::model::ParamVariation;
 use controller_core::TrajectoryKind;
@@ -155,7 +155,7 @@ pub fn reduction(cfg: &SimConfig) -> Option<Reduction> {
 /// phase vector z = (φ − φ_eq) + i φ̇/ω, one period maps zₙ ↦ zₙ₊₁ = R zₙ + c (R = e^{−iωT},
 /// c the response from rest), so zₙ circles z* = c/(1 − R) at the radius ρ = |z₀ − z*|, and
 /// inside a period z(nT + τ) = R(τ) zₙ + c(τ): the amplitude never exceeds
-/// maxτ |R(τ) z* + c(τ)| + ρ (Eq 38.3; reached as n grows when ωT/2π is irrational). `None`
+/// maxτ |R(τ) z* + c(τ)| + ρ (Eq L3; reached as n grows when ωT/2π is irrational). `None`
 /// at resonance (|1 − R| < 10⁻⁶: the swing grows without bound).
 pub fn swing_bound(
     omega: f64,
