@@ -1027,9 +1027,8 @@ impl<'a> Chatter<'a> {
         if flown < periods {
             let factor = (periods - from) as f64 / (flown - from) as f64;
             for j in 0..THRUSTERS {
-                for e in 0..2 {
-                    let b = before.0[j][e];
-                    crossings[j][e] = b + (crossings[j][e] - b) * factor;
+                for (c, b) in crossings[j].iter_mut().zip(before.0[j]) {
+                    *c = b + (*c - b) * factor;
                 }
                 tv[j] = before.1[j] + (tv[j] - before.1[j]) * factor;
             }

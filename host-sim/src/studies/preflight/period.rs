@@ -138,7 +138,7 @@ pub fn reduction(cfg: &SimConfig) -> Option<Reduction> {
             let levels = (0..LEVELS)
                 .map(|i| max.scaled(i as f64 / (LEVELS - 1) as f64))
                 .collect();
-            payload_period.is_finite().then(|| Reduction {
+            payload_period.is_finite().then_some(Reduction {
                 from: 0.0,
                 period,
                 long,
