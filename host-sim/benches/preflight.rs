@@ -1,7 +1,7 @@
 //! Preflight benchmarks (docs/real-vehicle.md#how-the-check-is-made): `host-sim check`'s work —
 //! the verdict over both scopes and, for a waypoint mission, the speed profile's search — on
-//! the shipped survey, a 32-point route (a payload staircase, a current) and a day-long
-//! circle; and the chatter term alone (its prediction and its search, Choices 500–504 and
+//! the shipped survey, a 32-point route (a payload staircase, a current), a day-long circle
+//! and the shipped real circle flown for a day (Choices 538–539); and the chatter term alone (its prediction and its search, Choices 500–504 and
 //! 516–517) on the survey and on the tuning study's main-job sample (`tune::MAIN_JOB_TUNE`:
 //! refused missions ask it up to scale 100). `cargo bench --profile host -p host-sim --bench
 //! preflight`; one thread.
@@ -31,6 +31,7 @@ fn bench(c: &mut Criterion) {
         ("survey-200x100", "scenarios/real/survey-200x100.toml"),
         ("route32", "benches/route32.toml"),
         ("day-circle", "benches/day-circle.toml"),
+        ("real-day-circle", "benches/real-day-circle.toml"),
     ] {
         let s = scenario(path);
         group.bench_function(name, |b| b.iter(|| check(black_box(&s), Engine::Fast)));

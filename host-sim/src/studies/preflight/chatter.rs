@@ -591,8 +591,42 @@ pub struct Chatter<'a> {
     unit: ThrustUnit,
     samples: Vec<RefSample>,
     currents: Vec<Vector3<f64>>,
-    period: Option<f64>,
+    /// How a periodic mission repeats (Choices 393, 538–539).
+    reduction: Option<period::Reduction>,
     rate_hz: f64,
+}
+
+/// The path time (s, at k = 1) the terms sample the reference over: to the first repetition,
+/// or a torus's window (its payload does not repeat).
+pub(super) fn reference_span(r: &period::Reduction) -> f64 {
+    match (r.long, &r.levels) {
+        (true, Some(_)) => r.window(1.0),
+        _ => r.checked(),
+    }
+}
+
+/// The control periods a flight of `periods` at scale `k` and `rate_hz` is flown over by the
+/// terms (Choice 539): all of them, or for a long mission its window (at least `cycle`
+/// periods past the repetition's start), and the period the repeating part starts at.
+pub(super) fn window_periods(
+    r: Option<&period::Reduction>,
+    periods: u64,
+    k: f64,
+    rate_hz: f64,
+    cycle: u64,
+) -> (u64, u64) {
+    match r.filter(|r| r.long) {
+        Some(r) => {
+            let from = (r.from * k * rate_hz).ceil() as u64;
+            let window = ((r.window(k) * k * rate_hz).ceil() as u64).max(from + cycle.max(1));
+            if window < periods {
+                (window, from)
+            } else {
+                (periods, periods)
+            }
+        }
+        None => (periods, periods),
+    }
 }
 
 impl<'a> Chatter<'a> {
@@ -601,6 +635,19 @@ impl<'a> Chatter<'a> {
     /// # Errors
     /// [`CheckError::Invalid`] for a loop the term cannot model; [`CheckError::Interrupted`].
     pub fn new(scenario: &'a Scenario) -> Result<Option<Self>, CheckError> {
+        Self::with_reduction(scenario, true)
+    }
+
+    /// [`Chatter::new`], or with `reduce` false the reference it is tested against: every
+    /// control period of the flight, the reference sampled over all of it (no Choice 393, 538
+    /// or 539).
+    ///
+    /// # Errors
+    /// As [`Chatter::new`].
+    pub fn with_reduction(
+        scenario: &'a Scenario,
+        reduce: bool,
+    ) -> Result<Option<Self>, CheckError> {
         let cfg = scenario.config();
         let Some(bound) = cfg.bound() else {
             return Ok(None);
@@ -634,8 +681,11 @@ impl<'a> Chatter<'a> {
         })
         .map_err(|e| CheckError::Invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / super::time_scale(cfg.time_scale);
-        let per = period::period(cfg);
-        let checked = per.map_or(span, |p| span.min(p + SAMPLE_PERIOD));
+        // A periodic mission's first period (Choice 393), a long one's window (Choice 539).
+        let reduction = period::reduction(cfg).filter(|_| reduce);
+        let checked = reduction
+            .as_ref()
+            .map_or(span, |r| span.min(reference_span(r) + SAMPLE_PERIOD));
         let (samples, _) = reference_samples(&path, checked)?;
         let mut out = Chatter {
             scenario,
@@ -653,7 +703,7 @@ impl<'a> Chatter<'a> {
             unit,
             samples,
             currents: current_corners(&cfg.current),
-            period: per,
+            reduction,
             rate_hz: f64::from(cfg.controller.rate_hz),
         };
         // ‖e‖ in δ: 3σ of the error the law sees, at the δ of the fastest scale (k = 1) with
@@ -907,12 +957,15 @@ impl<'a> Chatter<'a> {
     ) -> Result<Option<Flown>, CheckError> {
         let t = 1.0 / self.rate_hz;
         let periods = (self.duration(k) * self.rate_hz).round().max(1.0) as u64;
+        let cycle = stats.iter().map(|s| s.var.len() as u64).max().unwrap_or(1);
+        let (flown, from) =
+            window_periods(self.reduction.as_ref(), periods, k, self.rate_hz, cycle);
         let last = mean.len().saturating_sub(1);
         let span = last.max(1) as f64 * SAMPLE_PERIOD;
         let at = |n: u64| -> [f64; THRUSTERS] {
             let mut s = n as f64 * t / k;
-            if let Some(p) = self.period {
-                s %= p;
+            if let Some(r) = &self.reduction {
+                s = r.fold(s);
             }
             let x = (s / SAMPLE_PERIOD).min(span / SAMPLE_PERIOD);
             let j = (x.floor() as usize).min(last);
@@ -926,7 +979,11 @@ impl<'a> Chatter<'a> {
         let mut step = [0.0f64; THRUSTERS];
         let mut carry = [[None; 2]; THRUSTERS];
         let mut m0 = at(0);
-        for n in 0..periods {
+        let mut before = ([[0.0f64; 2]; THRUSTERS], [0.0f64; THRUSTERS]);
+        for n in 0..flown {
+            if n == from {
+                before = (crossings, tv);
+            }
             if n % 65_536 == 0 {
                 super::poll()?;
             }
@@ -964,6 +1021,17 @@ impl<'a> Chatter<'a> {
                 tv[j] += self.slope(j, m0[j]) * mean_abs(dm, dvar.sqrt());
             }
             m0 = m1;
+        }
+        // A long mission's window: the repeating part's sums extrapolated at their mean per
+        // period over the rest of the flight (Eq L2).
+        if flown < periods {
+            let factor = (periods - from) as f64 / (flown - from) as f64;
+            for j in 0..THRUSTERS {
+                for (c, b) in crossings[j].iter_mut().zip(before.0[j]) {
+                    *c = b + (*c - b) * factor;
+                }
+                tv[j] = before.1[j] + (tv[j] - before.1[j]) * factor;
+            }
         }
         Ok(Some(std::array::from_fn(|j| {
             (

@@ -584,8 +584,8 @@ pub struct Budget<'a> {
     /// Max reference speed per axis at k = 1, and the horizontal speed (m/s).
     speed: [f64; AXES],
     latency: f64,
-    /// The reference's period (s of path time), when it repeats.
-    period: Option<f64>,
+    /// How the reference repeats, when it does (Choices 393, 538–539).
+    reduction: Option<period::Reduction>,
     /// Every budget evaluated, by the bits of its time scale and duration (Choice 532): the
     /// check's search, the joined verdicts of both scopes and their rounding ask for the same
     /// scale more than once, and each is a propagation over the whole flight.
@@ -604,6 +604,18 @@ impl<'a> Budget<'a> {
     /// [`CheckError::Invalid`] for a loop the budget cannot model (an unstable one, an
     /// estimator without a steady state, a nominal model that cannot be built).
     pub fn new(scenario: &'a Scenario) -> Result<Option<Self>, CheckError> {
+        Self::with_reduction(scenario, true)
+    }
+
+    /// [`Budget::new`], or with `reduce` false the reference it is tested against: the whole
+    /// flight, the reference sampled over all of it (no Choice 393, 538 or 539).
+    ///
+    /// # Errors
+    /// As [`Budget::new`].
+    pub fn with_reduction(
+        scenario: &'a Scenario,
+        reduce: bool,
+    ) -> Result<Option<Self>, CheckError> {
         let cfg = scenario.config();
         let Some(bound) = cfg.bound() else {
             return Ok(None);
@@ -626,7 +638,11 @@ impl<'a> Budget<'a> {
         })
         .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / super::time_scale(cfg.time_scale);
-        let checked = period::period(cfg).map_or(span, |p| span.min(p + SAMPLE_PERIOD));
+        // A periodic mission's first period (Choice 393), a long one's window (Choice 539).
+        let reduction = period::reduction(cfg).filter(|_| reduce);
+        let checked = reduction.as_ref().map_or(span, |r| {
+            span.min(super::chatter::reference_span(r) + SAMPLE_PERIOD)
+        });
         let (samples, speed) = reference_samples(&path, checked)?;
         let nominal = Plant::new(
             scenario.controller().params().cast(f64::from),
@@ -648,7 +664,7 @@ impl<'a> Budget<'a> {
             nominal,
             speed,
             latency,
-            period: period::period(cfg),
+            reduction,
             memo: std::cell::RefCell::new(Vec::new()),
             sigmas: std::cell::RefCell::new(std::collections::HashMap::new()),
         }))
@@ -709,8 +725,8 @@ impl<'a> Budget<'a> {
         let span_samples = d.len().saturating_sub(1).max(1) as f64 * SAMPLE_PERIOD;
         let at = |t: f64| -> f64 {
             let mut s = t / k;
-            if let Some(p) = self.period {
-                s %= p;
+            if let Some(r) = &self.reduction {
+                s = r.fold(s);
             }
             let x = (s / SAMPLE_PERIOD).min(span_samples / SAMPLE_PERIOD);
             let j = (x.floor() as usize).min(d.len().saturating_sub(1));
@@ -718,7 +734,11 @@ impl<'a> Budget<'a> {
             let w = x - j as f64;
             d[j][i] * (1.0 - w) + d[j1][i] * w
         };
-        let steps = (duration.min(MAX_PROPAGATION) / lp.t).ceil() as u64;
+        let mut steps = (duration.min(MAX_PROPAGATION) / lp.t).ceil() as u64;
+        // A long mission: its window (Choice 539), the loop settled and the reference repeated.
+        if let Some(r) = self.reduction.as_ref().filter(|r| r.long) {
+            steps = steps.min((r.window(k) * k / lp.t).ceil() as u64);
+        }
         let (mut s, mut est) = (Vector2::zeros(), LoopEstimate::default());
         let mut worst = 0.0f64;
         for n in 0..steps {

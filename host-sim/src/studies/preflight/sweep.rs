@@ -130,6 +130,9 @@ pub(super) struct Checker<'a> {
     hint: [std::cell::Cell<Option<PointId>>; 2],
     /// The box's thrust span per sample at the 1/k it was judged at (Choice 530).
     screen: std::cell::RefCell<Screen>,
+    /// A long abs-sin mission's torus (Choice 538): the plant at each payload level, and the
+    /// largest roll swing its payload drives.
+    torus: Option<(Vec<Plant>, f64)>,
 }
 
 /// The currents the check takes (see the module docs of [`super`]).
@@ -209,6 +212,45 @@ fn path_samples(path: &Trajectory, checked: f64) -> Result<Vec<PathSample>, Chec
         .collect()
 }
 
+/// A long abs-sin mission's torus (Choice 538, [`period`]'s module docs): the plant at each
+/// payload level (trimmed if the scenario is; the first is level 0, the payload at t = 0), and
+/// the largest amplitude of the roll swing the payload drives over the whole mission
+/// ([`period::swing_bound`]; the start's swing with it). `None` when the swing has no bound.
+fn torus(
+    scenario: &Scenario,
+    path: &Trajectory,
+    levels: &[controller_core::model::ParamVariation<f64>],
+    payload_period: f64,
+) -> Result<Option<(Vec<Plant>, f64)>, CheckError> {
+    let cfg = scenario.config();
+    let params = |v: &controller_core::model::ParamVariation<f64>| {
+        let p = VehicleParams::auv150().with_variation(v);
+        match cfg.trimmed {
+            true => plant::trimmed(&p),
+            false => p,
+        }
+    };
+    let plants = levels
+        .iter()
+        .map(|v| {
+            Plant::new(params(v), PlantTerms::default())
+                .map_err(|e| CheckError::Invalid(format!("a payload level: {e}")))
+        })
+        .collect::<Result<Vec<_>, _>>()?;
+    let pitch = path_samples(path, 0.0)?
+        .first()
+        .map_or(0.0, |s| s.eta[PITCH]);
+    let omega = plants
+        .first()
+        .map_or(0.0, |p| attitude::roll_frequency(p, pitch));
+    let start = match cfg.initial_attitude() {
+        InitialAttitude::Level => Some(0.0),
+        InitialAttitude::Trim => None,
+    };
+    let heel = |t: f64| plant::static_heel(&cfg.plant_params_at(t), pitch).unwrap_or(0.0);
+    Ok(period::swing_bound(omega, start, &heel, payload_period).map(|a| (plants, a)))
+}
+
 /// The plant at every corner of the parameter box `bx` (trimmed to neutral buoyancy when the
 /// scenario's payload is).
 fn corner_plants(bx: ParamBox<f64>, trimmed: bool) -> Result<Vec<Plant>, CheckError> {
@@ -241,11 +283,21 @@ impl<'a> Checker<'a> {
         })
         .map_err(|e| invalid(format!("the mission at time scale 1: {e}")))?;
         let span = cfg.duration / time_scale(cfg.time_scale);
-        // A periodic mission: its first period (Choice 393), by the fast engine.
-        let checked = match (engine, period::period(cfg)) {
-            (Engine::Fast, Some(p)) => span.min(p),
-            _ => span,
+        // A periodic mission: its first period (Choice 393), a long one's after its
+        // staircase's last step or at its payload's levels (Choice 538), by the fast engine.
+        let mut reduction = match engine {
+            Engine::Fast => period::reduction(cfg),
+            Engine::Exhaustive => None,
         };
+        let torus = match reduction.as_ref().and_then(|r| r.levels.as_ref()) {
+            Some((levels, payload_period)) => torus(scenario, &path, levels, *payload_period)?,
+            None => None,
+        };
+        // A torus whose swing has no bound (resonance) is swept as written.
+        if torus.is_none() && reduction.as_ref().is_some_and(|r| r.levels.is_some()) {
+            reduction = None;
+        }
+        let checked = reduction.as_ref().map_or(span, |r| span.min(r.checked()));
         let samples = path_samples(&path, checked)?;
         let corners_peaks = blend_peaks(&path, span);
         let (n_samples, n_peaks) = (samples.len(), corners_peaks.len());
@@ -285,6 +337,7 @@ impl<'a> Checker<'a> {
             engine,
             hint: Default::default(),
             screen: std::cell::RefCell::new(Screen::new(n_samples, n_peaks)),
+            torus,
         })
     }
 
@@ -327,6 +380,24 @@ impl<'a> Checker<'a> {
                     }
                 })
                 .collect(),
+            Scope::AsWritten if self.torus.is_some() => {
+                let (plants, amplitude) = self
+                    .torus
+                    .as_ref()
+                    .map_or((&[][..], 0.0), |t| (&t.0[..], t.1));
+                let omega = plants.first().map_or(0.0, |p| {
+                    attitude::roll_frequency(p, self.samples[0].eta[PITCH])
+                });
+                (0..plants.len())
+                    .map(|i| CasePlants {
+                        at: vec![i],
+                        plants: plants.iter().collect(),
+                        roll: plants.iter().map(RollConsts::of).collect(),
+                        amplitude: vec![amplitude],
+                        omega,
+                    })
+                    .collect()
+            }
             Scope::AsWritten => {
                 let cfg = self.scenario.config();
                 let at: Vec<usize> = times
@@ -437,6 +508,8 @@ impl<'a> Checker<'a> {
         times: impl Iterator<Item = f64>,
     ) -> Result<Vec<Plant>, CheckError> {
         match scope {
+            // A torus's plants are its levels', built once (Choice 538).
+            Scope::AsWritten if self.torus.is_some() => Ok(Vec::new()),
             Scope::AsWritten => self.profile_plants(&times.collect::<Vec<_>>()),
             Scope::WholeBox => Ok(Vec::new()),
         }
