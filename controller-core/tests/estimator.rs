@@ -576,7 +576,10 @@ fn periods_not_run_move_the_stamp_to_the_first_of_them() {
     let (x, v) = memory.at_stamp();
     for i in 0..6 {
         let (xe, ve) = (z[i] + zd[i] * t + 0.5 * a[i] * t * t, zd[i] + a[i] * t);
-        assert!((x[i] - xe).abs() < 1e-6 && (v[i] - ve).abs() < 1e-6, "axis {i}: {x:?} {v:?}");
+        assert!(
+            (x[i] - xe).abs() < 1e-6 && (v[i] - ve).abs() < 1e-6,
+            "axis {i}: {x:?} {v:?}"
+        );
     }
     // Refused: stamped 101, not newer than the state's; the estimate is the state predicted
     // nine periods on (zero accelerations since).
