@@ -27,7 +27,7 @@ use firmware_images::image;
 // The golden vector's one definition, shared with the self-test that reads them.
 #[path = "src/bin/qemu_selftest/vector.rs"]
 mod vector;
-use vector::{estimator_steps, EstimatorGolden, Golden};
+use vector::{estimator_steps, EstimatorGolden, Golden, ESTIMATOR_CASES};
 
 // The STM32 image's link key from the environment (host-tested in tests/provision.rs).
 #[path = "src/provision.rs"]
@@ -444,8 +444,8 @@ fn golden(survey: &Path) -> String {
     s
 }
 
-/// The estimator's golden vectors: [`estimator_steps`] on every closed-form vector with Δu on
-/// that the law flies, by the default controller with the estimator on (Kalman).
+/// The estimator's golden vectors: each case of [`estimator_steps`] on every closed-form vector
+/// with Δu on that the law flies, by the default controller with the estimator on (Kalman).
 fn estimator_golden(vectors: &[Golden]) -> Vec<EstimatorGolden> {
     let mut cfg = ControllerConfig::default();
     cfg.estimator.kind = controller_core::EstimatorKind::Kalman;
@@ -455,25 +455,28 @@ fn estimator_golden(vectors: &[Golden]) -> Vec<EstimatorGolden> {
         let Ok(mission) = Mission::try_from(g.plan) else {
             continue;
         };
-        let Some(steps) = estimator_steps(g) else {
-            continue;
-        };
         if !g.robust || g.status != 0 {
             continue;
         }
         let tr = Trajectory::new(mission).expect("a golden vector's mission");
-        let mut memory = controller_core::Estimate::new();
-        let mut last = None;
-        for (ticks, solution) in steps {
-            last = Some(c.update_from_solution(&mut memory, ticks, &solution, &tr));
+        for case in 0..ESTIMATOR_CASES {
+            let Some(steps) = estimator_steps(g, case) else {
+                continue;
+            };
+            let mut memory = controller_core::Estimate::new();
+            let mut last = None;
+            for (ticks, solution) in steps {
+                last = Some(c.update_from_solution(&mut memory, ticks, &solution, &tr));
+            }
+            let o = last.expect("three steps");
+            assert!(o.status == Status::Ok, "the estimator's case flies: {o:?}");
+            out.push(EstimatorGolden {
+                vector,
+                case,
+                voltage: o.voltage,
+                tau: o.tau,
+            });
         }
-        let o = last.expect("three steps");
-        assert!(o.status == Status::Ok, "the estimator's case flies: {o:?}");
-        out.push(EstimatorGolden {
-            vector,
-            voltage: o.voltage,
-            tau: o.tau,
-        });
     }
     out
 }

@@ -556,6 +556,45 @@ fn a_solution_too_old_repeated_or_from_the_future_is_refused_and_the_state_held(
     }
 }
 
+/// Choice 492: periods the board did not run (here 101–109) are zero accelerations, and the
+/// record after them moves the state's stamp to the first of them, predicted under the model
+/// with the last period's acceleration (x + vT + aT²/2, v + aT), instead of filling the ring's
+/// sums period by period; a solution stamped before that first period is then refused, one
+/// stamped after it is taken, and the estimate at the new period is the closed-form prediction.
+#[test]
+fn periods_not_run_move_the_stamp_to_the_first_of_them() {
+    let g = gains(0.005, 0.002, 0.02);
+    let t = g.period;
+    let z = [1.0f32, 2.0, 3.0, 0.0, 0.1, 0.2];
+    let zd = [0.5f32, -0.2, 0.0, 0.0, 0.0, 0.01];
+    let a = [0.4f32, 0.2, -0.1, 0.0, 0.03, 0.0];
+    let mut memory = Estimate::new();
+    memory.step(&g, 100, 100, &z, &zd).unwrap();
+    memory.applied(&g, 100, &a);
+    memory.applied(&g, 110, &[0.0; 6]);
+    assert_eq!(memory.stamp(), 101);
+    let (x, v) = memory.at_stamp();
+    for i in 0..6 {
+        let (xe, ve) = (z[i] + zd[i] * t + 0.5 * a[i] * t * t, zd[i] + a[i] * t);
+        assert!(
+            (x[i] - xe).abs() < 1e-6 && (v[i] - ve).abs() < 1e-6,
+            "axis {i}: {x:?} {v:?}"
+        );
+    }
+    // Refused: stamped 101, not newer than the state's; the estimate is the state predicted
+    // nine periods on (zero accelerations since).
+    let mut m = memory;
+    let (e, ed) = m.step(&g, 110, 101, &[9.0; 6], &[9.0; 6]).unwrap();
+    assert_eq!(m.at_stamp(), (x, v));
+    for i in 0..6 {
+        assert!((e[i] - (x[i] + v[i] * 9.0 * t)).abs() < 1e-6 && (ed[i] - v[i]).abs() < 1e-6);
+    }
+    // Taken: stamped in the missed periods.
+    let mut m = memory;
+    m.step(&g, 110, 105, &z, &zd).unwrap();
+    assert_eq!(m.stamp(), 105);
+}
+
 /// A period recorded twice (lock-step: the board ran it once without a fresh frame, then on
 /// the frame) is as if recorded once with its last acceleration: the next solution is taken
 /// (not refused as older than the state) and the memory is the same, bit for bit.
@@ -739,8 +778,9 @@ proptest! {
 /// over any float: the prediction sums every held period's acceleration with its weight
 /// (Δη = Σ aₜ T² (to − t − ½), Δη̇ = Σ aₜ T), the stamp moved on when its period's entry is
 /// replaced (and, as Choice 430's filter does, a past period recorded again other than the latest
-/// dropped). In f64 it is the reference; in f32 it is that weighted-sum filter, which differs from
-/// the code Choice 430 replaced in that drop only.
+/// dropped, and, as Choice 492's does, after periods not run the stamp moved to the first of
+/// them). In f64 it is the reference; in f32 it is that weighted-sum filter, which differs from
+/// the code Choice 430 replaced in that drop and that move only.
 #[derive(Clone, Copy)]
 struct Weighted<T> {
     anchor: [T; 6],
@@ -750,6 +790,8 @@ struct Weighted<T> {
     valid: bool,
     accel: [[T; 6]; HORIZON],
     tick: [u64; HORIZON],
+    /// The latest period recorded (`u64::MAX`: none).
+    last: u64,
 }
 
 impl<T: nalgebra::RealField + Copy> Weighted<T> {
@@ -762,6 +804,7 @@ impl<T: nalgebra::RealField + Copy> Weighted<T> {
             valid: false,
             accel: [[T::zero(); 6]; HORIZON],
             tick: [u64::MAX; HORIZON],
+            last: u64::MAX,
         }
     }
 
@@ -818,6 +861,16 @@ impl<T: nalgebra::RealField + Copy> Weighted<T> {
     }
 
     fn applied(&mut self, g: &EstimatorGains, ticks: u64, a: &[T; 6]) {
+        if self.last != u64::MAX && ticks > self.last + 1 && self.valid && self.stamp <= self.last {
+            // Choice 492: periods not run; the stamp moves to the first of them.
+            let period = nalgebra::convert::<f64, T>(f64::from(g.period));
+            let first = self.last + 1;
+            (self.offset, self.velocity) = self.predicted(period, self.stamp, first);
+            self.stamp = first;
+        }
+        if self.last == u64::MAX || ticks > self.last {
+            self.last = ticks;
+        }
         let j = (ticks % HORIZON as u64) as usize;
         let old = self.tick[j];
         if self.valid && old != u64::MAX && old != ticks && old == self.stamp {

@@ -5,7 +5,7 @@
 use auv_link::{MissionSpec, UploadBuffer, UploadChunk, UploadHeader, UploadPart};
 use controller_core::{Mission, Table1Case, Trajectory};
 
-pub use crate::vector::{estimator_steps, EstimatorGolden, Golden};
+pub use crate::vector::{estimator_steps, EstimatorGolden, Golden, ESTIMATOR_CASES};
 
 /// build.rs's output: `GOLDEN`, `SURVEY_HEADER` and `SURVEY_CHUNKS`, written as the values'
 /// `Debug` form (every `f32` prints as the shortest literal that parses to its bits), so it

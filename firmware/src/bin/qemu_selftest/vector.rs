@@ -33,26 +33,39 @@ pub struct Golden {
 }
 
 /// One golden vector of the state estimator (docs/law.md#the-state-estimator): the host's
-/// output of the last of [`estimator_steps`] on `GOLDEN[vector]`'s inputs, the controller the
-/// default with the estimator on.
+/// output of the last of [`estimator_steps`] (case `case`) on `GOLDEN[vector]`'s inputs, the
+/// controller the default with the estimator on.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct EstimatorGolden {
     /// The index of the golden vector whose mission and inputs it flies.
     pub vector: usize,
+    /// The case of [`estimator_steps`].
+    pub case: usize,
     /// The host's voltages.
     pub voltage: [f32; THRUSTERS],
     /// The host's τ.
     pub tau: [f32; 6],
 }
 
-/// The estimator's case on a golden vector's inputs at tick k (≥ 3): the solution of tick
-/// k − 3 taken; tick k − 2 flown on it predicted (the navigation computer repeats its stamp);
-/// then at tick k the solution stamped k − 1 (one period late), 3 mm further in x: its
-/// correction at an old stamp, with both predictions and the recorded accelerations, is the
-/// estimator's largest fixed work. `(ticks, solution)` in order; `None` before tick 3.
-pub fn estimator_steps(g: &Golden) -> Option<[(u64, controller_core::Solution); 3]> {
+/// How many cases [`estimator_steps`] has.
+pub const ESTIMATOR_CASES: usize = 2;
+
+/// The estimator's cases on a golden vector's inputs at tick k (≥ 17), each three
+/// `(ticks, solution)` in order, the last counted; `None` before tick 17 or past the cases.
+///
+/// - Case 0, one period late: the solution of tick k − 3 taken; tick k − 2 flown on it
+///   predicted (the navigation computer repeats its stamp); then at tick k the solution stamped
+///   k − 1, 3 mm further in x: its correction at an old stamp, with both predictions and the
+///   recorded accelerations.
+/// - Case 1, the estimator's largest fixed work: the solution of tick k − 17 taken, tick k − 16
+///   flown on it predicted, then no period flown until tick k (a lock-step frame's `t_ticks`
+///   may jump so), whose solution is stamped k − 16, the oldest
+///   [`controller_core::estimator::HORIZON`] allows: the correction at k − 16 and the prediction to k, then the record fills the
+///   ring's sixteen periods k − 15 … k and moves the state's stamp to the oldest of them (a
+///   third prediction).
+pub fn estimator_steps(g: &Golden, case: usize) -> Option<[(u64, controller_core::Solution); 3]> {
     let k = g.ticks;
-    if k < 3 {
+    if k < 17 {
         return None;
     }
     let at = |stamp: u64, dx: f32| {
@@ -64,9 +77,17 @@ pub fn estimator_steps(g: &Golden) -> Option<[(u64, controller_core::Solution); 
             nu: g.nu,
         }
     };
-    Some([
-        (k - 3, at(k - 3, 0.0)),
-        (k - 2, at(k - 3, 0.0)),
-        (k, at(k - 1, 0.003)),
-    ])
+    match case {
+        0 => Some([
+            (k - 3, at(k - 3, 0.0)),
+            (k - 2, at(k - 3, 0.0)),
+            (k, at(k - 1, 0.003)),
+        ]),
+        1 => Some([
+            (k - 17, at(k - 17, 0.0)),
+            (k - 16, at(k - 17, 0.0)),
+            (k, at(k - 16, 0.003)),
+        ]),
+        _ => None,
+    }
 }
