@@ -192,8 +192,8 @@ fn validate_preflight_bounds_its_random_missions_and_acts_on_ctrl_c_while_making
 
 /// `check --json` printed nothing when interrupted (exit 130): stdout is exactly one JSON
 /// object, `"interrupted": true` with the verdict when it was made (a waypoint mission
-/// interrupted in its speed profile's search) and without one when it was not (a day-long
-/// circle interrupted in the check itself).
+/// interrupted in its speed profile's search) and without one when it was not (a ten-hour
+/// lawn-mower interrupted in the check itself).
 #[test]
 fn check_json_prints_the_verdict_so_far_when_interrupted() {
     let one_object = |stdout: &str| -> serde_json::Value {
@@ -224,7 +224,7 @@ fn check_json_prints_the_verdict_so_far_when_interrupted() {
     );
 
     let dir = tempdir("check-int");
-    let s = scenario(&dir, "day", DAY);
+    let s = scenario(&dir, "day", LONG);
     let child = host_sim()
         .args(["check", "--json", "--scenario"])
         .arg(&s)
@@ -234,25 +234,29 @@ fn check_json_prints_the_verdict_so_far_when_interrupted() {
         .unwrap();
     std::thread::sleep(std::time::Duration::from_millis(1500));
     signal(child.id(), libc::SIGINT);
-    let o = wait_at_most(child, std::time::Duration::from_secs(20), "check of a day");
+    let o = wait_at_most(
+        child,
+        std::time::Duration::from_secs(20),
+        "check of a ten-hour mission",
+    );
     assert_eq!(o.status.code(), Some(130), "{}", stderr(&o));
     let v = one_object(&String::from_utf8_lossy(&o.stdout));
     assert_eq!(v, serde_json::json!({"interrupted": true}));
 }
 
-/// A day-long circle whose payload varies (|sin| at 0.1 rad/s, incommensurate with the circle):
-/// its preflight alone is minutes of work (1.7·10⁶ distinct samples × 2⁹ corners). A circle
-/// with a constant payload is checked over one period (Choice 393), in milliseconds, so it
-/// would no longer be interrupted in its preflight.
-const DAY: &str = "name = \"day\"\nduration = 86400\n[trajectory]\nkind = \"circle\"\nradius = 10\n[variation]\nprofile = \"abs-sin\"\n";
+/// A ten-hour lawn-mower whose payload varies (|sin| at 0.1 rad/s): a path that does not
+/// repeat, so its preflight sweeps it as written (7.2·10⁵ samples × 2⁹ corners), tens of
+/// seconds of work. A day-long circle is no longer one: a periodic path flown for many periods is
+/// checked on one period (Choices 393, 538), in milliseconds to seconds.
+const LONG: &str = "name = \"day\"\nduration = 36000\n[trajectory]\nkind = \"lawn-mower\"\nscale = 1\n[variation]\nprofile = \"abs-sin\"\n";
 
-/// SIGINT 1.5 s into a day-long run used to act after about 80 s (the preflight did
+/// SIGINT 1.5 s into a ten-hour run used to act after about 80 s (the preflight did
 /// not look at the flag). Measured after the fix: ≈ 0.1 s. The bound is generous for a loaded
 /// machine and still fails the old behaviour.
 #[test]
 fn an_interrupt_before_the_first_period_acts_at_once() {
     let dir = tempdir("early-int");
-    let s = scenario(&dir, "day", DAY);
+    let s = scenario(&dir, "day", LONG);
     let out = dir.join("out");
     let child = spawn_run(&s, &out);
     std::thread::sleep(std::time::Duration::from_millis(1500));
