@@ -596,15 +596,6 @@ pub struct Chatter<'a> {
     rate_hz: f64,
 }
 
-/// The path time (s, at k = 1) the terms sample the reference over: to the first repetition,
-/// or a torus's window (its payload does not repeat).
-pub(super) fn reference_span(r: &period::Reduction) -> f64 {
-    match (r.long, &r.levels) {
-        (true, Some(_)) => r.window(1.0),
-        _ => r.checked(),
-    }
-}
-
 /// The control periods a flight of `periods` at scale `k` and `rate_hz` is flown over by the
 /// terms (Choice 539): all of them, or for a long mission its window (at least `cycle`
 /// periods past the repetition's start), and the period the repeating part starts at.
@@ -685,7 +676,7 @@ impl<'a> Chatter<'a> {
         let reduction = period::reduction(cfg).filter(|_| reduce);
         let checked = reduction
             .as_ref()
-            .map_or(span, |r| span.min(reference_span(r) + SAMPLE_PERIOD));
+            .map_or(span, |r| span.min(r.reference_span() + SAMPLE_PERIOD));
         let (samples, _) = reference_samples(&path, checked)?;
         let mut out = Chatter {
             scenario,
@@ -960,19 +951,7 @@ impl<'a> Chatter<'a> {
         let cycle = stats.iter().map(|s| s.var.len() as u64).max().unwrap_or(1);
         let (flown, from) =
             window_periods(self.reduction.as_ref(), periods, k, self.rate_hz, cycle);
-        let last = mean.len().saturating_sub(1);
-        let span = last.max(1) as f64 * SAMPLE_PERIOD;
-        let at = |n: u64| -> [f64; THRUSTERS] {
-            let mut s = n as f64 * t / k;
-            if let Some(r) = &self.reduction {
-                s = r.fold(s);
-            }
-            let x = (s / SAMPLE_PERIOD).min(span / SAMPLE_PERIOD);
-            let j = (x.floor() as usize).min(last);
-            let j1 = (j + 1).min(last);
-            let w = x - j as f64;
-            std::array::from_fn(|i| mean[j][i] * (1.0 - w) + mean[j1][i] * w)
-        };
+        let at = |n: u64| self.mean_at(mean, n as f64 * t / k);
         let mut crossings = [[0.0f64; 2]; THRUSTERS];
         let mut tv = [0.0f64; THRUSTERS];
         let mut sigma = [0.0f64; THRUSTERS];
@@ -1022,16 +1001,9 @@ impl<'a> Chatter<'a> {
             }
             m0 = m1;
         }
-        // A long mission's window: the repeating part's sums extrapolated at their mean per
-        // period over the rest of the flight (Eq L2).
         if flown < periods {
             let factor = (periods - from) as f64 / (flown - from) as f64;
-            for j in 0..THRUSTERS {
-                for (c, b) in crossings[j].iter_mut().zip(before.0[j]) {
-                    *c = b + (*c - b) * factor;
-                }
-                tv[j] = before.1[j] + (tv[j] - before.1[j]) * factor;
-            }
+            extrapolate(&mut crossings, &mut tv, &before, factor);
         }
         Ok(Some(std::array::from_fn(|j| {
             (
@@ -1041,6 +1013,21 @@ impl<'a> Chatter<'a> {
                 tv[j],
             )
         })))
+    }
+
+    /// The mean thrusts at path time `s` (s, at k = 1), folded onto a periodic mission's
+    /// checked span, linear between the reference's samples (`mean`, one a sample).
+    fn mean_at(&self, mean: &[[f64; THRUSTERS]], mut s: f64) -> [f64; THRUSTERS] {
+        let last = mean.len().saturating_sub(1);
+        let span = last.max(1) as f64 * SAMPLE_PERIOD;
+        if let Some(r) = &self.reduction {
+            s = r.fold(s);
+        }
+        let x = (s / SAMPLE_PERIOD).min(span / SAMPLE_PERIOD);
+        let j = (x.floor() as usize).min(last);
+        let j1 = (j + 1).min(last);
+        let w = x - j as f64;
+        std::array::from_fn(|i| mean[j][i] * (1.0 - w) + mean[j1][i] * w)
     }
 
     /// |dV/dT| of thruster `j` at thrust `x` (V/N), 0 where the supply limit clamps it.
@@ -1169,6 +1156,23 @@ type MeanThrusts = Vec<Vec<[f64; THRUSTERS]>>;
 /// Index of roll and pitch in η.
 const ROLL: usize = 3;
 const PITCH: usize = 4;
+
+/// A long mission's window (Eq L2): the repeating part's sums (past `before`, the sums at the
+/// period it starts) extrapolated at their mean per period by `factor`, the flight's repeating
+/// periods over the window's.
+fn extrapolate(
+    crossings: &mut [[f64; 2]; THRUSTERS],
+    tv: &mut [f64; THRUSTERS],
+    before: &([[f64; 2]; THRUSTERS], [f64; THRUSTERS]),
+    factor: f64,
+) {
+    for j in 0..THRUSTERS {
+        for (c, b) in crossings[j].iter_mut().zip(before.0[j]) {
+            *c = b + (*c - b) * factor;
+        }
+        tv[j] = before.1[j] + (tv[j] - before.1[j]) * factor;
+    }
+}
 
 /// The vehicle on the reference sample `r` at time scale `k` with roll `phi`: η, ν = J⁻¹η̇,
 /// ν̇ = J⁻¹(η̈ − J̇ν).

@@ -640,9 +640,9 @@ impl<'a> Budget<'a> {
         let span = cfg.duration / super::time_scale(cfg.time_scale);
         // A periodic mission's first period (Choice 393), a long one's window (Choice 539).
         let reduction = period::reduction(cfg).filter(|_| reduce);
-        let checked = reduction.as_ref().map_or(span, |r| {
-            span.min(super::chatter::reference_span(r) + SAMPLE_PERIOD)
-        });
+        let checked = reduction
+            .as_ref()
+            .map_or(span, |r| span.min(r.reference_span() + SAMPLE_PERIOD));
         let (samples, speed) = reference_samples(&path, checked)?;
         let nominal = Plant::new(
             scenario.controller().params().cast(f64::from),

@@ -81,6 +81,15 @@ impl Reduction {
         self.from + periods * self.period
     }
 
+    /// The path time the terms (chatter, budget) sample the reference over (s, at k = 1): to
+    /// the first repetition, or a torus's window (its payload does not repeat).
+    pub fn reference_span(&self) -> f64 {
+        match (self.long, &self.levels) {
+            (true, Some(_)) => self.window(1.0),
+            _ => self.checked(),
+        }
+    }
+
     /// Path time `s` folded onto the checked span: itself before [`Reduction::from`], then
     /// `from + (s − from) mod P` (for `from` = 0, `s mod P`, as Choice 393 always did).
     /// Meaningless for a torus (its payload does not repeat): `s` itself.
