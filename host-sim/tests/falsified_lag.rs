@@ -5,25 +5,13 @@
 //! the steady demand (without the lag the same missions fly within bounds). The check now keeps
 //! the lag's share of each thruster's envelope (Choice 509, docs/real-vehicle.md#the-lags-share).
 
-use host_sim::scenario::{load_scenario, Scenario};
+#[path = "common/falsified.rs"]
+mod falsified;
+
+use falsified::{at_scale, mission};
+use host_sim::scenario::Scenario;
 use host_sim::sim::{self, bound, LocalController, Observer, Recording, Sample};
 use host_sim::studies::preflight::{self, DEFAULT_MARGIN};
-
-fn mission(file: &str) -> Scenario {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(file);
-    load_scenario(&path).unwrap()
-}
-
-fn at_scale(s: &Scenario, k: f64) -> Scenario {
-    let span = s.config().duration / f64::from(s.config().time_scale);
-    s.with(|c| {
-        c.time_scale = k as f32;
-        c.duration = span * k;
-    })
-    .unwrap()
-}
 
 /// Watches nothing.
 struct Nothing;

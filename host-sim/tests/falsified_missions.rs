@@ -5,7 +5,11 @@
 //! offset, Choice 550, docs/real-vehicle.md#the-attitude-the-vehicle-holds): the missions are
 //! refused at the scales it proposed then, and proposed at scales where they fly within bounds.
 
-use host_sim::scenario::{load_scenario, Scenario};
+#[path = "common/falsified.rs"]
+mod falsified;
+
+use falsified::{at_scale, mission};
+use host_sim::scenario::Scenario;
 use host_sim::sim::{self, bound, LocalController, Observer, Recording, Sample};
 use host_sim::studies::preflight::{self, DEFAULT_MARGIN};
 
@@ -17,22 +21,6 @@ const FALSIFIED: [(&str, f64); 2] = [
 ];
 /// `horz fore` in the thrusters' order.
 const HORZ_FORE: usize = 3;
-
-fn mission(file: &str) -> Scenario {
-    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("tests/data")
-        .join(file);
-    load_scenario(&path).unwrap()
-}
-
-fn at_scale(s: &Scenario, k: f64) -> Scenario {
-    let span = s.config().duration / f64::from(s.config().time_scale);
-    s.with(|c| {
-        c.time_scale = k as f32;
-        c.duration = span * k;
-    })
-    .unwrap()
-}
 
 /// The thrust each period demanded of `horz fore`.
 struct Demands(Vec<f64>);
