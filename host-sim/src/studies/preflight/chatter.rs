@@ -702,7 +702,7 @@ impl<'a> Chatter<'a> {
         let (_, delta) = out.mean_thrusts(1.0)?;
         let stats = out.stats_at(delta)?;
         out.error_norm = 3.0
-            * [0, 1, 2, 4, 5]
+            * controller_core::axes::ACTUATED
                 .iter()
                 .map(|&a| stats[a].err_var)
                 .sum::<f64>()

@@ -42,6 +42,7 @@
 //! Not modelled here: a payload profile's later jumps (each a step of the mismatch too), and
 //! a wandering current's rate (the falsifying missions searched did not need it).
 
+use controller_core::axes::ACTUATED;
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::kinematics::{self, Attitude};
 use controller_core::{Mission, Trajectory};
@@ -52,8 +53,6 @@ use super::CheckError;
 use crate::plant::{Plant, PlantState, PlantTerms};
 use crate::scenario::Scenario;
 
-/// The controlled axes of η (x, y, z, pitch, yaw).
-const CONTROLLED: [usize; 5] = [0, 1, 2, 4, 5];
 /// Periods the step response is flown (20 s at 100 Hz: every loop of the vehicle's gains has
 /// settled long before).
 const STEP_PERIODS: usize = 2000;
@@ -148,7 +147,7 @@ pub fn reserve(scenario: &Scenario) -> Result<[f64; THRUSTERS], CheckError> {
     // Per axis, the force (N, N·m) the lag adds to the command's peak: the mismatch's step
     // and the start offset together, at the worst relative sign (L2).
     let mut extra = [0.0; 6];
-    for &j in &CONTROLLED {
+    for &j in &ACTUATED {
         // The nominal feedback K₁, K₂: outside its boundary layer the switching term is a
         // bounded push, not a gain (module docs).
         let lp = Loop::with_delta(scenario, j, 0.0)?;
@@ -161,7 +160,7 @@ pub fn reserve(scenario: &Scenario) -> Result<[f64; THRUSTERS], CheckError> {
     }
     let alloc = scenario.controller().allocation();
     let mut out = [0.0; THRUSTERS];
-    for &j in &CONTROLLED {
+    for &j in &ACTUATED {
         let mut unit = Vector6::<f32>::zeros();
         unit[j] = 1.0;
         let column = alloc.thrusts(&unit);
