@@ -133,10 +133,11 @@ pub const BUDGETS: [StepBudget; 3] = [
         // maps take no cbrtf since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
         stages: [8_400, 6_200, 1_000, 930, 500],
-        // Measured 24 597 on the largest fixed work (Choice 494), 24 426 one period late
-        // (24 683 before Choice 492, 24 757 before Choice 493); solution, filter, estimate,
-        // record: 7 535, 1 108, 7 505, 603 (libm's sinf/cosf in the solution's and the
-        // estimate's attitude).
+        // Measured 24 453 one period late, 24 362 on the largest fixed work (Choice 554;
+        // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
+        // before Choice 493); solution, filter, estimate, record: 7 535, 1 131, 7 509, 268
+        // (603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
+        // attitude).
         update_from_solution: 26_000,
         estimator_stages: [8_400, 1_280, 8_400, 300],
         // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
@@ -154,9 +155,10 @@ pub const BUDGETS: [StepBudget; 3] = [
         // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
         stages: [450, 680, 700, 930, 480],
-        // Measured 5 043 on the largest fixed work (Choice 494), 4 790 one period late (5 047
-        // before Choice 492, 5 124 before Choice 493); solution, filter, estimate, record: 346,
-        // 1 107, 326, 606.
+        // Measured 4 818 one period late, 4 799 on the largest fixed work (Choice 554; 4 790
+        // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
+        // Choice 493); solution, filter, estimate, record: 345, 1 129, 321, 267 (606 before
+        // Choice 554).
         update_from_solution: 5_300,
         estimator_stages: [400, 1_280, 380, 300],
         // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
