@@ -33,7 +33,8 @@
 //! **Choice 341:** the filter's state is kept at the stamp of the newest solution taken (the
 //! delayed horizon), and the estimate the law uses is that state predicted forward to the
 //! current period with the accelerations applied since ([`Estimate::step`]). A solution older
-//! than [`HORIZON`] periods, not newer than the last one taken, stamped in the future, or not
+//! than [`MAX_AGE`] periods (or, after periods the board did not run, stamped before the first
+//! of them, Choice 554), not newer than the last one taken, stamped in the future, or not
 //! finite is refused: the state is held and predicted, never corrected by it.
 
 use nalgebra::{Matrix2, Vector6};
@@ -42,10 +43,16 @@ use crate::axes::YAW;
 use crate::kinematics::Kinematics;
 use crate::math::times_zero;
 
-/// How many periods of applied acceleration the estimator keeps: the oldest solution it can
-/// correct at its stamp and predict forward (Choice 341: 16 periods, 160 ms at 100 Hz, covers a
-/// DVL-aided INS's latency of some tens of milliseconds with room).
+/// How many periods of applied acceleration the estimator keeps, the current one included:
+/// the oldest solution it can correct at its stamp and predict forward is [`MAX_AGE`] periods
+/// old (Choice 341: 16 periods; Choice 554: 15 periods, 150 ms at 100 Hz, covers a DVL-aided
+/// INS's latency of some tens of milliseconds with room).
 pub const HORIZON: usize = 16;
+
+/// The oldest a solution may be, in periods, to be taken: [`HORIZON`] − 1 (**Choice 554**: the
+/// record of the period it arrives in then keeps every period after its stamp, so the state
+/// taken is never predicted again, a third time, by that record; 150 ms at 100 Hz).
+pub const MAX_AGE: u64 = HORIZON as u64 - 1;
 
 /// Fixed number of doubling steps of [`steady_state_gain`]: the error of the structure-preserving
 /// doubling algorithm falls like ρ^(2^k) with ρ < 1 the filter's closed-loop spectral radius,
@@ -610,8 +617,9 @@ impl Estimate {
     }
 
     /// Period `ticks`: takes the solution `z` = (η, η̇) stamped `stamp` if it is usable
-    /// (finite, not newer than `ticks`, newer than the last taken, at most [`HORIZON`] periods
-    /// old), correcting the state at that stamp; returns the estimate (η̂, η̂̇) at `ticks`, or
+    /// (finite, not newer than `ticks`, newer than the last taken, at most [`MAX_AGE`] periods
+    /// old and, after periods not run, not before the first of them: Choice 554), correcting
+    /// the state at that stamp; returns the estimate (η̂, η̂̇) at `ticks`, or
     /// `None` before any solution was taken. A yaw innovation is wrapped to (−π, π], so the
     /// yaw state stays within half a turn of the solution's heading (its anchor).
     pub fn step(
@@ -628,7 +636,12 @@ impl Estimate {
         }
         // Choice 527: finiteness as Σ x·0 (±0 when all are finite, NaN otherwise).
         let finite = times_zero(eta) + times_zero(eta_dot) == 0.0;
-        let in_window = stamp <= ticks && ticks - stamp <= HORIZON as u64;
+        // Choice 554: only a stamp the period's record keeps (`Estimate::kept_from`): at most
+        // MAX_AGE old and, after periods not run (`ticks` more than one past the last
+        // recorded; never with none recorded, `last` = NONE = u64::MAX), after the last
+        // recorded.
+        let after_gap_too_old = stamp <= self.last && ticks.saturating_sub(1) > self.last;
+        let in_window = stamp <= ticks && ticks - stamp <= MAX_AGE && !after_gap_too_old;
         if finite && in_window {
             if !self.valid {
                 self.anchor = *eta;
@@ -674,6 +687,18 @@ impl Estimate {
         Some((core::array::from_fn(|i| self.anchor[i] + o[i]), v))
     }
 
+    /// The oldest period the record of period `ticks` keeps for a prediction to start from:
+    /// the ring's oldest once `ticks` is recorded, and after periods not run (`ticks` more than
+    /// one past the last recorded) not before the first of them ([`Estimate::applied`]).
+    fn kept_from(&self, ticks: u64) -> u64 {
+        let oldest = (ticks + 1).saturating_sub(HORIZON as u64);
+        match self.last {
+            NONE => oldest,
+            last if ticks > last && ticks - last > 1 => (last + 1).max(oldest),
+            _ => oldest,
+        }
+    }
+
     /// Records the acceleration `a` applied over period `ticks` (a non-finite one is recorded
     /// as zero: unknown). The state's stamp is first moved, predicted, to the oldest period
     /// a prediction may start from once `ticks` is recorded, so that a prediction from the
@@ -700,14 +725,9 @@ impl Estimate {
             return;
         }
         let h = HORIZON as u64;
-        let oldest = (ticks + 1).saturating_sub(h);
         // Nothing recorded yet, or periods not run since the last recorded.
         let fresh = self.last == NONE || ticks - self.last > 1;
-        let keep_from = match self.last {
-            NONE => oldest,
-            last if fresh => (last + 1).max(oldest),
-            _ => oldest,
-        };
+        let keep_from = self.kept_from(ticks);
         if self.valid && self.stamp < keep_from {
             let (o, v) = self.predicted(gains, self.stamp, keep_from);
             self.offset = o;

@@ -7,7 +7,7 @@
 #![allow(clippy::field_reassign_with_default)]
 
 use controller_core::estimator::{
-    steady_state_gain, Estimate, EstimatorConfig, EstimatorGains, EstimatorKind, HORIZON,
+    steady_state_gain, Estimate, EstimatorConfig, EstimatorGains, EstimatorKind, HORIZON, MAX_AGE,
 };
 use controller_core::{
     ConfigError, Controller, ControllerConfig, Solution, Status, Table1Case, Trajectory,
@@ -483,7 +483,7 @@ fn a_steady_current_leaves_no_prediction_error_with_the_disturbance_state() {
 fn prediction_over_the_solution_age_is_exact_under_the_model() {
     let g = gains(0.005, 0.002, 0.02);
     let t = 0.01f64;
-    for age in 0..=HORIZON as u64 {
+    for age in 0..=MAX_AGE {
         let mut noise = Normal(17 + age);
         let n = 400u64;
         let mut p = vec![[0.0f64; 6]];
@@ -539,6 +539,7 @@ fn a_solution_too_old_repeated_or_from_the_future_is_refused_and_the_state_held(
         (101, 102),
         (200, 100),
         (101, 101 - HORIZON as u64 - 1),
+        (101, 101 - HORIZON as u64),
     ] {
         let mut m = memory;
         m.step(&g, ticks, stamp, &jump, &jump).unwrap();
@@ -836,7 +837,14 @@ impl<T: nalgebra::RealField + Copy> Weighted<T> {
         eta_dot: &[T; 6],
     ) -> ([T; 6], [T; 6]) {
         let period = nalgebra::convert::<f64, T>(f64::from(g.period));
-        if stamp <= ticks && ticks - stamp <= HORIZON as u64 {
+        // Choice 554: a stamp the period's record keeps.
+        let oldest = (ticks + 1).saturating_sub(HORIZON as u64);
+        let kept_from = if self.last != u64::MAX && ticks > self.last + 1 {
+            (self.last + 1).max(oldest)
+        } else {
+            oldest
+        };
+        if stamp <= ticks && stamp >= kept_from {
             if !self.valid {
                 (self.anchor, self.offset, self.velocity) = (*eta, [T::zero(); 6], *eta_dot);
                 (self.stamp, self.valid) = (stamp, true);
@@ -966,4 +974,49 @@ fn a_day_of_periods_does_not_drift() {
         day[0] <= 2.0 * hour[0] && day[1] <= 2.0 * hour[1],
         "{hour:?} → {day:?}"
     );
+}
+
+/// Choice 554: a solution is taken only at a stamp the period's record keeps, so that the
+/// state it corrects is never predicted a third time in that period: at most [`MAX_AGE`] =
+/// [`HORIZON`] − 1 periods old, and after periods not run not before the first of them. Before,
+/// a solution [`HORIZON`] periods old, or stamped at the last period recorded before a gap, was
+/// taken and the record moved the state's stamp again at once.
+#[test]
+fn a_solution_is_taken_only_at_a_stamp_the_periods_record_keeps() {
+    let g = gains(0.005, 0.002, 0.02);
+    let z = [1.0f32, 2.0, 3.0, 0.0, 0.1, 0.2];
+    let zd = [0.5f32, 0.0, 0.0, 0.0, 0.0, 0.0];
+    let jump = [1.5f32, 2.0, 3.0, 0.0, 0.1, 0.2];
+    let mut memory = Estimate::new();
+    memory.step(&g, 100, 100, &z, &zd).unwrap();
+    memory.applied(&g, 100, &[0.0; 6]);
+    for tick in 101..=120 {
+        memory.step(&g, tick, 100, &z, &zd).unwrap();
+        memory.applied(&g, tick, &[0.0; 6]);
+    }
+    // Every period run, no solution yet: MAX_AGE old is taken, HORIZON old is not.
+    let mut first = Estimate::new();
+    for tick in 100..=120 {
+        first.applied(&g, tick, &[0.0; 6]);
+    }
+    let mut taken = first;
+    taken.step(&g, 121, 121 - MAX_AGE, &jump, &zd).unwrap();
+    assert_eq!(taken.stamp(), 121 - MAX_AGE);
+    let mut refused = first;
+    assert!(refused
+        .step(&g, 121, 121 - HORIZON as u64, &jump, &zd)
+        .is_none());
+    // Periods 121..=124 not run: a stamp at or before the last recorded (120) is refused, the
+    // first missed period's is taken.
+    let mut refused = memory;
+    refused.step(&g, 125, 120, &jump, &zd).unwrap();
+    assert_eq!(refused.at_stamp(), memory.at_stamp());
+    let mut taken = memory;
+    taken.step(&g, 125, 121, &jump, &zd).unwrap();
+    assert_eq!(taken.stamp(), 121);
+    // Taken, its stamp survives the period's record: not moved (nor predicted) again.
+    let before = taken;
+    taken.applied(&g, 125, &[0.0; 6]);
+    assert_eq!(taken.at_stamp(), before.at_stamp());
+    assert_eq!(taken.stamp(), 121);
 }

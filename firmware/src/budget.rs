@@ -98,19 +98,23 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
         // against 445 for the closed forms.
         stages: [500, 720, 680, 930, 480],
-        // Measured 5 185 on the largest fixed work (Choice 494; 7 713 before Choice 492, whose
-        // record filled sixteen periods of sums), 4 908 one period late (5 164 before Choice
+        // Measured 4 942 on the largest fixed work, 4 937 one period late (Choice 554: a
+        // solution is taken only at a stamp its period's record keeps, so no third prediction;
+        // 5 185 and 4 908 before it, on Choice 494's case, a solution 16 periods late after 16
+        // not run; 7 713 before Choice 492, whose
+        // record filled sixteen periods of sums; 4 908 one period late was 5 164 before Choice
         // 492, 5 245 before Choice 493; 5 887 with the inverse map's roots, Choice
         // 491, and the estimator's finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
         // 510, before Choices 520–522 and 524; 6 273 before both, 7 200 before Choices
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
         // 2 450 of it and the law on the estimate ≈ 2 700 (docs/law.md#the-state-estimator).
         update_from_solution: 5_450,
-        // solution, filter, estimate, record: measured 390, 1 107, 356, 605 (the record 3 132
+        // solution, filter, estimate, record: measured 393, 1 134, 354, 264 (the record 605
+        // before Choice 554, whose acceptance test adds 27 to the filter; 3 132
         // on Choice 494's case before Choice 492; 1 249 and 532 before Choice 527's finiteness
         // sums; the filter's disturbance state, Choice 510, adds about 210: its correction and
         // d·Δt²/2, d·Δt in both predictions).
-        estimator_stages: [450, 1_280, 410, 700],
+        estimator_stages: [450, 1_280, 410, 300],
         // Measured 35 960 (the whole patch host-sim sends, protocol 8: 71 bytes of the law's
         // settings more to decode, a digest over 190 bytes, 120 before, and the rebuild's
         // Lyapunov solve and loop-rate rule on the law sent, Choice 508; 29 160 with protocol
@@ -129,12 +133,13 @@ pub const BUDGETS: [StepBudget; 3] = [
         // maps take no cbrtf since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
         stages: [8_400, 6_200, 1_000, 930, 500],
-        // Measured 24 597 on the largest fixed work (Choice 494), 24 426 one period late
-        // (24 683 before Choice 492, 24 757 before Choice 493); solution, filter, estimate,
-        // record: 7 535, 1 108, 7 505, 603 (libm's sinf/cosf in the solution's and the
-        // estimate's attitude).
+        // Measured 24 453 one period late, 24 362 on the largest fixed work (Choice 554;
+        // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
+        // before Choice 493); solution, filter, estimate, record: 7 535, 1 131, 7 509, 268
+        // (603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
+        // attitude).
         update_from_solution: 26_000,
-        estimator_stages: [8_400, 1_280, 8_400, 700],
+        estimator_stages: [8_400, 1_280, 8_400, 300],
         // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
         // cosf in the rebuild, its sin/cos in the waypoint build).
         work: WorkBudget {
@@ -150,11 +155,12 @@ pub const BUDGETS: [StepBudget; 3] = [
         // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
         stages: [450, 680, 700, 930, 480],
-        // Measured 5 043 on the largest fixed work (Choice 494), 4 790 one period late (5 047
-        // before Choice 492, 5 124 before Choice 493); solution, filter, estimate, record: 346,
-        // 1 107, 326, 606.
+        // Measured 4 818 one period late, 4 799 on the largest fixed work (Choice 554; 4 790
+        // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
+        // Choice 493); solution, filter, estimate, record: 345, 1 129, 321, 267 (606 before
+        // Choice 554).
         update_from_solution: 5_300,
-        estimator_stages: [400, 1_280, 380, 700],
+        estimator_stages: [400, 1_280, 380, 300],
         // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
         work: WorkBudget {
             set_config: 41_000,

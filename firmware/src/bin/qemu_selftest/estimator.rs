@@ -1,7 +1,7 @@
 //! The state estimator on the target (docs/law.md#the-state-estimator): its golden vectors
 //! ([`ESTIMATOR_GOLDEN`], the host's outputs of `update_from_solution` on the same steps) bit
 //! for bit, and the instructions of `update_from_solution` with the estimator on at its
-//! largest fixed work (a solution 16 periods late after 16 periods not flown, the
+//! largest fixed work (a solution 15 periods late after 15 periods not flown, the
 //! second of [`estimator_steps`]' cases), counted as the stages are
 //! ([`Counter`]): the whole call, each of its [`EstimatorStage`]s, and `update`'s count on the
 //! same inputs for the estimator's share. The whole call's largest count is held against
@@ -163,7 +163,7 @@ pub fn run(counter: &Counter) -> bool {
         );
     }
     info!(
-        "update_from_solution per case of estimator_steps (max): one period late {}, sixteen periods late after sixteen not flown {}",
+        "update_from_solution per case of estimator_steps (max): one period late {}, fifteen periods late after fifteen not flown {}",
         case_max[0],
         case_max[1]
     );

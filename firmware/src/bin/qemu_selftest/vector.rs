@@ -59,10 +59,10 @@ pub const ESTIMATOR_CASES: usize = 2;
 ///   recorded accelerations.
 /// - Case 1, the estimator's largest fixed work: the solution of tick k − 17 taken, tick k − 16
 ///   flown on it predicted, then no period flown until tick k (a lock-step frame's `t_ticks`
-///   may jump so), whose solution is stamped k − 16, the oldest
-///   [`controller_core::estimator::HORIZON`] allows: the correction at k − 16 and the prediction to k, then the record fills the
-///   ring's sixteen periods k − 15 … k and moves the state's stamp to the oldest of them (a
-///   third prediction).
+///   may jump so), whose solution is stamped k − 15, the first period not flown (the oldest
+///   taken after them, Choice 554; [`controller_core::estimator::MAX_AGE`] old): the correction
+///   at k − 15 and the prediction to k, both past the last period recorded, then the record
+///   starts the ring's sums afresh at k (the stamp it keeps: no third prediction).
 pub fn estimator_steps(g: &Golden, case: usize) -> Option<[(u64, controller_core::Solution); 3]> {
     let k = g.ticks;
     if k < 17 {
@@ -86,7 +86,7 @@ pub fn estimator_steps(g: &Golden, case: usize) -> Option<[(u64, controller_core
         1 => Some([
             (k - 17, at(k - 17, 0.0)),
             (k - 16, at(k - 17, 0.0)),
-            (k, at(k - 16, 0.003)),
+            (k, at(k - 15, 0.003)),
         ]),
         _ => None,
     }
