@@ -728,11 +728,20 @@ pub struct Budget<'a> {
     /// check's search, the joined verdicts of both scopes and their rounding ask for the same
     /// scale more than once, and each is a propagation over the whole flight.
     memo: std::cell::RefCell<Vec<([u64; 2], PathBudget)>>,
-    /// Every σ propagated, by its axis and the bits of what it reads (Choice 535): the
+}
+
+/// The most σ [`SIGMAS`] keeps; past it, it starts again (a check asks for tens).
+const SIGMA_MEMO_LIMIT: usize = 4096;
+
+thread_local! {
+    /// Every σ propagated on this thread, by the bits of all it reads (Choices 535, 555): the
     /// draws' σ does not depend on the time scale (a ping's error, not the heading's share of
-    /// the speed), and with fixes the propagation stops where the covariance repeats, so every
-    /// scale of a search past that length asks for the same one.
-    sigmas: std::cell::RefCell<std::collections::HashMap<Vec<u64>, f64>>,
+    /// the speed), with fixes the propagation stops where the covariance repeats, so every
+    /// scale of a search past that length asks for the same one; and the budgets a check
+    /// builds (the profile's probes, the fix-period search, both scopes) fly the same loops on
+    /// the same navigation. Keyed by the loop, not by the budget or its axis.
+    static SIGMAS: std::cell::RefCell<std::collections::HashMap<Vec<u64>, f64>> =
+        std::cell::RefCell::new(std::collections::HashMap::new());
 }
 
 impl<'a> Budget<'a> {
@@ -804,7 +813,6 @@ impl<'a> Budget<'a> {
             latency,
             reduction,
             memo: std::cell::RefCell::new(Vec::new()),
-            sigmas: std::cell::RefCell::new(std::collections::HashMap::new()),
         }))
     }
 
@@ -910,18 +918,22 @@ impl<'a> Budget<'a> {
     }
 
     /// [`noise_sigma`] of axis `i` under `noise` over a flight of `duration` s, propagated
-    /// once per distinct input (the same bits in, the same σ out).
+    /// once per distinct input on a thread ([`SIGMAS`]: the same bits in, the same σ out).
     fn noise_sigma(&self, i: usize, noise: &AxisNoise, duration: f64, stop: f64) -> f64 {
         let lp = &self.loops[i];
         let steps = propagation_steps(lp, noise, duration);
         let source = |s: &Option<(f64, f64, Timing)>| -> Vec<u64> {
             match s {
                 None => vec![0],
-                Some((sigma, bias, timing)) => [1.0, *sigma, *bias, timing.rate_hz]
+                // The outages' count first: the key reads back one way only.
+                Some((sigma, bias, timing)) => [1, timing.outages.len() as u64]
                     .into_iter()
-                    .chain(timing.outages.iter().flatten().copied())
-                    .map(f64::to_bits)
-                    .chain([timing.outages.len() as u64])
+                    .chain(
+                        [*sigma, *bias, timing.rate_hz]
+                            .into_iter()
+                            .chain(timing.outages.iter().flatten().copied())
+                            .map(f64::to_bits),
+                    )
                     .collect(),
             }
         };
@@ -938,11 +950,17 @@ impl<'a> Budget<'a> {
         key.extend(noise.white.map(f64::to_bits));
         key.extend(source(&noise.fix));
         key.extend(source(&noise.ping));
-        if let Some(&sigma) = self.sigmas.borrow().get(&key) {
+        if let Some(sigma) = SIGMAS.with(|m| m.borrow().get(&key).copied()) {
             return sigma;
         }
         let sigma = noise_sigma(lp, noise, steps, stop);
-        self.sigmas.borrow_mut().insert(key, sigma);
+        SIGMAS.with(|m| {
+            let mut m = m.borrow_mut();
+            if m.len() >= SIGMA_MEMO_LIMIT {
+                m.clear();
+            }
+            m.insert(key, sigma);
+        });
         sigma
     }
 
