@@ -501,10 +501,81 @@ fn propagation_steps(lp: &Loop, noise: &AxisNoise, duration: f64) -> u64 {
     (span.min(MAX_PROPAGATION) / t).ceil() as u64
 }
 
-/// σ = maxₜ √P_ee over `steps` periods of the loop `lp` ([`propagation_steps`], module
-/// docs), stopping once above `stop_above`.
-fn noise_sigma(lp: &Loop, noise: &AxisNoise, steps: u64, stop_above: f64) -> f64 {
-    let t = lp.t;
+/// A map on the noise propagation's state that is the identity but on a few rows (**Choice
+/// 555**): the loop's step changes s, the drift f and h, the estimator's correction x̂ and d̂.
+/// `A P Aᵀ` then changes only those rows and columns of P, each entry a sum over the row's
+/// non-zero entries: `O(N·nnz)` operations, not the dense product's `2N³`.
+///
+/// The sums are taken as the dense product (nalgebra's column-by-column `gemm`) takes them:
+/// over the columns in ascending order, starting from the first product. The terms it leaves
+/// out are products with an exact zero, whose sum with anything is that thing, so every
+/// non-zero entry of P is bit for bit the dense product's (a zero entry may differ in sign).
+#[derive(Clone, Debug)]
+pub(super) struct SparseMap {
+    /// The rows that are not the identity's, each with its non-zero entries, columns
+    /// ascending.
+    rows: Vec<(usize, Vec<(usize, f64)>)>,
+}
+
+impl SparseMap {
+    /// The rows of `a` that are not the identity's.
+    pub(super) fn of(a: &Cov) -> Self {
+        let rows = (0..N)
+            .filter(|&i| (0..N).any(|k| a[(i, k)] != if k == i { 1.0 } else { 0.0 }))
+            .map(|i| {
+                let row = (0..N)
+                    .filter(|&k| a[(i, k)] != 0.0)
+                    .map(|k| (k, a[(i, k)]))
+                    .collect();
+                (i, row)
+            })
+            .collect();
+        SparseMap { rows }
+    }
+
+    /// Σₖ aₖ·x(k) over a row's entries, in the dense product's order.
+    fn dot(row: &[(usize, f64)], x: impl Fn(usize) -> f64) -> f64 {
+        let mut it = row.iter();
+        let Some(&(k0, a0)) = it.next() else {
+            return 0.0;
+        };
+        let mut sum = a0 * x(k0);
+        for &(k, a) in it {
+            sum += a * x(k);
+        }
+        sum
+    }
+
+    /// P ← A P Aᵀ in place: the rows of A P that differ from P's, then the columns of
+    /// (A P) Aᵀ that differ from A P's.
+    pub(super) fn sandwich(&self, p: &mut Cov) {
+        let mut new = [[0.0; N]; N];
+        for ((_, row), out) in self.rows.iter().zip(new.iter_mut()) {
+            for (j, o) in out.iter_mut().enumerate() {
+                *o = Self::dot(row, |k| p[(k, j)]);
+            }
+        }
+        for ((i, _), out) in self.rows.iter().zip(new.iter()) {
+            for (j, o) in out.iter().enumerate() {
+                p[(*i, j)] = *o;
+            }
+        }
+        for ((_, row), out) in self.rows.iter().zip(new.iter_mut()) {
+            for (i, o) in out.iter_mut().enumerate() {
+                *o = Self::dot(row, |k| p[(i, k)]);
+            }
+        }
+        for ((j, _), out) in self.rows.iter().zip(new.iter()) {
+            for (i, o) in out.iter().enumerate() {
+                p[(i, *j)] = *o;
+            }
+        }
+    }
+}
+
+/// The initial covariance of the noise propagation: each held source's first draw and the
+/// biases (module docs).
+fn initial_covariance(noise: &AxisNoise) -> Cov {
     let (fix_s, fix_b) = noise.fix.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
     let (ping_s, ping_b) = noise.ping.as_ref().map_or((0.0, 0.0), |x| (x.0, x.1));
     let mut p = Cov::zeros();
@@ -513,6 +584,59 @@ fn noise_sigma(lp: &Loop, noise: &AxisNoise, steps: u64, stop_above: f64) -> f64
     p[(6, 6)] = ping_b * ping_b;
     p[(7, 7)] = noise.accel_bias * noise.accel_bias;
     p[(8, 8)] = fix_b * fix_b;
+    p
+}
+
+/// σ = maxₜ √P_ee over `steps` periods of the loop `lp` ([`propagation_steps`], module
+/// docs), stopping once above `stop_above`. Each period's maps are applied as
+/// [`SparseMap`]s (Choice 555): bit for bit the dense products of
+/// [`noise_sigma_dense`], the reference it is tested against.
+fn noise_sigma(lp: &Loop, noise: &AxisNoise, steps: u64, stop_above: f64) -> f64 {
+    let t = lp.t;
+    let fix_s = noise.fix.as_ref().map_or(0.0, |x| x.0);
+    let ping_s = noise.ping.as_ref().map_or(0.0, |x| x.0);
+    let mut p = initial_covariance(noise);
+    let maps = period_maps(lp, noise);
+    let (loop_step, drift) = (SparseMap::of(&maps.loop_step), SparseMap::of(&maps.drift));
+    let correct = maps.correct.as_ref().map(SparseMap::of);
+    let q_white = maps.q_white;
+    let samples = |src: &Option<(f64, f64, Timing)>, k: u64| {
+        src.as_ref().is_some_and(|x| samples_at(&x.2, k, t))
+    };
+    let mut worst = 0.0f64;
+    for n in 0..steps {
+        loop_step.sandwich(&mut p);
+        if lp.k.is_none() {
+            p += q_white;
+        }
+        drift.sandwich(&mut p);
+        if samples(&noise.fix, n + 1) {
+            redraw(&mut p, 4, fix_s * fix_s);
+        }
+        if samples(&noise.ping, n + 1) {
+            redraw(&mut p, 5, ping_s * ping_s);
+        }
+        if let Some(c) = &correct {
+            c.sandwich(&mut p);
+            p += q_white;
+        }
+        worst = worst.max(p[(0, 0)]);
+        if !worst.is_finite() || worst.sqrt() > stop_above {
+            return worst.sqrt();
+        }
+    }
+    // A zero of either sign is σ = +0.
+    (worst.max(0.0) + 0.0).sqrt()
+}
+
+/// [`noise_sigma`] with the dense products, period by period: the reference the sparse one
+/// is tested against (bit for bit).
+#[cfg(test)]
+fn noise_sigma_dense(lp: &Loop, noise: &AxisNoise, steps: u64, stop_above: f64) -> f64 {
+    let t = lp.t;
+    let fix_s = noise.fix.as_ref().map_or(0.0, |x| x.0);
+    let ping_s = noise.ping.as_ref().map_or(0.0, |x| x.0);
+    let mut p = initial_covariance(noise);
     let PeriodMaps {
         loop_step,
         drift,
@@ -544,7 +668,21 @@ fn noise_sigma(lp: &Loop, noise: &AxisNoise, steps: u64, stop_above: f64) -> f64
             return worst.sqrt();
         }
     }
-    worst.max(0.0).sqrt()
+    (worst.max(0.0) + 0.0).sqrt()
+}
+
+/// The navigation's part of one axis's budget (Choice 422): q, σ of the draws and of the
+/// biases, and q·σ + q_b·σ_b (m).
+struct NavigationPart {
+    quantile: f64,
+    sigma: f64,
+    bias: f64,
+    noise: f64,
+}
+
+/// The predicted max path error √(Σ eᵢ²) of the axes' budgets (Choice 424).
+fn path_total(axis: &[f64; AXES]) -> f64 {
+    axis.iter().map(|x| x * x).sum::<f64>().sqrt()
 }
 
 /// q with 2φ(q)/q = `tail` (Mills' bound on P(|x| > q) for a standard normal x).
@@ -590,11 +728,20 @@ pub struct Budget<'a> {
     /// check's search, the joined verdicts of both scopes and their rounding ask for the same
     /// scale more than once, and each is a propagation over the whole flight.
     memo: std::cell::RefCell<Vec<([u64; 2], PathBudget)>>,
-    /// Every σ propagated, by its axis and the bits of what it reads (Choice 535): the
+}
+
+/// The most σ [`SIGMAS`] keeps; past it, it starts again (a check asks for tens).
+const SIGMA_MEMO_LIMIT: usize = 4096;
+
+thread_local! {
+    /// Every σ propagated on this thread, by the bits of all it reads (Choices 535, 555): the
     /// draws' σ does not depend on the time scale (a ping's error, not the heading's share of
-    /// the speed), and with fixes the propagation stops where the covariance repeats, so every
-    /// scale of a search past that length asks for the same one.
-    sigmas: std::cell::RefCell<std::collections::HashMap<Vec<u64>, f64>>,
+    /// the speed), with fixes the propagation stops where the covariance repeats, so every
+    /// scale of a search past that length asks for the same one; and the budgets a check
+    /// builds (the profile's probes, the fix-period search, both scopes) fly the same loops on
+    /// the same navigation. Keyed by the loop, not by the budget or its axis.
+    static SIGMAS: std::cell::RefCell<std::collections::HashMap<Vec<u64>, f64>> =
+        std::cell::RefCell::new(std::collections::HashMap::new());
 }
 
 impl<'a> Budget<'a> {
@@ -666,7 +813,6 @@ impl<'a> Budget<'a> {
             latency,
             reduction,
             memo: std::cell::RefCell::new(Vec::new()),
-            sigmas: std::cell::RefCell::new(std::collections::HashMap::new()),
         }))
     }
 
@@ -772,30 +918,49 @@ impl<'a> Budget<'a> {
     }
 
     /// [`noise_sigma`] of axis `i` under `noise` over a flight of `duration` s, propagated
-    /// once per distinct input (the same bits in, the same σ out).
+    /// once per distinct input on a thread ([`SIGMAS`]: the same bits in, the same σ out).
     fn noise_sigma(&self, i: usize, noise: &AxisNoise, duration: f64, stop: f64) -> f64 {
         let lp = &self.loops[i];
         let steps = propagation_steps(lp, noise, duration);
         let source = |s: &Option<(f64, f64, Timing)>| -> Vec<u64> {
             match s {
                 None => vec![0],
-                Some((sigma, bias, timing)) => [1.0, *sigma, *bias, timing.rate_hz]
+                // The outages' count first: the key reads back one way only.
+                Some((sigma, bias, timing)) => [1, timing.outages.len() as u64]
                     .into_iter()
-                    .chain(timing.outages.iter().flatten().copied())
-                    .map(f64::to_bits)
-                    .chain([timing.outages.len() as u64])
+                    .chain(
+                        [*sigma, *bias, timing.rate_hz]
+                            .into_iter()
+                            .chain(timing.outages.iter().flatten().copied())
+                            .map(f64::to_bits),
+                    )
                     .collect(),
             }
         };
-        let mut key = vec![i as u64, steps, stop.to_bits(), noise.accel_bias.to_bits()];
+        // Keyed by the loop's own bits, not its axis: x and y mostly fly the same loop on the
+        // same navigation (Choice 555).
+        let mut key: Vec<u64> = [lp.t, lp.gain[0], lp.gain[1]]
+            .into_iter()
+            .chain(lp.k.iter().flat_map(|k| k.iter().copied()))
+            .chain(lp.kd.iter().copied())
+            .map(f64::to_bits)
+            .collect();
+        key.extend([u64::from(lp.k.is_some()), steps, stop.to_bits()]);
+        key.push(noise.accel_bias.to_bits());
         key.extend(noise.white.map(f64::to_bits));
         key.extend(source(&noise.fix));
         key.extend(source(&noise.ping));
-        if let Some(&sigma) = self.sigmas.borrow().get(&key) {
+        if let Some(sigma) = SIGMAS.with(|m| m.borrow().get(&key).copied()) {
             return sigma;
         }
         let sigma = noise_sigma(lp, noise, steps, stop);
-        self.sigmas.borrow_mut().insert(key, sigma);
+        SIGMAS.with(|m| {
+            let mut m = m.borrow_mut();
+            if m.len() >= SIGMA_MEMO_LIMIT {
+                m.clear();
+            }
+            m.insert(key, sigma);
+        });
         sigma
     }
 
@@ -809,6 +974,48 @@ impl<'a> Budget<'a> {
         let b = self.evaluate_at_for(k, duration)?;
         self.memo.borrow_mut().push((key, b.clone()));
         Ok(b)
+    }
+
+    /// The navigation's part of axis `i`'s budget (module docs, Choice 422) with the
+    /// navigation of `scenario` (the budget's own, or a probe's of [`Budget::fix_period_needed`]),
+    /// the horizontal reference speed `horizontal` (m/s), over a flight of `duration` s.
+    fn navigation_part(
+        &self,
+        scenario: &Scenario,
+        i: usize,
+        horizontal: f64,
+        duration: f64,
+    ) -> NavigationPart {
+        let noise = axis_noise(scenario, i, horizontal);
+        let fixes = noise
+            .fix
+            .as_ref()
+            .map_or(1.0, |(_, _, t)| (duration * t.rate_hz).max(1.0));
+        // The draws (a fix's, a ping's, white noise: new ones all flight) and the biases
+        // (one draw a flight), each at its own quantile (Choice 422).
+        let mut draws = noise.clone();
+        draws.accel_bias = 0.0;
+        for src in [&mut draws.fix, &mut draws.ping].into_iter().flatten() {
+            src.1 = 0.0;
+        }
+        let mut biases = noise;
+        biases.white = [0.0; 2];
+        for src in [&mut biases.fix, &mut biases.ping].into_iter().flatten() {
+            src.0 = 0.0;
+        }
+        // p for the draws and p for the biases: by the union bound the two together miss
+        // with at most 2p, the figure the budget reports (`miss_probability`).
+        let q = quantile(MISS_PROBABILITY / (AXES as f64 * fixes));
+        // σ beyond the bound: the budget cannot fit (q > 1), no need to fly further.
+        let stop = self.bound;
+        let sigma = self.noise_sigma(i, &draws, duration, stop);
+        let bias = self.noise_sigma(i, &biases, duration, stop);
+        NavigationPart {
+            quantile: q,
+            sigma,
+            bias,
+            noise: q * sigma + quantile(MISS_PROBABILITY / AXES as f64) * bias,
+        }
     }
 
     /// [`Budget::at_for`], evaluated.
@@ -838,34 +1045,11 @@ impl<'a> Budget<'a> {
             needs: None,
         };
         for i in 0..AXES {
-            let noise = axis_noise(self.scenario, i, horizontal);
-            let fixes = noise
-                .fix
-                .as_ref()
-                .map_or(1.0, |(_, _, t)| (duration * t.rate_hz).max(1.0));
-            // The draws (a fix's, a ping's, white noise: new ones all flight) and the biases
-            // (one draw a flight), each at its own quantile (Choice 422).
-            let mut draws = noise.clone();
-            draws.accel_bias = 0.0;
-            for src in [&mut draws.fix, &mut draws.ping].into_iter().flatten() {
-                src.1 = 0.0;
-            }
-            let mut biases = noise;
-            biases.white = [0.0; 2];
-            for src in [&mut biases.fix, &mut biases.ping].into_iter().flatten() {
-                src.0 = 0.0;
-            }
-            // p for the draws and p for the biases: by the union bound the two together miss
-            // with at most 2p, the figure the budget reports (`miss_probability`).
-            let q = quantile(MISS_PROBABILITY / (AXES as f64 * fixes));
-            // σ beyond the bound: the budget cannot fit (q > 1), no need to fly further.
-            let stop = self.bound;
-            let sigma = self.noise_sigma(i, &draws, duration, stop);
-            let bias = self.noise_sigma(i, &biases, duration, stop);
-            out.quantile[i] = q;
-            out.noise_sigma[i] = sigma;
-            out.bias_sigma[i] = bias;
-            out.noise[i] = q * sigma + quantile(MISS_PROBABILITY / AXES as f64) * bias;
+            let nav = self.navigation_part(self.scenario, i, horizontal, duration);
+            out.quantile[i] = nav.quantile;
+            out.noise_sigma[i] = nav.sigma;
+            out.bias_sigma[i] = nav.bias;
+            out.noise[i] = nav.noise;
             let response = d
                 .iter()
                 .map(|c| self.lag_response(i, c, k, duration))
@@ -873,7 +1057,7 @@ impl<'a> Budget<'a> {
             out.lag[i] = response + self.speed[i] / k * self.latency;
             out.axis[i] = out.noise[i] + out.lag[i];
         }
-        out.total = out.axis.iter().map(|x| x * x).sum::<f64>().sqrt();
+        out.total = path_total(&out.axis);
         Ok(out)
     }
 
@@ -972,6 +1156,9 @@ impl<'a> Budget<'a> {
     fn fix_period_needed(&self, k: f64) -> Option<f64> {
         let k0 = super::time_scale(self.scenario.config().time_scale);
         let base = self.scenario.config().navigation.as_ref()?;
+        let duration = self.duration(k0);
+        let lag = self.at_for(k, duration).ok()?.lag;
+        let horizontal = self.speed[0].hypot(self.speed[1]) / k;
         let with_period = |period: f64| -> Option<bool> {
             let mut m = base.clone();
             let mut fix = m
@@ -988,8 +1175,12 @@ impl<'a> Budget<'a> {
             fix.timing.rate_hz = 1.0 / period;
             m.fix = Some(fix);
             let s = self.scenario.with(|c| c.navigation = Some(m)).ok()?;
-            let b = Budget::new(&s).ok()??;
-            Some(b.at_for(k, self.duration(k0)).ok()?.fits())
+            // Only the navigation's part changes with the fixes (Choice 555): the lag is the
+            // budget's own at (k, duration).
+            let axis: [f64; AXES] = std::array::from_fn(|i| {
+                self.navigation_part(&s, i, horizontal, duration).noise + lag[i]
+            });
+            Some(path_total(&axis) <= self.bound)
         };
         let control = 1.0 / f64::from(self.scenario.config().controller.rate_hz);
         if !with_period(control)? {
@@ -1101,6 +1292,74 @@ mod tests {
             sigma,
             tau: 300.0,
             seed: 1,
+        }
+    }
+
+    fn timing(rate_hz: f64, outages: Vec<[f64; 2]>) -> Timing {
+        Timing {
+            rate_hz,
+            latency: 0.0,
+            outages,
+        }
+    }
+
+    /// The sparse propagation (Choice 555) is the dense one bit for bit: on the loop with the
+    /// board's estimator (disturbance state on) and without, at each axis's gains, under fixes,
+    /// pings, outages, white noise, an acceleration bias, and nothing at all.
+    #[test]
+    fn the_sparse_propagation_is_the_dense_one_bit_for_bit() {
+        let e = crate::scenario::navigation::real_chain_estimator();
+        let c = controller_core::ControllerConfig::default();
+        let mut loops = Vec::new();
+        for axis in 0..AXES {
+            let b = board_gain(&e, 100, axis).expect("the real chain's estimator has a gain");
+            let gain = [f64::from(c.k1[axis]) + 13.7, f64::from(c.k2[axis]) + 5.3];
+            let on = Loop {
+                t: 0.01,
+                gain,
+                k: Some(b.k.cast::<f64>()),
+                kd: RowVector2::new(f64::from(b.kd[0]), f64::from(b.kd[1])),
+            };
+            let off = Loop {
+                k: None,
+                kd: RowVector2::zeros(),
+                ..on
+            };
+            loops.extend([on, off]);
+        }
+        let full = AxisNoise {
+            fix: Some((0.004, 0.002, timing(1.0, vec![]))),
+            ping: Some((0.005, 0.003, timing(5.0, vec![]))),
+            accel_bias: 0.001,
+            white: [0.001, 0.002],
+        };
+        let outages = AxisNoise {
+            fix: Some((0.01, 0.0, timing(0.2, vec![[3.0, 17.5]]))),
+            ping: Some((0.0, 0.004, timing(4.0, vec![[10.0, 12.0]]))),
+            accel_bias: 0.0,
+            white: [0.0; 2],
+        };
+        let no_fix = AxisNoise {
+            fix: None,
+            ..full.clone()
+        };
+        let white_only = AxisNoise {
+            white: [0.003, 0.0],
+            ..AxisNoise::default()
+        };
+        let noises = [full, outages, no_fix, white_only, AxisNoise::default()];
+        for (l, lp) in loops.iter().enumerate() {
+            for (j, noise) in noises.iter().enumerate() {
+                for (steps, stop) in [(3_000, f64::INFINITY), (3_000, 0.004)] {
+                    let sparse = noise_sigma(lp, noise, steps, stop);
+                    let dense = noise_sigma_dense(lp, noise, steps, stop);
+                    assert_eq!(
+                        sparse.to_bits(),
+                        dense.to_bits(),
+                        "loop {l}, noise {j}, stop {stop}: {sparse} vs {dense}"
+                    );
+                }
+            }
         }
     }
 
