@@ -3,7 +3,11 @@
 //! thruster lag of 0.22–0.26 s and a start offset of 1–2 cm. Every saturated period was in the
 //! first two seconds: the feedback taking up the mismatch through lagged thrusters overshoots
 //! the steady demand (without the lag the same missions fly within bounds). The check now keeps
-//! the lag's share of each thruster's envelope (Choice 509, docs/real-vehicle.md#the-lags-share).
+//! the lag's share of each thruster's envelope (Choice 509, docs/real-vehicle.md#the-lags-share),
+//! with the loop's gain at the law's own δ at the start, the boundary layer's (δ/μ)p inside
+//! it (Choice 546): the three missions the search still found with Choice 509 alone (an abs-sin
+//! payload, a staircase in a Gauss–Markov current; every saturated period again in the first
+//! 1.2 s) are refused where they missed.
 
 #[path = "common/falsified.rs"]
 mod falsified;
@@ -29,20 +33,61 @@ fn within(s: &Scenario) -> bool {
     bound::within_bound(&run)
 }
 
-/// The mission at scale 1 (what the check proposed before) misses; without its lag it flies
-/// (the lag is the cause); the check now refuses it at 1. It proposes 1.84, where the 70 s
-/// mission the search wrote flies within bounds (0.9 % of its periods saturated) but this
-/// 20 s span does not (the start's 1.3 s of saturation is 3 % of it): the reserve is short
-/// of this start's overshoot (docs/real-vehicle.md#the-lags-share), so that is not asserted.
+/// The mission at scale 1 (what the check proposed before Choice 509) misses; without its
+/// lag it flies (the lag is the cause). Choice 509 proposed 1.84, where this 20 s span still
+/// saturates (3 % of its periods, the start's 1.3 s): no speed cures a start transient, and
+/// the check now refuses it at every scale.
 #[test]
-fn a_lagged_start_is_refused_where_it_missed() {
+fn a_lagged_start_is_refused_at_every_scale() {
     let m = mission("falsified-lag-start-r1.toml");
+    assert!(!within(&m));
+    assert!(!within(&at_scale(&m, 1.84)));
+    assert!(within(&m.with(|c| c.thruster_lag = None).unwrap()));
+    let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
+    assert!(p.smallest_time_scale.is_none(), "{p}");
+}
+
+/// An abs-sin payload, lag 0.14 s, proposed at 1.05 by Choice 509 alone: it misses there (3.6 %
+/// of the periods saturated, all in 0.14–0.88 s: the start, not the payload's motion) and flies
+/// without its lag; the check now refuses it at 1.05 and proposes a scale at which it flies
+/// (1.84: no period saturated).
+#[test]
+fn an_abs_sin_start_is_proposed_slower_where_it_missed() {
+    let m = mission("falsified-lag-abs-sin-ce-s1.toml");
+    assert!(!within(&m));
+    assert!(within(&m.with(|c| c.thruster_lag = None).unwrap()));
+    let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
+    assert!(!p.feasible(), "{p}");
+    let k = p.smallest_time_scale.unwrap();
+    assert!(k > 1.05, "{k}");
+    assert!(within(&at_scale(&m, k)), "{k}");
+}
+
+/// The same kind at lag 0.16 s, proposed at 1 by Choice 509 alone: it misses at 1 and flies at
+/// what the check now proposes.
+#[test]
+fn a_second_abs_sin_start_is_proposed_slower_where_it_missed() {
+    let m = mission("falsified-lag-abs-sin-random-s2.toml");
     assert!(!within(&m));
     assert!(within(&m.with(|c| c.thruster_lag = None).unwrap()));
     let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
     assert!(!p.feasible(), "{p}");
     let k = p.smallest_time_scale.unwrap();
     assert!(k > 1.0, "{k}");
+    assert!(within(&at_scale(&m, k)), "{k}");
+}
+
+/// A staircase payload in a Gauss–Markov current, lag 0.23 s, proposed at 1.5 by Choice 509
+/// alone: it misses at 1.5 and at 4 (its start saturates 1.2 s at every speed; the later
+/// jump does not saturate) and flies without its lag; the check now refuses it at every scale.
+#[test]
+fn a_staircase_start_is_refused_at_every_scale() {
+    let m = mission("falsified-lag-staircase-random-s1.toml");
+    assert!(!within(&m));
+    assert!(!within(&at_scale(&m, 4.0)));
+    assert!(within(&m.with(|c| c.thruster_lag = None).unwrap()));
+    let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
+    assert!(p.smallest_time_scale.is_none(), "{p}");
 }
 
 /// A mission whose start transient saturates at every speed (it misses at scale 1 and at 4):
@@ -55,4 +100,19 @@ fn a_start_no_speed_cures_is_refused_at_every_scale() {
     assert!(within(&m.with(|c| c.thruster_lag = None).unwrap()));
     let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
     assert!(p.smallest_time_scale.is_none(), "{p}");
+}
+
+/// Open (docs/search.md#against-the-real-preflight): a 1.7 cm depth offset through a 0.26 s
+/// lag, which the check calls feasible at 1. The first command answers the offset (+223 N on
+/// depth); the lagged loop reverses past it on the other side (−386 N at 0.4 s, 2.8 % of the
+/// periods saturated, all in 0.17–0.72 s); without its lag it flies. The share measures |u|,
+/// not the side the reversal takes. Ignored until the share is kept on that side.
+#[test]
+#[ignore = "open: a lagged start offset's reversal on a thruster's other side"]
+fn a_lagged_offset_reversal_is_refused_where_it_missed() {
+    let m = mission("falsified-lag-offset-reversal-ce-s10.toml");
+    assert!(!within(&m));
+    assert!(within(&m.with(|c| c.thruster_lag = None).unwrap()));
+    let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
+    assert!(!p.feasible(), "{p}");
 }
