@@ -22,7 +22,7 @@ use super::{
 };
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::{InitialAttitude, Scenario};
-use fast::{RollConsts, SampleKeys, Shared};
+use fast::{Kept, RollConsts, SampleKeys, Shared};
 use screen::{Screen, Span};
 
 /// An unallocated part above this (relative to 1 + |τ|) means the axis was given up; below it
@@ -133,6 +133,9 @@ pub(super) struct Checker<'a> {
     /// A long abs-sin mission's torus (Choice 538): the plant at each payload level, and the
     /// largest roll swing its payload drives.
     torus: Option<(Vec<Plant>, f64)>,
+    /// What a box point's verdict reads besides its sample and the law's configuration, by
+    /// its bits: the key of the samples [`Kept`] across checkers (Choice 537).
+    context: Vec<u64>,
 }
 
 /// The currents the check takes (see the module docs of [`super`]).
@@ -191,6 +194,39 @@ fn params_key(p: &VehicleParams<f64>) -> Vec<u64> {
         .chain(p.damping)
         .chain(p.r_b_xy);
     fields.map(|x| (x + 0.0).to_bits()).collect()
+}
+
+/// [`Checker::context`]: the corners' and the nominal plants' parameters, the currents, the
+/// margin envelope, the path's K_d, and the first sample's pitch and the start, which set the
+/// corners' roll swing (Choice 537).
+fn context(
+    corners: &[Plant],
+    nominal: &Plant,
+    currents: &[Vector3<f64>],
+    envelope: &ThrustEnvelope,
+    accel_bound: f64,
+    (pitch, start): (f64, InitialAttitude),
+) -> Vec<u64> {
+    let mut out: Vec<u64> = corners
+        .iter()
+        .chain(std::iter::once(nominal))
+        .flat_map(|p| params_key(p.params()))
+        .collect();
+    out.extend(currents.iter().flat_map(|c| c.iter().map(|x| x.to_bits())));
+    out.push(u64::MAX);
+    out.extend(
+        envelope
+            .min
+            .iter()
+            .chain(&envelope.max)
+            .map(|x| u64::from(x.to_bits())),
+    );
+    out.extend([accel_bound.to_bits(), pitch.to_bits()]);
+    out.push(match start {
+        InitialAttitude::Level => 0,
+        InitialAttitude::Trim => 1,
+    });
+    out
 }
 
 /// The path at k = 1 sampled at [`SAMPLE_RATE_HZ`] over its first `checked` seconds.
@@ -324,7 +360,16 @@ impl<'a> Checker<'a> {
                 "the allocator on the {margin} margin envelope: {e}"
             ))
         })?;
+        let context = context(
+            &corners,
+            &nominal,
+            &currents,
+            &margin_envelope,
+            f64::from(path.accel_bound()),
+            (samples[0].eta[PITCH], cfg.initial_attitude()),
+        );
         Ok(Checker {
+            context,
             scenario,
             samples,
             corners_peaks,
@@ -627,8 +672,11 @@ impl<'a> Checker<'a> {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
             let smp = self.sample(peak, j);
+            let mut key = Vec::new();
             if self.engine == Engine::Fast {
-                if let Some(first) = seen.insert(smp, j, inv_k, &prepared.cases, m) {
+                let yaw_free = fast::yaw_free(inv_k, &self.currents);
+                key = SampleKeys::key(smp, inv_k, (&prepared.cases, m), yaw_free);
+                if let Some(first) = seen.insert(key.clone(), j) {
                     // The same inputs: the same span as the sample that had them first.
                     if recording {
                         let mut screen = self.screen.borrow_mut();
@@ -646,6 +694,14 @@ impl<'a> Checker<'a> {
                     .clears(peak, j, inv_k, &self.margin_envelope)
             {
                 continue;
+            }
+            // Judged inside the margin before, in this context (Choice 537).
+            let config = self.scenario.controller().config();
+            if screening {
+                if let Some(span) = Kept::get(config, &self.context, inv_k, &mut key) {
+                    self.screen.borrow_mut().record(peak, j, inv_k, span);
+                    continue;
+                }
             }
             if recording {
                 out.span = Some(Span::EMPTY);
@@ -671,6 +727,9 @@ impl<'a> Checker<'a> {
             }
             if let Some(span) = out.span.take() {
                 self.screen.borrow_mut().record(peak, j, inv_k, span);
+                if screening {
+                    Kept::insert(config, &self.context, inv_k, key, span);
+                }
             }
         }
         Ok(())
