@@ -196,39 +196,6 @@ fn params_key(p: &VehicleParams<f64>) -> Vec<u64> {
     fields.map(|x| (x + 0.0).to_bits()).collect()
 }
 
-/// [`Checker::context`]: the corners' and the nominal plants' parameters, the currents, the
-/// margin envelope, the path's K_d, and the first sample's pitch and the start, which set the
-/// corners' roll swing (Choice 537).
-fn context(
-    corners: &[Plant],
-    nominal: &Plant,
-    currents: &[Vector3<f64>],
-    envelope: &ThrustEnvelope,
-    accel_bound: f64,
-    (pitch, start): (f64, InitialAttitude),
-) -> Vec<u64> {
-    let mut out: Vec<u64> = corners
-        .iter()
-        .chain(std::iter::once(nominal))
-        .flat_map(|p| params_key(p.params()))
-        .collect();
-    out.extend(currents.iter().flat_map(|c| c.iter().map(|x| x.to_bits())));
-    out.push(u64::MAX);
-    out.extend(
-        envelope
-            .min
-            .iter()
-            .chain(&envelope.max)
-            .map(|x| u64::from(x.to_bits())),
-    );
-    out.extend([accel_bound.to_bits(), pitch.to_bits()]);
-    out.push(match start {
-        InitialAttitude::Level => 0,
-        InitialAttitude::Trim => 1,
-    });
-    out
-}
-
 /// The path at k = 1 sampled at [`SAMPLE_RATE_HZ`] over its first `checked` seconds.
 fn path_samples(path: &Trajectory, checked: f64) -> Result<Vec<PathSample>, CheckError> {
     let n = (checked * f64::from(SAMPLE_RATE_HZ)).ceil().max(1.0) as u64;
@@ -360,16 +327,8 @@ impl<'a> Checker<'a> {
                 "the allocator on the {margin} margin envelope: {e}"
             ))
         })?;
-        let context = context(
-            &corners,
-            &nominal,
-            &currents,
-            &margin_envelope,
-            f64::from(path.accel_bound()),
-            (samples[0].eta[PITCH], cfg.initial_attitude()),
-        );
-        Ok(Checker {
-            context,
+        let mut checker = Checker {
+            context: Vec::new(),
             scenario,
             samples,
             corners_peaks,
@@ -383,7 +342,38 @@ impl<'a> Checker<'a> {
             hint: Default::default(),
             screen: std::cell::RefCell::new(Screen::new(n_samples, n_peaks)),
             torus,
-        })
+        };
+        checker.context = checker.context();
+        Ok(checker)
+    }
+
+    /// [`Checker::context`]: the corners' and the nominal plants' parameters, the currents,
+    /// the margin envelope, the path's K_d, and the first sample's pitch and the start, which
+    /// set the corners' roll swing (Choice 537).
+    fn context(&self) -> Vec<u64> {
+        let mut out: Vec<u64> = self
+            .corners
+            .iter()
+            .chain(std::iter::once(&self.nominal))
+            .flat_map(|p| params_key(p.params()))
+            .collect();
+        let currents = self
+            .currents
+            .iter()
+            .flat_map(|c| c.iter().map(|x| x.to_bits()));
+        out.extend(currents);
+        out.push(u64::MAX);
+        let env = &self.margin_envelope;
+        out.extend(
+            env.min
+                .iter()
+                .chain(&env.max)
+                .map(|x| u64::from(x.to_bits())),
+        );
+        let pitch = self.samples[0].eta[PITCH];
+        out.extend([self.accel_bound.to_bits(), pitch.to_bits()]);
+        out.push(self.start().map_or(u64::MAX, f64::to_bits));
+        out
     }
 
     /// The real time of each sample at 1/k = `inv_k` (at rest: at the scenario's scale).
@@ -651,7 +641,8 @@ impl<'a> Checker<'a> {
     /// inputs equal, bit for bit, a point already judged in this sweep (Choice 391): it
     /// would give the same forces, so neither the first violation nor a peak can change.
     /// Over the box, a verdict-only sweep skips a sample its screen clears and records the
-    /// span of each it judges in full (Choice 530).
+    /// span of each it judges in full (Choice 530), and asks first whether it was judged
+    /// inside the margin before in this context (Choice 537).
     #[allow(clippy::too_many_arguments)]
     fn sweep_points(
         &self,
@@ -695,7 +686,6 @@ impl<'a> Checker<'a> {
             {
                 continue;
             }
-            // Judged inside the margin before, in this context (Choice 537).
             let config = self.scenario.controller().config();
             if screening {
                 if let Some(span) = Kept::get(config, &self.context, inv_k, &mut key) {
