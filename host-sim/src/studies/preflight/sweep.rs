@@ -138,6 +138,11 @@ pub(super) struct Checker<'a> {
     context: Vec<u64>,
 }
 
+/// [`super::forget_kept`].
+pub(super) fn forget_kept() {
+    Kept::forget();
+}
+
 /// The currents the check takes (see the module docs of [`super`]).
 fn currents(model: &CurrentModel) -> Vec<Vector3<f64>> {
     match model {

@@ -330,6 +330,11 @@ thread_local! {
 }
 
 impl Kept {
+    /// Forgets every context this thread kept.
+    pub(super) fn forget() {
+        KEPT.with(|k| k.borrow_mut().0.clear());
+    }
+
     /// The index of the context (`config`, `context`), if kept.
     fn find(&self, config: &ControllerConfig, context: &[u64]) -> Option<usize> {
         self.0
