@@ -323,7 +323,7 @@ struct Context {
 const KEPT_CONTEXTS: usize = 4;
 /// The most samples [`Kept`] holds over its contexts (a few hundred bytes each); past it, it
 /// starts again.
-const KEPT_SAMPLES: usize = 1 << 20;
+const KEPT_SAMPLES: usize = 1 << 17;
 
 thread_local! {
     static KEPT: RefCell<Kept> = RefCell::new(Kept::default());
