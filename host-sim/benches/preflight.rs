@@ -18,8 +18,9 @@ fn scenario(path: &str) -> Scenario {
     load_scenario(&Path::new(env!("CARGO_MANIFEST_DIR")).join(path)).expect("the scenario")
 }
 
-/// What `host-sim check` computes.
+/// What `host-sim check` computes, afresh (nothing kept from an earlier iteration, Choice 537).
 fn check(s: &Scenario, engine: Engine) {
+    preflight::forget_kept();
     preflight::check_with(s, DEFAULT_MARGIN, true, engine).expect("the check");
     profile::propose_with(s, DEFAULT_MARGIN, engine).expect("the profile");
 }

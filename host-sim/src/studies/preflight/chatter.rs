@@ -390,6 +390,52 @@ fn crossing_probability_carried(
     bvn_upper_pair_given(-a, b, -r, ph, pk)
 }
 
+/// A crossing's inputs (the two means, the two σ, the covariance, the level), by their bits.
+type CrossingKey = [u64; 6];
+/// The Φ pair a crossing carries to the next period ([`crossing_probability_carried`]).
+type Carry = Option<(u64, (f64, f64))>;
+
+/// The crossings of one pass over the flight where the mean thrust stands still (its two
+/// periods' bits equal), kept by their inputs' bits (**Choice 556**): on a leg flown at a
+/// constant speed the mean thrusts stand still and the noise's statistics repeat with their
+/// sources' cycle, so a pass asks the same crossing again and again. Exact: [`crossing_probability_carried`] gives the fresh crossing's bits whatever
+/// it carried (Choice 517), and the carry it leaves is a function of the inputs alone (the
+/// second period's standardised distance and its Φ pair, or nothing), so a kept crossing
+/// gives back its probability and its carry. At most [`KEPT_CROSSINGS`] are kept.
+#[derive(Default)]
+struct Crossings(std::collections::HashMap<CrossingKey, (f64, Carry)>);
+
+/// The most crossings [`Crossings`] keeps in one pass (about 80 bytes each).
+const KEPT_CROSSINGS: usize = 1 << 18;
+
+impl Crossings {
+    /// [`crossing_probability_carried`], kept by its inputs.
+    fn crossing(
+        &mut self,
+        m: [f64; 2],
+        s: [f64; 2],
+        cov: f64,
+        level: f64,
+        carry: &mut Carry,
+    ) -> f64 {
+        // Only where the mean stands still (a leg at a constant speed): on a turn or a circle
+        // it moves every period, and the key would cost without being asked again.
+        if m[0].to_bits() != m[1].to_bits() {
+            return crossing_probability_carried(m, s, cov, level, carry);
+        }
+        let key = [m[0], m[1], s[0], s[1], cov, level].map(f64::to_bits);
+        if let Some(&(p, after)) = self.0.get(&key) {
+            *carry = after;
+            return p;
+        }
+        let p = crossing_probability_carried(m, s, cov, level, carry);
+        if self.0.len() < KEPT_CROSSINGS {
+            self.0.insert(key, (p, *carry));
+        }
+        p
+    }
+}
+
 /// One axis's command noise over one cycle of its sources: var u and cov(uₖ₊₁, uₖ) per period,
 /// period k of the flight at index k mod the cycle.
 #[derive(Clone, Debug, Default)]
@@ -957,6 +1003,7 @@ impl<'a> Chatter<'a> {
         let mut sigma = [0.0f64; THRUSTERS];
         let mut step = [0.0f64; THRUSTERS];
         let mut carry = [[None; 2]; THRUSTERS];
+        let mut kept = Crossings::default();
         let mut m0 = at(0);
         let mut before = ([[0.0f64; 2]; THRUSTERS], [0.0f64; THRUSTERS]);
         for n in 0..flown {
@@ -988,13 +1035,8 @@ impl<'a> Chatter<'a> {
                 sigma[j] = sigma[j].max(s[0]);
                 step[j] = step[j].max(dvar.sqrt());
                 for (e, level) in self.band[j].iter().enumerate() {
-                    crossings[j][e] += crossing_probability_carried(
-                        [m0[j], m1[j]],
-                        s,
-                        cov,
-                        *level,
-                        &mut carry[j][e],
-                    );
+                    crossings[j][e] +=
+                        kept.crossing([m0[j], m1[j]], s, cov, *level, &mut carry[j][e]);
                 }
                 let dm = m1[j] - m0[j];
                 tv[j] += self.slope(j, m0[j]) * mean_abs(dm, dvar.sqrt());
@@ -1427,6 +1469,45 @@ mod tests {
             (m0, s0) = (m1, s1);
         }
         assert!(nonzero > 10_000);
+    }
+
+    /// A kept crossing (Choice 556) is the carried one, bit for bit, and leaves the same
+    /// carry: over a pass whose means stand still on a leg (each level near, far, and with
+    /// no noise) and whose σ repeat with a cycle of 7 periods, broken by turns where
+    /// everything moves; most of the pass is kept.
+    #[test]
+    fn a_kept_crossing_is_the_carried_one() {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(556);
+        let mut kept = Crossings::default();
+        let (mut carries, mut carries_kept) = ([None; 2], [None; 2]);
+        let (mut m0, mut s0) = (4.0f64, 2.0f64);
+        for n in 0..30_000u64 {
+            let turn = n % 5000 < 300;
+            let x: [f64; 3] = std::array::from_fn(|_| StandardNormal.sample(&mut rng));
+            let m1 = match (turn, (n / 5000) % 3) {
+                (false, _) if n % 5000 == 4000 => m0 + 1e-9,
+                (true, _) => 4.0 + 6.0 * x[0],
+                (false, 0) => 4.5,
+                (false, 1) => 40.0,
+                _ => -3.0,
+            };
+            let s1 = match n % 7 {
+                0 if (n / 5000) % 2 == 1 => 0.0,
+                i => 1.0 + 0.25 * i as f64 + if turn { 0.1 * x[1].abs() } else { 0.0 },
+            };
+            let cov = s0 * s1 * 0.95;
+            for (e, level) in [4.2, -4.2].into_iter().enumerate() {
+                let (carry, carry_kept) = (&mut carries[e], &mut carries_kept[e]);
+                let carried = crossing_probability_carried([m0, m1], [s0, s1], cov, level, carry);
+                let k = kept.crossing([m0, m1], [s0, s1], cov, level, carry_kept);
+                assert_eq!(carried.to_bits(), k.to_bits(), "period {n}");
+                assert_eq!(carry.map(|c| c.0), carry_kept.map(|c| c.0), "period {n}");
+                let pair = |c: Carry| c.map(|c| (c.1 .0.to_bits(), c.1 .1.to_bits()));
+                assert_eq!(pair(*carry), pair(*carry_kept), "period {n}");
+            }
+            (m0, s0) = (m1, s1);
+        }
+        assert!(kept.0.len() < 10_000, "{} kept", kept.0.len());
     }
 
     /// Rice's formula: a stationary Gaussian process of σ and autocorrelation e^{−τ²/(2ℓ²)}

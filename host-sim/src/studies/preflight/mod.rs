@@ -425,6 +425,13 @@ pub fn check(scenario: &Scenario, margin: f64) -> Result<Preflight, CheckError> 
     check_with(scenario, margin, true, Engine::Fast)
 }
 
+/// Forgets the box's samples this thread kept judged inside the margin (Choice 537): a
+/// benchmark that times `check` afresh each iteration calls it, or the later iterations
+/// would find the first's samples kept.
+pub fn forget_kept() {
+    sweep::forget_kept();
+}
+
 /// [`check`] of the mission as written only (no [`Preflight::whole_box`]): what flying it
 /// needs, at a 2⁹th of the work.
 ///

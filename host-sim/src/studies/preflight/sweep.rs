@@ -22,7 +22,7 @@ use super::{
 };
 use crate::plant::{self, CurrentModel, Plant, PlantState, PlantTerms};
 use crate::scenario::{InitialAttitude, Scenario};
-use fast::{RollConsts, SampleKeys, Shared};
+use fast::{Kept, RollConsts, SampleKeys, Shared};
 use screen::{Screen, Span};
 
 /// An unallocated part above this (relative to 1 + |τ|) means the axis was given up; below it
@@ -133,6 +133,14 @@ pub(super) struct Checker<'a> {
     /// A long abs-sin mission's torus (Choice 538): the plant at each payload level, and the
     /// largest roll swing its payload drives.
     torus: Option<(Vec<Plant>, f64)>,
+    /// What a box point's verdict reads besides its sample and the law's configuration, by
+    /// its bits: the key of the samples [`Kept`] across checkers (Choice 537).
+    context: Vec<u64>,
+}
+
+/// [`super::forget_kept`].
+pub(super) fn forget_kept() {
+    Kept::forget();
 }
 
 /// The currents the check takes (see the module docs of [`super`]).
@@ -324,7 +332,8 @@ impl<'a> Checker<'a> {
                 "the allocator on the {margin} margin envelope: {e}"
             ))
         })?;
-        Ok(Checker {
+        let mut checker = Checker {
+            context: Vec::new(),
             scenario,
             samples,
             corners_peaks,
@@ -338,7 +347,38 @@ impl<'a> Checker<'a> {
             hint: Default::default(),
             screen: std::cell::RefCell::new(Screen::new(n_samples, n_peaks)),
             torus,
-        })
+        };
+        checker.context = checker.context();
+        Ok(checker)
+    }
+
+    /// [`Checker::context`]: the corners' and the nominal plants' parameters, the currents,
+    /// the margin envelope, the path's K_d, and the first sample's pitch and the start, which
+    /// set the corners' roll swing (Choice 537).
+    fn context(&self) -> Vec<u64> {
+        let mut out: Vec<u64> = self
+            .corners
+            .iter()
+            .chain(std::iter::once(&self.nominal))
+            .flat_map(|p| params_key(p.params()))
+            .collect();
+        let currents = self
+            .currents
+            .iter()
+            .flat_map(|c| c.iter().map(|x| x.to_bits()));
+        out.extend(currents);
+        out.push(u64::MAX);
+        let env = &self.margin_envelope;
+        out.extend(
+            env.min
+                .iter()
+                .chain(&env.max)
+                .map(|x| u64::from(x.to_bits())),
+        );
+        let pitch = self.samples[0].eta[PITCH];
+        out.extend([self.accel_bound.to_bits(), pitch.to_bits()]);
+        out.push(self.start().map_or(u64::MAX, f64::to_bits));
+        out
     }
 
     /// The real time of each sample at 1/k = `inv_k` (at rest: at the scenario's scale).
@@ -606,7 +646,8 @@ impl<'a> Checker<'a> {
     /// inputs equal, bit for bit, a point already judged in this sweep (Choice 391): it
     /// would give the same forces, so neither the first violation nor a peak can change.
     /// Over the box, a verdict-only sweep skips a sample its screen clears and records the
-    /// span of each it judges in full (Choice 530).
+    /// span of each it judges in full (Choice 530), and asks first whether it was judged
+    /// inside the margin before in this context (Choice 537).
     #[allow(clippy::too_many_arguments)]
     fn sweep_points(
         &self,
@@ -627,8 +668,11 @@ impl<'a> Checker<'a> {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
             let smp = self.sample(peak, j);
+            let mut key = Vec::new();
             if self.engine == Engine::Fast {
-                if let Some(first) = seen.insert(smp, j, inv_k, &prepared.cases, m) {
+                let yaw_free = fast::yaw_free(inv_k, &self.currents);
+                key = SampleKeys::key(smp, inv_k, (&prepared.cases, m), yaw_free);
+                if let Some(first) = seen.insert(key.clone(), j) {
                     // The same inputs: the same span as the sample that had them first.
                     if recording {
                         let mut screen = self.screen.borrow_mut();
@@ -646,6 +690,13 @@ impl<'a> Checker<'a> {
                     .clears(peak, j, inv_k, &self.margin_envelope)
             {
                 continue;
+            }
+            let config = self.scenario.controller().config();
+            if screening {
+                if let Some(span) = Kept::get(config, &self.context, inv_k, &mut key) {
+                    self.screen.borrow_mut().record(peak, j, inv_k, span);
+                    continue;
+                }
             }
             if recording {
                 out.span = Some(Span::EMPTY);
@@ -671,6 +722,9 @@ impl<'a> Checker<'a> {
             }
             if let Some(span) = out.span.take() {
                 self.screen.borrow_mut().record(peak, j, inv_k, span);
+                if screening {
+                    Kept::insert(config, &self.context, inv_k, key, span);
+                }
             }
         }
         Ok(())

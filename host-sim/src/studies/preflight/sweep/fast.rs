@@ -14,9 +14,11 @@ use std::collections::HashMap;
 use controller_core::kinematics::{self, Attitude};
 use nalgebra::{Vector3, Vector6};
 
+use super::screen::Span;
 use super::{CasePlants, Checker, PathSample, Point};
 use crate::plant::{roll_moments, Plant, PlantState};
 use crate::studies::preflight::attitude;
+use controller_core::config::ControllerConfig;
 
 /// Index of roll, pitch and yaw in η, ν and τ.
 const ROLL: usize = 3;
@@ -237,6 +239,18 @@ fn heel(
     Some(roll.phi0 + s.asin())
 }
 
+/// Whether a sweep at 1/k = `inv_k` under `currents` is yaw-free (**Choice 529**): at rest
+/// (1/k = 0) every rate is η̇_d·0 and η̈_d·0, exact zeros, and so are ν, ν̇ but a swing's ṗ, J⁻¹J̇ν
+/// and, without a current (every component ±0), the current in the body frame Rᵀv_c; the
+/// yaw enters a point's force only through J⁻¹, J⁻¹J̇ν and R, each multiplied there by one
+/// of those zeros, and the restoring force reads φ and θ alone. So the forces, the heel, the
+/// offsets and the thrusts are the same bits (up to the sign of an exact zero, which no
+/// comparison sees) at every yaw, and the sample's key leaves its yaw out: a lawn-mower's
+/// turns and legs at rest are one sample per roll and pitch.
+pub(super) fn yaw_free(inv_k: f64, currents: &[Vector3<f64>]) -> bool {
+    inv_k == 0.0 && currents.iter().all(|c| c.iter().all(|&x| x == 0.0))
+}
+
 /// The inputs of a sample that its forces depend on (the reference's attitude, its rates at
 /// the sweep's time scale — η̇_d/k and η̈_d/k², as [`Shared`] forms them — and the
 /// mission-as-written case's plant and swing there), bit for bit: a sweep judges each key
@@ -248,24 +262,9 @@ pub(super) struct SampleKeys(HashMap<Vec<u64>, usize>);
 
 impl SampleKeys {
     /// Records the key of sample `smp` (index `j`) at 1/k = `inv_k` and prepared index `m` of
-    /// `cases`; the index of the sample that had it first, if it was already there.
-    pub(super) fn insert(
-        &mut self,
-        smp: &PathSample,
-        j: usize,
-        inv_k: f64,
-        cases: &[CasePlants<'_>],
-        m: usize,
-    ) -> Option<usize> {
-        let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
-        key.extend(smp.eta.iter().skip(3).map(|x| x.to_bits()));
-        key.extend((smp.eta_dot * inv_k).iter().map(|x| x.to_bits()));
-        key.extend((smp.eta_ddot * (inv_k * inv_k)).iter().map(|x| x.to_bits()));
-        // A case constant along the path (every corner of the box) adds nothing.
-        for (plant, amplitude) in cases.iter().filter_map(|c| c.key(m)) {
-            key.push(plant as u64);
-            key.push(amplitude.to_bits());
-        }
+    /// `cases`; the index of the sample that had it first, if it was already there. With
+    /// `yaw_free` (at rest without a current, [`yaw_free`]) the key leaves out the yaw.
+    pub(super) fn insert(&mut self, key: Vec<u64>, j: usize) -> Option<usize> {
         match self.0.entry(key) {
             std::collections::hash_map::Entry::Occupied(e) => Some(*e.get()),
             std::collections::hash_map::Entry::Vacant(e) => {
@@ -273,5 +272,224 @@ impl SampleKeys {
                 None
             }
         }
+    }
+
+    /// The key of sample `smp` at 1/k = `inv_k` and prepared index `m` of `cases`: what
+    /// [`SampleKeys::insert`] records. With `yaw_free` (at rest without a current,
+    /// [`yaw_free`]) it leaves out the yaw.
+    pub(super) fn key(
+        smp: &PathSample,
+        inv_k: f64,
+        (cases, m): (&[CasePlants<'_>], usize),
+        yaw_free: bool,
+    ) -> Vec<u64> {
+        let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
+        let attitude = match yaw_free {
+            true => &smp.eta.as_slice()[3..YAW],
+            false => &smp.eta.as_slice()[3..],
+        };
+        key.extend(attitude.iter().map(|x| x.to_bits()));
+        key.extend((smp.eta_dot * inv_k).iter().map(|x| x.to_bits()));
+        key.extend((smp.eta_ddot * (inv_k * inv_k)).iter().map(|x| x.to_bits()));
+        // A case constant along the path (every corner of the box) adds nothing.
+        for (plant, amplitude) in cases.iter().filter_map(|c| c.key(m)) {
+            key.push(plant as u64);
+            key.push(amplitude.to_bits());
+        }
+        key
+    }
+}
+
+/// The box's samples judged inside the margin by verdict-only sweeps, kept across checkers
+/// (**Choice 537**): by the checker's context (what a point's verdict reads besides its
+/// sample: the law's configuration, the corners' and the nominal plants' parameters, the
+/// currents, the margin envelope, the path's K_d, the start and the first sample's pitch that
+/// set the corners' swing) and, within it, by 1/k and the sample's key. `check` sweeps the box
+/// at the scenario's scale, and the speed profile's check as flown sweeps it again on the
+/// profile it proposes; a file that pins the profile `check` proposes (the shipped real
+/// missions do) asks the same samples twice. The last [`KEPT_CONTEXTS`] contexts are kept
+/// (the profile's per-part search is one between), and at most [`KEPT_SAMPLES`] samples.
+#[derive(Default)]
+pub(super) struct Kept(Vec<Context>);
+
+/// One context of [`Kept`] and its samples judged inside the margin.
+struct Context {
+    config: ControllerConfig,
+    context: Vec<u64>,
+    inside: HashMap<Vec<u64>, Span>,
+}
+
+/// The contexts [`Kept`] holds, the latest used last.
+const KEPT_CONTEXTS: usize = 4;
+/// The most samples [`Kept`] holds over its contexts (a few hundred bytes each); past it, it
+/// starts again.
+const KEPT_SAMPLES: usize = 1 << 17;
+
+thread_local! {
+    static KEPT: RefCell<Kept> = RefCell::new(Kept::default());
+}
+
+impl Kept {
+    /// Forgets every context this thread kept.
+    pub(super) fn forget() {
+        KEPT.with(|k| k.borrow_mut().0.clear());
+    }
+
+    /// The index of the context (`config`, `context`), if kept.
+    fn find(&self, config: &ControllerConfig, context: &[u64]) -> Option<usize> {
+        self.0
+            .iter()
+            .position(|c| c.config == *config && c.context == context)
+    }
+
+    /// The span of the sample keyed `key` at 1/k = `inv_k`, judged inside the margin in the
+    /// context (`config`, `context`), if it was.
+    pub(super) fn get(
+        config: &ControllerConfig,
+        context: &[u64],
+        inv_k: f64,
+        key: &mut Vec<u64>,
+    ) -> Option<Span> {
+        key.push(inv_k.to_bits());
+        let span = KEPT.with(|k| {
+            let k = k.borrow();
+            k.find(config, context)
+                .and_then(|i| k.0[i].inside.get(key.as_slice()).copied())
+        });
+        key.pop();
+        span
+    }
+
+    /// Keeps the sample keyed `key` at 1/k = `inv_k` as judged inside the margin, with its
+    /// span, in the context (`config`, `context`).
+    pub(super) fn insert(
+        config: &ControllerConfig,
+        context: &[u64],
+        inv_k: f64,
+        mut key: Vec<u64>,
+        span: Span,
+    ) {
+        key.push(inv_k.to_bits());
+        KEPT.with(|k| {
+            let mut k = k.borrow_mut();
+            let total: usize = k.0.iter().map(|c| c.inside.len()).sum();
+            if total >= KEPT_SAMPLES {
+                k.0.clear();
+            }
+            let i = match k.find(config, context) {
+                Some(i) => i,
+                None => {
+                    if k.0.len() >= KEPT_CONTEXTS {
+                        k.0.remove(0);
+                    }
+                    k.0.push(Context {
+                        config: *config,
+                        context: context.to_vec(),
+                        inside: HashMap::new(),
+                    });
+                    k.0.len() - 1
+                }
+            };
+            // The latest used last: the oldest is the one replaced.
+            let mut c = k.0.remove(i);
+            c.inside.insert(key, span);
+            k.0.push(c);
+        });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{Checker, Scope};
+    use crate::plant::CurrentModel;
+    use crate::scenario::{load_scenario, Scenario};
+    use crate::studies::preflight::{Engine, DEFAULT_MARGIN};
+
+    /// Every thruster's smallest and largest demand over the box's 2⁹ corners at rest on
+    /// sample `j`, by the reference engine (no key, no screen: every corner from scratch).
+    fn demands_at_rest(checker: &Checker, j: usize) -> Vec<(f64, f64)> {
+        let sweep = checker
+            .sweep_samples(Scope::WholeBox, 0.0, true, j..j + 1, 1)
+            .expect("the sweep");
+        sweep.peaks.iter().map(|p| (p.0, p.2)).collect()
+    }
+
+    /// Choice 529's premise on the reference's arithmetic: at rest without a current, the
+    /// demands are the same at every yaw of the same roll and pitch (the shipped survey's
+    /// legs and turns: 0°, 90°, 180° and the turns between); under a current they are not,
+    /// so the key keeps the yaw there.
+    #[test]
+    fn at_rest_without_a_current_the_demands_do_not_depend_on_the_yaw() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let still = Checker::new(&survey, DEFAULT_MARGIN, Engine::Exhaustive).expect("a checker");
+        let roll_pitch = |j: usize| {
+            let e = still.samples[j].eta;
+            (e[3].to_bits(), e[4].to_bits())
+        };
+        // Samples of the same roll and pitch, their yaws all different.
+        let mut yaws: Vec<u64> = Vec::new();
+        let picked: Vec<usize> = (0..still.samples.len())
+            .step_by(7)
+            .filter(|&j| roll_pitch(j) == roll_pitch(0))
+            .filter(|&j| {
+                let yaw = still.samples[j].eta[5].to_bits();
+                let new = !yaws.contains(&yaw);
+                yaws.push(yaw);
+                new
+            })
+            .take(40)
+            .collect();
+        assert!(picked.len() >= 20, "{} yaws", picked.len());
+        let first = demands_at_rest(&still, picked[0]);
+        for &j in &picked[1..] {
+            assert_eq!(demands_at_rest(&still, j), first, "sample {j}");
+        }
+        // Under a current the body-frame current turns with the yaw.
+        let mut cfg = survey.config().clone();
+        cfg.current = CurrentModel::Constant([0.3, 0.0, 0.0]);
+        let drifting = Scenario::new(cfg).expect("the survey under a current");
+        let moving =
+            Checker::new(&drifting, DEFAULT_MARGIN, Engine::Exhaustive).expect("a checker");
+        let under = demands_at_rest(&moving, picked[0]);
+        assert!(picked[1..]
+            .iter()
+            .any(|&j| demands_at_rest(&moving, j) != under));
+    }
+
+    /// Choice 537's context: the same mission flown for another duration (the profile's
+    /// check as flown of a file that pins it) is the same context, and so its kept samples
+    /// are asked; a current, another margin, an untrimmed payload or another path are not.
+    #[test]
+    fn kept_samples_are_asked_only_in_the_same_context() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let context = |s: &Scenario, margin: f64| {
+            Checker::new(s, margin, Engine::Fast)
+                .expect("a checker")
+                .context
+        };
+        let with = |f: &dyn Fn(&mut crate::scenario::SimConfig)| {
+            let mut cfg = survey.config().clone();
+            f(&mut cfg);
+            Scenario::new(cfg).expect("a scenario")
+        };
+        let base = context(&survey, DEFAULT_MARGIN);
+        assert_eq!(
+            context(&with(&|c| c.duration = 600.0), DEFAULT_MARGIN),
+            base
+        );
+        assert_ne!(context(&survey, 0.7), base);
+        let current = with(&|c| c.current = CurrentModel::Constant([0.2, 0.0, 0.0]));
+        assert_ne!(context(&current, DEFAULT_MARGIN), base);
+        assert_ne!(context(&with(&|c| c.trimmed = false), DEFAULT_MARGIN), base);
+        let circle = load_scenario(
+            &std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+                .join("scenarios/real/circular-10R.toml"),
+        )
+        .expect("the circle");
+        assert_ne!(context(&circle, DEFAULT_MARGIN), base);
     }
 }
