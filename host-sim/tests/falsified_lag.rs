@@ -102,13 +102,13 @@ fn a_start_no_speed_cures_is_refused_at_every_scale() {
     assert!(p.smallest_time_scale.is_none(), "{p}");
 }
 
-/// Open (docs/search.md#against-the-real-preflight): a 1.7 cm depth offset through a 0.26 s
-/// lag, which the check calls feasible at 1. The first command answers the offset (+223 N on
-/// depth); the lagged loop reverses past it on the other side (−386 N at 0.4 s, 2.8 % of the
-/// periods saturated, all in 0.17–0.72 s); without its lag it flies. The share measures |u|,
-/// not the side the reversal takes. Ignored until the share is kept on that side.
+/// A 1.7 cm depth offset through a 0.26 s lag, which Choices 509 and 546–547 called feasible
+/// at 1 (docs/search.md#against-the-real-preflight). The first command answers the offset
+/// (+223 N on depth); the lagged loop reverses past it on the other side (−386 N at 0.4 s,
+/// 2.8 % of the periods saturated, all in 0.17–0.72 s); without its lag it flies. (L2)
+/// measured |u|, not the side the reversal takes; the signed share (Choice 557) keeps the
+/// swing on the side it takes and refuses it.
 #[test]
-#[ignore = "open: a lagged start offset's reversal on a thruster's other side"]
 fn a_lagged_offset_reversal_is_refused_where_it_missed() {
     let m = mission("falsified-lag-offset-reversal-ce-s10.toml");
     assert!(!within(&m));

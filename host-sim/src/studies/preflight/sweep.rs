@@ -314,14 +314,13 @@ impl<'a> Checker<'a> {
         let nominal = Plant::new(law_model, PlantTerms::default())
             .map_err(|e| invalid(format!("the law's nominal model: {e}")))?;
         let currents = currents(&cfg.current);
-        // The navigation's noise force (Choice 372) and the lag's overshoot (Choice 509) are
-        // kept on each side.
-        let mut kept = super::navigation::share(scenario, None).thrust;
-        for (k, r) in kept.iter_mut().zip(super::lag::reserve(scenario)?) {
-            *k += r;
-        }
-        let margin_envelope =
-            super::navigation::keep(controller.envelope().scaled(margin as f32), &kept);
+        // The navigation's noise force (Choice 372) is kept on each side, the lag's overshoot
+        // (Choices 509, 557) on the side it takes.
+        let kept = super::navigation::share(scenario, None).thrust;
+        let margin_envelope = super::lag::reserve(scenario)?.keep(super::navigation::keep(
+            controller.envelope().scaled(margin as f32),
+            &kept,
+        ));
         let margin_allocator = Allocator::new(
             controller.allocation(),
             &margin_envelope,
