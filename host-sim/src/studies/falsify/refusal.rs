@@ -5,16 +5,17 @@
 //!
 //! A refused candidate is one for which `check` proposes no time scale. Each of the check's
 //! limits that fits at no scale is taken where it is loosest — at rest for the force (the
-//! static check, k = ∞), at the slowest scale the search tries ([`MAX_TIME_SCALE`]) for the
-//! path-error budget and the chatter term — and its need is normalised by its own limit:
+//! static check, k = ∞), at the slowest scale the search tries
+//! (`Trajectory::MAX_TIME_SCALE`) for the path-error budget and the chatter term (its mean
+//! thrust held still between the reference's samples, Choice 560:
+//! [`chatter::Chatter::slowest_held`], within a few per cent of the full pass at half the
+//! search's time) — and its need is normalised by its own limit:
 //! need / limit − 1, the fraction by which the slowest flight the check can name still misses
 //! it (0: on the limit). A limit that fits at some scale adds nothing, so a refusal by the
 //! joint search alone (every limit fits, but no common scale was found) is on the boundary.
 //! The refusal's distance is the largest of these: the least of the per-limit robustness
 //! terms 1 − need/limit, negated, as [`crate::sim::bound::robustness`] takes the least of the
 //! flight's, so that no unit hides another.
-
-use controller_core::Trajectory;
 
 use crate::scenario::Scenario;
 use crate::studies::preflight::{chatter, CheckError, Preflight, Violation};
@@ -23,9 +24,6 @@ use crate::studies::preflight::{chatter, CheckError, Preflight, Violation};
 /// flown candidate can have (each term is 1 − value/limit of a value ≥ 0, so at most 1), so
 /// that any candidate the check calls feasible ranks before every refused one.
 pub const REFUSED_BASE: f64 = 2.0;
-
-/// The slowest time scale the check searches.
-const MAX_TIME_SCALE: f64 = Trajectory::MAX_TIME_SCALE as f64;
 
 /// Per limit of the check, how far beyond it the refused mission stays where the limit is
 /// loosest, as a fraction of the limit (0: within it, or it fits at some scale).
@@ -36,7 +34,7 @@ pub struct Excess {
     /// The path-error budget's speed-independent part against the bound.
     pub path: f64,
     /// The chatter term's worst reversals per second, and command total variation, at the
-    /// slowest scale, against the bound's limits.
+    /// slowest scale (the mean held between samples, Choice 560), against the bound's limits.
     pub reversals: f64,
     pub command_tv: f64,
 }
@@ -98,7 +96,8 @@ pub fn excess(mission: &Scenario, p: &Preflight) -> Result<Excess, CheckError> {
         .is_some_and(|c| c.smallest_time_scale.is_none())
     {
         if let Some(model) = chatter::Chatter::new(mission)? {
-            let slowest = model.at(MAX_TIME_SCALE, 1.0)?;
+            let slowest = model.slowest_held()?;
+
             out.reversals = beyond(slowest.worst_reversals().0, slowest.max_reversals_per_s);
             out.command_tv = beyond(slowest.worst_tv().0, slowest.max_command_tv);
         }

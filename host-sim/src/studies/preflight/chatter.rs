@@ -890,7 +890,7 @@ impl<'a> Chatter<'a> {
         let order = std::iter::once(first).chain((0..means.len()).filter(|&c| c != first));
         let mut per_corner = vec![None; means.len()];
         for c in order {
-            match self.flown(&stats, &means[c], k, noise * noise, Some(duration))? {
+            match self.flown(&stats, &means[c], k, noise * noise, Some(duration), false)? {
                 Some(r) => per_corner[c] = Some(r),
                 None => {
                     self.last_refused.set(c);
@@ -916,14 +916,41 @@ impl<'a> Chatter<'a> {
             .max(tv / duration / self.bound.max_command_tv)
     }
 
+    /// The term at the slowest scale ([`MAX_TIME_SCALE`]) with the mean thrust held still
+    /// between the reference's samples (**Choice 560**): each sample's mean for the stretch of
+    /// the flight up to the next (a staircase, not the line between them), the noise and the
+    /// stretch's length as [`Chatter::at`] flies them. Where the mean stands still the flight
+    /// asks the same crossings again with the noise's cycle, which [`Crossings`] keeps, so
+    /// the pass costs about one cycle per sample instead of every period; the mean's steps
+    /// keep its total variation. Not [`Chatter::at`]`(MAX_TIME_SCALE, 1.0)`'s figures: its
+    /// approximation at the slowest scale, for the refusal's score
+    /// (`falsify::refusal`, Choice 551), which needs no verdict.
+    ///
+    /// # Errors
+    /// As [`Chatter::at`].
+    pub fn slowest_held(&self) -> Result<ChatterPrediction, CheckError> {
+        self.predict_with(MAX_TIME_SCALE, 1.0, true)
+    }
+
     /// [`Chatter::at`], evaluated.
     fn predict(&self, k: f64, noise: f64) -> Result<ChatterPrediction, CheckError> {
+        self.predict_with(k, noise, false)
+    }
+
+    /// [`Chatter::predict`], the mean held between samples with `held`
+    /// ([`Chatter::slowest_held`]).
+    fn predict_with(
+        &self,
+        k: f64,
+        noise: f64,
+        held: bool,
+    ) -> Result<ChatterPrediction, CheckError> {
         let (means, delta) = self.mean_thrusts(k)?;
         let stats = self.stats_at(delta)?;
         let duration = self.duration(k);
         let mut per_corner = Vec::with_capacity(means.len());
         for mean in &means {
-            let flown = self.flown(&stats, mean, k, noise * noise, None)?;
+            let flown = self.flown(&stats, mean, k, noise * noise, None, held)?;
             per_corner.push(flown.ok_or(CheckError::Interrupted)?);
         }
         Ok(self.assemble(k, duration, &per_corner))
@@ -983,7 +1010,9 @@ impl<'a> Chatter<'a> {
     /// corner), the noise's variance scaled by `scale2`: the largest σ, the largest step σ,
     /// the expected reversals (min of the two edges' crossings) and the expected total
     /// variation (V). With `stop` (the flight's duration), `None` as soon as a thruster's
-    /// partial sums are past the bound ([`Chatter::fits_with`]).
+    /// partial sums are past the bound ([`Chatter::fits_with`]). With `held`, the mean held
+    /// still between samples ([`Chatter::slowest_held`]).
+    // Long: one pass over the flight's periods, its sums carried from one to the next.
     fn flown(
         &self,
         stats: &[AxisStats; 6],
@@ -991,13 +1020,14 @@ impl<'a> Chatter<'a> {
         k: f64,
         scale2: f64,
         stop: Option<f64>,
+        held: bool,
     ) -> Result<Option<Flown>, CheckError> {
         let t = 1.0 / self.rate_hz;
         let periods = (self.duration(k) * self.rate_hz).round().max(1.0) as u64;
         let cycle = stats.iter().map(|s| s.var.len() as u64).max().unwrap_or(1);
         let (flown, from) =
             window_periods(self.reduction.as_ref(), periods, k, self.rate_hz, cycle);
-        let at = |n: u64| self.mean_at(mean, n as f64 * t / k);
+        let at = |n: u64| self.mean_at(mean, n as f64 * t / k, held);
         let mut crossings = [[0.0f64; 2]; THRUSTERS];
         let mut tv = [0.0f64; THRUSTERS];
         let mut sigma = [0.0f64; THRUSTERS];
@@ -1023,6 +1053,10 @@ impl<'a> Chatter<'a> {
                 }
             }
             let m1 = at(n + 1);
+            if held && m1 != m0 {
+                // A step: the kept crossings were the last stretch's (their mean is gone).
+                kept.0.clear();
+            }
             let now: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n));
             let next: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n + 1));
             for j in 0..THRUSTERS {
@@ -1058,8 +1092,9 @@ impl<'a> Chatter<'a> {
     }
 
     /// The mean thrusts at path time `s` (s, at k = 1), folded onto a periodic mission's
-    /// checked span, linear between the reference's samples (`mean`, one a sample).
-    fn mean_at(&self, mean: &[[f64; THRUSTERS]], mut s: f64) -> [f64; THRUSTERS] {
+    /// checked span, linear between the reference's samples (`mean`, one a sample), or with
+    /// `held` the last sample's.
+    fn mean_at(&self, mean: &[[f64; THRUSTERS]], mut s: f64, held: bool) -> [f64; THRUSTERS] {
         let last = mean.len().saturating_sub(1);
         let span = last.max(1) as f64 * SAMPLE_PERIOD;
         if let Some(r) = &self.reduction {
@@ -1068,6 +1103,9 @@ impl<'a> Chatter<'a> {
         let x = (s / SAMPLE_PERIOD).min(span / SAMPLE_PERIOD);
         let j = (x.floor() as usize).min(last);
         let j1 = (j + 1).min(last);
+        if held {
+            return mean[j];
+        }
         let w = x - j as f64;
         std::array::from_fn(|i| mean[j][i] * (1.0 - w) + mean[j1][i] * w)
     }
