@@ -336,7 +336,11 @@ impl SampleKeys {
         (cases, m): (&[CasePlants<'_>], usize),
         yaw_free: bool,
     ) -> Vec<u64> {
-        let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
+        // Room for the attitude and the rates (15 words), [`Kept`]'s 1/k, and the cases that
+        // add to it: over the box none do, and room for its 2⁹ corners was 8 kB a key, kept
+        // with it by [`Kept`] (Choice 562: 207 MB of `check`'s 344 MB on a 32-point route).
+        let keyed = cases.iter().filter(|c| c.key(m).is_some()).count();
+        let mut key: Vec<u64> = Vec::with_capacity(16 + 2 * keyed);
         let attitude = match yaw_free {
             true => &smp.eta.as_slice()[3..YAW],
             false => &smp.eta.as_slice()[3..],
@@ -522,6 +526,56 @@ mod tests {
         assert!(picked[1..]
             .iter()
             .any(|&j| demands_at_rest(&moving, j) != under));
+    }
+
+    /// Choice 563: a box sample's key holds 15 words (the attitude and the rates) and has
+    /// room for [`Kept`](super::Kept)'s 1/k, not for two words per corner (8 kB a key, which
+    /// `Kept` kept with it: 207 MB of `check` on a 32-point route); a case that varies along
+    /// the path (the mission as written) adds its two words.
+    #[test]
+    fn a_box_samples_key_has_room_for_its_words_only() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let checker = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        let times = checker.times(1.0);
+        let cases = checker.cases(Scope::WholeBox, &times, &[]);
+        assert_eq!(cases.len(), 512);
+        let key = super::SampleKeys::key(&checker.samples[3], 1.0, (&cases, 3), false);
+        assert_eq!(key.len(), 15);
+        assert!(key.capacity() <= 16, "room for {} words", key.capacity());
+    }
+
+    /// Choice 562: the bit hasher gives equal keys equal hashes and spreads nearby heels (one
+    /// bit apart) over the table's low bits; a kept context is found by a checker's serial
+    /// only after its context was matched, and another checker's serial does not find it.
+    #[test]
+    fn bit_keys_hash_apart_and_serials_find_only_their_context() {
+        use std::hash::{BuildHasher, BuildHasherDefault};
+        let build = BuildHasherDefault::<super::BitsHasher>::default();
+        let heel = 0.0123_f64.to_bits();
+        let low: std::collections::HashSet<u64> =
+            (0..64).map(|i| build.hash_one(heel + i) & 63).collect();
+        assert!(low.len() > 32, "{} of 64 buckets", low.len());
+        assert_eq!(build.hash_one(vec![1u64, 2]), build.hash_one(vec![1u64, 2]));
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let a = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        let b = Checker::new(&survey, 0.5, Engine::Fast).expect("a checker");
+        assert_ne!(a.serial, b.serial);
+        let config = survey.controller().config();
+        super::Kept::forget();
+        let span = super::Span::EMPTY;
+        super::Kept::insert(config, (&a.context, a.serial), 1.0, vec![7], span);
+        let ask = |c: &Checker| super::Kept::get(config, (&c.context, c.serial), 1.0, &mut vec![7]);
+        assert!(ask(&a).is_some());
+        assert!(ask(&b).is_none());
+        // A second checker of the same context matches it by comparison, then by serial.
+        let a2 = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        assert!(ask(&a2).is_some() && ask(&a2).is_some());
+        assert!(ask(&b).is_none());
+        super::Kept::forget();
     }
 
     /// Choice 537's context: the same mission flown for another duration (the profile's
