@@ -697,8 +697,7 @@ impl<'a> Checker<'a> {
             }
             let config = self.scenario.controller().config();
             if screening {
-                if let Some(span) = Kept::get(config, (&self.context, self.serial), inv_k, &mut key)
-                {
+                if let Some(span) = Kept::get(config, self.kept(), inv_k, &mut key) {
                     self.screen.borrow_mut().record(peak, j, inv_k, span);
                     continue;
                 }
@@ -728,11 +727,16 @@ impl<'a> Checker<'a> {
             if let Some(span) = out.span.take() {
                 self.screen.borrow_mut().record(peak, j, inv_k, span);
                 if screening {
-                    Kept::insert(config, (&self.context, self.serial), inv_k, key, span);
+                    Kept::insert(config, self.kept(), inv_k, key, span);
                 }
             }
         }
         Ok(())
+    }
+
+    /// This checker's context and serial, as [`Kept`] asks for them (Choice 562).
+    fn kept(&self) -> (&[u64], u64) {
+        (&self.context, self.serial)
     }
 
     fn sample(&self, peak: bool, j: usize) -> &PathSample {
