@@ -136,6 +136,9 @@ pub(super) struct Checker<'a> {
     /// What a box point's verdict reads besides its sample and the law's configuration, by
     /// its bits: the key of the samples [`Kept`] across checkers (Choice 537).
     context: Vec<u64>,
+    /// This checker's number, unique in the process: [`Kept`] knows a context it has matched
+    /// against this checker's by it, without comparing the context again (Choice 562).
+    serial: u64,
 }
 
 /// [`super::forget_kept`].
@@ -333,6 +336,7 @@ impl<'a> Checker<'a> {
         })?;
         let mut checker = Checker {
             context: Vec::new(),
+            serial: fast::next_serial(),
             scenario,
             samples,
             corners_peaks,
@@ -692,7 +696,7 @@ impl<'a> Checker<'a> {
             }
             let config = self.scenario.controller().config();
             if screening {
-                if let Some(span) = Kept::get(config, &self.context, inv_k, &mut key) {
+                if let Some(span) = Kept::get(config, self.kept(), inv_k, &mut key) {
                     self.screen.borrow_mut().record(peak, j, inv_k, span);
                     continue;
                 }
@@ -722,11 +726,16 @@ impl<'a> Checker<'a> {
             if let Some(span) = out.span.take() {
                 self.screen.borrow_mut().record(peak, j, inv_k, span);
                 if screening {
-                    Kept::insert(config, &self.context, inv_k, key, span);
+                    Kept::insert(config, self.kept(), inv_k, key, span);
                 }
             }
         }
         Ok(())
+    }
+
+    /// This checker's context and serial, as [`Kept`] asks for them (Choice 562).
+    fn kept(&self) -> (&[u64], u64) {
+        (&self.context, self.serial)
     }
 
     fn sample(&self, peak: bool, j: usize) -> &PathSample {

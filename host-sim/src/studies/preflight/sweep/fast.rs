@@ -8,8 +8,10 @@
 //! those of its own roll and pitch offset; and the key by which a sweep recognises a sample
 //! it has already judged ([`SampleKeys`]).
 
-use std::cell::RefCell;
+use std::cell::{Cell, RefCell};
 use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use controller_core::kinematics::{self, Attitude};
 use nalgebra::{Vector3, Vector6};
@@ -24,6 +26,57 @@ use controller_core::config::ControllerConfig;
 const ROLL: usize = 3;
 const PITCH: usize = 4;
 const YAW: usize = 5;
+
+/// A hasher for keys that are bits already (a heel's `f64` bits, the words of a sample's
+/// key), in the manner of FxHash: each word is folded in by a rotate, an exclusive or and a
+/// multiplication (**Choice 562**). The std's SipHash resists chosen keys, which these are
+/// not, at several times the cost: it was ~4 % of `check` on a 32-point route, hashing a
+/// heel per box corner. Only the speed of a lookup depends on the hash, never what it finds.
+#[derive(Clone, Copy, Default)]
+pub(super) struct BitsHasher(u64);
+
+impl BitsHasher {
+    /// FxHash's multiplier (an odd constant with well-spread bits).
+    const K: u64 = 0x517c_c1b7_2722_0a95;
+
+    fn add(&mut self, word: u64) {
+        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(Self::K);
+    }
+}
+
+impl Hasher for BitsHasher {
+    fn finish(&self) -> u64 {
+        // The product's high bits are its best mixed; the table reads the low ones.
+        self.0.rotate_left(26)
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.add(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u64(&mut self, word: u64) {
+        self.add(word);
+    }
+
+    fn write_usize(&mut self, word: usize) {
+        self.add(word as u64);
+    }
+}
+
+/// A hash map keyed by bits ([`BitsHasher`]).
+type BitsMap<K, V> = HashMap<K, V, BuildHasherDefault<BitsHasher>>;
+
+/// The source of [`Checker`]s' serial numbers (0 is none's).
+static SERIALS: AtomicU64 = AtomicU64::new(1);
+
+/// A serial number no checker in this process had before (Choice 562).
+pub(super) fn next_serial() -> u64 {
+    SERIALS.fetch_add(1, Ordering::Relaxed)
+}
 
 /// A plant's roll constants: the heeling moment m_y, the righting coefficient k₄, ρ = |(m_y,
 /// k₄)| and the static heel atan2(m_y, k₄) with its sine and cosine
@@ -73,7 +126,7 @@ pub(super) struct Shared {
     /// does not read meet the same heel bit for bit (ΔI_x, ΔI_y, ΔI_z multiply p, q and ṗ,
     /// exact zeros where the state at the static heel neither rolls nor pitches), and its
     /// state and nominal force are formed once per sample.
-    heels: RefCell<HashMap<u64, AtHeel>>,
+    heels: RefCell<BitsMap<u64, AtHeel>>,
 }
 
 /// The attitude and state at one heel on a sample, and the law's nominal force there
@@ -99,7 +152,7 @@ impl Shared {
             eta_dot: smp.eta_dot * inv_k,
             eta_ddot: smp.eta_ddot * (inv_k * inv_k),
             level: RefCell::new(Vec::new()),
-            heels: RefCell::new(HashMap::new()),
+            heels: RefCell::new(BitsMap::default()),
         }
     }
 
@@ -258,7 +311,7 @@ pub(super) fn yaw_free(inv_k: f64, currents: &[Vector3<f64>]) -> bool {
 /// every sample of one attitude is one key, so a straight leg with its speed changes, or a
 /// whole lawn-mower line, is judged once.
 #[derive(Default)]
-pub(super) struct SampleKeys(HashMap<Vec<u64>, usize>);
+pub(super) struct SampleKeys(BitsMap<Vec<u64>, usize>);
 
 impl SampleKeys {
     /// Records the key of sample `smp` (index `j`) at 1/k = `inv_k` and prepared index `m` of
@@ -283,7 +336,11 @@ impl SampleKeys {
         (cases, m): (&[CasePlants<'_>], usize),
         yaw_free: bool,
     ) -> Vec<u64> {
-        let mut key: Vec<u64> = Vec::with_capacity(15 + 2 * cases.len());
+        // Room for the attitude and the rates (15 words), [`Kept`]'s 1/k, and the cases that
+        // add to it: over the box none do, and room for its 2⁹ corners was 8 kB a key, kept
+        // with it by [`Kept`] (Choice 562: 207 MB of `check`'s 344 MB on a 32-point route).
+        let keyed = cases.iter().filter(|c| c.key(m).is_some()).count();
+        let mut key: Vec<u64> = Vec::with_capacity(16 + 2 * keyed);
         let attitude = match yaw_free {
             true => &smp.eta.as_slice()[3..YAW],
             false => &smp.eta.as_slice()[3..],
@@ -316,7 +373,11 @@ pub(super) struct Kept(Vec<Context>);
 struct Context {
     config: ControllerConfig,
     context: Vec<u64>,
-    inside: HashMap<Vec<u64>, Span>,
+    inside: BitsMap<Vec<u64>, Span>,
+    /// The serial of the last checker found to have this context (0: none yet): its later
+    /// lookups skip comparing the context, tens of thousands of words over the box's 2⁹
+    /// corners, that it cannot have changed (Choice 562).
+    matched: Cell<u64>,
 }
 
 /// The contexts [`Kept`] holds, the latest used last.
@@ -335,18 +396,26 @@ impl Kept {
         KEPT.with(|k| k.borrow_mut().0.clear());
     }
 
-    /// The index of the context (`config`, `context`), if kept.
-    fn find(&self, config: &ControllerConfig, context: &[u64]) -> Option<usize> {
-        self.0
+    /// The index of the context (`config`, `context`) of the checker numbered `serial`, if
+    /// kept. A checker's configuration and context do not change after it is built, so a
+    /// context matched once against its serial is its context at every later lookup.
+    fn find(&self, config: &ControllerConfig, (context, serial): (&[u64], u64)) -> Option<usize> {
+        if let Some(i) = self.0.iter().position(|c| c.matched.get() == serial) {
+            return Some(i);
+        }
+        let i = self
+            .0
             .iter()
-            .position(|c| c.config == *config && c.context == context)
+            .position(|c| c.config == *config && c.context == context)?;
+        self.0[i].matched.set(serial);
+        Some(i)
     }
 
     /// The span of the sample keyed `key` at 1/k = `inv_k`, judged inside the margin in the
     /// context (`config`, `context`), if it was.
     pub(super) fn get(
         config: &ControllerConfig,
-        context: &[u64],
+        context: (&[u64], u64),
         inv_k: f64,
         key: &mut Vec<u64>,
     ) -> Option<Span> {
@@ -364,7 +433,7 @@ impl Kept {
     /// span, in the context (`config`, `context`).
     pub(super) fn insert(
         config: &ControllerConfig,
-        context: &[u64],
+        context: (&[u64], u64),
         inv_k: f64,
         mut key: Vec<u64>,
         span: Span,
@@ -384,8 +453,9 @@ impl Kept {
                     }
                     k.0.push(Context {
                         config: *config,
-                        context: context.to_vec(),
-                        inside: HashMap::new(),
+                        context: context.0.to_vec(),
+                        inside: BitsMap::default(),
+                        matched: Cell::new(context.1),
                     });
                     k.0.len() - 1
                 }
@@ -456,6 +526,56 @@ mod tests {
         assert!(picked[1..]
             .iter()
             .any(|&j| demands_at_rest(&moving, j) != under));
+    }
+
+    /// Choice 563: a box sample's key holds 15 words (the attitude and the rates) and has
+    /// room for [`Kept`](super::Kept)'s 1/k, not for two words per corner (8 kB a key, which
+    /// `Kept` kept with it: 207 MB of `check` on a 32-point route); a case that varies along
+    /// the path (the mission as written) adds its two words.
+    #[test]
+    fn a_box_samples_key_has_room_for_its_words_only() {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let checker = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        let times = checker.times(1.0);
+        let cases = checker.cases(Scope::WholeBox, &times, &[]);
+        assert_eq!(cases.len(), 512);
+        let key = super::SampleKeys::key(&checker.samples[3], 1.0, (&cases, 3), false);
+        assert_eq!(key.len(), 15);
+        assert!(key.capacity() <= 16, "room for {} words", key.capacity());
+    }
+
+    /// Choice 562: the bit hasher gives equal keys equal hashes and spreads nearby heels (one
+    /// bit apart) over the table's low bits; a kept context is found by a checker's serial
+    /// only after its context was matched, and another checker's serial does not find it.
+    #[test]
+    fn bit_keys_hash_apart_and_serials_find_only_their_context() {
+        use std::hash::{BuildHasher, BuildHasherDefault};
+        let build = BuildHasherDefault::<super::BitsHasher>::default();
+        let heel = 0.0123_f64.to_bits();
+        let low: std::collections::HashSet<u64> =
+            (0..64).map(|i| build.hash_one(heel + i) & 63).collect();
+        assert!(low.len() > 32, "{} of 64 buckets", low.len());
+        assert_eq!(build.hash_one(vec![1u64, 2]), build.hash_one(vec![1u64, 2]));
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let a = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        let b = Checker::new(&survey, 0.5, Engine::Fast).expect("a checker");
+        assert_ne!(a.serial, b.serial);
+        let config = survey.controller().config();
+        super::Kept::forget();
+        let span = super::Span::EMPTY;
+        super::Kept::insert(config, (&a.context, a.serial), 1.0, vec![7], span);
+        let ask = |c: &Checker| super::Kept::get(config, (&c.context, c.serial), 1.0, &mut vec![7]);
+        assert!(ask(&a).is_some());
+        assert!(ask(&b).is_none());
+        // A second checker of the same context matches it by comparison, then by serial.
+        let a2 = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        assert!(ask(&a2).is_some() && ask(&a2).is_some());
+        assert!(ask(&b).is_none());
+        super::Kept::forget();
     }
 
     /// Choice 537's context: the same mission flown for another duration (the profile's
