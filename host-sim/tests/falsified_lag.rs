@@ -117,3 +117,21 @@ fn a_lagged_offset_reversal_is_refused_where_it_missed() {
     let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
     assert!(!p.feasible(), "{p}");
 }
+
+/// Open (found by `falsify --reach realities --budget 250 --restarts 20 --shard 2/20 --seed 1
+/// --duration 20`): a 2 cm sway and −1.6 cm depth start offset on a lawn-mower whose demand at
+/// the start already holds horz fore at −71.2 N, 79 % of its weak side's margin envelope; the
+/// check calls it feasible at 1.02 and the start transient saturates 1.2 % of the periods. The
+/// lag (10 ms) is not the cause: without it the mission still misses (1.1 %), without the
+/// offset it flies. The shares keep what the lag adds to the start's transient, not the
+/// transient itself. Ignored until the check keeps the offset's own transient on its side.
+#[test]
+#[ignore = "open: a start offset's own transient on a weak side held near the margin"]
+fn a_start_offset_transient_near_the_margin_is_refused_where_it_missed() {
+    let m = mission("falsified-offset-start-ce-r2.toml");
+    assert!(!within(&m));
+    assert!(!within(&m.with(|c| c.thruster_lag = None).unwrap()));
+    assert!(within(&m.with(|c| c.initial_offset = [0.0; 6]).unwrap()));
+    let p = preflight::check_as_written(&m, DEFAULT_MARGIN).unwrap();
+    assert!(!p.feasible(), "{p}");
+}
