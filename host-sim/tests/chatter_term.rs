@@ -101,6 +101,21 @@ fn white_noise_flown_as_told_is_refused_at_every_scale() {
     assert!(run.metrics.reversals_per_s > p.max_reversals_per_s);
 }
 
+/// The contract's `random` disturbed random missions (seed 1) on `survey`, cut to `duration` s.
+fn disturbed_on_survey(random: usize, duration: f64) -> Vec<Scenario> {
+    let campaign = Campaign {
+        masks: Vec::new(),
+        random,
+        seed: 1,
+        navigation: vec![Preset::Survey],
+        disturbed: true,
+    };
+    let all = campaign.missions().unwrap();
+    (0..all.len())
+        .map(|i| all.get(i).unwrap().with(|c| c.duration = duration).unwrap())
+        .collect()
+}
+
 /// The search's decision (Choice 516) stops a pass over the flight once a partial sum is past
 /// the bound; it answers what the full prediction answers, at every scale and noise fraction
 /// asked: on the shipped circle (at its own scale 1.31, where it fits), the white noise flown as told (refused at
@@ -110,18 +125,8 @@ fn white_noise_flown_as_told_is_refused_at_every_scale() {
 #[test]
 fn the_stopping_decision_answers_what_the_full_prediction_answers() {
     let white = white_noise_circle();
-    let campaign = Campaign {
-        masks: Vec::new(),
-        random: 4,
-        seed: 1,
-        navigation: vec![Preset::Survey],
-        disturbed: true,
-    };
-    let all = campaign.missions().unwrap();
     let mut missions = vec![real("real-circular-10R"), white];
-    for i in 0..all.len() {
-        missions.push(all.get(i).unwrap().with(|c| c.duration = 20.0).unwrap());
-    }
+    missions.extend(disturbed_on_survey(4, 20.0));
     let (mut stopped, mut kept) = (0, 0);
     for s in &missions {
         let name = &s.config().name;
@@ -159,18 +164,8 @@ fn the_stopping_decision_answers_what_the_full_prediction_answers() {
 /// `survey` (several current corners).
 #[test]
 fn the_held_slowest_pass_is_within_a_few_per_cent_of_the_full_one() {
-    let campaign = Campaign {
-        masks: Vec::new(),
-        random: 2,
-        seed: 1,
-        navigation: vec![Preset::Survey],
-        disturbed: true,
-    };
-    let all = campaign.missions().unwrap();
     let mut missions = vec![white_noise_circle().with(|c| c.duration = 10.0).unwrap()];
-    for i in 0..all.len() {
-        missions.push(all.get(i).unwrap().with(|c| c.duration = 5.0).unwrap());
-    }
+    missions.extend(disturbed_on_survey(2, 5.0));
     let k = f64::from(controller_core::Trajectory::MAX_TIME_SCALE);
     for s in &missions {
         let name = &s.config().name;
