@@ -345,6 +345,51 @@ impl Plant {
         tau
     }
 
+    /// The roll row τ₄ of [`required_force_at`](Self::required_force_at), bit for bit: each
+    /// term's roll component by the operations, in the order, that the whole vector's
+    /// arithmetic gives it — M ν̇'s row as nalgebra's matrix–vector product sums it (column by
+    /// column), the two Coriolis terms' (ν₁ × a + ω × b)ₓ from the rows of M_RB ν and M_A ν_r
+    /// they read, M_A ν̇_c's zero (the current's derivative, −ω × Rᵀv_c, has no angular part),
+    /// the damping's and the restoring moment's roll rows (Eq 1). The preflight's heel reads
+    /// this row alone, once per box corner and sample (**Choice 564**): about half the whole
+    /// vector's work.
+    pub fn required_roll_at(
+        &self,
+        s: &PlantState,
+        att: &Attitude<f64>,
+        nu_dot: &Vector6<f64>,
+        current: &Vector3<f64>,
+    ) -> f64 {
+        const R: usize = 3;
+        let vc_body = kinematics::rotation(att).transpose() * current;
+        let nu_c = Vector6::new(vc_body.x, vc_body.y, vc_body.z, 0.0, 0.0, 0.0);
+        let nu_r = s.nu - nu_c;
+        // Row i of a 6 × 6 product with `x`, summed as the product sums it.
+        let row = |m: &Matrix6<f64>, i: usize, x: &Vector6<f64>| {
+            (1..6).fold(m[(i, 0)] * x[0], |y, j| m[(i, j)] * x[j] + y)
+        };
+        let mass = row(&self.m, R, nu_dot);
+        // (ν₁ × a + ω × b)ₓ of `coriolis_force_of(ab, ν)`, from ab's rows 1, 2, 4 and 5.
+        let coriolis = |ab: [f64; 4], nu: &Vector6<f64>| {
+            let [a1, a2, b1, b2] = ab;
+            (nu[1] * a2 - nu[2] * a1) + (nu[4] * b2 - nu[5] * b1)
+        };
+        let rb = [1, 2, 4, 5].map(|i| row(&self.m_rb, i, &s.nu));
+        let added = [1, 2, 4, 5].map(|i| self.m_a[i] * nu_r[i]);
+        let mut tau = mass + coriolis(rb, &s.nu) + coriolis(added, &nu_r) - self.m_a[R] * 0.0;
+        if self.terms.damping {
+            tau += self.params.damping[R] * nu_r[R].abs() * nu_r[R];
+        }
+        if self.terms.restoring {
+            let p = &self.params;
+            let (w, b) = (p.weight(), p.buoyancy);
+            let my = p.r_g[1] * w - p.r_b_xy[1] * b;
+            let k4 = p.r_g[2] * w - p.z_b_roll * b;
+            tau += -my * att.ctheta * att.cphi + k4 * att.ctheta * att.sphi;
+        }
+        tau
+    }
+
     /// One classical RK4 step of length `h` with τ and the current held (zero-order hold).
     ///
     /// The sines and cosines of the Euler angles are evaluated (libm) at the step's start

@@ -390,8 +390,9 @@ fn crossing_probability_carried(
     bvn_upper_pair_given(-a, b, -r, ph, pk)
 }
 
-/// A crossing's inputs (the two means, the two σ, the covariance, the level), by their bits.
-type CrossingKey = [u64; 6];
+/// A crossing's inputs where the mean stands still (the mean, the two σ, the covariance, the
+/// level), by their bits.
+type CrossingKey = [u64; 5];
 /// The Φ pair a crossing carries to the next period ([`crossing_probability_carried`]).
 type Carry = Option<(u64, (f64, f64))>;
 
@@ -401,9 +402,11 @@ type Carry = Option<(u64, (f64, f64))>;
 /// sources' cycle, so a pass asks the same crossing again and again. Exact: [`crossing_probability_carried`] gives the fresh crossing's bits whatever
 /// it carried (Choice 517), and the carry it leaves is a function of the inputs alone (the
 /// second period's standardised distance and its Φ pair, or nothing), so a kept crossing
-/// gives back its probability and its carry. At most [`KEPT_CROSSINGS`] are kept.
+/// gives back its probability and its carry. At most [`KEPT_CROSSINGS`] are kept. Hashed by
+/// [`BitsHasher`](super::bits::BitsHasher) (Choice 562), not SipHash: the lookups were ~2 % of
+/// `check` on the survey; what a lookup finds is the same.
 #[derive(Default)]
-struct Crossings(std::collections::HashMap<CrossingKey, (f64, Carry)>);
+struct Crossings(super::bits::BitsMap<CrossingKey, (f64, Carry)>);
 
 /// The most crossings [`Crossings`] keeps in one pass (about 80 bytes each).
 const KEPT_CROSSINGS: usize = 1 << 18;
@@ -423,7 +426,7 @@ impl Crossings {
         if m[0].to_bits() != m[1].to_bits() {
             return crossing_probability_carried(m, s, cov, level, carry);
         }
-        let key = [m[0], m[1], s[0], s[1], cov, level].map(f64::to_bits);
+        let key = [m[0], s[0], s[1], cov, level].map(f64::to_bits);
         if let Some(&(p, after)) = self.0.get(&key) {
             *carry = after;
             return p;
@@ -1036,6 +1039,12 @@ impl<'a> Chatter<'a> {
         let mut kept = Crossings::default();
         let mut m0 = at(0);
         let mut before = ([[0.0f64; 2]; THRUSTERS], [0.0f64; THRUSTERS]);
+        let mut next: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(0));
+        let mut v_next: [f64; THRUSTERS] = std::array::from_fn(|j| {
+            let c = &self.coeff[j];
+            (0..6).map(|a| c[a] * next[a].0).sum::<f64>() * scale2
+        });
+        let mut slopes: [Option<(u64, f64)>; THRUSTERS] = [None; THRUSTERS];
         for n in 0..flown {
             if n == from {
                 before = (crossings, tv);
@@ -1057,12 +1066,15 @@ impl<'a> Chatter<'a> {
                 // A step: the kept crossings were the last stretch's (their mean is gone).
                 kept.0.clear();
             }
-            let now: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n));
-            let next: [(f64, f64); 6] = std::array::from_fn(|a| stats[a].at(n + 1));
+            // This period's statistics are the last one's `next`, and its v₀ the last one's v₁:
+            // the same expressions of the same inputs, carried rather than formed twice.
+            let now = next;
+            next = std::array::from_fn(|a| stats[a].at(n + 1));
             for j in 0..THRUSTERS {
                 let c = &self.coeff[j];
-                let v0: f64 = (0..6).map(|a| c[a] * now[a].0).sum::<f64>() * scale2;
+                let v0 = v_next[j];
                 let v1: f64 = (0..6).map(|a| c[a] * next[a].0).sum::<f64>() * scale2;
+                v_next[j] = v1;
                 let cov: f64 = (0..6).map(|a| c[a] * now[a].1).sum::<f64>() * scale2;
                 let s = [v0.sqrt(), v1.sqrt()];
                 let dvar = (v0 + v1 - 2.0 * cov).max(0.0);
@@ -1073,7 +1085,13 @@ impl<'a> Chatter<'a> {
                         kept.crossing([m0[j], m1[j]], s, cov, *level, &mut carry[j][e]);
                 }
                 let dm = m1[j] - m0[j];
-                tv[j] += self.slope(j, m0[j]) * mean_abs(dm, dvar.sqrt());
+                // The slope at the last period's mean again where the mean stands still.
+                let slope = match slopes[j] {
+                    Some((bits, v)) if bits == m0[j].to_bits() => v,
+                    _ => self.slope(j, m0[j]),
+                };
+                slopes[j] = Some((m0[j].to_bits(), slope));
+                tv[j] += slope * mean_abs(dm, dvar.sqrt());
             }
             m0 = m1;
         }

@@ -51,6 +51,7 @@ use crate::interrupt;
 use crate::scenario::Scenario;
 
 pub mod attitude;
+mod bits;
 pub mod chatter;
 pub mod lag;
 pub mod navigation;

@@ -9,8 +9,6 @@
 //! it has already judged ([`SampleKeys`]).
 
 use std::cell::{Cell, RefCell};
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 use controller_core::kinematics::{self, Attitude};
@@ -20,55 +18,13 @@ use super::screen::Span;
 use super::{CasePlants, Checker, PathSample, Point};
 use crate::plant::{roll_moments, Plant, PlantState};
 use crate::studies::preflight::attitude;
+use crate::studies::preflight::bits::BitsMap;
 use controller_core::config::ControllerConfig;
 
 /// Index of roll, pitch and yaw in η, ν and τ.
 const ROLL: usize = 3;
 const PITCH: usize = 4;
 const YAW: usize = 5;
-
-/// A hasher for keys that are bits already (a heel's `f64` bits, the words of a sample's
-/// key), in the manner of FxHash: each word is folded in by a rotate, an exclusive or and a
-/// multiplication (**Choice 562**). The std's SipHash resists chosen keys, which these are
-/// not, at several times the cost: it was ~4 % of `check` on a 32-point route, hashing a
-/// heel per box corner. Only the speed of a lookup depends on the hash, never what it finds.
-#[derive(Clone, Copy, Default)]
-pub(super) struct BitsHasher(u64);
-
-impl BitsHasher {
-    /// FxHash's multiplier (an odd constant with well-spread bits).
-    const K: u64 = 0x517c_c1b7_2722_0a95;
-
-    fn add(&mut self, word: u64) {
-        self.0 = (self.0.rotate_left(5) ^ word).wrapping_mul(Self::K);
-    }
-}
-
-impl Hasher for BitsHasher {
-    fn finish(&self) -> u64 {
-        // The product's high bits are its best mixed; the table reads the low ones.
-        self.0.rotate_left(26)
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.add(u64::from_le_bytes(word));
-        }
-    }
-
-    fn write_u64(&mut self, word: u64) {
-        self.add(word);
-    }
-
-    fn write_usize(&mut self, word: usize) {
-        self.add(word as u64);
-    }
-}
-
-/// A hash map keyed by bits ([`BitsHasher`]).
-type BitsMap<K, V> = HashMap<K, V, BuildHasherDefault<BitsHasher>>;
 
 /// The source of [`Checker`]s' serial numbers (0 is none's).
 static SERIALS: AtomicU64 = AtomicU64::new(1);
@@ -257,10 +213,15 @@ pub(super) fn check_point(
     let psi = smp.eta[YAW] + d_psi;
     let psi_sc = psi.sin_cos();
     for (phi, p_dot) in at.swing.extremes(heel) {
+        // At the heel itself (no swing) its sine and cosine are the heel's state's.
+        let phi_sc = match phi.to_bits() == heel.to_bits() {
+            true => (h.att.sphi, h.att.cphi),
+            false => phi.sin_cos(),
+        };
         let att = Attitude {
             spsi: psi_sc.0,
             cpsi: psi_sc.1,
-            ..shared.attitude(phi.sin_cos(), theta_sc)
+            ..shared.attitude(phi_sc, theta_sc)
         };
         let (state, nu_dot) = shared.state(smp, phi, (theta, psi), &att, p_dot);
         let tau = plant
@@ -287,7 +248,8 @@ fn heel(
     }
     // Here the static heel exists (k₄ > 0, cos θ ≠ 0): `state` is at it, as `attitude::heel`
     // puts it.
-    let dynamic = plant.required_force_at(state, att, nu_dot, current)[ROLL];
+    // The roll row alone (Choice 564): the same bits as the whole force's.
+    let dynamic = plant.required_roll_at(state, att, nu_dot, current);
     let s = (-dynamic / (c_theta * roll.rho)).clamp(-1.0, 1.0);
     Some(roll.phi0 + s.asin())
 }
@@ -546,13 +508,57 @@ mod tests {
         assert!(key.capacity() <= 16, "room for {} words", key.capacity());
     }
 
+    /// Choice 564: the roll row alone is the whole force's roll row, bit for bit, at every
+    /// corner of the box over random states, attitudes, accelerations and currents (zeros
+    /// among them, for the signs of zero), with and without the damping and restoring terms.
+    #[test]
+    fn the_roll_row_alone_is_the_whole_forces_bit_for_bit() {
+        use crate::plant::{Plant, PlantState, PlantTerms};
+        use controller_core::kinematics::Attitude;
+        use nalgebra::{Vector3, Vector6};
+        use rand::{RngExt, SeedableRng};
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = load_scenario(&path).expect("the survey");
+        let checker = Checker::new(&survey, DEFAULT_MARGIN, Engine::Fast).expect("a checker");
+        let mut rng = rand::rngs::StdRng::seed_from_u64(564);
+        let mut x = |scale: f64| match rng.random_range(0..8) {
+            0 => 0.0,
+            1 => -0.0,
+            _ => scale * rng.random_range(-1.0..1.0),
+        };
+        let flags = [(true, true), (false, true), (true, false), (false, false)];
+        for (c, corner) in checker.corners.iter().enumerate() {
+            let (damping, restoring) = flags[c % 4];
+            let terms = PlantTerms { damping, restoring };
+            let plant = Plant::new(*corner.params(), terms).expect("a plant");
+            for _ in 0..20 {
+                let eta = Vector6::from_fn(|_, _| x(1.2));
+                let state = PlantState {
+                    eta,
+                    nu: Vector6::from_fn(|_, _| x(1.5)),
+                };
+                let att = Attitude::from_eta(&eta);
+                let nu_dot = Vector6::from_fn(|_, _| x(0.8));
+                let current = Vector3::from_fn(|_, _| x(0.4));
+                let whole = plant.required_force_at(&state, &att, &nu_dot, &current)[3];
+                let roll = plant.required_roll_at(&state, &att, &nu_dot, &current);
+                assert_eq!(
+                    roll.to_bits(),
+                    whole.to_bits(),
+                    "corner {c}: {roll} {whole}"
+                );
+            }
+        }
+    }
+
     /// Choice 562: the bit hasher gives equal keys equal hashes and spreads nearby heels (one
     /// bit apart) over the table's low bits; a kept context is found by a checker's serial
     /// only after its context was matched, and another checker's serial does not find it.
     #[test]
     fn bit_keys_hash_apart_and_serials_find_only_their_context() {
         use std::hash::{BuildHasher, BuildHasherDefault};
-        let build = BuildHasherDefault::<super::BitsHasher>::default();
+        let build = BuildHasherDefault::<crate::studies::preflight::bits::BitsHasher>::default();
         let heel = 0.0123_f64.to_bits();
         let low: std::collections::HashSet<u64> =
             (0..64).map(|i| build.hash_one(heel + i) & 63).collect();
