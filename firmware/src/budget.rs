@@ -98,7 +98,7 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
         // against 445 for the closed forms.
         stages: [500, 720, 680, 930, 480],
-        // Measured KW_LARGEST on the largest fixed work, KW_LATE one period late (Choice 572:
+        // Measured 4 760 on the largest fixed work, 4 751 one period late (Choice 572:
         // `fly` records the output before returning it, no 196-byte copy; Choice 513: wrap_pi's
         // floor by the FPU; 4 942 and 4 937 before them). Choice 554: a
         // solution is taken only at a stamp its period's record keeps, so no third prediction;
@@ -111,7 +111,8 @@ pub const BUDGETS: [StepBudget; 3] = [
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
         // 2 150 of it and the law on the estimate ≈ 2 750 (docs/law.md#the-state-estimator).
         update_from_solution: 5_000,
-        // solution, filter, estimate, record: measured 393, 1 134, 354, 264 (the record 605
+        // solution, filter, estimate, record: measured 390, 1 127, 348, 266 (393, 1 134, 354,
+        // 264 before Choices 513 and 572; the record 605
         // before Choice 554, whose acceptance test adds 27 to the filter; 3 132
         // on Choice 494's case before Choice 492; 1 249 and 532 before Choice 527's finiteness
         // sums; the filter's disturbance state, Choice 510, adds about 210: its correction and
