@@ -136,7 +136,8 @@ pub const BUDGETS: [StepBudget; 3] = [
         // maps take no cbrtf since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
         stages: [8_400, 6_200, 1_000, 930, 500],
-        // Measured 24 453 one period late, 24 362 on the largest fixed work (Choice 554;
+        // Measured 24 259 one period late, 24 177 on the largest fixed work (24 453 and 24 362
+        // before Choices 513 and 572; Choice 554;
         // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
         // before Choice 493); solution, filter, estimate, record: 7 535, 1 131, 7 509, 268
         // (603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
@@ -158,7 +159,8 @@ pub const BUDGETS: [StepBudget; 3] = [
         // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
         stages: [450, 680, 700, 930, 480],
-        // Measured 4 818 one period late, 4 799 on the largest fixed work (Choice 554; 4 790
+        // Measured 4 623 one period late, 4 595 on the largest fixed work (4 818 and 4 799
+        // before Choices 513 and 572; Choice 554; 4 790
         // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
         // Choice 493); solution, filter, estimate, record: 345, 1 129, 321, 267 (606 before
         // Choice 554).

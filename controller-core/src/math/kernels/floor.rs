@@ -13,6 +13,8 @@ const INTEGRAL: f32 = 8_388_608.0;
 /// not whole), then ⌊x⌋ is one less. x = −0 keeps its sign (the truncation, +0, is not
 /// above it, so it is returned with x's sign; every other whole result is not zero or
 /// has x's sign already).
+// The negated compare is the point: it is true for NaN too, which returns as it is.
+#[allow(clippy::neg_cmp_op_on_partial_ord)]
 #[inline]
 pub fn floor(x: f32) -> f32 {
     if !(x.abs() < INTEGRAL) {
