@@ -258,6 +258,14 @@ enum LawInput<'a> {
     Estimated(&'a Estimated),
 }
 
+/// What [`Controller::fly`] records its output into with the estimator on: the estimator's
+/// parts, its memory and the estimate the law flew ([`Controller::estimator_record_stage`]).
+struct Recording<'a> {
+    parts: &'a EstimatorParts,
+    memory: &'a mut Estimate,
+    est: &'a Estimated,
+}
+
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
 /// solution holds at (`t_ticks` of the link's state frame).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -477,16 +485,37 @@ impl Controller {
         nu: &[f32; 6],
         trajectory: &Trajectory,
     ) -> Output {
-        self.fly(ticks, &LawInput::Told { eta, nu }, trajectory)
+        self.fly(ticks, &LawInput::Told { eta, nu }, trajectory, None)
     }
 
     /// The law's stages on `input`, checked: the one body of [`Controller::update`] and of
     /// [`Controller::update_from_solution`] (Choice 364: one caller of the stages, so they
-    /// stay inlined).
+    /// stay inlined). With `record` (the estimator's parts, memory and the estimate flown),
+    /// the output is recorded by [`Controller::estimator_record_stage`] here, before it is
+    /// returned (**Choice 572**: recorded by the caller after the return, the 196-byte
+    /// output was first written to the caller's stack and then copied to its own return
+    /// value, about 180 instructions on the target).
     #[inline(never)]
-    fn fly(&self, ticks: u64, input: &LawInput, trajectory: &Trajectory) -> Output {
-        match self.step(ticks, input, trajectory) {
-            Ok(out) if out.all_finite() => out,
+    fn fly(
+        &self,
+        ticks: u64,
+        input: &LawInput,
+        trajectory: &Trajectory,
+        record: Option<Recording>,
+    ) -> Output {
+        let stepped = self.step(ticks, input, trajectory);
+        let finite = matches!(&stepped, Ok(out) if out.all_finite());
+        if let Some(r) = record {
+            match &stepped {
+                Ok(out) if finite => {
+                    Self::estimator_record_stage(r.parts, r.memory, ticks, r.est, out)
+                }
+                // The fail-safe below: nothing applied (the record stage's fault case).
+                _ => r.memory.applied(&r.parts.gains, ticks, &[0.0; 6]),
+            }
+        }
+        match stepped {
+            Ok(out) if finite => out,
             Ok(_) => Output::fail_safe(Fault::NonFiniteResult),
             Err(fault) => Output::fail_safe(fault),
         }
@@ -525,15 +554,15 @@ impl Controller {
             let state = Self::estimator_filter_stage(parts, memory, ticks, solution, &told);
             self.estimator_estimate_stage(state, &told)
         });
-        match estimated {
+        // By reference: the estimate stays where its stage left it (a move copied it).
+        match &estimated {
             Err(fault) => {
                 memory.applied(&parts.gains, ticks, &[0.0; 6]);
-                Output::fail_safe(fault)
+                Output::fail_safe(*fault)
             }
             Ok(est) => {
-                let out = self.fly(ticks, &LawInput::Estimated(&est), trajectory);
-                Self::estimator_record_stage(parts, memory, ticks, &est, &out);
-                out
+                let record = Recording { parts, memory, est };
+                self.fly(ticks, &LawInput::Estimated(est), trajectory, Some(record))
             }
         }
     }

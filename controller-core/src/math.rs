@@ -172,7 +172,7 @@ pub fn norm<const N: usize>(v: &[f32; N]) -> f32 {
 #[inline]
 pub fn wrap_pi(x: f32) -> f32 {
     // r ∈ [−π, π) up to rounding; map −π to +π to make the interval (−π, π].
-    let r = x - TAU * libm::floorf((x + PI) / TAU);
+    let r = x - TAU * kernels::floor((x + PI) / TAU);
     if r <= -PI {
         r + TAU
     } else if r > PI {

@@ -566,3 +566,59 @@ fn exhaustive_cbrt_every_f32() {
     println!("every f32: cbrt {:.4} ulp at {:e}", w.ulps, w.at);
     assert!(w.ulps <= CBRT_MAX_ULPS);
 }
+
+/// Whether `kernels::floor(x)` is ⌊x⌋ bit for bit (the host's f64 floor of the same value, exact
+/// in f32: a whole number below 2²⁴ or x itself), NaN for NaN.
+fn floor_is_exact(b: u32) -> bool {
+    let x = f32::from_bits(b);
+    let got = kernels::floor(x);
+    if x.is_nan() {
+        return got.is_nan();
+    }
+    got.to_bits() == ((x as f64).floor() as f32).to_bits()
+}
+
+#[test]
+fn floor_is_exact_on_every_sign_and_binade_and_next_to_every_small_whole_number() {
+    let strided_ok = strided(0, u32::MAX, 997).all(floor_is_exact);
+    // Every f32 within 8 ulps of each whole number up to 2¹⁶ (±), where truncation and floor
+    // part; ±0, ±∞, NaN and the edges of the integral range 2²³.
+    let near_whole = (0..=65_536u32).flat_map(|n| {
+        let b = (n as f32).to_bits();
+        (b.saturating_sub(8)..=b + 8).flat_map(|m| [m, m | 0x8000_0000])
+    });
+    let edges = [
+        0.0f32,
+        -0.0,
+        0.5,
+        -0.5,
+        8_388_607.5,
+        -8_388_607.5,
+        8_388_608.0,
+    ]
+    .into_iter()
+    .chain([
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        f32::MIN,
+        f32::MAX,
+    ])
+    .map(f32::to_bits);
+    let bad: Vec<u32> = near_whole
+        .chain(edges)
+        .filter(|&b| !floor_is_exact(b))
+        .collect();
+    assert!(
+        strided_ok && bad.is_empty(),
+        "{:?}",
+        &bad[..bad.len().min(8)]
+    );
+}
+
+#[test]
+#[ignore = "exhaustive: every f32, seconds"]
+fn exhaustive_floor_every_f32() {
+    let bad = (0..=u32::MAX).filter(|&b| !floor_is_exact(b)).count();
+    assert_eq!(bad, 0);
+}

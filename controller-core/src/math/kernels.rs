@@ -8,6 +8,7 @@
 //! | [`atan2`] | one division to [0, 1], three intervals, minimax of degree 9 | see below |
 //! | [`cbrt`] | exponent ÷ 3, cubic guess, exact residual, one Halley step | see below |
 //! | [`sqrt`] | `vsqrt.f32` on the target, libm on the host: correctly rounded | 0 ulp |
+//! | [`floor`] | the FPU's truncation to an integer, one less when above | 0 ulp (exact) |
 //!
 //! Errors in ulps of the f32 result, measured against the host's f64 functions of the same f32
 //! inputs (the stratified sweeps of `tests/kernels.rs`, every range and binade): sin 0.81 ulp,
@@ -25,6 +26,7 @@
 
 mod atan2;
 mod cbrt;
+mod floor;
 #[doc(hidden)]
 pub mod reduce;
 mod sin_cos;
@@ -32,5 +34,6 @@ mod sqrt;
 
 pub use atan2::atan2;
 pub use cbrt::cbrt;
+pub use floor::floor;
 pub use sin_cos::{cos, sin, sin_cos, sin_cos_turns};
 pub use sqrt::sqrt;
