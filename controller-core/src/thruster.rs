@@ -120,6 +120,13 @@ const TUN_V0: f64 = ((TUN_A * TUN_T0 + TUN_B) * TUN_T0 + TUN_C) * TUN_T0 + TUN_D
 /// σ = √(P/(3A)) = √359.893… (no const sqrt; checked below).
 const TUN_SIGMA: f64 = 18.970_854_839_287_906;
 const TUN_K: f64 = TUN_A * TUN_SIGMA * TUN_SIGMA * TUN_SIGMA;
+/// The tunnel map's inverse constants as its f32 arithmetic takes them: (V₀, K, T₀, σ) of
+/// T = T₀ + σ y with y³ + 3y + 2h = 0, h = ½ (V₀ − V)/K ([`ThrusterMap::thrust`] of
+/// [`ThrusterMap::Tunnel`]). For a host caller that evaluates the same inverse on several
+/// voltages side by side, bit for bit (the simulator's thrusters); nothing on the target reads
+/// it.
+pub const TUNNEL_INVERSE_F32: [f32; 4] =
+    [TUN_V0 as f32, TUN_K as f32, TUN_T0 as f32, TUN_SIGMA as f32];
 const _: () = {
     let rel = (3.0 * TUN_A * TUN_SIGMA * TUN_SIGMA - TUN_P) / TUN_P;
     assert!(rel < 1e-14 && rel > -1e-14);

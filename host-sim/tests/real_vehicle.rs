@@ -691,3 +691,44 @@ fn a_trim_start_floats_at_the_heel_and_a_level_start_swings_to_twice_it() {
     let paper = host_sim::scenario::paper::config(controller_core::Table1Case::Circular10R, true);
     assert_eq!(paper.initial_attitude(), InitialAttitude::Level);
 }
+
+/// Choice 570: the thrusters' four tunnel maps side by side are the scalar map, bit for bit,
+/// on every 997th f32 (±0, subnormals, the supply range, beyond it, ±∞, NaN), every 257th
+/// within ±1 V and every f32 within 2¹⁶ ulps of ±24 V, where the simulated voltages lie.
+#[test]
+fn the_tunnels_side_by_side_are_the_scalar_map_bit_for_bit() {
+    use controller_core::thruster::ThrusterMap;
+    use host_sim::sim::thrusters::tunnel_thrusts;
+    let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
+    let stride = (0..=u32::MAX).step_by(997).map(f32::from_bits);
+    let specials = [
+        0.0,
+        -0.0,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+        24.0,
+        -24.0,
+    ];
+    let near = |x: f32| {
+        let b = x.to_bits();
+        (b - (1 << 16)..=b + (1 << 16)).map(f32::from_bits)
+    };
+    let within_1v = (0..=1.0f32.to_bits())
+        .step_by(257)
+        .flat_map(|b| [f32::from_bits(b), -f32::from_bits(b)]);
+    let all: Vec<f32> = stride
+        .chain(specials)
+        .chain(within_1v)
+        .chain(near(24.0))
+        .chain(near(-24.0))
+        .collect();
+    for lanes in all.chunks(4) {
+        let mut v = [1.0; 4];
+        v[..lanes.len()].copy_from_slice(lanes);
+        for (got, v) in tunnel_thrusts(v).iter().zip(v) {
+            let want = ThrusterMap::Tunnel.thrust(v);
+            assert!(same(*got, want), "V = {v:e}: {got:e} against {want:e}");
+        }
+    }
+}

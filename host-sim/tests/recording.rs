@@ -58,7 +58,7 @@ fn metrics_only_recording_keeps_no_samples_and_the_same_summary() {
             c.divergence_limit = 2.0;
         })
         .unwrap();
-    for scenario in [circle, real] {
+    for scenario in [circle.clone(), real.clone()] {
         let (mut seen_full, mut seen_lean) = (Count::default(), Count::default());
         let full = sim::fly(
             &scenario,
@@ -82,4 +82,51 @@ fn metrics_only_recording_keeps_no_samples_and_the_same_summary() {
         );
         assert_eq!(seen_lean.0, seen_full.0);
     }
+    unwatched_runs_fly_as_watched_ones(&[circle, real]);
+}
+
+/// Choice 569: a metrics-only run that no observer watches takes the law's η_d for the loop's
+/// reference and stops after the control it would have preceded; its outcome, metrics, fault
+/// counts and plant factorisations are those of the run that keeps everything, bit for bit,
+/// whether it completes or diverges.
+fn unwatched_runs_fly_as_watched_ones(scenarios: &[host_sim::scenario::Scenario]) {
+    for scenario in scenarios {
+        let full = sim::fly(
+            scenario,
+            &mut LocalController::new(scenario),
+            &mut Count::default(),
+            Recording::Plot,
+        );
+        let lean = sim::fly(
+            scenario,
+            &mut LocalController::new(scenario),
+            &mut (),
+            Recording::MetricsOnly,
+        );
+        assert_eq!(lean.outcome, full.outcome, "{}", scenario.config().name);
+        assert_eq!(
+            format!("{:?}", lean.metrics),
+            format!("{:?}", full.metrics),
+            "{}",
+            scenario.config().name
+        );
+        assert_eq!(lean.faults, full.faults);
+        assert_eq!(lean.plant_factorisations, full.plant_factorisations);
+    }
+}
+
+/// The shipped real-circle campaign's runs (study-grade step and draws, the survey navigation,
+/// the estimator, a drawn current and payload) fly unwatched as they fly watched (Choice 569).
+#[test]
+fn the_shipped_campaigns_runs_fly_unwatched_as_watched() {
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("campaigns/real-circle.campaign.toml");
+    let campaign = host_sim::studies::campaign::Campaign::load(&file).unwrap();
+    let runs: Vec<_> = (0..3)
+        .map(|i| {
+            let scenario = campaign.scenario(i, &campaign.draw(i)).unwrap();
+            scenario.with(|c| c.duration = 20.0).unwrap()
+        })
+        .collect();
+    unwatched_runs_fly_as_watched_ones(&runs);
 }

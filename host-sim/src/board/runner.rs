@@ -228,6 +228,7 @@ impl BoardInTheLoop {
             delta: t.delta,
             delta_clamped: t.delta_clamped,
             w_norm: t.w_norm,
+            eta_d: None,
             board: Some(board),
         })
     }

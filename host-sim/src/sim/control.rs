@@ -3,7 +3,7 @@
 //! hardware in the loop), a period's answer is a [`ControlOut`].
 
 use controller_core::effectiveness::THRUSTERS;
-use controller_core::{Controller, Estimate, Solution, Trajectory};
+use controller_core::{Controller, Estimate, Solution, Status, Trajectory};
 
 use super::record::{BoardLoss, BoardReport, ControlStatus, UploadRound};
 use crate::scenario::Scenario;
@@ -26,6 +26,11 @@ pub struct ControlOut {
     pub delta: f32,
     pub delta_clamped: bool,
     pub w_norm: f32,
+    /// η_d of the period as the law sampled it (its trajectory at the period's tick), when
+    /// the law ran here and ran ([`ControlStatus::is_ok`]); `None` from a board and in
+    /// fail-safe. The loop takes it for its own reference where nothing else is asked of
+    /// the sample (Choice 569, [`super::fly`]).
+    pub eta_d: Option<[f32; 6]>,
     /// What a board in the loop reported besides (PIL, HIL); none in SIL.
     pub board: Option<BoardReport>,
 }
@@ -52,6 +57,13 @@ pub trait ControlSource {
     /// (a board).
     fn upload_rounds(&self) -> &[UploadRound] {
         &[]
+    }
+
+    /// Whether the law runs here, in this process, with no effect outside it: asking it for
+    /// a period the run then stops at changes nothing anyone sees (a board would have been
+    /// sent the period's frames). [`LocalController`] does.
+    fn runs_here(&self) -> bool {
+        false
     }
 }
 
@@ -94,7 +106,12 @@ impl ControlSource for LocalController<'_> {
             delta: out.delta,
             delta_clamped: out.delta_clamped,
             w_norm: out.w_norm,
+            eta_d: (out.status == Status::Ok).then_some(out.eta_d),
             board: None,
         })
+    }
+
+    fn runs_here(&self) -> bool {
+        true
     }
 }

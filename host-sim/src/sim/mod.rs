@@ -71,6 +71,15 @@ pub fn run(scenario: &Scenario) -> RunResult {
 /// `observer` as it is made and keeping what `recording` says. Per control period k
 /// (t = k/rate): measure, control, actuate, then hold the thrust for the period while the plant
 /// is integrated (docs/simulator.md#table-1). Memory stays bounded whatever the duration.
+///
+/// **Choice 569:** a run that keeps only its metrics, that no observer watches and whose law
+/// runs here ([`ControlSource::runs_here`]: a campaign's, a Monte Carlo's) samples its
+/// trajectory once a period, not twice: it measures and controls first and takes the law's
+/// η_d for its reference (the same trajectory at the same tick, so the same bits), sampling
+/// it itself only where the law did not run. The stop check then follows the control it
+/// would have preceded; a run that stops there drops that control, which nobody saw. What no
+/// metric reads is then left out of the samples: η̇_d and η̈_d (zero), the payload, what the
+/// law was told, the thrust demand, the navigation's arrivals and τ applied.
 pub fn fly(
     scenario: &Scenario,
     source: &mut dyn ControlSource,
@@ -80,6 +89,7 @@ pub fn fly(
     let cfg = scenario.config();
     let (steps, substeps, period) = (scenario.steps(), scenario.substeps(), scenario.period());
     let h = period / substeps as f64;
+    let lean = recording == Recording::MetricsOnly && !observer.watches() && source.runs_here();
     let mut vehicle = Vehicle::new(scenario);
     let mut navigation = Navigation::of(cfg);
     let mut thrusters = Thrusters::new(cfg, scenario.controller(), h);
@@ -87,15 +97,20 @@ pub fn fly(
     let mut outcome = Outcome::Completed;
     for k in 0..=steps {
         let t = k as f64 * period;
-        let reference = scenario.trajectory().sample(k, cfg.controller.rate_hz);
+        // 1. Measure and control (before the stop check when lean).
+        let mut control = || {
+            let (eta, nu) = navigation.measure(&vehicle.state);
+            (eta, nu, source.control(k, &eta, &nu))
+        };
+        let early = lean.then(&mut control);
+        let reference = reference(scenario, k, &early);
         let error = tracking_error(&vehicle.state, &reference);
         if let Some(stop) = stop(t, &vehicle.state, &error, cfg.divergence_limit) {
             outcome = stop;
             break;
         }
-        // 1. Measure and control.
-        let (eta, nu) = navigation.measure(&vehicle.state);
-        let out = match source.control(k, &eta, &nu) {
+        let (eta, nu, controlled) = early.unwrap_or_else(control);
+        let out = match controlled {
             Ok(out) => out,
             // A board's wait for its answer gives up on a stop request.
             Err(Stop::Interrupted) => {
@@ -110,11 +125,14 @@ pub fn fly(
         // 2. Actuate: the thrust the thrusters are driven towards.
         let target = thrusters.target(&out);
         let mut sample = sample_of(t, &vehicle.state, &reference, error, &out);
-        sample.payload = cfg.variation.at(t).mass;
-        sample.signals.eta_told = eta;
-        sample.signals.nu_told = nu;
-        sample.signals.thrust_demand = target;
-        sample.signals.navigation = navigation.solution().map(|s| s.arrived).unwrap_or_default();
+        if !lean {
+            sample.payload = cfg.variation.at(t).mass;
+            sample.signals.eta_told = eta;
+            sample.signals.nu_told = nu;
+            sample.signals.thrust_demand = target;
+            sample.signals.navigation =
+                navigation.solution().map(|s| s.arrived).unwrap_or_default();
+        }
         // 3. Hold it for the period: thruster lag, RK4 substeps (none after the last sample).
         let (thrust, held): (Thrusts, Result<(), (f64, String)>) = if k < steps {
             thrusters.hold(&target, substeps, |j, tau| {
@@ -125,7 +143,9 @@ pub fn fly(
             (thrusters.applied_or(&target), Ok(()))
         };
         sample.thrust = thrust;
-        sample.tau_applied = thrusters.wrench(&thrust).into();
+        if !lean {
+            sample.tau_applied = thrusters.wrench(&thrust).into();
+        }
         recorder.record(&sample);
         if let Err((t, reason)) = held {
             outcome = Outcome::Diverged { t, reason };
@@ -135,6 +155,30 @@ pub fn fly(
     let (metrics, faults, samples) = recorder.finish();
     let flown = (metrics, faults, samples, vehicle.factorisations());
     result(scenario, outcome, flown)
+}
+
+/// What the law was told and what it answered for one period.
+type Controlled = ([f32; 6], [f32; 6], Result<ControlOut, Stop>);
+
+/// The loop's reference of period `k`: the law's η_d if it answered this period already
+/// (`early`, Choice 569; η̇_d and η̈_d zero), else the trajectory sampled here.
+fn reference(scenario: &Scenario, k: u64, early: &Option<Controlled>) -> Desired {
+    match early {
+        Some((
+            _,
+            _,
+            Ok(ControlOut {
+                eta_d: Some(eta_d), ..
+            }),
+        )) => Desired {
+            eta: (*eta_d).into(),
+            eta_dot: nalgebra::Vector6::zeros(),
+            eta_ddot: nalgebra::Vector6::zeros(),
+        },
+        _ => scenario
+            .trajectory()
+            .sample(k, scenario.config().controller.rate_hz),
+    }
 }
 
 /// The run's result: its outcome held against the bound, with what the flight measured.

@@ -62,6 +62,9 @@ impl<'a> Thrusters<'a> {
                 .thrusts(&Vector6::from(out.tau));
             return thrusts.map(f64::from);
         }
+        // The four tunnels' inverse maps side by side (Choice 570), used where the map is
+        // evaluated here.
+        let tunnels = tunnel_thrusts(std::array::from_fn(|j| out.voltage[TUNNELS + j]));
         let mut t = [0.0; THRUSTERS];
         for (i, t) in t.iter_mut().enumerate() {
             let v = out.voltage[i];
@@ -73,6 +76,8 @@ impl<'a> Thrusters<'a> {
                 // newtons_of_voltage(v), the same f32 operations. Elsewhere, and from a board
                 // (read by its voltages alone), the map is evaluated here: PIL = SIL.
                 Some(law) if thruster::reports_inverse_map(self.maps[i], clamped, v) => law[i],
+                // newtons_of_voltage: thrust(v) · the unit's newtons.
+                _ if i >= TUNNELS => tunnels[i - TUNNELS] * self.unit.newtons(),
                 _ => self.maps[i].newtons_of_voltage(self.unit, v),
             } as f64;
         }
@@ -133,4 +138,56 @@ impl<'a> Thrusters<'a> {
         self.applied = Some(applied);
         (first.unwrap_or(*target), result)
     }
+}
+
+/// The index of the first of the four tunnel thrusters ([`thruster::default_maps`]: the main
+/// thruster, then four tunnels).
+const TUNNELS: usize = 1;
+const _: () = {
+    let maps = thruster::default_maps();
+    assert!(THRUSTERS == TUNNELS + 4);
+    assert!(matches!(maps[0], ThrusterMap::Main));
+    let mut i = TUNNELS;
+    while i < THRUSTERS {
+        assert!(matches!(maps[i], ThrusterMap::Tunnel));
+        i += 1;
+    }
+};
+
+/// `ThrusterMap::Tunnel.thrust` of four voltages (Eq 31 inverted: polynomial units), bit for
+/// bit: each lane takes the same f32 operations in the same order, h = ½ (V₀ − V)/K,
+/// s = m √((h/m)² + (1/m)²) with m = max(|h|, 1), w = −h − s (h ≥ 0) or s − h, u = ∛w and
+/// T = T₀ + σ (u − 1/u) ([`thruster::TUNNEL_INVERSE_F32`], `controller_core::math::cbrt`).
+///
+/// **Choice 570:** written a step at a time over the four lanes, so that the four chains of
+/// divisions, a square root and a cube root run side by side (the compiler keeps the lanes
+/// together, in vector registers where it can), where four calls of the scalar map ran them
+/// one after another: a tenth of a study-grade run's CPU before. A lane that is not finite
+/// (NaN, ±∞: the scalar map's own early answers) sends all four through the scalar map.
+pub fn tunnel_thrusts(v: [f32; 4]) -> [f32; 4] {
+    use controller_core::math::{cbrt, exact_sqrt};
+    if !v.iter().all(|v| v.is_finite()) {
+        return v.map(|v| ThrusterMap::Tunnel.thrust(v));
+    }
+    let [v0, k, t0, sigma] = thruster::TUNNEL_INVERSE_F32;
+    let h = lanes(|i| 0.5 * ((v0 - v[i]) / k));
+    let m = lanes(|i| if h[i].abs() > 1.0 { h[i].abs() } else { 1.0 });
+    let hm = lanes(|i| h[i] / m[i]);
+    let im = lanes(|i| 1.0 / m[i]);
+    let s = lanes(|i| m[i] * exact_sqrt(hm[i] * hm[i] + im[i] * im[i]));
+    let w = lanes(|i| {
+        if h[i] >= 0.0 {
+            -h[i] - s[i]
+        } else {
+            s[i] - h[i]
+        }
+    });
+    let u = lanes(|i| cbrt(w[i]));
+    lanes(|i| t0 + sigma * (u[i] - 1.0 / u[i]))
+}
+
+/// The four lanes of one step.
+#[inline(always)]
+fn lanes(f: impl FnMut(usize) -> f32) -> [f32; 4] {
+    std::array::from_fn(f)
 }
