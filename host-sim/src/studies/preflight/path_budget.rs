@@ -44,6 +44,18 @@
 //! 1/G₁). The budget takes the peak of the loop's response to d flown along the reference,
 //! which this bound caps. With no estimator a solution τ_lat late adds V·τ_lat.
 //!
+//! **The loop the lag is flown on** (Choice 567): the loop as the law flies it, not the
+//! stiffest one. Its boundary layer's gain is δ/μ with δ the law's Eq 29, which along a
+//! survey mission is 3–4, not δ_max = 25 (a 7× stiffer loop answered the current with 28.7 mm
+//! where the flight showed 33 mm without a lag); δ is taken on a grid from Eq 29's least along
+//! the reference (‖e‖ = 0) to its largest with ‖e‖ at the bound, the worst response kept. The
+//! thrusters' lag τ_L is in the loop: the acceleration applied over a period is the lag's mean
+//! over the held command ((L1) of [`super::lag`]; the lag delayed the answer to the current:
+//! 44 mm flown against 33 mm without it). The loop starts at the scenario's start offset
+//! s₀ = [e₀ᵢ, 0], the estimate on it (the board's first solution becomes its estimate), each
+//! sign of e₀ᵢ against d's taken: a run's error starts at the offset. The ℓ₁ gain (`lag_gain`)
+//! stays the δ_max loop's without the lag: it is reported, not used.
+//!
 //! **Budget** (Choice 424): per axis eᵢ = q·σᵢ + ‖hᵢ‖₁ max|dᵢ| (+ V τ_lat), and the path
 //! error √(Σ eᵢ²), as the run's max path combines its axes' maxima. At time scale k the
 //! reference's speed falls as 1/k, its acceleration as 1/k², its jerk as 1/k³: the budget's
@@ -53,6 +65,7 @@
 
 use controller_core::estimator::{AxisGain, EstimatorConfig, EstimatorGains, EstimatorKind};
 use controller_core::kinematics::{self, Attitude};
+use controller_core::law::{uncertainty_bound, DeltaInputs};
 use controller_core::model::VehicleParams;
 use controller_core::{Mission, Trajectory};
 use nalgebra::{Matrix2, RowVector2, SMatrix, Vector2, Vector3, Vector6};
@@ -77,6 +90,8 @@ const SETTLED: f64 = 120.0;
 /// Periods of the impulse response summed for ‖h‖₁, at most (a stable loop's has died long
 /// before: 600 s at 100 Hz).
 const MAX_IMPULSE_PERIODS: usize = 60_000;
+/// The ratio between the boundary layer's δ the lag is flown at (Choice 567).
+const LAG_DELTA_STEP: f64 = 2.0;
 /// Standard deviations of a Gauss–Markov current's corners (as the force check's).
 const CURRENT_SIGMAS: f64 = super::GAUSS_MARKOV_SIGMAS;
 
@@ -280,6 +295,26 @@ impl Loop {
             }
         };
         Ok(Loop { t, gain, k, kd })
+    }
+
+    /// This loop with the boundary layer's gain at δ = `delta` (its estimator's rows kept:
+    /// they do not depend on δ), as [`Loop::with_delta`] builds it.
+    pub(super) fn regained(&self, scenario: &Scenario, axis: usize, delta: f64) -> Self {
+        let controller = scenario.controller();
+        let c = controller.config();
+        let lyap = controller.lyapunov();
+        let robust = if c.robust {
+            delta / f64::from(c.mu)
+        } else {
+            0.0
+        };
+        Loop {
+            gain: [
+                f64::from(c.k1[axis]) + robust * f64::from(lyap[axis].p12),
+                f64::from(c.k2[axis]) + robust * f64::from(lyap[axis].p22),
+            ],
+            ..*self
+        }
     }
 
     /// The law's input u = −G ŝ on the estimate (the estimator on) or on `s` (off).
@@ -722,6 +757,10 @@ pub struct Budget<'a> {
     /// Max reference speed per axis at k = 1, and the horizontal speed (m/s).
     speed: [f64; AXES],
     latency: f64,
+    /// The reference's K_d of Eq 19 at k = 1 (m/s²), and per sample ‖ν‖, ‖J⁻¹J̇ν‖ at k = 1
+    /// and |cos θ|: Eq 29's inputs (Choice 567).
+    accel_bound: f64,
+    delta_inputs: Vec<[f64; 3]>,
     /// How the reference repeats, when it does (Choices 393, 538–539).
     reduction: Option<period::Reduction>,
     /// Every budget evaluated, by the bits of its time scale and duration (Choice 532): the
@@ -801,6 +840,7 @@ impl<'a> Budget<'a> {
             (Some(m), EstimatorKind::Off) => m.ins.timing.latency,
             _ => 0.0,
         };
+        let eq29 = samples.iter().map(delta_inputs).collect();
         Ok(Some(Budget {
             scenario,
             bound: bound.max_path,
@@ -811,6 +851,8 @@ impl<'a> Budget<'a> {
             nominal,
             speed,
             latency,
+            accel_bound: f64::from(path.accel_bound()),
+            delta_inputs: eq29,
             reduction,
             memo: std::cell::RefCell::new(Vec::new()),
         }))
@@ -862,14 +904,74 @@ impl<'a> Budget<'a> {
         Ok(out)
     }
 
-    /// max|eᵢ| of the linear loop of axis `i` flown on d (one current corner's, at time scale
-    /// `k`) over a flight of `duration` s: d at the control periods by linear interpolation
-    /// between the reference's samples (a periodic mission's repeating).
-    fn lag_response(&self, i: usize, d: &[[f64; AXES]], k: f64, duration: f64) -> f64 {
-        let lp = &self.loops[i];
+    /// The boundary layer's δ the lag is flown at, at time scale `k` (module docs, Choice
+    /// 567): Eq 29 along the reference, from its least with ‖e‖ = 0 (the law's δ is never
+    /// below it) to its largest with ‖e‖ at the bound (the errors the budget allows), in
+    /// steps of at most [`LAG_DELTA_STEP`], each at most δ_max.
+    fn lag_deltas(&self, k: f64) -> Vec<f64> {
+        let controller = self.scenario.controller();
+        let constants = controller.delta_constants();
+        let delta_max = f64::from(controller.config().delta_max);
+        let (mut least, mut most) = (f64::INFINITY, 0.0f64);
+        // ‖ν‖ falls as 1/k and ‖J⁻¹J̇ν‖ (quadratic in ν) as 1/k².
+        for &[nu, jjn, cos_theta] in &self.delta_inputs {
+            let delta = |error_norm: f64| {
+                f64::from(uncertainty_bound(
+                    constants,
+                    &DeltaInputs {
+                        accel_bound: (self.accel_bound / (k * k)) as f32,
+                        error_norm: error_norm as f32,
+                        nu_norm: (nu / k) as f32,
+                        jinv_jdot_nu_norm: (jjn / (k * k)) as f32,
+                        cos_theta_abs: cos_theta as f32,
+                    },
+                ))
+            };
+            least = least.min(delta(0.0));
+            most = most.max(delta(self.bound));
+        }
+        let clamp = |d: f64| {
+            if d.is_finite() && d > 0.0 {
+                d.min(delta_max)
+            } else {
+                delta_max
+            }
+        };
+        let (least, most) = (clamp(least), clamp(most).max(clamp(least)));
+        let steps = ((most / least).ln() / LAG_DELTA_STEP.ln()).ceil().max(1.0) as i32;
+        (0..=steps)
+            .map(|j| least * (most / least).powf(f64::from(j) / f64::from(steps)))
+            .collect()
+    }
+
+    /// The periods of the lag's flight at time scale `k` over `duration` s: the whole flight,
+    /// or a long mission's window (Choice 539: the loop settled and the reference repeated).
+    fn lag_steps(&self, lp: &Loop, k: f64, duration: f64) -> u64 {
+        let steps = (duration.min(MAX_PROPAGATION) / lp.t).ceil() as u64;
+        match self.reduction.as_ref().filter(|r| r.long) {
+            Some(r) => steps.min((r.window(k) * k / lp.t).ceil() as u64),
+            None => steps,
+        }
+    }
+
+    /// |eᵢ| after each of `steps` periods of the linear loop `lp` of axis `i` flown on d (one
+    /// current corner's at time scale `k`; `None`: no d) from the start offset `start` (the
+    /// estimate on it: the board's first solution becomes its estimate), with the thrusters'
+    /// lag in the loop (Choice 567); `visit` is told each period's |e|. d at the control
+    /// periods by linear interpolation between the reference's samples (a periodic mission's
+    /// repeating).
+    fn fly_lag(
+        &self,
+        (i, lp): (usize, &Loop),
+        d: Option<&[[f64; AXES]]>,
+        (k, steps): (f64, u64),
+        start: f64,
+        mut visit: impl FnMut(usize, f64) -> bool,
+    ) {
         let (f, g) = (lp.f(), lp.g());
-        let span_samples = d.len().saturating_sub(1).max(1) as f64 * SAMPLE_PERIOD;
         let at = |t: f64| -> f64 {
+            let Some(d) = d else { return 0.0 };
+            let span_samples = d.len().saturating_sub(1).max(1) as f64 * SAMPLE_PERIOD;
             let mut s = t / k;
             if let Some(r) = &self.reduction {
                 s = r.fold(s);
@@ -880,19 +982,66 @@ impl<'a> Budget<'a> {
             let w = x - j as f64;
             d[j][i] * (1.0 - w) + d[j1][i] * w
         };
-        let mut steps = (duration.min(MAX_PROPAGATION) / lp.t).ceil() as u64;
-        // A long mission: its window (Choice 539), the loop settled and the reference repeated.
-        if let Some(r) = self.reduction.as_ref().filter(|r| r.long) {
-            steps = steps.min((r.window(k) * k / lp.t).ceil() as u64);
-        }
-        let (mut s, mut est) = (Vector2::zeros(), LoopEstimate::default());
-        let mut worst = 0.0f64;
+        // The acceleration applied over a period is the lag's mean over the held command,
+        // (L1) of [`super::lag`].
+        let (lambda, mean) = match self.scenario.config().thruster_lag {
+            Some(tl) if tl > 0.0 => {
+                let l = (-lp.t / tl).exp();
+                (l, (tl / lp.t) * (1.0 - l))
+            }
+            _ => (0.0, 0.0),
+        };
+        let mut s = Vector2::new(start, 0.0);
+        let mut est = LoopEstimate { x: s, d: 0.0 };
+        // The thrusters hold the law's first command before the flight (the simulator's lag
+        // starts at its first target).
+        let mut applied = lp.input(&s, &est);
         for n in 0..steps {
             let u = lp.input(&s, &est);
-            let s_next = f * s + g * (u + at(n as f64 * lp.t));
+            let a = u + (applied - u) * mean;
+            applied = u + (applied - u) * lambda;
+            let s_next = f * s + g * (a + at(n as f64 * lp.t));
             est = lp.estimate_step(&est, u, &s_next);
             s = s_next;
-            worst = worst.max(s[0].abs());
+            if !visit(n as usize, s[0].abs()) {
+                return;
+            }
+        }
+    }
+
+    /// maxₜ |eᵢ(t)| of axis `i`'s lag part at time scale `k` over `duration` s (Choice 567):
+    /// per δ of `deltas`, the loop's response to the start offset e₀ᵢ (once) and to each
+    /// current corner's d; the response is linear, so the worse sign of e₀ᵢ at each period
+    /// is |e_d(t)| + |e_off(t)|, and the run's error starts at |e₀ᵢ|.
+    fn lag_part(
+        &self,
+        i: usize,
+        d: &[Vec<[f64; AXES]>],
+        deltas: &[f64],
+        k: f64,
+        duration: f64,
+    ) -> f64 {
+        let offset = self.scenario.config().initial_offset[i].abs();
+        let mut worst = offset;
+        for &delta in deltas {
+            let lp = self.loops[i].regained(self.scenario, i, delta);
+            let steps = self.lag_steps(&lp, k, duration);
+            // The offset's transient, until it has died (a stable loop's does in seconds).
+            let mut off = Vec::new();
+            if offset > 0.0 {
+                let mut quiet = 0;
+                self.fly_lag((i, &lp), None, (k, steps), offset, |_, e| {
+                    off.push(e);
+                    quiet = if e < 1e-9 * offset { quiet + 1 } else { 0 };
+                    quiet < 1000
+                });
+            }
+            for c in d {
+                self.fly_lag((i, &lp), Some(c), (k, steps), 0.0, |n, e| {
+                    worst = worst.max(e + off.get(n).copied().unwrap_or(0.0));
+                    true
+                });
+            }
         }
         worst
     }
@@ -1021,6 +1170,7 @@ impl<'a> Budget<'a> {
     /// [`Budget::at_for`], evaluated.
     fn evaluate_at_for(&self, k: f64, duration: f64) -> Result<PathBudget, CheckError> {
         let d = self.mismatch(k)?;
+        let deltas = self.lag_deltas(k);
         let mismatch: [f64; AXES] = std::array::from_fn(|i| {
             d.iter()
                 .flat_map(|c| c.iter().map(move |x| x[i].abs()))
@@ -1050,10 +1200,7 @@ impl<'a> Budget<'a> {
             out.noise_sigma[i] = nav.sigma;
             out.bias_sigma[i] = nav.bias;
             out.noise[i] = nav.noise;
-            let response = d
-                .iter()
-                .map(|c| self.lag_response(i, c, k, duration))
-                .fold(0.0, f64::max);
+            let response = self.lag_part(i, &d, &deltas, k, duration);
             out.lag[i] = response + self.speed[i] / k * self.latency;
             out.axis[i] = out.noise[i] + out.lag[i];
         }
@@ -1248,6 +1395,14 @@ pub(super) fn reference_samples(
         }
     }
     Ok((samples, speed))
+}
+
+/// Eq 29's inputs of a reference sample at k = 1: ‖ν‖, ‖J⁻¹J̇ν‖ and |cos θ|.
+fn delta_inputs(r: &RefSample) -> [f64; 3] {
+    let att = Attitude::from_eta(&r.eta);
+    let nu = kinematics::jacobian_inv(&att) * r.eta_dot;
+    let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
+    [nu.norm(), jjn.norm(), att.ctheta.abs()]
 }
 
 /// The currents the budget flies: the constant one, or a Gauss–Markov one's mean and its
