@@ -481,13 +481,16 @@ struct Shares<'a> {
 }
 
 impl<'a> Shares<'a> {
-    /// `None` on ideal actuators (they never saturate).
+    /// `None` on ideal actuators (they never saturate), and without a lag and a start
+    /// offset: the loop's transient is then the mismatch's own step, which the margin is
+    /// measured to cover (the contract's missions fly within it).
     fn new(scenario: &'a Scenario, margin: f64) -> Result<Option<Self>, CheckError> {
         let cfg = scenario.config();
-        if cfg.ideal_actuators {
+        let lag = cfg.thruster_lag.filter(|l| *l > 0.0).unwrap_or(0.0);
+        let offset = ACTUATED.iter().any(|&j| cfg.initial_offset[j] != 0.0);
+        if cfg.ideal_actuators || (lag == 0.0 && !offset) {
             return Ok(None);
         }
-        let lag = cfg.thruster_lag.filter(|l| *l > 0.0).unwrap_or(0.0);
         let controller = scenario.controller();
         let mass = Plant::new(controller.params().cast(f64::from), PlantTerms::default())
             .map_err(|e| CheckError::Invalid(format!("the law's nominal model: {e}")))?
