@@ -160,3 +160,14 @@ fn the_proposal_does_not_hang_on_the_written_scale() {
     assert_eq!(a, b);
     assert!(a.is_some());
 }
+
+/// Found by the same search (cross-entropy restart 4, seed 1): a figure-eight, lag 0.28 s, a
+/// 1.6 cm depth and −0.0097 rad pitch start offset, main and vert fore reversed, called
+/// feasible at 1 on main; depth's and pitch's lagged swings together take vert fore to −24 V
+/// from 0.23 to 0.64 s (2.1 % saturated); without its lag it flies. (L2') summed each axis's
+/// peak but kept the lower side at zero where the demand never went; (L2'') sums the axes on
+/// the thruster period by period and a share beyond its side crosses zero (Choice 548).
+#[test]
+fn a_depth_and_pitch_swing_on_one_thruster_is_refused_where_it_missed() {
+    refused_at_every_scale("falsified-lag-depth-pitch-ce-r4.toml", &[]);
+}
