@@ -651,8 +651,7 @@ impl<'a> Checker<'a> {
         // Over the box the fast engine records every sample's span, and skips those its
         // screen clears when the sweep gives a verdict only.
         let recording = self.engine == Engine::Fast && scope == Scope::WholeBox;
-        let screening = recording && !full;
-        let margin = self.margins.at(inv_k)?;
+        let (screening, margin) = (recording && !full, self.margins.at(inv_k)?);
         for (m, j) in points {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
