@@ -75,6 +75,10 @@
 //! moved), the start's roll and pitch (depth, pitch and yaw are kept on their own body axis),
 //! and the η axis's own mass M̂ⱼⱼ for surge and sway at any heading.
 
+use std::cell::RefCell;
+use std::rc::Rc;
+
+use controller_core::allocation::Allocator;
 use controller_core::axes::ACTUATED;
 use controller_core::effectiveness::THRUSTERS;
 use controller_core::kinematics::{self, Attitude};
@@ -114,7 +118,8 @@ pub(super) fn response_peak(
 /// The range [minₖ uₖ, maxₖ uₖ] (m/s² or rad/s², signed) of the loop `lp`'s command from the
 /// initial error `e0` under the unexplained acceleration `d(k)` of period k, flown `periods`
 /// periods, with the thrusters' lag `lag` (s; 0: none), (L1); both ends include 0 (the
-/// command's peak on each side, (L2')).
+/// command's peak on each side).
+#[cfg(test)]
 pub(super) fn response_range(
     lp: &Loop,
     lag: f64,
@@ -122,6 +127,28 @@ pub(super) fn response_range(
     periods: usize,
     d: impl Fn(usize) -> f64,
 ) -> (f64, f64) {
+    let (mut lo, mut hi) = (0.0f64, 0.0f64);
+    let finite = fly(lp, lag, e0, periods, d, |u, _| {
+        lo = lo.min(u);
+        hi = hi.max(u);
+    });
+    match finite {
+        true => (lo, hi),
+        false => (f64::NEG_INFINITY, f64::INFINITY),
+    }
+}
+
+/// Flies the loop `lp` (L1) from the initial error `e0` under `d(k)` for `periods` periods
+/// with the thrusters' lag `lag` (s; 0: none), giving `visit` each period's command uₖ and
+/// dₖ; false if the loop diverged.
+fn fly(
+    lp: &Loop,
+    lag: f64,
+    e0: f64,
+    periods: usize,
+    d: impl Fn(usize) -> f64,
+    mut visit: impl FnMut(f64, f64),
+) -> bool {
     let (f, g) = (lp.f(), lp.g());
     let (lambda, mean) = if lag > 0.0 {
         let l = (-lp.t / lag).exp();
@@ -137,21 +164,20 @@ pub(super) fn response_range(
     // The thrusters hold the law's first command before the mission starts (the simulator's
     // lag starts at its first target).
     let mut applied = lp.input(&s, &est);
-    let (mut lo, mut hi) = (0.0f64, 0.0f64);
     for k in 0..periods {
         let u = lp.input(&s, &est);
-        lo = lo.min(u);
-        hi = hi.max(u);
+        let dk = d(k);
+        visit(u, dk);
         let a = u + (applied - u) * mean;
         applied = u + (applied - u) * lambda;
-        let next = f * s + g * (a + d(k));
+        let next = f * s + g * (a + dk);
         est = lp.estimate_step(&est, u, &next);
         s = next;
         if !s.iter().all(|x| x.is_finite()) {
-            return (f64::NEG_INFINITY, f64::INFINITY);
+            return false;
         }
     }
-    (lo, hi)
+    true
 }
 
 /// What the loop starts from at 1/k = `inv_k`: the mismatch Δτ = τ − τ̂ at the start of the
@@ -164,7 +190,7 @@ struct Start {
 }
 
 /// The loop's start at the path's first sample at 1/k = `inv_k` ([`Start`]).
-fn start(scenario: &Scenario, inv_k: f64) -> Result<Start, CheckError> {
+fn start(scenario: &Scenario, inv_k: f64, periods: usize) -> Result<Start, CheckError> {
     let cfg = scenario.config();
     let path = Trajectory::new(Mission {
         time_scale: 1.0,
@@ -211,13 +237,15 @@ fn start(scenario: &Scenario, inv_k: f64) -> Result<Start, CheckError> {
         } else {
             delta_max
         },
-        payload: payload_profile(scenario, &state, &nu_dot)?,
+        payload: payload_profile(scenario, periods, &state, &nu_dot)?,
     })
 }
 
-/// Periods the loop is flown (L3): the mission's span, at most the payload's profile (its
-/// last step, or one period π/ω of an abs-sin) and [`STEP_PERIODS`] after it to settle.
-fn horizon(scenario: &Scenario) -> usize {
+/// Periods the loop is flown (L3): the mission's span at 1/k = `inv_k` (its path's span
+/// times k, whatever the scale it is written at; at rest, unbounded), at most the payload's
+/// profile (its last step, or one period π/ω of an abs-sin) and [`STEP_PERIODS`] after it to
+/// settle.
+fn horizon(scenario: &Scenario, inv_k: f64) -> usize {
     let cfg = scenario.config();
     let t = 1.0 / f64::from(scenario.controller().config().rate_hz);
     let profile = match &cfg.variation {
@@ -227,7 +255,8 @@ fn horizon(scenario: &Scenario) -> usize {
         }
         _ => 0.0,
     };
-    let span = (cfg.duration / t).ceil().max(1.0);
+    let duration = cfg.duration / super::time_scale(cfg.time_scale) / inv_k;
+    let span = (duration / t).ceil().max(1.0);
     let wanted = (profile / t).ceil().min(MAX_PROFILE_PERIODS as f64) + STEP_PERIODS as f64;
     span.min(wanted) as usize
 }
@@ -237,6 +266,7 @@ fn horizon(scenario: &Scenario) -> usize {
 /// (the mismatch is affine in Δp at a state).
 fn payload_profile(
     scenario: &Scenario,
+    n: usize,
     state: &PlantState,
     nu_dot: &Vector6<f64>,
 ) -> Result<Vec<Vector6<f64>>, CheckError> {
@@ -246,7 +276,6 @@ fn payload_profile(
             .map_err(|e| CheckError::Invalid(format!("the payload at t = {t} s: {e}")))?;
         Ok(plant.required_force(state, nu_dot, &Vector3::zeros()))
     };
-    let n = horizon(scenario);
     let t = 1.0 / f64::from(scenario.controller().config().rate_hz);
     let at0 = force(0.0)?;
     let mut out = Vec::with_capacity(n);
@@ -271,6 +300,9 @@ fn payload_profile(
     Ok(out)
 }
 
+/// The width (N) a side with no room left keeps, for the allocator.
+const SLIVER: f32 = 1e-3;
+
 /// Per thruster, the thrust (N) the lag's overshoot adds above its command (`upper`, rᵢ⁺)
 /// and below it (`lower`, rᵢ⁻), each kept on its own side of the margin envelope, (L2').
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -283,7 +315,9 @@ pub struct Reserve {
 
 impl Reserve {
     /// The envelope with rᵢ⁺ kept below its upper side and rᵢ⁻ above its lower side, as
-    /// [`super::navigation::keep`] keeps one share on both (an emptied side stays at zero).
+    /// [`super::navigation::keep`] keeps one share on both. A share larger than its side
+    /// crosses zero (Choice 548): the transient is measured from the demand, so a demand must
+    /// then stand on the other side by the excess; a side with no room left is a sliver.
     pub fn keep(&self, envelope: ThrustEnvelope) -> ThrustEnvelope {
         let mut e = envelope;
         for i in 0..THRUSTERS {
@@ -291,10 +325,10 @@ impl Reserve {
             if up == 0.0 && down == 0.0 {
                 continue;
             }
-            e.min[i] = (e.min[i] + down as f32).min(0.0);
-            e.max[i] = (e.max[i] - up as f32).max(0.0);
+            e.min[i] += down as f32;
+            e.max[i] -= up as f32;
             if e.max[i] <= e.min[i] {
-                e.max[i] = e.min[i] + f32::EPSILON;
+                e.max[i] = e.min[i] + SLIVER.max(e.min[i].abs() * 1e-6);
             }
         }
         e
@@ -315,72 +349,318 @@ fn body_direction(j: usize, yaw: f64) -> Vector6<f32> {
     v.cast()
 }
 
-/// Per thruster, the thrust (N) the lag's overshoot needs on each side of the margin
-/// envelope, (L2'); zeros without a lag or on ideal actuators.
-pub fn reserve(scenario: &Scenario) -> Result<Reserve, CheckError> {
+/// The part of the room between the envelope and the margin envelope the margin covers of the
+/// loop's own transient without a lag, (L2'') (**Choice 548**).
+pub const COVERED: f64 = 1.0;
+
+/// The share of the periods the bound lets saturate a start's transient may take, (L2'')
+/// (**Choice 548**): the rest is left to the flight's other saturations.
+pub const SATURATED_SHARE: f64 = 0.2;
+
+/// Per period k, per thruster, the loop's excursion (N, ≥ 0) below ([k][i][.][0]) and above
+/// ([k][i][.][1]) the span between its feedforward and its steady demand, with the thrusters'
+/// lag ([k][i][0]) and without ([k][i][1]), the largest over the currents, (L2'').
+#[derive(Clone, Debug, Default, PartialEq)]
+struct Excursions(Vec<[[[f64; 2]; 2]; THRUSTERS]>);
+
+impl Excursions {
+    /// The larger of each, period by period.
+    fn max(mut self, other: &Excursions) -> Excursions {
+        for (a, b) in self.0.iter_mut().zip(&other.0) {
+            for (x, y) in a
+                .iter_mut()
+                .flatten()
+                .flatten()
+                .zip(b.iter().flatten().flatten())
+            {
+                *x = x.max(*y);
+            }
+        }
+        self
+    }
+
+    /// Per thruster, lag and side, the level the excursion passes in more than `allowed`
+    /// periods (its `allowed`-th largest from 0; 0 when it passes 0 in no more).
+    fn level(&self, allowed: usize) -> [[[f64; 2]; 2]; THRUSTERS] {
+        let mut out = [[[0.0f64; 2]; 2]; THRUSTERS];
+        let mut v = Vec::with_capacity(self.0.len());
+        for (i, o) in out.iter_mut().enumerate() {
+            for (which, o) in o.iter_mut().enumerate() {
+                for (side, o) in o.iter_mut().enumerate() {
+                    v.clear();
+                    v.extend(self.0.iter().map(|p| p[i][which][side]));
+                    if allowed < v.len() {
+                        let (_, x, _) = v.select_nth_unstable_by(allowed, |a, b| b.total_cmp(a));
+                        *o = *x;
+                    }
+                }
+            }
+        }
+        out
+    }
+}
+
+/// The loop's excursions on every thruster from the start at 1/k = `inv_k` (at rest: 0),
+/// flown `periods` periods under each current the check takes (L2''): every controlled
+/// axis's loop at the law's δ there, its start offset at its sign as written and its mismatch
+/// at its own, the axes' commands summed on each thruster period by period through the
+/// allocation's signed column at the start's heading.
+fn excursions(
+    scenario: &Scenario,
+    lag: f64,
+    mass: &nalgebra::Matrix6<f64>,
+    inv_k: f64,
+    periods: usize,
+) -> Result<Excursions, CheckError> {
     let cfg = scenario.config();
-    let lag = match cfg.thruster_lag {
-        Some(l) if l > 0.0 && !cfg.ideal_actuators => l,
-        _ => return Ok(Reserve::default()),
-    };
-    let scale = super::time_scale(cfg.time_scale);
-    let mass = Plant::new(
-        scenario.controller().params().cast(f64::from),
-        PlantTerms::default(),
-    )
-    .map_err(|e| CheckError::Invalid(format!("the law's nominal model: {e}")))?
-    .mass_matrix();
-    // Per axis, the force (N, N·m) the lag adds to the command above ([0]) and below ([1]):
-    // the mismatch's step and the start offset (its sign as written) together, the mismatch
-    // at either sign, at the scenario's speed and at rest, each with the law's δ there (L2').
-    let mut extra = [[0.0f64; 2]; 6];
-    let mut yaw = 0.0;
-    for inv_k in [1.0 / scale, 0.0] {
-        let st = start(scenario, inv_k)?;
-        yaw = st.yaw;
-        let n = st.payload.len();
-        for &j in &ACTUATED {
-            let lp = Loop::with_delta(scenario, j, st.delta)?;
-            let (m, e0) = (mass[(j, j)], cfg.initial_offset[j]);
-            // The currents' extremes of this axis's start mismatch (the body's Δτ along η's
-            // axis j at the start's heading); the loop takes it up, ë = u − Δτⱼ/M̂ⱼⱼ.
-            let dir = body_direction(j, st.yaw).cast::<f64>();
-            let along = |v: &Vector6<f64>| dir.dot(v);
-            let lo = st.mismatch.iter().map(along).fold(f64::INFINITY, f64::min);
-            let hi = st
-                .mismatch
-                .iter()
-                .map(along)
-                .fold(f64::NEG_INFINITY, f64::max);
-            for c in [lo, hi] {
-                let d = |k: usize| -(c + along(&st.payload[k])) / m;
-                let (lag_lo, lag_hi) = response_range(&lp, lag, e0, n, d);
-                let (lo0, hi0) = response_range(&lp, 0.0, e0, n, d);
-                extra[j][0] = extra[j][0].max(m * (lag_hi - hi0));
-                extra[j][1] = extra[j][1].max(m * (lo0 - lag_lo));
+    let st = start(scenario, inv_k, periods)?;
+    let n = st.payload.len();
+    let alloc = scenario.controller().allocation();
+    let mut loops = Vec::with_capacity(ACTUATED.len());
+    for &j in &ACTUATED {
+        let dir = body_direction(j, st.yaw);
+        let column = alloc.thrusts(&dir).map(|b| f64::from(b) * mass[(j, j)]);
+        let lp = Loop::with_delta(scenario, j, st.delta)?;
+        loops.push((j, lp, dir.cast::<f64>(), column));
+    }
+    let lags: &[f64] = if lag > 0.0 { &[lag, 0.0] } else { &[0.0] };
+    let mut out = Excursions(vec![[[[0.0f64; 2]; 2]; THRUSTERS]; n]);
+    for mismatch in &st.mismatch {
+        for (which, &l) in lags.iter().enumerate() {
+            // Per period and thruster, the loop's thrust and its steady demand (N).
+            let mut thrust = vec![[0.0f64; THRUSTERS]; n];
+            let mut steady = vec![[0.0f64; THRUSTERS]; n];
+            for (j, lp, dir, column) in &loops {
+                let m = mass[(*j, *j)];
+                // The plant needs Δτ more than the law's model gives: ë = u − Δτⱼ/M̂ⱼⱼ (L3).
+                let c = dir.dot(mismatch);
+                let d = |k: usize| -(c + dir.dot(&st.payload[k])) / m;
+                let mut k = 0;
+                let finite = fly(lp, l, cfg.initial_offset[*j], n, d, |u, dk| {
+                    for i in 0..THRUSTERS {
+                        thrust[k][i] += column[i] * u;
+                        steady[k][i] -= column[i] * dk;
+                    }
+                    k += 1;
+                });
+                if !finite {
+                    return Err(CheckError::Invalid(format!(
+                        "the loop with a thruster lag of {l} s is unstable"
+                    )));
+                }
+            }
+            for ((v, s), o) in thrust.iter().zip(&steady).zip(out.0.iter_mut()) {
+                for i in 0..THRUSTERS {
+                    let x = &mut o[i][which];
+                    x[0] = x[0].max(s[i].min(0.0) - v[i]);
+                    x[1] = x[1].max(v[i] - s[i].max(0.0));
+                }
             }
         }
     }
-    let alloc = scenario.controller().allocation();
-    let mut out = Reserve::default();
-    for &j in &ACTUATED {
-        let [up, down] = extra[j];
-        let column = alloc.thrusts(&body_direction(j, yaw));
-        for (i, b) in column.iter().enumerate() {
-            // A positive entry moves thruster i as the axis's command does; a negative one
-            // against it: the command's excursion above is the thruster's below.
-            let b = f64::from(*b);
-            let (with, against) = (b.max(0.0), (-b).max(0.0));
-            out.upper[i] += with * up + against * down;
-            out.lower[i] += with * down + against * up;
+    if lag <= 0.0 {
+        for x in out.0.iter_mut().flatten() {
+            x[1] = x[0];
         }
     }
-    if out.upper.iter().chain(&out.lower).any(|x| !x.is_finite()) {
-        return Err(CheckError::Invalid(format!(
-            "the loop with a thruster lag of {lag} s is unstable"
-        )));
-    }
     Ok(out)
+}
+
+/// The loop's transient on each thruster's sides at every time scale, (L2''): what the
+/// margin does not cover of it, kept on the side it takes.
+struct Shares<'a> {
+    scenario: &'a Scenario,
+    lag: f64,
+    mass: nalgebra::Matrix6<f64>,
+    /// Per thruster, what the margin covers below ([0]) and above ([1]) (N): [`COVERED`] of
+    /// the room between the envelope and the margin envelope.
+    covered: [[f64; 2]; THRUSTERS],
+    /// The excursions from the start at rest (which every time scale keeps too) by the
+    /// periods flown.
+    rest: RefCell<Vec<(usize, Excursions)>>,
+}
+
+impl<'a> Shares<'a> {
+    /// `None` on ideal actuators (they never saturate), and without a lag and a start
+    /// offset: the loop's transient is then the mismatch's own step, which the margin is
+    /// measured to cover (the contract's missions fly within it).
+    fn new(scenario: &'a Scenario, margin: f64) -> Result<Option<Self>, CheckError> {
+        let cfg = scenario.config();
+        let lag = cfg.thruster_lag.filter(|l| *l > 0.0).unwrap_or(0.0);
+        let offset = ACTUATED.iter().any(|&j| cfg.initial_offset[j] != 0.0);
+        if cfg.ideal_actuators || (lag == 0.0 && !offset) {
+            return Ok(None);
+        }
+        let controller = scenario.controller();
+        let mass = Plant::new(controller.params().cast(f64::from), PlantTerms::default())
+            .map_err(|e| CheckError::Invalid(format!("the law's nominal model: {e}")))?
+            .mass_matrix();
+        let env = controller.envelope();
+        let room = COVERED * (1.0 - margin);
+        let covered =
+            std::array::from_fn(|i| [-room * f64::from(env.min[i]), room * f64::from(env.max[i])]);
+        Ok(Some(Shares {
+            scenario,
+            lag,
+            mass,
+            covered,
+            rest: RefCell::new(Vec::new()),
+        }))
+    }
+
+    /// Per thruster, the loop's transient the margin does not cover at 1/k = `inv_k` (L2'').
+    fn reserve(&self, inv_k: f64) -> Result<Reserve, CheckError> {
+        // The mission's span at this scale, flown from the start at its speed and at rest;
+        // at rest the mission is unbounded and a start's transient takes none of it.
+        if inv_k <= 0.0 {
+            return Ok(Reserve::default());
+        }
+        let n = horizon(self.scenario, inv_k);
+        let cached = self
+            .rest
+            .borrow()
+            .iter()
+            .find(|r| r.0 == n)
+            .map(|r| r.1.clone());
+        let rest = match cached {
+            Some(r) => r,
+            None => {
+                let r = excursions(self.scenario, self.lag, &self.mass, 0.0, n)?;
+                self.rest.borrow_mut().push((n, r.clone()));
+                r
+            }
+        };
+        let exc = excursions(self.scenario, self.lag, &self.mass, inv_k, n)?.max(&rest);
+        // The periods the bound lets saturate, at most [`SATURATED_SHARE`] of them.
+        let cfg = self.scenario.config();
+        let t_period = 1.0 / f64::from(self.scenario.controller().config().rate_hz);
+        let periods = cfg.duration / super::time_scale(cfg.time_scale) / inv_k / t_period;
+        let fraction = cfg.bound().map_or(0.0, |b| b.saturated);
+        let allowed = (SATURATED_SHARE * fraction * periods).floor() as usize;
+        let t = exc.level(allowed);
+        let mut out = Reserve::default();
+        for (i, [lagged, plain]) in t.iter().enumerate() {
+            let kept =
+                |side: usize| (lagged[side] - plain[side].min(self.covered[i][side])).max(0.0);
+            (out.lower[i], out.upper[i]) = (kept(0), kept(1));
+        }
+        if out.upper.iter().chain(&out.lower).any(|x| !x.is_finite()) {
+            return Err(CheckError::Invalid(format!(
+                "the loop with a thruster lag of {} s is unstable",
+                self.lag
+            )));
+        }
+        Ok(out)
+    }
+}
+
+/// The margin envelope at one time scale with the loop's transient kept (L2''), and its
+/// allocator.
+pub struct Margin {
+    pub envelope: ThrustEnvelope,
+    pub allocator: Allocator,
+}
+
+/// The margin envelope at each time scale the check asks for (**Choice 558**): the loop's
+/// transient at that scale kept on the envelope `base`, so that the verdict at a scale does
+/// not depend on the scale the file is written at; each scale's built once.
+pub struct Margins<'a> {
+    scenario: &'a Scenario,
+    margin: f64,
+    shares: Option<Shares<'a>>,
+    base: Rc<Margin>,
+    cache: RefCell<Vec<(u64, Rc<Margin>)>>,
+}
+
+impl<'a> Margins<'a> {
+    /// The margin envelope `base` (the navigation's share kept) of `scenario` at the fraction
+    /// `margin` of the envelope.
+    pub fn new(
+        scenario: &'a Scenario,
+        margin: f64,
+        base: ThrustEnvelope,
+    ) -> Result<Self, CheckError> {
+        let shares = Shares::new(scenario, margin)?;
+        let base = Rc::new(margin_at(scenario, margin, base)?);
+        Ok(Margins {
+            scenario,
+            margin,
+            shares,
+            base,
+            cache: RefCell::new(Vec::new()),
+        })
+    }
+
+    /// The margin envelope and its allocator at 1/k = `inv_k` (at rest: 0).
+    pub fn at(&self, inv_k: f64) -> Result<Rc<Margin>, CheckError> {
+        let Some(shares) = &self.shares else {
+            return Ok(self.base.clone());
+        };
+        let key = inv_k.to_bits();
+        if let Some((_, m)) = self.cache.borrow().iter().find(|(k, _)| *k == key) {
+            return Ok(m.clone());
+        }
+        let reserve = shares.reserve(inv_k)?;
+        let m = match reserve == Reserve::default() {
+            true => self.base.clone(),
+            false => Rc::new(margin_at(
+                self.scenario,
+                self.margin,
+                reserve.keep(self.base.envelope),
+            )?),
+        };
+        self.cache.borrow_mut().push((key, m.clone()));
+        Ok(m)
+    }
+
+    /// What the margin envelope at each scale reads besides the base envelope, by its bits:
+    /// the scenario as a whole but its name and time scale (the check's [`Kept`] context).
+    ///
+    /// [`Kept`]: super::sweep
+    pub fn context(&self) -> Vec<u64> {
+        let env = &self.base.envelope;
+        let mut out: Vec<u64> = env
+            .min
+            .iter()
+            .chain(&env.max)
+            .map(|x| u64::from(x.to_bits()))
+            .collect();
+        if self.shares.is_some() {
+            use std::hash::{Hash, Hasher};
+            let mut cfg = self.scenario.config().clone();
+            cfg.name.clear();
+            cfg.time_scale = 1.0;
+            cfg.speed_limits = None;
+            let mut h = std::collections::hash_map::DefaultHasher::new();
+            format!("{cfg:?}").hash(&mut h);
+            out.extend([self.margin.to_bits(), h.finish()]);
+        }
+        out
+    }
+}
+
+/// The envelope `env` with its allocator.
+fn margin_at(scenario: &Scenario, margin: f64, env: ThrustEnvelope) -> Result<Margin, CheckError> {
+    let controller = scenario.controller();
+    let allocator = Allocator::new(controller.allocation(), &env, &controller.config().priority)
+        .map_err(|e| {
+            CheckError::Invalid(format!(
+                "the allocator on the {margin} margin envelope: {e}"
+            ))
+        })?;
+    Ok(Margin {
+        envelope: env,
+        allocator,
+    })
+}
+
+/// Per thruster, the loop's transient the margin does not cover on each side at 1/k = `inv_k`
+/// and at rest, (L2''); zeros on ideal actuators.
+pub fn reserve(scenario: &Scenario, margin: f64, inv_k: f64) -> Result<Reserve, CheckError> {
+    match Shares::new(scenario, margin)? {
+        Some(s) => s.reserve(inv_k),
+        None => Ok(Reserve::default()),
+    }
 }
 
 #[cfg(test)]
@@ -415,7 +695,7 @@ mod tests {
     }
 
     /// [`Reserve::keep`] takes rᵢ⁺ from the upper side and rᵢ⁻ from the lower, each only
-    /// there, and never crosses zero.
+    /// there, and crosses zero by what a share exceeds its side.
     #[test]
     fn a_reserve_is_kept_on_its_own_side() {
         let mut env = ThrustEnvelope {
@@ -428,8 +708,7 @@ mod tests {
         r.lower[1] = 50.0;
         let k = r.keep(env);
         assert_eq!((k.min[0], k.max[0]), (-90.0, 170.0));
-        assert_eq!(k.min[1], 0.0);
-        assert!(k.max[1] > 0.0);
+        assert_eq!((k.min[1], k.max[1]), (40.0, 200.0));
         assert_eq!((k.min[2], k.max[2]), (-90.0, 200.0));
     }
 
@@ -493,7 +772,10 @@ mod tests {
                 ])
             })
             .unwrap();
-        let (h, j) = (reserve(&held).unwrap(), reserve(&jump).unwrap());
+        let (h, j) = (
+            reserve(&held, 0.8, 1.0).unwrap(),
+            reserve(&jump, 0.8, 1.0).unwrap(),
+        );
         let (h, j) = (both(&h), both(&j));
         assert!(h.iter().zip(&j).all(|(h, j)| j >= h), "{h:?} {j:?}");
         assert!(h.iter().zip(&j).any(|(h, j)| j > h), "{h:?} {j:?}");

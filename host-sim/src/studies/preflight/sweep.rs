@@ -11,11 +11,12 @@ use controller_core::kinematics::{self, Attitude};
 use controller_core::model::VehicleParams;
 use controller_core::thruster::ThrustEnvelope;
 use controller_core::uncertainty::ParamBox;
-use controller_core::{allocation::Allocator, allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
+use controller_core::{allocation::AxisPriority, axes::NAMES as AXIS_NAMES};
 use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 
 use super::attitude::{self, Stiffness, Swing};
+use super::lag::Margin;
 use super::period;
 use super::{
     poll, time_scale, CheckError, Engine, Scope, Violation, GAUSS_MARKOV_SIGMAS, SAMPLE_RATE_HZ,
@@ -123,8 +124,8 @@ pub(super) struct Checker<'a> {
     /// The law's nominal model, as a plant: what its feedforward gives.
     nominal: Plant,
     currents: Vec<Vector3<f64>>,
-    margin_allocator: Allocator,
-    margin_envelope: ThrustEnvelope,
+    /// The margin envelope and its allocator at each time scale (Choices 372, 548, 558).
+    margins: super::lag::Margins<'a>,
     engine: Engine,
     /// Per scope, where the last infeasible probe failed (Choice 392).
     hint: [std::cell::Cell<Option<PointId>>; 2],
@@ -320,20 +321,11 @@ impl<'a> Checker<'a> {
         // The navigation's noise force (Choice 372) is kept on each side, the lag's overshoot
         // (Choices 509, 557) on the side it takes.
         let kept = super::navigation::share(scenario, None).thrust;
-        let margin_envelope = super::lag::reserve(scenario)?.keep(super::navigation::keep(
-            controller.envelope().scaled(margin as f32),
-            &kept,
-        ));
-        let margin_allocator = Allocator::new(
-            controller.allocation(),
-            &margin_envelope,
-            &controller.config().priority,
-        )
-        .map_err(|e| {
-            invalid(format!(
-                "the allocator on the {margin} margin envelope: {e}"
-            ))
-        })?;
+        let margins = super::lag::Margins::new(
+            scenario,
+            margin,
+            super::navigation::keep(controller.envelope().scaled(margin as f32), &kept),
+        )?;
         let mut checker = Checker {
             context: Vec::new(),
             serial: fast::next_serial(),
@@ -344,8 +336,7 @@ impl<'a> Checker<'a> {
             corners,
             nominal,
             currents,
-            margin_allocator,
-            margin_envelope,
+            margins,
             engine,
             hint: Default::default(),
             screen: std::cell::RefCell::new(Screen::new(n_samples, n_peaks)),
@@ -371,13 +362,7 @@ impl<'a> Checker<'a> {
             .flat_map(|c| c.iter().map(|x| x.to_bits()));
         out.extend(currents);
         out.push(u64::MAX);
-        let env = &self.margin_envelope;
-        out.extend(
-            env.min
-                .iter()
-                .chain(&env.max)
-                .map(|x| u64::from(x.to_bits())),
-        );
+        out.extend(self.margins.context());
         let pitch = self.samples[0].eta[PITCH];
         out.extend([self.accel_bound.to_bits(), pitch.to_bits()]);
         out.push(self.start().map_or(u64::MAX, f64::to_bits));
@@ -599,13 +584,13 @@ impl<'a> Checker<'a> {
             let m = merged.iter().position(|x| x.1 == Some(id.sample));
             let prepared = self.prepare_at(scope, merged.iter().map(|m| m.0).collect(), &owned);
             if let Some(m) = m {
-                let ctx = self.at_sample(self.sample(true, id.sample), inv_k);
+                let ctx = self.at_sample(self.sample(true, id.sample), inv_k)?;
                 self.check_one(&prepared, m, id, &ctx, false, &mut out);
             }
         } else {
             let owned = self.owned(scope, self.times(inv_k).into_iter())?;
             let prepared = self.prepare_at(scope, self.times(inv_k), &owned);
-            let ctx = self.at_sample(self.sample(false, id.sample), inv_k);
+            let ctx = self.at_sample(self.sample(false, id.sample), inv_k)?;
             self.check_one(&prepared, id.sample, id, &ctx, false, &mut out);
         }
         Ok(out.first.is_some())
@@ -666,7 +651,7 @@ impl<'a> Checker<'a> {
         // Over the box the fast engine records every sample's span, and skips those its
         // screen clears when the sweep gives a verdict only.
         let recording = self.engine == Engine::Fast && scope == Scope::WholeBox;
-        let screening = recording && !full;
+        let (screening, margin) = (recording && !full, self.margins.at(inv_k)?);
         for (m, j) in points {
             // One sample is every case (up to 2⁹ corners): tens of microseconds.
             poll()?;
@@ -690,7 +675,7 @@ impl<'a> Checker<'a> {
                 && self
                     .screen
                     .borrow()
-                    .clears(peak, j, inv_k, &self.margin_envelope)
+                    .clears(peak, j, inv_k, &margin.envelope)
             {
                 continue;
             }
@@ -704,7 +689,7 @@ impl<'a> Checker<'a> {
             if recording {
                 out.span = Some(Span::EMPTY);
             }
-            let ctx = self.at_sample(smp, inv_k);
+            let ctx = self.at_sample(smp, inv_k)?;
             for case in 0..prepared.cases.len() {
                 for current in 0..self.currents.len() {
                     let id = PointId {
@@ -746,15 +731,16 @@ impl<'a> Checker<'a> {
     }
 
     /// What every case at sample `smp` shares at 1/k = `inv_k`.
-    fn at_sample(&self, smp: &PathSample, inv_k: f64) -> AtSample {
-        AtSample {
+    fn at_sample(&self, smp: &PathSample, inv_k: f64) -> Result<AtSample, CheckError> {
+        Ok(AtSample {
             inv_k,
             stiffness: self.stiffness(smp, inv_k),
             shared: match self.engine {
                 Engine::Fast => Some(Shared::new(smp, inv_k)),
                 Engine::Exhaustive => None,
             },
-        }
+            margin: self.margins.at(inv_k)?,
+        })
     }
 
     /// The point `id` at prepared index `m`, by the checker's engine.
@@ -779,11 +765,11 @@ impl<'a> Checker<'a> {
             stiffness: ctx.stiffness,
         };
         match &ctx.shared {
-            None => self.check_point(&at, full, out),
+            None => self.check_point(&at, &ctx.margin, full, out),
             Some(shared) => {
                 let roll = &case.roll[case.index(m)];
                 fast::check_point(self, &at, shared, roll, &mut |t, tau| {
-                    self.judge(t, tau, full, out)
+                    self.judge(&ctx.margin, t, tau, full, out)
                 });
             }
         }
@@ -809,7 +795,7 @@ impl<'a> Checker<'a> {
         &self.nominal
     }
 
-    fn check_point(&self, at: &Point, full: bool, out: &mut Sweep) {
+    fn check_point(&self, at: &Point, margin: &Margin, full: bool, out: &mut Sweep) {
         let (smp, inv_k, plant, current) = (at.smp, at.inv_k, at.plant, at.current);
         let level = Self::static_heel(plant, smp);
         let (state, nu_dot) = state_at(smp, inv_k, level, (0.0, 0.0), 0.0);
@@ -824,13 +810,13 @@ impl<'a> Checker<'a> {
         for (phi, p_dot) in at.swing.extremes(heel) {
             let (state, nu_dot) = state_at(smp, inv_k, phi, offset, p_dot);
             let tau = plant.required_force(&state, &nu_dot, current).cast::<f32>();
-            self.judge(at.t, &tau, full, out);
+            self.judge(margin, at.t, &tau, full, out);
         }
     }
 
     /// The body force `tau` at time `t` through the allocator: the peaks (if `full`) and the
     /// first violation of the margin envelope.
-    fn judge(&self, t: f64, tau: &Vector6<f32>, full: bool, out: &mut Sweep) {
+    fn judge(&self, margin: &Margin, t: f64, tau: &Vector6<f32>, full: bool, out: &mut Sweep) {
         let allocation = self.scenario.controller().allocation();
         if let Some(span) = out.span.as_mut() {
             span.add(&allocation.thrusts(tau));
@@ -848,24 +834,24 @@ impl<'a> Checker<'a> {
             }
         }
         if out.first.is_none() {
-            let a = self.margin_allocator.allocate(tau);
+            let a = margin.allocator.allocate(tau);
             let lost = |r: usize| a.unallocated[r].abs() > GIVEN_UP * (1.0 + tau[r].abs());
             if (0..6).any(lost) {
                 let priority = &self.scenario.controller().config().priority;
-                out.first = Some(self.violation(t, tau, priority, &lost));
+                out.first = Some(self.violation(&margin.envelope, t, tau, priority, &lost));
             }
         }
     }
 
     fn violation(
         &self,
+        env: &ThrustEnvelope,
         t: f64,
         tau: &Vector6<f32>,
         priority: &AxisPriority,
         lost: &dyn Fn(usize) -> bool,
     ) -> Violation {
         let demand = self.scenario.controller().allocation().thrusts(tau);
-        let env = &self.margin_envelope;
         let excess = |i: usize| {
             let (lo, hi) = (env.min[i], env.max[i]);
             (demand[i] - hi).max(lo - demand[i]) / (hi - lo)
@@ -944,6 +930,8 @@ pub(super) struct Point<'s> {
 /// engine's [`Shared`].
 struct AtSample {
     inv_k: f64,
+    /// The margin envelope at this 1/k (Choice 558).
+    margin: std::rc::Rc<Margin>,
     stiffness: Stiffness,
     shared: Option<Shared>,
 }
