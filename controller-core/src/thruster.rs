@@ -120,13 +120,6 @@ const TUN_V0: f64 = ((TUN_A * TUN_T0 + TUN_B) * TUN_T0 + TUN_C) * TUN_T0 + TUN_D
 /// σ = √(P/(3A)) = √359.893… (no const sqrt; checked below).
 const TUN_SIGMA: f64 = 18.970_854_839_287_906;
 const TUN_K: f64 = TUN_A * TUN_SIGMA * TUN_SIGMA * TUN_SIGMA;
-/// The tunnel map's inverse constants as its f32 arithmetic takes them: (V₀, K, T₀, σ) of
-/// T = T₀ + σ y with y³ + 3y + 2h = 0, h = ½ (V₀ − V)/K ([`ThrusterMap::thrust`] of
-/// [`ThrusterMap::Tunnel`]). For a host caller that evaluates the same inverse on several
-/// voltages side by side, bit for bit (the simulator's thrusters); nothing on the target reads
-/// it.
-pub const TUNNEL_INVERSE_F32: [f32; 4] =
-    [TUN_V0 as f32, TUN_K as f32, TUN_T0 as f32, TUN_SIGMA as f32];
 const _: () = {
     let rel = (3.0 * TUN_A * TUN_SIGMA * TUN_SIGMA - TUN_P) / TUN_P;
     assert!(rel < 1e-14 && rel > -1e-14);
@@ -297,6 +290,37 @@ fn tunnel_thrust(v: f32) -> f32 {
     let u = math::cbrt(w);
     let y = u - 1.0 / u;
     TUN_T0 as f32 + TUN_SIGMA as f32 * y
+}
+
+/// [`ThrusterMap::Tunnel`]'s thrust of four voltages (Eq 31 inverted, polynomial units), bit
+/// for bit `tunnel_thrust` of each: every lane takes the same f32 operations in the same order,
+/// a step at a time over the four, so the four chains of divisions, a square root and a cube
+/// root overlap (**Choice 570**: the simulator's four tunnels each period; nothing on the
+/// target calls it). A lane that is not finite sends the four through the scalar map.
+pub fn tunnel_thrusts(v: [f32; 4]) -> [f32; 4] {
+    if !v.iter().all(|v| v.is_finite()) {
+        return v.map(tunnel_thrust);
+    }
+    let h = lanes(|i| 0.5 * ((TUN_V0 as f32 - v[i]) / TUN_K as f32));
+    let m = lanes(|i| if h[i].abs() > 1.0 { h[i].abs() } else { 1.0 });
+    let hm = lanes(|i| h[i] / m[i]);
+    let im = lanes(|i| 1.0 / m[i]);
+    let s = lanes(|i| m[i] * math::exact_sqrt(hm[i] * hm[i] + im[i] * im[i]));
+    let w = lanes(|i| {
+        if h[i] >= 0.0 {
+            -h[i] - s[i]
+        } else {
+            s[i] - h[i]
+        }
+    });
+    let u = lanes(|i| math::cbrt(w[i]));
+    lanes(|i| TUN_T0 as f32 + TUN_SIGMA as f32 * (u[i] - 1.0 / u[i]))
+}
+
+/// The four lanes of one step of [`tunnel_thrusts`].
+#[inline(always)]
+fn lanes(f: impl FnMut(usize) -> f32) -> [f32; 4] {
+    core::array::from_fn(f)
 }
 
 fn main_thrust(v: f32) -> f32 {

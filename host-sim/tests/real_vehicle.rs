@@ -697,8 +697,7 @@ fn a_trim_start_floats_at_the_heel_and_a_level_start_swings_to_twice_it() {
 /// within ±1 V and every f32 within 2¹⁶ ulps of ±24 V, where the simulated voltages lie.
 #[test]
 fn the_tunnels_side_by_side_are_the_scalar_map_bit_for_bit() {
-    use controller_core::thruster::ThrusterMap;
-    use host_sim::sim::thrusters::tunnel_thrusts;
+    use controller_core::thruster::{tunnel_thrusts, ThrusterMap};
     let same = |a: f32, b: f32| a.to_bits() == b.to_bits() || (a.is_nan() && b.is_nan());
     let stride = (0..=u32::MAX).step_by(997).map(f32::from_bits);
     let specials = [

@@ -8,7 +8,7 @@
 //! - a control period in fail-safe: every thruster off (0 N).
 
 use controller_core::effectiveness::THRUSTERS;
-use controller_core::thruster::{self, ThrusterMap};
+use controller_core::thruster::{self, tunnel_thrusts, ThrusterMap};
 use controller_core::{Controller, ThrustUnit};
 use nalgebra::{Matrix6x5, SVector, Vector6};
 
@@ -153,41 +153,3 @@ const _: () = {
         i += 1;
     }
 };
-
-/// `ThrusterMap::Tunnel.thrust` of four voltages (Eq 31 inverted: polynomial units), bit for
-/// bit: each lane takes the same f32 operations in the same order, h = ½ (V₀ − V)/K,
-/// s = m √((h/m)² + (1/m)²) with m = max(|h|, 1), w = −h − s (h ≥ 0) or s − h, u = ∛w and
-/// T = T₀ + σ (u − 1/u) ([`thruster::TUNNEL_INVERSE_F32`], `controller_core::math::cbrt`).
-///
-/// **Choice 570:** written a step at a time over the four lanes, so that the four chains of
-/// divisions, a square root and a cube root run side by side (the compiler keeps the lanes
-/// together, in vector registers where it can), where four calls of the scalar map ran them
-/// one after another: a tenth of a study-grade run's CPU before. A lane that is not finite
-/// (NaN, ±∞: the scalar map's own early answers) sends all four through the scalar map.
-pub fn tunnel_thrusts(v: [f32; 4]) -> [f32; 4] {
-    use controller_core::math::{cbrt, exact_sqrt};
-    if !v.iter().all(|v| v.is_finite()) {
-        return v.map(|v| ThrusterMap::Tunnel.thrust(v));
-    }
-    let [v0, k, t0, sigma] = thruster::TUNNEL_INVERSE_F32;
-    let h = lanes(|i| 0.5 * ((v0 - v[i]) / k));
-    let m = lanes(|i| if h[i].abs() > 1.0 { h[i].abs() } else { 1.0 });
-    let hm = lanes(|i| h[i] / m[i]);
-    let im = lanes(|i| 1.0 / m[i]);
-    let s = lanes(|i| m[i] * exact_sqrt(hm[i] * hm[i] + im[i] * im[i]));
-    let w = lanes(|i| {
-        if h[i] >= 0.0 {
-            -h[i] - s[i]
-        } else {
-            s[i] - h[i]
-        }
-    });
-    let u = lanes(|i| cbrt(w[i]));
-    lanes(|i| t0 + sigma * (u[i] - 1.0 / u[i]))
-}
-
-/// The four lanes of one step.
-#[inline(always)]
-fn lanes(f: impl FnMut(usize) -> f32) -> [f32; 4] {
-    std::array::from_fn(f)
-}
