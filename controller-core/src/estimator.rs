@@ -416,17 +416,24 @@ pub fn applied_acceleration(
 }
 
 /// No period recorded yet.
-const NONE: u64 = u64::MAX;
+const NONE: u32 = u32::MAX;
 
-/// The ring slot of period `t`.
-fn slot(t: u64) -> usize {
-    (t % HORIZON as u64) as usize
+/// **Choice 499:** the estimator keeps its periods as u32 counts from an anchor period
+/// (`Estimate::epoch`), below this bound: u64 arithmetic is a pair of instructions or a call
+/// on the 32-bit board, and a prediction's bookkeeping is all such comparisons and
+/// differences. A period 2³¹ or more past the anchor (248 days at 100 Hz) moves the anchor on
+/// (`Estimate::now`).
+const SPAN: u64 = 1 << 31;
+
+/// The ring slot of period `t` (relative to the anchor, a multiple of [`HORIZON`] periods).
+fn slot(t: u32) -> usize {
+    (t % HORIZON as u32) as usize
 }
 
 /// A count of periods as f32 (exact below 2²⁴; a u32's conversion is one instruction on the
-/// board, a u64's a library call).
-fn periods(n: u64) -> f32 {
-    n.min(u64::from(u32::MAX)) as u32 as f32
+/// board).
+fn periods(n: u32) -> f32 {
+    n as f32
 }
 
 /// Sums of the accelerations applied in the periods [b, τ) of one set of running sums (base
@@ -479,15 +486,19 @@ pub struct Estimate {
     velocity: [f32; 6],
     /// The disturbance acceleration d (Choice 510; zero without the state).
     disturbance: [f32; 6],
-    stamp: u64,
+    /// The period every period below counts from (Choice 499): a multiple of [`HORIZON`],
+    /// so a period's ring slot is that of its count.
+    epoch: u64,
+    /// The stamp, in periods from `epoch`.
+    stamp: u32,
     valid: bool,
     /// The latest period recorded ([`NONE`]: none). The ring holds every period of
     /// (last − HORIZON, last], a period the board did not run as a zero acceleration.
-    last: u64,
+    last: u32,
     /// The acceleration of period `last`.
     accel: [f32; 6],
     /// The period each set of sums starts from (its sums are zero there).
-    base: [u64; 2],
+    base: [u32; 2],
     /// Each set's sums before period t (over [base, t)) at slot t mod HORIZON.
     before: [[Sums; 2]; HORIZON],
 }
@@ -506,6 +517,7 @@ impl Estimate {
             offset: [0.0; 6],
             velocity: [0.0; 6],
             disturbance: [0.0; 6],
+            epoch: 0,
             stamp: 0,
             valid: false,
             last: NONE,
@@ -522,7 +534,7 @@ impl Estimate {
 
     /// The stamp (ticks) of the newest solution taken.
     pub fn stamp(&self) -> u64 {
-        self.stamp
+        self.epoch + u64::from(self.stamp)
     }
 
     /// The filter's state [η, η̇] at its stamp.
@@ -547,17 +559,65 @@ impl Estimate {
         self.base = [0; 2];
     }
 
+    /// Period `ticks` in periods from the anchor (Choice 499). Before the anchor (time went
+    /// back past it), everything is forgotten and the anchor is period 0 again; 2³¹ periods or
+    /// more past it, the anchor moves on by whole rings to 2³⁰ periods or so before `ticks`,
+    /// and what it holds moves with it, unless some of it was more than that old (2³⁰
+    /// periods, 124 days at 100 Hz: a solution not renewed for as long is forgotten, as in a
+    /// new mission). Below 2³¹ periods from 0 the anchor never moves.
+    fn now(&mut self, ticks: u64) -> u32 {
+        let d = ticks.wrapping_sub(self.epoch);
+        if d < SPAN {
+            return d as u32;
+        }
+        self.move_epoch(ticks)
+    }
+
+    /// [`Estimate::now`]'s rare case: time went back past the anchor or ran 2³¹ past it.
+    fn move_epoch(&mut self, ticks: u64) -> u32 {
+        if ticks < self.epoch {
+            self.reset();
+            self.epoch = 0;
+            if ticks < SPAN {
+                return ticks as u32;
+            }
+        }
+        let h = HORIZON as u64;
+        let shift = (ticks - self.epoch - SPAN / 2) / h * h;
+        let held = [
+            (self.valid, self.stamp),
+            (self.last != NONE, self.last),
+            (self.last != NONE, self.base[0]),
+            (self.last != NONE, self.base[1]),
+        ];
+        if held.iter().any(|&(kept, t)| kept && u64::from(t) < shift) {
+            self.reset();
+        } else {
+            // All held periods are ≥ shift (< 2³¹), so the shift fits a u32.
+            let s = shift as u32;
+            if self.valid {
+                self.stamp -= s;
+            }
+            if self.last != NONE {
+                self.last -= s;
+                self.base = self.base.map(|b| b - s);
+            }
+        }
+        self.epoch += shift;
+        (ticks - self.epoch) as u32
+    }
+
     /// The oldest period the ring holds (0 before any is recorded).
-    fn oldest(&self) -> u64 {
+    fn oldest(&self) -> u32 {
         match self.last {
             NONE => 0,
-            last => (last + 1).saturating_sub(HORIZON as u64),
+            last => (last + 1).saturating_sub(HORIZON as u32),
         }
     }
 
     /// Set `k`'s sums over [base, t), for t ≥ the set's base and t ≥ [`Estimate::oldest`]
     /// (zero at or before its base: nothing is counted there).
-    fn at(&self, k: usize, t: u64) -> At<'_> {
+    fn at(&self, k: usize, t: u32) -> At<'_> {
         if self.last == NONE || t <= self.base[k] {
             At {
                 sums: &Sums::ZERO,
@@ -571,7 +631,7 @@ impl Estimate {
         } else {
             At {
                 sums: &self.before[slot(self.last)][k],
-                past: (t - self.last).min(u64::from(u32::MAX)) as u32,
+                past: t - self.last,
             }
         }
     }
@@ -590,7 +650,7 @@ impl Estimate {
     /// since and the disturbance (constant over it, Choice 510): the position as its offset
     /// from the anchor, and the velocity. Periods older than the ring weigh zero. Fixed work
     /// (Choice 430).
-    fn predicted(&self, gains: &EstimatorGains, from: u64, to: u64) -> ([f32; 6], [f32; 6]) {
+    fn predicted(&self, gains: &EstimatorGains, from: u32, to: u32) -> ([f32; 6], [f32; 6]) {
         let t = gains.period;
         let dt = periods(to.saturating_sub(from)) * t;
         let lo = from.max(self.oldest());
@@ -630,7 +690,8 @@ impl Estimate {
         eta: &[f32; 6],
         eta_dot: &[f32; 6],
     ) -> Option<([f32; 6], [f32; 6])> {
-        if self.valid && ticks < self.stamp {
+        let now = self.now(ticks);
+        if self.valid && now < self.stamp {
             // Time went back: a new mission.
             self.reset();
         }
@@ -638,10 +699,14 @@ impl Estimate {
         let finite = times_zero(eta) + times_zero(eta_dot) == 0.0;
         // Choice 554: only a stamp the period's record keeps (`Estimate::kept_from`): at most
         // MAX_AGE old and, after periods not run (`ticks` more than one past the last
-        // recorded; never with none recorded, `last` = NONE = u64::MAX), after the last
-        // recorded.
-        let after_gap_too_old = stamp <= self.last && ticks.saturating_sub(1) > self.last;
-        let in_window = stamp <= ticks && ticks - stamp <= MAX_AGE && !after_gap_too_old;
+        // recorded; never with none recorded, `last` = NONE = u32::MAX), after the last
+        // recorded. The age, as u64 (the inputs), then all in periods from the anchor, which
+        // is at least MAX_AGE before `now` or period 0 (Choice 499).
+        let age = ticks.wrapping_sub(stamp);
+        let young = age <= MAX_AGE && age as u32 <= now;
+        let stamp = now.wrapping_sub(age as u32);
+        let after_gap_too_old = stamp <= self.last && now.saturating_sub(1) > self.last;
+        let in_window = young && !after_gap_too_old;
         if finite && in_window {
             if !self.valid {
                 self.anchor = *eta;
@@ -683,15 +748,15 @@ impl Estimate {
         if !self.valid {
             return None;
         }
-        let (o, v) = self.predicted(gains, self.stamp, ticks);
+        let (o, v) = self.predicted(gains, self.stamp, now);
         Some((core::array::from_fn(|i| self.anchor[i] + o[i]), v))
     }
 
     /// The oldest period the record of period `ticks` keeps for a prediction to start from:
     /// the ring's oldest once `ticks` is recorded, and after periods not run (`ticks` more than
     /// one past the last recorded) not before the first of them ([`Estimate::applied`]).
-    fn kept_from(&self, ticks: u64) -> u64 {
-        let oldest = (ticks + 1).saturating_sub(HORIZON as u64);
+    fn kept_from(&self, ticks: u32) -> u32 {
+        let oldest = (ticks + 1).saturating_sub(HORIZON as u32);
         match self.last {
             NONE => oldest,
             last if ticks > last && ticks - last > 1 => (last + 1).max(oldest),
@@ -718,13 +783,14 @@ impl Estimate {
     /// taken.
     pub fn applied(&mut self, gains: &EstimatorGains, ticks: u64, a: &[f32; 6]) {
         let finite = times_zero(a) == 0.0;
+        let ticks = self.now(ticks);
         if self.last != NONE && ticks <= self.last {
             if ticks == self.last {
                 self.accel = if finite { *a } else { [0.0; 6] };
             }
             return;
         }
-        let h = HORIZON as u64;
+        let h = HORIZON as u32;
         // Nothing recorded yet, or periods not run since the last recorded.
         let fresh = self.last == NONE || ticks - self.last > 1;
         let keep_from = self.kept_from(ticks);

@@ -1020,3 +1020,86 @@ fn a_solution_is_taken_only_at_a_stamp_the_periods_record_keeps() {
     assert_eq!(taken.at_stamp(), before.at_stamp());
     assert_eq!(taken.stamp(), 121);
 }
+
+/// One scripted flight of the estimator from period `t0`: a solution every period, most
+/// 1–3 periods late, one refused (15 periods not run, then a solution stamped before them),
+/// a period recorded twice, a jump of the solution; each period's estimate, stamp and state.
+type Flown = Vec<(Option<([f32; 6], [f32; 6])>, u64, ([f32; 6], [f32; 6]))>;
+fn scripted_flight(g: &EstimatorGains, t0: u64) -> Flown {
+    let mut m = Estimate::new();
+    let mut flown = Vec::new();
+    let mut k = 0u64;
+    for n in 0..120u64 {
+        // Periods 60–74 are not run.
+        k = if n == 60 { k + 16 } else { k + 1 };
+        let late = if n == 60 { 18 } else { n % 4 };
+        let stamp = (t0 + k).saturating_sub(late);
+        let s = stamp.saturating_sub(t0) as f32;
+        let jump = if n >= 90 { 1.0 } else { 0.0 };
+        let z = [0.02 * s + jump, -0.01 * s, 3.0, 0.0, 0.1, 0.001 * s];
+        let zd = [2.0f32, -1.0, 0.0, 0.0, 0.0, 0.1];
+        let e = m.step(g, t0 + k, stamp, &z, &zd);
+        let a = [0.1 * (n % 7) as f32, -0.05, 0.02, 0.0, 0.01, 0.0];
+        if n % 11 == 0 {
+            m.applied(g, t0 + k, &[9.0; 6]);
+        }
+        m.applied(g, t0 + k, &a);
+        flown.push((e, m.stamp() - t0, m.at_stamp()));
+    }
+    flown
+}
+
+/// Choice 499: the estimator counts periods in u32 from an anchor that moves on by whole rings
+/// 2³¹ periods past it; a mission that starts anywhere (at 0, across 2³¹ and 2³² periods, near
+/// the end of u64) flies the same bits as one that starts at 0 (the filter depends only on
+/// differences of periods), and time that goes back past the anchor starts a new mission.
+#[test]
+fn the_estimator_flies_the_same_bits_wherever_its_periods_start() {
+    let g = gains_with(0.005, 0.002, 0.02, 60.0);
+    let reference = scripted_flight(&g, 0);
+    assert!(reference.iter().all(|f| f.0.is_some()));
+    for t0 in [
+        1u64 << 20,
+        (1 << 31) - 50,
+        (1 << 32) - 37,
+        (1 << 32) + 5,
+        (1 << 40) - 1,
+        u64::MAX - 300,
+    ] {
+        assert_eq!(scripted_flight(&g, t0), reference, "start {t0}");
+    }
+    // Time goes back past a moved anchor: forgotten, the next solution starts anew.
+    let z = [1.0f32; 6];
+    let mut m = Estimate::new();
+    let t = (1u64 << 33) + 7;
+    m.step(&g, t, t, &z, &z).unwrap();
+    m.applied(&g, t, &z);
+    let mut fresh = Estimate::new();
+    for mem in [&mut m, &mut fresh] {
+        assert_eq!(mem.step(&g, 1000, 1000, &z, &z), Some((z, z)));
+        assert_eq!(mem.stamp(), 1000);
+    }
+}
+
+/// Choice 499: a solution not renewed for 2³⁰ periods or more (124 days at 100 Hz) when the
+/// anchor moves on is forgotten, as in a new mission: the next solution is taken as the state;
+/// one renewed is carried across the move (the same estimate as from an anchor at 0).
+#[test]
+fn a_solution_older_than_the_anchors_move_is_forgotten() {
+    let g = gains(0.005, 0.002, 0.02);
+    let (z, zd) = (
+        [1.0f32, 2.0, 3.0, 0.0, 0.1, 0.2],
+        [0.5f32, 0.0, 0.0, 0.0, 0.0, 0.0],
+    );
+    let mut m = Estimate::new();
+    m.step(&g, 10, 10, &z, &zd).unwrap();
+    m.applied(&g, 10, &[0.0; 6]);
+    // Held and predicted up to 2³¹ − 1 periods on (no solution since).
+    let t = (1u64 << 31) - 1;
+    assert!(m.step(&g, t, 0, &z, &zd).is_some());
+    assert_eq!(m.stamp(), 10);
+    // Past 2³¹: the anchor moves on and the state more than 2³⁰ old is forgotten.
+    let t = 1u64 << 31;
+    assert_eq!(m.step(&g, t, 0, &z, &zd), None);
+    assert_eq!(m.step(&g, t, t, &z, &zd), Some((z, zd)));
+}
