@@ -92,6 +92,9 @@ const SETTLED: f64 = 120.0;
 const MAX_IMPULSE_PERIODS: usize = 60_000;
 /// The ratio between the boundary layer's δ the lag is flown at (Choice 567).
 const LAG_DELTA_STEP: f64 = 2.0;
+/// How much the lag loop's ‖h‖₁ is widened before it decides that a flight cannot raise the
+/// worst (Choice 559): covers the sum's truncated tail and the flights' rounding.
+const LAG_SKIP_MARGIN: f64 = 1e-3;
 /// Standard deviations of a Gauss–Markov current's corners (as the force check's).
 const CURRENT_SIGMAS: f64 = super::GAUSS_MARKOV_SIGMAS;
 
@@ -984,13 +987,7 @@ impl<'a> Budget<'a> {
         };
         // The acceleration applied over a period is the lag's mean over the held command,
         // (L1) of [`super::lag`].
-        let (lambda, mean) = match self.scenario.config().thruster_lag {
-            Some(tl) if tl > 0.0 => {
-                let l = (-lp.t / tl).exp();
-                (l, (tl / lp.t) * (1.0 - l))
-            }
-            _ => (0.0, 0.0),
-        };
+        let (lambda, mean) = self.lag_terms(lp);
         let mut s = Vector2::new(start, 0.0);
         let mut est = LoopEstimate { x: s, d: 0.0 };
         // The thrusters hold the law's first command before the flight (the simulator's lag
@@ -1009,10 +1006,56 @@ impl<'a> Budget<'a> {
         }
     }
 
+    /// ‖h‖₁ of the impulse response from d to e of [`Budget::fly_lag`]'s loop `lp` (the
+    /// thrusters' lag in it), widened by [`LAG_SKIP_MARGIN`]; `None` when it has not died
+    /// within [`MAX_IMPULSE_PERIODS`] (an unstable or barely damped loop).
+    fn lag_l1(&self, lp: &Loop) -> Option<f64> {
+        let (f, g) = (lp.f(), lp.g());
+        let (lambda, mean) = self.lag_terms(lp);
+        let mut s = Vector2::zeros();
+        let mut est = LoopEstimate::default();
+        let mut applied = 0.0;
+        let mut sum = 0.0;
+        for n in 0..MAX_IMPULSE_PERIODS {
+            let u = lp.input(&s, &est);
+            let a = u + (applied - u) * mean;
+            applied = u + (applied - u) * lambda;
+            let s_next = f * s + g * (a + if n == 0 { 1.0 } else { 0.0 });
+            est = lp.estimate_step(&est, u, &s_next);
+            s = s_next;
+            if !s.iter().all(|x| x.is_finite()) {
+                return None;
+            }
+            sum += s[0].abs();
+            let small = 1e-15 * sum.max(1e-300);
+            let quiet = s.amax() < small && est.x.amax() < small && est.d.abs() < small;
+            if n > 100 && quiet && applied.abs() < small {
+                return Some(sum * (1.0 + LAG_SKIP_MARGIN));
+            }
+        }
+        None
+    }
+
+    /// The thrusters' lag over one period of `lp`: the state's decay λ = e^(−T/τ_L) and the
+    /// held command's mean share ((L1) of [`super::lag`]); (0, 0) without a lag.
+    fn lag_terms(&self, lp: &Loop) -> (f64, f64) {
+        match self.scenario.config().thruster_lag {
+            Some(tl) if tl > 0.0 => {
+                let l = (-lp.t / tl).exp();
+                (l, (tl / lp.t) * (1.0 - l))
+            }
+            _ => (0.0, 0.0),
+        }
+    }
+
     /// maxₜ |eᵢ(t)| of axis `i`'s lag part at time scale `k` over `duration` s (Choice 567):
     /// per δ of `deltas`, the loop's response to the start offset e₀ᵢ (once) and to each
     /// current corner's d; the response is linear, so the worse sign of e₀ᵢ at each period
-    /// is |e_d(t)| + |e_off(t)|, and the run's error starts at |e₀ᵢ|.
+    /// is |e_d(t)| + |e_off(t)|, and the run's error starts at |e₀ᵢ|. A corner's flight is
+    /// skipped when it cannot raise the worst (**Choice 559**): |e_d(t)| ≤ ‖h‖₁·max|d| (d at
+    /// a period is a convex combination of the samples'), so a flight whose
+    /// ‖h‖₁·max|d| + maxₜ|e_off| is not above the worst so far leaves the max as it is (an
+    /// axis the reference never accelerates on, d = 0, is never flown).
     fn lag_part(
         &self,
         i: usize,
@@ -1036,7 +1079,15 @@ impl<'a> Budget<'a> {
                     quiet < 1000
                 });
             }
+            let off_peak = off.iter().copied().fold(0.0, f64::max);
+            let l1 = self.lag_l1(&lp);
             for c in d {
+                if let Some(l1) = l1 {
+                    let peak = c.iter().map(|x| x[i].abs()).fold(0.0, f64::max);
+                    if l1 * peak + off_peak <= worst {
+                        continue;
+                    }
+                }
                 self.fly_lag((i, &lp), Some(c), (k, steps), 0.0, |n, e| {
                     worst = worst.max(e + off.get(n).copied().unwrap_or(0.0));
                     true
@@ -1577,5 +1628,101 @@ mod tests {
         );
         assert!(s[1].abs() < 1e-9, "ė {}", s[1]);
         assert!((est.d - d).abs() < 1e-6 * d, "d̂ {} vs d {d}", est.d);
+    }
+
+    fn survey_with(change: impl FnOnce(&mut crate::scenario::SimConfig)) -> Scenario {
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = crate::scenario::load_scenario(&path).expect("the shipped survey");
+        survey.with(change).expect("the survey changed")
+    }
+
+    /// Choice 559's skip rests on |e_d(t)| ≤ ‖h‖₁·max|d| for the loop as flown (the lag in
+    /// it): random sign-flipping d, the adversary of the ℓ₁ bound, never beats it.
+    #[test]
+    fn the_lag_loops_l1_gain_bounds_every_flight() {
+        let scenario = survey_with(|c| c.thruster_lag = Some(0.4));
+        let b = Budget::new(&scenario).expect("a budget").expect("a bound");
+        let mut seed = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = move || {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for i in 0..AXES {
+            for delta in [1.0, 3.0, 8.0, 25.0] {
+                let lp = b.loops[i].regained(&scenario, i, delta);
+                let l1 = b.lag_l1(&lp).expect("a stable loop");
+                for _ in 0..4 {
+                    let hold = 1 + (next() * 40.0) as usize;
+                    let mut d = Vec::new();
+                    let mut sign = 1.0;
+                    for j in 0..3_000 {
+                        if j % hold == 0 && next() < 0.5 {
+                            sign = -sign;
+                        }
+                        d.push([sign * (0.5 + 0.5 * next()); AXES]);
+                    }
+                    let most = d.iter().map(|x| x[i].abs()).fold(0.0, f64::max);
+                    let mut peak = 0.0f64;
+                    b.fly_lag((i, &lp), Some(&d), (1.0, 30_000), 0.0, |_, e| {
+                        peak = peak.max(e);
+                        true
+                    });
+                    assert!(
+                        peak > 0.0 && peak <= l1 * most,
+                        "axis {i} δ {delta}: {peak} > {l1}·{most}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// The lag part with the skip is the max of every flight (brute force: each δ, each
+    /// corner, flown), bit for bit, with an offset, a lag and a wandering current.
+    #[test]
+    fn skipping_flights_leaves_the_lag_part_as_flown() {
+        let scenario = survey_with(|c| {
+            c.thruster_lag = Some(0.3);
+            c.initial_offset[0] = 0.02;
+            c.current = gauss_markov([0.05, 0.05, 0.01]);
+            c.duration = 200.0;
+        });
+        let b = Budget::new(&scenario).expect("a budget").expect("a bound");
+        for k in [1.0, 1.7, MAX_TIME_SCALE] {
+            let d = b.mismatch(k).expect("d");
+            let deltas = b.lag_deltas(k);
+            let duration = b.duration(k);
+            for i in 0..AXES {
+                let offset = scenario.config().initial_offset[i].abs();
+                let mut want = offset;
+                for &delta in &deltas {
+                    let lp = b.loops[i].regained(&scenario, i, delta);
+                    let steps = b.lag_steps(&lp, k, duration);
+                    // The offset's transient as the budget keeps it: until 1 000 quiet periods.
+                    let (mut off, mut quiet) = (Vec::new(), 0);
+                    if offset > 0.0 {
+                        b.fly_lag((i, &lp), None, (k, steps), offset, |_, e| {
+                            off.push(e);
+                            quiet = if e < 1e-9 * offset { quiet + 1 } else { 0 };
+                            quiet < 1000
+                        });
+                    }
+                    for c in &d {
+                        b.fly_lag((i, &lp), Some(c), (k, steps), 0.0, |n, e| {
+                            want = want.max(e + off.get(n).copied().unwrap_or(0.0));
+                            true
+                        });
+                    }
+                }
+                let got = b.lag_part(i, &d, &deltas, k, duration);
+                assert_eq!(
+                    got.to_bits(),
+                    want.to_bits(),
+                    "k {k} axis {i}: {got} vs {want}"
+                );
+            }
+        }
     }
 }
