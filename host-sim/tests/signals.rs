@@ -255,11 +255,26 @@ const LONG: &str = "name = \"day\"\nduration = 36000\n[trajectory]\nkind = \"law
 /// machine and still fails the old behaviour.
 #[test]
 fn an_interrupt_before_the_first_period_acts_at_once() {
-    let dir = tempdir("early-int");
+    interrupted_in_the_preflight("early-int", 1500);
+}
+
+/// The same 6 s in: there the preflight matched each of the mission's 7.2·10⁵ samples to its
+/// plant by searching every plant before it (quadratic, no look at the flag: hours), and a
+/// SIGINT went unanswered (CI hung on the test above under load, 2026-12-05). Now by the
+/// parameters' bits.
+#[test]
+fn an_interrupt_while_the_preflight_matches_samples_to_plants_acts_at_once() {
+    interrupted_in_the_preflight("match-int", 6000);
+}
+
+/// SIGINT `after_ms` into a `run` of the [`LONG`] mission, still in its preflight: the run
+/// stops within 10 s, exit 130, its report says nothing was simulated, nothing half-written.
+fn interrupted_in_the_preflight(tag: &str, after_ms: u64) {
+    let dir = tempdir(tag);
     let s = scenario(&dir, "day", LONG);
     let out = dir.join("out");
     let child = spawn_run(&s, &out);
-    std::thread::sleep(std::time::Duration::from_millis(1500));
+    std::thread::sleep(std::time::Duration::from_millis(after_ms));
     let t0 = std::time::Instant::now();
     signal(child.id(), libc::SIGINT);
     let o = child.wait_with_output().unwrap();

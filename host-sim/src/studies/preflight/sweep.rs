@@ -16,6 +16,7 @@ use controller_core::{Mission, Trajectory};
 use nalgebra::{Vector3, Vector6};
 
 use super::attitude::{self, Stiffness, Swing};
+use super::bits::BitsMap;
 use super::lag::Margin;
 use super::period;
 use super::{
@@ -428,11 +429,20 @@ impl<'a> Checker<'a> {
             }
             Scope::AsWritten => {
                 let cfg = self.scenario.config();
+                // Each sample's plant by its parameters' bits, as `profile_plants` found them
+                // (the first of equal ones): a search through `owned` per sample was quadratic
+                // in a long varying mission's length (~10⁶ plants a day).
+                let index: BitsMap<Vec<u64>, usize> = owned
+                    .iter()
+                    .enumerate()
+                    .rev()
+                    .map(|(i, q)| (params_key(q.params()), i))
+                    .collect();
                 let at: Vec<usize> = times
                     .iter()
                     .map(|&t| {
-                        let p = cfg.plant_params_at(t);
-                        owned.iter().position(|q| *q.params() == p).unwrap_or(0)
+                        let key = params_key(&cfg.plant_params_at(t));
+                        index.get(&key).copied().unwrap_or(0)
                     })
                     .collect();
                 let heel = |t: f64| {
