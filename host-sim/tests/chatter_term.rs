@@ -175,20 +175,16 @@ fn the_held_slowest_pass_is_within_a_few_per_cent_of_the_full_one() {
         assert_eq!(held.time_scale, full.time_scale);
         let close = |a: f64, b: f64| (a - b).abs() <= 0.03 * b.abs().max(1e-9);
         for (h, f) in held.thrusters.iter().zip(&full.thrusters) {
-            assert!(
-                close(h.reversals_per_s, f.reversals_per_s),
-                "{name} {}: reversals held {} full {}",
-                f.thruster,
-                h.reversals_per_s,
-                f.reversals_per_s
-            );
-            assert!(
-                close(h.command_tv, f.command_tv),
-                "{name} {}: TV held {} full {}",
-                f.thruster,
-                h.command_tv,
-                f.command_tv
-            );
+            for (what, held, full) in [
+                ("reversals", h.reversals_per_s, f.reversals_per_s),
+                ("TV", h.command_tv, f.command_tv),
+            ] {
+                assert!(
+                    close(held, full),
+                    "{name} {}: {what} held {held} full {full}",
+                    f.thruster
+                );
+            }
         }
     }
 }
