@@ -13,7 +13,7 @@
 use core::hint::black_box;
 
 use controller_core::{
-    Controller, ControllerConfig, Estimate, EstimatorKind, EstimatorStage, Trajectory,
+    Controller, ControllerConfig, Estimate, EstimatorKind, EstimatorStage, Table1Case, Trajectory,
 };
 use defmt::{error, info};
 
@@ -42,6 +42,8 @@ pub fn run(counter: &Counter) -> bool {
     let (mut max, mut sum, mut share) = (0u32, 0u32, 0u32);
     let (mut stage_max, mut stage_sum) = ([0u32; STAGES], [0u32; STAGES]);
     let mut case_max = [0u32; ESTIMATOR_CASES];
+    // The largest whole call per Table-1 path (either heading): where the worst case flies.
+    let mut mission_max = [0u32; Table1Case::ALL.len()];
     let mut tr = Trajectory::EMPTY;
     for e in &ESTIMATOR_GOLDEN {
         let g = &GOLDEN[e.vector];
@@ -94,6 +96,9 @@ pub fn run(counter: &Counter) -> bool {
         let count = with.saturating_sub(copy);
         max = max.max(count);
         if let Some(m) = case_max.get_mut(e.case) {
+            *m = (*m).max(count);
+        }
+        if let Some(m) = g.case().and_then(|i| mission_max.get_mut(i)) {
             *m = (*m).max(count);
         }
         sum += count;
@@ -166,6 +171,11 @@ pub fn run(counter: &Counter) -> bool {
         "update_from_solution per case of estimator_steps (max): one period late {}, fifteen periods late after fifteen not flown {}",
         case_max[0],
         case_max[1]
+    );
+    info!(
+        "update_from_solution per mission (max over both cases), {=[?]}: {=[?]}",
+        Table1Case::ALL.map(|c| c.name()),
+        mission_max
     );
     info!(
         "step update_from_solution (estimator on, late solutions): max={} mean={} instructions (the estimator's share over update: {})",
