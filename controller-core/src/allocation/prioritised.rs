@@ -48,6 +48,7 @@ use crate::allocation::priority::AxisPriority;
 use crate::allocation::pseudo_inverse::PseudoInverse;
 use crate::axes::ROLL;
 use crate::effectiveness::THRUSTERS;
+use crate::math::times_zero;
 use crate::thruster::ThrustEnvelope;
 
 /// A thrust within this fraction of its envelope's width from a bound counts as on the bound
@@ -126,7 +127,8 @@ impl Allocator {
     /// ignored (see the module docs). Fixed work. A non-finite τ gives 0 N on every thruster
     /// with every saturation bit set and a zero unallocated part.
     pub fn allocate(&self, tau: &Vector6<f32>) -> Allocated {
-        if !tau.iter().all(|x| x.is_finite()) {
+        // Σ τᵢ·0 is NaN exactly when some τᵢ is not finite (Choice 524).
+        if times_zero(&(*tau).into()) != 0.0 {
             return Allocated {
                 thrusts: [0.0; THRUSTERS],
                 saturated: (1 << THRUSTERS) - 1,
@@ -139,8 +141,21 @@ impl Allocator {
             saturated: 0,
             unallocated: [0.0; 6],
         };
+        // Each rule on its own fixed-size path (Choice 573): no loop over a block's size.
         for block in &self.blocks[..self.count] {
-            self.solve(block, tau, &exact, &mut out);
+            match block.rule {
+                Rule::Single => self.solve_single(block, tau, &mut out),
+                Rule::Lexicographic(seg) => {
+                    self.solve_pair(block, tau, &mut out, |g, ta, tb, lo, hi| {
+                        lexicographic(g, &seg, ta, tb, lo, hi)
+                    })
+                }
+                Rule::LeastSquares(w) => {
+                    self.solve_pair(block, tau, &mut out, |g, ta, tb, lo, hi| {
+                        least_squares(g, w, ta, tb, lo, hi)
+                    })
+                }
+            }
         }
         out
     }
@@ -169,49 +184,56 @@ impl Allocator {
         w
     }
 
-    /// One block: keep B₅⁻¹τ if it fits, else solve within the box.
-    fn solve(
+    /// A one-thruster block: keep B₅⁻¹τ if it fits, else clamp τ_a/g to the envelope.
+    #[inline(always)]
+    fn solve_single(&self, block: &Block, tau: &Vector6<f32>, out: &mut Allocated) {
+        let i = block.thrusters[0];
+        let (lo, hi) = (self.envelope.min[i], self.envelope.max[i]);
+        let t = out.thrusts[i];
+        if t >= lo && t <= hi {
+            return;
+        }
+        let a = block.axes[0];
+        let ta = tau[a];
+        let g = block.g[0][0];
+        let v = clamp(ta / g, lo, hi);
+        out.thrusts[i] = v;
+        out.saturated |= on_bound(v, lo, hi) << i;
+        out.unallocated[a] = ta - g * v;
+    }
+
+    /// A two-thruster block: keep B₅⁻¹τ if both fit, else `within` the box (its rule).
+    #[inline(always)]
+    fn solve_pair(
         &self,
         block: &Block,
         tau: &Vector6<f32>,
-        exact: &[f32; THRUSTERS],
         out: &mut Allocated,
+        within: impl FnOnce(&[[f32; 2]; 2], f32, f32, [f32; 2], [f32; 2]) -> [f32; 2],
     ) {
-        let n = if block.rule == Rule::Single { 1 } else { 2 };
         let [i, j] = block.thrusters;
         let lo = [self.envelope.min[i], self.envelope.min[j]];
         let hi = [self.envelope.max[i], self.envelope.max[j]];
-        let fits = (0..n).all(|c| {
-            let t = exact[block.thrusters[c]];
-            t >= lo[c] && t <= hi[c]
-        });
-        if fits {
+        let (ti, tj) = (out.thrusts[i], out.thrusts[j]);
+        if ti >= lo[0] && ti <= hi[0] && tj >= lo[1] && tj <= hi[1] {
             return;
         }
-        let ta = tau[block.axes[0]];
-        let tb = tau[block.axes[1]];
-        let t = match block.rule {
-            Rule::Single => [clamp(ta / block.g[0][0], lo[0], hi[0]), 0.0],
-            Rule::Lexicographic(seg) => lexicographic(&block.g, &seg, ta, tb, lo, hi),
-            Rule::LeastSquares(w) => least_squares(&block.g, w, ta, tb, lo, hi),
-        };
-        for c in 0..n {
-            let k = block.thrusters[c];
-            let v = clamp(t[c], lo[c], hi[c]);
-            out.thrusts[k] = v;
-            let tol = ON_BOUND * (hi[c] - lo[c]);
-            if v - lo[c] <= tol || hi[c] - v <= tol {
-                out.saturated |= 1 << k;
-            }
-        }
-        let tk = [out.thrusts[i], out.thrusts[j]];
-        for r in 0..n {
-            let achieved = if n == 1 {
-                block.g[0][0] * tk[0]
-            } else {
-                block.g[r][0] * tk[0] + block.g[r][1] * tk[1]
-            };
-            out.unallocated[block.axes[r]] = tau[block.axes[r]] - achieved;
-        }
+        let [a, b] = block.axes;
+        let (ta, tb) = (tau[a], tau[b]);
+        let g = &block.g;
+        let t = within(g, ta, tb, lo, hi);
+        let v = [clamp(t[0], lo[0], hi[0]), clamp(t[1], lo[1], hi[1])];
+        out.thrusts[i] = v[0];
+        out.thrusts[j] = v[1];
+        out.saturated |= (on_bound(v[0], lo[0], hi[0]) << i) | (on_bound(v[1], lo[1], hi[1]) << j);
+        out.unallocated[a] = ta - (g[0][0] * v[0] + g[0][1] * v[1]);
+        out.unallocated[b] = tb - (g[1][0] * v[0] + g[1][1] * v[1]);
     }
+}
+
+/// 1 when `v` lies within [`ON_BOUND`] of the envelope's width from `lo` or `hi`, else 0.
+#[inline(always)]
+fn on_bound(v: f32, lo: f32, hi: f32) -> u8 {
+    let tol = ON_BOUND * (hi - lo);
+    u8::from(v - lo <= tol || hi - v <= tol)
 }
