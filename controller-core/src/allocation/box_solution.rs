@@ -40,7 +40,8 @@ fn reach(g: [f32; 2], lo: [f32; 2], hi: [f32; 2]) -> (f32, f32) {
     (a, b)
 }
 
-/// Lexicographic solution of a two-thruster block (see [`Segment`]).
+/// Lexicographic solution of a two-thruster block (see [`Segment`]); both thrusts inside the
+/// box.
 pub(super) fn lexicographic(
     g: &[[f32; 2]; 2],
     seg: &Segment,
@@ -69,8 +70,9 @@ pub(super) fn lexicographic(
         }
     }
     if q_lo > q_hi {
-        // Empty only by rounding (c is reachable): the segment is a point.
-        let mid = 0.5 * (q_lo + q_hi);
+        // Empty only by rounding (c is reachable): the segment is a point, kept in T_q's box
+        // (so that every thrust this returns is inside the box).
+        let mid = clamp(0.5 * (q_lo + q_hi), lo[q], hi[q]);
         q_lo = mid;
         q_hi = mid;
     }
@@ -85,7 +87,7 @@ pub(super) fn lexicographic(
 }
 
 /// Weighted least squares over the box (see the module docs): the best of the four edge
-/// optima and the four corners.
+/// optima and the four corners, each inside the box.
 pub(super) fn least_squares(
     g: &[[f32; 2]; 2],
     w: [f32; 2],

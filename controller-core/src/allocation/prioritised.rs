@@ -221,8 +221,9 @@ impl Allocator {
         let [a, b] = block.axes;
         let (ta, tb) = (tau[a], tau[b]);
         let g = &block.g;
-        let t = within(g, ta, tb, lo, hi);
-        let v = [clamp(t[0], lo[0], hi[0]), clamp(t[1], lo[1], hi[1])];
+        // Both rules return thrusts inside the box (lexicographic clamps each, least squares
+        // picks among clamped candidates), so no clamp follows.
+        let v = within(g, ta, tb, lo, hi);
         out.thrusts[i] = v[0];
         out.thrusts[j] = v[1];
         out.saturated |= (on_bound(v[0], lo[0], hi[0]) << i) | (on_bound(v[1], lo[1], hi[1]) << j);
@@ -235,5 +236,6 @@ impl Allocator {
 #[inline(always)]
 fn on_bound(v: f32, lo: f32, hi: f32) -> u8 {
     let tol = ON_BOUND * (hi - lo);
-    u8::from(v - lo <= tol || hi - v <= tol)
+    // Both tests, without a branch between them.
+    u8::from(v - lo <= tol) | u8::from(hi - v <= tol)
 }
