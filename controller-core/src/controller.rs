@@ -805,7 +805,8 @@ impl Controller {
             &u,
             &kin.jinv_jdot_nu,
         );
-        if !tau.iter().all(|x| x.is_finite()) {
+        // Σ τᵢ·0 is NaN exactly when some τᵢ is not finite (Choice 524).
+        if times_zero(&tau.into()) != 0.0 {
             return Err(Fault::NonFiniteResult);
         }
         Ok(StepLaw {

@@ -187,7 +187,8 @@ pub fn uncertainty_bound(c: &DeltaConstants, x: &DeltaInputs) -> f32 {
 /// [`Kinematics::jinv_jdot_nu`], passed in because δ(e,t) needs its norm too; `kin` is the
 /// step's one kinematics value. C(ν)ν and D(ν)ν are formed as vectors
 /// ([`model::coriolis_force_of`], [`model::damping_force`]); `m_hat` is a
-/// [`model::mass_matrix`], whose structure [`model::mass_mul`] multiplies by (Choice 521).
+/// [`model::mass_matrix`], whose structure [`model::mass_mul_pair`] multiplies by, both
+/// products at once (Choices 521, 573).
 pub fn body_force<T: RealField + Copy>(
     m_hat: &Matrix6<T>,
     params: &VehicleParams<T>,
@@ -197,8 +198,9 @@ pub fn body_force<T: RealField + Copy>(
     jinv_jdot_nu: &Vector6<T>,
 ) -> Vector6<T> {
     let accel = kin.jinv_mul(u) - jinv_jdot_nu;
-    model::mass_mul(m_hat, &accel)
-        + model::coriolis_force_of(&model::mass_mul(m_hat, nu), nu)
+    let (m_accel, m_nu) = model::mass_mul_pair(m_hat, &accel, nu);
+    m_accel
+        + model::coriolis_force_of(&m_nu, nu)
         + model::damping_force(params, nu)
         + model::restoring(params, &kin.att)
 }

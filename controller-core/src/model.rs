@@ -282,6 +282,35 @@ pub fn mass_mul<T: RealField + Copy>(m: &Matrix6<T>, x: &Vector6<T>) -> Vector6<
     )
 }
 
+/// [`mass_mul`] of two vectors at once, (M x, M y): each entry of M is loaded once for both
+/// (the law's M̂(J⁻¹u − J⁻¹J̇ν) and M̂ν, Choice 573); the same operations, so the same bits.
+#[inline]
+pub fn mass_mul_pair<T: RealField + Copy>(
+    m: &Matrix6<T>,
+    x: &Vector6<T>,
+    y: &Vector6<T>,
+) -> (Vector6<T>, Vector6<T>) {
+    let row = |i: usize, [a, b, c]: [usize; 3]| {
+        let (ma, mb, mc) = (m[(i, a)], m[(i, b)], m[(i, c)]);
+        (
+            ma * x[a] + mb * x[b] + mc * x[c],
+            ma * y[a] + mb * y[b] + mc * y[c],
+        )
+    };
+    let r = [
+        row(0, [0, 4, 5]),
+        row(1, [1, 3, 5]),
+        row(2, [2, 3, 4]),
+        row(3, [1, 2, 3]),
+        row(4, [0, 2, 4]),
+        row(5, [0, 1, 5]),
+    ];
+    (
+        Vector6::from_fn(|i, _| r[i].0),
+        Vector6::from_fn(|i, _| r[i].1),
+    )
+}
+
 /// Coriolis–centripetal matrix of a symmetric inertia `m` in Kirchhoff form (docs/model.md#the-coriolis-and-centripetal-matrix):
 /// C(ν) = [[0, −S(a)], [−S(a), −S(b)]] with [a; b] = M ν, so C(ν) ν = [ω × a; v × a + ω × b]
 /// and νᵀ C(ν) ν = 0.

@@ -152,7 +152,7 @@ proptest! {
     /// Choice 521: `mass_mul` (M x from M's 18 structural non-zeros) has the bits of nalgebra's
     /// dense M x, in f32 as the law runs it, for any parameters `mass_matrix` takes (the centre
     /// of gravity anywhere in a box of ±0.5 m, every inertia and added mass positive). A zero
-    /// may differ in its sign only.
+    /// may differ in its sign only. `mass_mul_pair` gives `mass_mul`'s bits for each of its two.
     #[test]
     fn structured_mass_product_has_the_dense_products_bits(
         x in proptest::array::uniform6(-1.0e3f32..1.0e3),
@@ -174,6 +174,14 @@ proptest! {
                 fast[i].to_bits() == dense[i].to_bits() || (fast[i] == 0.0 && dense[i] == 0.0),
                 "row {}: {} vs {}", i, fast[i], dense[i]
             );
+        }
+        // Choice 573: the pair product is the single one twice, bit for bit, either order.
+        let y = nalgebra::Vector6::from([x[3], -x[0], x[5], x[1], -x[4], x[2]]);
+        let (px, py) = model::mass_mul_pair(&m, &x, &y);
+        let (sx, sy) = (model::mass_mul(&m, &x), model::mass_mul(&m, &y));
+        for i in 0..6 {
+            prop_assert_eq!(px[i].to_bits(), sx[i].to_bits(), "row {} of M x", i);
+            prop_assert_eq!(py[i].to_bits(), sy[i].to_bits(), "row {} of M y", i);
         }
     }
 
