@@ -413,29 +413,16 @@ impl Trajectory {
             time,
         };
         let p = paths::planar(self, &ph);
-        let mut eta = Vector6::<f32>::zeros();
-        let mut eta_dot = Vector6::<f32>::zeros();
-        let mut eta_ddot = Vector6::<f32>::zeros();
-        eta[0] = p.x;
-        eta[1] = p.y;
-        eta[2] = p.z;
-        eta_dot[0] = p.d[0][0];
-        eta_dot[1] = p.d[0][1];
-        eta_dot[2] = p.z_dot;
-        eta_ddot[0] = p.d[1][0];
-        eta_ddot[1] = p.d[1][1];
-        eta_ddot[2] = p.z_ddot;
         let (psi, rate, accel) = match self.mission.heading {
             HeadingMode::Tangent => tangent(&p),
             HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h, &p),
         };
-        eta[5] = psi;
-        eta_dot[5] = rate;
-        eta_ddot[5] = accel;
+        // Each vector written once, in place (Choice 573: zeroed first, then filled, it was
+        // written twice).
         Desired {
-            eta,
-            eta_dot,
-            eta_ddot,
+            eta: Vector6::new(p.x, p.y, p.z, 0.0, 0.0, psi),
+            eta_dot: Vector6::new(p.d[0][0], p.d[0][1], p.z_dot, 0.0, 0.0, rate),
+            eta_ddot: Vector6::new(p.d[1][0], p.d[1][1], p.z_ddot, 0.0, 0.0, accel),
         }
     }
 }
