@@ -178,6 +178,8 @@ fn two_block(
             inv_gap: 1.0 / g[0][0],
             ratio,
             inv_alpha: 1.0 / alpha,
+            // Set by the allocator, which knows the envelope (`Allocator::new`).
+            reach: (0.0, 0.0),
         })
     };
     Ok(Block {

@@ -14,6 +14,9 @@ pub(super) struct Segment {
     pub(super) ratio: f32,
     /// 1/α.
     pub(super) inv_alpha: f32,
+    /// The range of g_a·T over the box, ([`reach`] of the block's higher axis), formed once
+    /// with the allocator from its envelope (Choice 573).
+    pub(super) reach: (f32, f32),
 }
 
 /// `x` in [lo, hi] (lo ≤ hi), without panicking: `f32::clamp` asserts lo ≤ hi. NaN stays NaN.
@@ -30,7 +33,7 @@ pub(super) fn clamp(x: f32, lo: f32, hi: f32) -> f32 {
 
 /// The range of g·T over the box [lo, hi] (interval arithmetic on a sum of two products).
 #[inline]
-fn reach(g: [f32; 2], lo: [f32; 2], hi: [f32; 2]) -> (f32, f32) {
+pub(super) fn reach(g: [f32; 2], lo: [f32; 2], hi: [f32; 2]) -> (f32, f32) {
     let (mut a, mut b) = (0.0f32, 0.0f32);
     for c in 0..2 {
         let (x, y) = (g[c] * lo[c], g[c] * hi[c]);
@@ -52,7 +55,8 @@ pub(super) fn lexicographic(
 ) -> [f32; 2] {
     // p is the block's first thruster (Choice 493).
     let (p, q) = (0, 1);
-    let (r_lo, r_hi) = reach(g[0], lo, hi);
+    // reach(g[0], lo, hi), formed with the allocator.
+    let (r_lo, r_hi) = seg.reach;
     let c = clamp(ta, r_lo, r_hi);
     // T_q such that T_p = (c − g_aq T_q)/g_ap lies in [lo_p, hi_p], and T_q in its own box.
     let (mut q_lo, mut q_hi) = (lo[q], hi[q]);

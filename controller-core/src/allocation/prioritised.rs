@@ -42,7 +42,7 @@
 use nalgebra::Vector6;
 
 use crate::allocation::blocks::{self, Block, Rule};
-use crate::allocation::box_solution::{clamp, least_squares, lexicographic};
+use crate::allocation::box_solution::{clamp, least_squares, lexicographic, reach};
 use crate::allocation::error::AllocationError;
 use crate::allocation::priority::AxisPriority;
 use crate::allocation::pseudo_inverse::PseudoInverse;
@@ -103,7 +103,16 @@ impl Allocator {
             return Err(AllocationError::Weight { axis, weight });
         }
         let b = pseudo_inverse.matrix();
-        let (blocks, count) = blocks::split(&b, priority)?;
+        let (mut blocks, count) = blocks::split(&b, priority)?;
+        // The higher axis's reach over each lexicographic block's box, once (Choice 573).
+        for block in &mut blocks[..count] {
+            let [i, j] = block.thrusters;
+            if let Rule::Lexicographic(seg) = &mut block.rule {
+                let lo = [envelope.min[i], envelope.min[j]];
+                let hi = [envelope.max[i], envelope.max[j]];
+                seg.reach = reach(block.g[0], lo, hi);
+            }
+        }
         Ok(Allocator {
             pseudo_inverse: *pseudo_inverse,
             envelope: *envelope,
