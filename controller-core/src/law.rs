@@ -188,7 +188,7 @@ pub fn uncertainty_bound(c: &DeltaConstants, x: &DeltaInputs) -> f32 {
 /// step's one kinematics value. C(ν)ν and D(ν)ν are formed as vectors
 /// ([`model::coriolis_force_of`], [`model::damping_force`]); `m_hat` is a
 /// [`model::mass_matrix`], whose structure [`model::mass_mul_pair`] multiplies by, both
-/// products at once (Choices 521, 573).
+/// products at once (Choices 521, 574).
 pub fn body_force<T: RealField + Copy>(
     m_hat: &Matrix6<T>,
     params: &VehicleParams<T>,

@@ -283,7 +283,7 @@ pub fn mass_mul<T: RealField + Copy>(m: &Matrix6<T>, x: &Vector6<T>) -> Vector6<
 }
 
 /// [`mass_mul`] of two vectors at once, (M x, M y): each entry of M is loaded once for both
-/// (the law's M̂(J⁻¹u − J⁻¹J̇ν) and M̂ν, Choice 573); the same operations, so the same bits.
+/// (the law's M̂(J⁻¹u − J⁻¹J̇ν) and M̂ν, Choice 574); the same operations, so the same bits.
 #[inline]
 pub fn mass_mul_pair<T: RealField + Copy>(
     m: &Matrix6<T>,

@@ -175,7 +175,7 @@ proptest! {
                 "row {}: {} vs {}", i, fast[i], dense[i]
             );
         }
-        // Choice 573: the pair product is the single one twice, bit for bit, either order.
+        // Choice 574: the pair product is the single one twice, bit for bit, either order.
         let y = nalgebra::Vector6::from([x[3], -x[0], x[5], x[1], -x[4], x[2]]);
         let (px, py) = model::mass_mul_pair(&m, &x, &y);
         let (sx, sy) = (model::mass_mul(&m, &x), model::mass_mul(&m, &y));

@@ -417,7 +417,7 @@ impl Trajectory {
             HeadingMode::Tangent => tangent(&p),
             HeadingMode::Paper => paths::paper_heading(self, theta, &ph.h, &p),
         };
-        // Each vector written once, in place (Choice 573: zeroed first, then filled, it was
+        // Each vector written once, in place (Choice 571: zeroed first, then filled, it was
         // written twice).
         Desired {
             eta: Vector6::new(p.x, p.y, p.z, 0.0, 0.0, psi),
