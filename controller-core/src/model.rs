@@ -270,17 +270,22 @@ pub fn mass_matrix<T: RealField + Copy>(p: &VehicleParams<T>) -> Matrix6<T> {
 /// this structure are not read: call it only with a matrix [`mass_matrix`] built.
 #[inline]
 pub fn mass_mul<T: RealField + Copy>(m: &Matrix6<T>, x: &Vector6<T>) -> Vector6<T> {
-    let row =
-        |i: usize, [a, b, c]: [usize; 3]| m[(i, a)] * x[a] + m[(i, b)] * x[b] + m[(i, c)] * x[c];
-    Vector6::new(
-        row(0, [0, 4, 5]),
-        row(1, [1, 3, 5]),
-        row(2, [2, 3, 4]),
-        row(3, [1, 2, 3]),
-        row(4, [0, 2, 4]),
-        row(5, [0, 1, 5]),
-    )
+    Vector6::from_fn(|i, _| {
+        let [a, b, c] = MASS_COLUMNS[i];
+        m[(i, a)] * x[a] + m[(i, b)] * x[b] + m[(i, c)] * x[c]
+    })
 }
+
+/// The columns of each row's structural non-zeros in [`mass_matrix`]'s structure, in column
+/// order: the diagonal and the two of the skew block.
+const MASS_COLUMNS: [[usize; 3]; 6] = [
+    [0, 4, 5],
+    [1, 3, 5],
+    [2, 3, 4],
+    [1, 2, 3],
+    [0, 2, 4],
+    [0, 1, 5],
+];
 
 /// [`mass_mul`] of two vectors at once, (M x, M y): each entry of M is loaded once for both
 /// (the law's M̂(J⁻¹u − J⁻¹J̇ν) and M̂ν, Choice 574); the same operations, so the same bits.
@@ -290,21 +295,14 @@ pub fn mass_mul_pair<T: RealField + Copy>(
     x: &Vector6<T>,
     y: &Vector6<T>,
 ) -> (Vector6<T>, Vector6<T>) {
-    let row = |i: usize, [a, b, c]: [usize; 3]| {
+    let r: [(T, T); 6] = core::array::from_fn(|i| {
+        let [a, b, c] = MASS_COLUMNS[i];
         let (ma, mb, mc) = (m[(i, a)], m[(i, b)], m[(i, c)]);
         (
             ma * x[a] + mb * x[b] + mc * x[c],
             ma * y[a] + mb * y[b] + mc * y[c],
         )
-    };
-    let r = [
-        row(0, [0, 4, 5]),
-        row(1, [1, 3, 5]),
-        row(2, [2, 3, 4]),
-        row(3, [1, 2, 3]),
-        row(4, [0, 2, 4]),
-        row(5, [0, 1, 5]),
-    ];
+    });
     (
         Vector6::from_fn(|i, _| r[i].0),
         Vector6::from_fn(|i, _| r[i].1),

@@ -90,15 +90,17 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "kernels",
         update: 4_000,
-        // kinematics, trajectory, law, allocation, voltage maps: measured 444, 640, 605, 811,
-        // 424 (the allocation 891 before Choice 493; Choices 520–522, 524 and 526 took them
-        // from 499, 639, 682, 888, 1 112; an unclamped tunnel reports its command, no Cardano
-        // root on the step). The trajectory stage's 720:
+        // kinematics, trajectory, law, allocation, voltage maps: measured 447, 627, 555, 518,
+        // 430 (Choices 571, 573 and 574: the trajectory 630, the law 597 and the allocation
+        // 809 before them; the allocation 891 before Choice 493; Choices 520–522, 524 and 526
+        // took them from 499, 639, 682, 888, 1 112; an unclamped tunnel reports its command, no
+        // Cardano root on the step). The trajectory stage's 720:
         // a waypoint path's sample (two fixed binary searches, the time law's piece and the
-        // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
-        // against 445 for the closed forms.
-        stages: [500, 720, 680, 930, 480],
-        // Measured 4 652 on the largest fixed work, 4 644 one period late (Choice 499: the
+        // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 627 on the survey's golden vectors,
+        // against 435 for the closed forms.
+        stages: [500, 720, 640, 600, 480],
+        // Measured 4 272 on the largest fixed work, 4 253 one period late (Choices 571, 573 and
+        // 574, the law's stages: 4 652 and 4 644 before them; Choice 499: the
         // estimator's periods as u32 counts; 4 760 and 4 751 before it; Choice 572:
         // `fly` records the output before returning it, no 196-byte copy; Choice 513: wrap_pi's
         // floor by the FPU; 4 942 and 4 937 before them). Choice 554: a
@@ -110,7 +112,7 @@ pub const BUDGETS: [StepBudget; 3] = [
         // 491, and the estimator's finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
         // 510, before Choices 520–522 and 524; 6 273 before both, 7 200 before Choices
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
-        // 2 150 of it and the law on the estimate ≈ 2 750 (docs/law.md#the-state-estimator).
+        // 2 030 of it and the law on the estimate ≈ 2 240 (docs/law.md#the-state-estimator).
         update_from_solution: 4_900,
         // solution, filter, estimate, record: measured 391, 1 029, 348, 260 (390, 1 127, 348,
         // 266 before Choice 499's u32 periods; 393, 1 134, 354,
@@ -134,11 +136,14 @@ pub const BUDGETS: [StepBudget; 3] = [
     // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
     StepBudget {
         backend: "libm",
-        // Measured 15 240 (the SysTick count); stages 7 540, 5 471, 849, 890, 423 (the voltage
-        // maps take no cbrtf since Choice 526, no libm sqrtf since Choice 520).
+        // Measured 14 920 (the SysTick count; 15 240 before Choices 571, 573 and 574); stages
+        // 7 541, 5 470, 805, 517, 426 (the law 849
+        // and the allocation 890 before Choices 573 and 574; the voltage maps take no cbrtf
+        // since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
-        stages: [8_400, 6_200, 1_000, 930, 500],
-        // Measured 24 153 one period late, 24 071 on the largest fixed work (Choice 499; 24 259
+        stages: [8_400, 6_200, 930, 600, 490],
+        // Measured 23 836 one period late, 23 703 on the largest fixed work (Choices 571, 573
+        // and 574: 24 153 and 24 071 before them; Choice 499; 24 259
         // and 24 177 before it; 24 453 and 24 362
         // before Choices 513 and 572; Choice 554;
         // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
@@ -158,11 +163,14 @@ pub const BUDGETS: [StepBudget; 3] = [
     // micromath takes the kernels' cbrt (it has none), so its maps cost the kernels'.
     StepBudget {
         backend: "micromath",
-        // Measured 3 000 (the SysTick count); stages 377, 570, 618, 890, 422 (the waypoint
-        // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
+        // Measured 2 600 (the SysTick count; 3 000 before Choices 571, 573 and 574); stages 379,
+        // 554, 577, 519, 429 (the trajectory
+        // 570, the law 618 and the allocation 890 before Choices 571, 573 and 574; the waypoint
+        // path's trajectory stage the 554, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
-        stages: [450, 680, 700, 930, 480],
-        // Measured 4 515 one period late, 4 488 on the largest fixed work (Choice 499; 4 623
+        stages: [450, 640, 660, 600, 480],
+        // Measured 4 171 one period late, 4 165 on the largest fixed work (Choices 571, 573 and
+        // 574: 4 515 and 4 488 before them; Choice 499; 4 623
         // and 4 595 before it; 4 818 and 4 799
         // before Choices 513 and 572; Choice 554; 4 790
         // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
