@@ -550,9 +550,9 @@ impl Controller {
         let Some(parts) = &self.estimator else {
             return self.update(ticks, &solution.eta, &solution.nu, trajectory);
         };
-        let estimated = self.estimator_solution_stage(solution).and_then(|told| {
-            let state = Self::estimator_filter_stage(parts, memory, ticks, solution, &told);
-            self.estimator_estimate_stage(state, &told)
+        let estimated = self.estimator_solution_stage(solution).and_then(|eta_dot| {
+            let state = Self::estimator_filter_stage(parts, memory, ticks, solution, &eta_dot);
+            self.estimator_estimate_stage(state, solution, &eta_dot)
         });
         // By reference: the estimate stays where its stage left it (a move copied it).
         match &estimated {
@@ -574,24 +574,19 @@ impl Controller {
     }
 
     /// Stage [`EstimatorStage::Solution`]: the solution checked as [`Controller::update`]
-    /// checks it, J at its attitude and its η̇ = J(η)ν, as an [`Estimated`] state (the law
-    /// flies it so before any solution is taken).
+    /// checks it and its η̇ = J(η)ν, what the filter takes. **Choice 577:** only η̇: J at the
+    /// solution's attitude is formed again by the estimate stage on the one path that flies
+    /// the solution as told (before any is taken), rather than kept alive through the filter.
     #[doc(hidden)]
     #[inline]
-    pub fn estimator_solution_stage(&self, solution: &Solution) -> Result<Estimated, Fault> {
+    pub fn estimator_solution_stage(&self, solution: &Solution) -> Result<[f32; 6], Fault> {
         check_inputs(&solution.eta, &solution.nu)?;
-        let (kin, cos_theta_abs) = self.checked_kinematics(&solution.eta)?;
-        Ok(Estimated {
-            eta: solution.eta,
-            nu: solution.nu,
-            eta_dot: kin.eta_dot(&Vector6::from(solution.nu)),
-            kin,
-            cos_theta_abs,
-        })
+        let (kin, _) = self.checked_kinematics(&solution.eta)?;
+        Ok(kin.eta_dot(&Vector6::from(solution.nu)).into())
     }
 
-    /// Stage [`EstimatorStage::Filter`]: the solution (η, η̇ of `told`) taken into `memory` at
-    /// its stamp and the state predicted to `ticks` ([`Estimate::step`]).
+    /// Stage [`EstimatorStage::Filter`]: the solution (its η, and `eta_dot` its η̇) taken into
+    /// `memory` at its stamp and the state predicted to `ticks` ([`Estimate::step`]).
     #[doc(hidden)]
     #[inline]
     pub fn estimator_filter_stage(
@@ -599,29 +594,32 @@ impl Controller {
         memory: &mut Estimate,
         ticks: u64,
         solution: &Solution,
-        told: &Estimated,
+        eta_dot: &[f32; 6],
     ) -> Option<([f32; 6], [f32; 6])> {
-        memory.step(
-            &parts.gains,
-            ticks,
-            solution.stamp,
-            &solution.eta,
-            &told.eta_dot.into(),
-        )
+        memory.step(&parts.gains, ticks, solution.stamp, &solution.eta, eta_dot)
     }
 
     /// Stage [`EstimatorStage::Estimate`]: the state the law flies on: the filter's (η̂, η̂̇)
-    /// with J(η̂) (pitch limit checked) and ν̂ = J(η̂)⁻¹η̂̇, or the solution as told (`told`)
-    /// before any could be taken.
+    /// with J(η̂) (pitch limit checked) and ν̂ = J(η̂)⁻¹η̂̇, or, before any solution could be
+    /// taken, the solution as told (with `told_eta_dot` its η̇, J at its attitude: no more work
+    /// than the estimate's).
     #[doc(hidden)]
     #[inline]
     pub fn estimator_estimate_stage(
         &self,
         state: Option<([f32; 6], [f32; 6])>,
-        told: &Estimated,
+        solution: &Solution,
+        told_eta_dot: &[f32; 6],
     ) -> Result<Estimated, Fault> {
         let Some((eta, eta_dot)) = state else {
-            return Ok(*told);
+            let (kin, cos_theta_abs) = self.checked_kinematics(&solution.eta)?;
+            return Ok(Estimated {
+                eta: solution.eta,
+                nu: solution.nu,
+                eta_dot: Vector6::from(*told_eta_dot),
+                kin,
+                cos_theta_abs,
+            });
         };
         if times_zero(&eta) + times_zero(&eta_dot) != 0.0 {
             return Err(Fault::NonFiniteResult);

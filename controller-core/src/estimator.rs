@@ -718,9 +718,10 @@ impl Estimate {
             } else if stamp > self.stamp {
                 // The prior at the stamp, its position as an offset from the old anchor.
                 let (o, v) = self.predicted(gains, self.stamp, stamp);
-                let mut offset = [0.0f32; 6];
-                let mut vel = v;
-                let mut dist = self.disturbance;
+                // Corrected in place (Choice 578), the state held for a posterior that is
+                // not finite (Choice 527), which is not kept.
+                let held = (self.offset, self.velocity, self.disturbance);
+                let mut zero = 0.0f32;
                 for i in 0..6 {
                     // z − prior = (z − anchor) − offset: near each other, so exact first.
                     let mut dz = (eta[i] - self.anchor[i]) - o[i];
@@ -730,18 +731,21 @@ impl Estimate {
                     let dv = eta_dot[i] - v[i];
                     let k = &gains.axes[i].k;
                     // Posterior − z, with z the new anchor: (prior − z) + K₀·[dz, dv].
-                    offset[i] = (k[(0, 0)] - 1.0) * dz + k[(0, 1)] * dv;
-                    vel[i] = v[i] + k[(1, 0)] * dz + k[(1, 1)] * dv;
+                    let offset = (k[(0, 0)] - 1.0) * dz + k[(0, 1)] * dv;
+                    let vel = v[i] + k[(1, 0)] * dz + k[(1, 1)] * dv;
                     let kd = &gains.axes[i].kd;
-                    dist[i] += kd[0] * dz + kd[1] * dv;
+                    let dist = self.disturbance[i] + (kd[0] * dz + kd[1] * dv);
+                    // Finiteness as Σ x·0 (Choice 527) over the posterior.
+                    zero += (eta[i] + offset) * 0.0 + vel * 0.0 + dist * 0.0;
+                    self.offset[i] = offset;
+                    self.velocity[i] = vel;
+                    self.disturbance[i] = dist;
                 }
-                let posterior: [f32; 6] = core::array::from_fn(|i| eta[i] + offset[i]);
-                if times_zero(&posterior) + times_zero(&vel) + times_zero(&dist) == 0.0 {
+                if zero == 0.0 {
                     self.anchor = *eta;
-                    self.offset = offset;
-                    self.velocity = vel;
-                    self.disturbance = dist;
                     self.stamp = stamp;
+                } else {
+                    (self.offset, self.velocity, self.disturbance) = held;
                 }
             }
         }
