@@ -574,7 +574,7 @@ impl Controller {
     }
 
     /// Stage [`EstimatorStage::Solution`]: the solution checked as [`Controller::update`]
-    /// checks it and its η̇ = J(η)ν, what the filter takes. **Choice 577:** only η̇: J at the
+    /// checks it and its η̇ = J(η)ν, what the filter takes. **Choice 561:** only η̇: J at the
     /// solution's attitude is formed again by the estimate stage on the one path that flies
     /// the solution as told (before any is taken), rather than kept alive through the filter.
     #[doc(hidden)]

@@ -718,7 +718,7 @@ impl Estimate {
             } else if stamp > self.stamp {
                 // The prior at the stamp, its position as an offset from the old anchor.
                 let (o, v) = self.predicted(gains, self.stamp, stamp);
-                // Corrected in place (Choice 578), the state held for a posterior that is
+                // Corrected in place (Choice 566), the state held for a posterior that is
                 // not finite (Choice 527), which is not kept.
                 let held = (self.offset, self.velocity, self.disturbance);
                 let mut zero = 0.0f32;

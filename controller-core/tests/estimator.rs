@@ -561,7 +561,7 @@ fn a_solution_too_old_repeated_or_from_the_future_is_refused_and_the_state_held(
 /// Choice 527: a finite solution whose correction is not finite (the innovation overflows f32)
 /// is not kept: the state, its stamp and its disturbance are those held before, and the
 /// estimate is the held state predicted, bit for bit what a refused solution gives (on both
-/// filters; the correction is made in place and the held state put back, Choice 578).
+/// filters; the correction is made in place and the held state put back, Choice 566).
 #[test]
 fn a_correction_that_is_not_finite_leaves_the_held_state_predicted() {
     for (g, with_disturbance) in [
