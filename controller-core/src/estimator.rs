@@ -453,6 +453,14 @@ impl Sums {
     };
 }
 
+/// A period as an [`Estimate`] counts it ([`Estimate::period`], Choice 568): the tick, and
+/// the tick in periods from the memory's anchor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Period {
+    ticks: u64,
+    now: u32,
+}
+
 /// Where a set's sums at a period are: the sums at a held period, and how many periods past
 /// it (0: the sums themselves; m > 0: the last period recorded, its acceleration added, then
 /// m − 1 periods without one, B′ = B + (m − 1)·A).
@@ -690,7 +698,32 @@ impl Estimate {
         eta: &[f32; 6],
         eta_dot: &[f32; 6],
     ) -> Option<([f32; 6], [f32; 6])> {
-        let now = self.now(ticks);
+        let period = self.period(ticks);
+        self.step_in(gains, period, stamp, eta, eta_dot)
+    }
+
+    /// Period `ticks` as this memory counts it (Choice 499), for [`Estimate::step_in`] and
+    /// [`Estimate::applied_in`] in the same period. **Choice 568:** the controller converts
+    /// its u64 tick once a period, not once in each (the conversion may move the anchor, which
+    /// nothing else does, so the count holds until the next period's).
+    pub fn period(&mut self, ticks: u64) -> Period {
+        Period {
+            ticks,
+            now: self.now(ticks),
+        }
+    }
+
+    /// [`Estimate::step`] in `period` (made by [`Estimate::period`] of this memory for this
+    /// period).
+    pub fn step_in(
+        &mut self,
+        gains: &EstimatorGains,
+        period: Period,
+        stamp: u64,
+        eta: &[f32; 6],
+        eta_dot: &[f32; 6],
+    ) -> Option<([f32; 6], [f32; 6])> {
+        let Period { ticks, now } = period;
         if self.valid && now < self.stamp {
             // Time went back: a new mission.
             self.reset();
@@ -786,8 +819,15 @@ impl Estimate {
     /// stamped before that first missed period is then refused as not newer than the last
     /// taken.
     pub fn applied(&mut self, gains: &EstimatorGains, ticks: u64, a: &[f32; 6]) {
+        let period = self.period(ticks);
+        self.applied_in(gains, period, a);
+    }
+
+    /// [`Estimate::applied`] in `period` (made by [`Estimate::period`] of this memory for this
+    /// period).
+    pub fn applied_in(&mut self, gains: &EstimatorGains, period: Period, a: &[f32; 6]) {
         let finite = times_zero(a) == 0.0;
-        let ticks = self.now(ticks);
+        let ticks = period.now;
         if self.last != NONE && ticks <= self.last {
             if ticks == self.last {
                 self.accel = if finite { *a } else { [0.0; 6] };

@@ -105,7 +105,7 @@ pub fn run(counter: &Counter) -> bool {
         };
         // `memory` again: the memory after the filter, which the record stage starts from.
         memory = before;
-        let state =
+        let (period, state) =
             Controller::estimator_filter_stage(&parts, &mut memory, ticks, &solution, &eta_dot);
         let Ok(est) = c.estimator_estimate_stage(state, &solution, &eta_dot) else {
             continue;
@@ -140,7 +140,7 @@ pub fn run(counter: &Counter) -> bool {
                         Controller::estimator_record_stage(
                             black_box(&parts),
                             black_box(&mut m),
-                            black_box(ticks),
+                            black_box(period),
                             black_box(&est),
                             black_box(&o),
                         );
