@@ -573,6 +573,7 @@ impl Estimate {
     /// and what it holds moves with it, unless some of it was more than that old (2³⁰
     /// periods, 124 days at 100 Hz: a solution not renewed for as long is forgotten, as in a
     /// new mission). Below 2³¹ periods from 0 the anchor never moves.
+    #[inline]
     fn now(&mut self, ticks: u64) -> u32 {
         let d = ticks.wrapping_sub(self.epoch);
         if d < SPAN {
@@ -582,6 +583,8 @@ impl Estimate {
     }
 
     /// [`Estimate::now`]'s rare case: time went back past the anchor or ran 2³¹ past it.
+    #[cold]
+    #[inline(never)]
     fn move_epoch(&mut self, ticks: u64) -> u32 {
         if ticks < self.epoch {
             self.reset();
