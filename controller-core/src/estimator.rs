@@ -718,6 +718,7 @@ impl Estimate {
 
     /// [`Estimate::step`] in `period` (made by [`Estimate::period`] of this memory for this
     /// period).
+    #[inline]
     pub fn step_in(
         &mut self,
         gains: &EstimatorGains,
