@@ -677,12 +677,27 @@ impl Estimate {
         let (s, e) = (self.at(k, lo), self.at(k, hi));
         let mut p = self.offset;
         let mut v = self.velocity;
-        for i in 0..6 {
-            let (sa, sb) = self.sums_at(&s, i);
-            let (ea, eb) = self.sums_at(&e, i);
+        // η += (η̇ + d·Δt/2)·Δt + T²·(B(τ) − B(s) − n·A(s)), η̇ += d·Δt + T·(A(τ) − A(s)).
+        let mut advance = |i: usize, (sa, sb): (f32, f32), (ea, eb): (f32, f32)| {
             let d = self.disturbance[i];
             p[i] += (v[i] + 0.5 * d * dt) * dt + t * t * (eb - sb - n * sa);
             v[i] += d * dt + t * (ea - sa);
+        };
+        if s.past > 0 && e.past > 0 {
+            // Both ends past the last period recorded (the prediction to the current period
+            // from a stamp after it): one set of sums, the last period's acceleration added
+            // once for both (`Estimate::sums_at`'s operations, shared; Choice 568).
+            let (ms, me) = (periods(s.past - 1), periods(e.past - 1));
+            for i in 0..6 {
+                let (a, b) = (e.sums.a[i], e.sums.b[i]);
+                let a1 = a + self.accel[i];
+                let c = b + a + 0.5 * self.accel[i];
+                advance(i, (a1, c + ms * a1), (a1, c + me * a1));
+            }
+        } else {
+            for i in 0..6 {
+                advance(i, self.sums_at(&s, i), self.sums_at(&e, i));
+            }
         }
         (p, v)
     }
