@@ -12,7 +12,7 @@ use crate::allocation::{Allocated, Allocator, PseudoInverse};
 use crate::axes::ACTUATED;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
-use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind, Period};
+use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind, Period, StateAt};
 use crate::kinematics::{Attitude, Kinematics};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw};
 use crate::math::times_zero;
@@ -607,7 +607,7 @@ impl Controller {
         ticks: u64,
         solution: &Solution,
         eta_dot: &[f32; 6],
-    ) -> (Period, Option<([f32; 6], [f32; 6])>) {
+    ) -> (Period, Option<StateAt>) {
         let period = memory.period(ticks);
         let state = memory.step_in(&parts.gains, period, solution.stamp, &solution.eta, eta_dot);
         (period, state)

@@ -453,6 +453,9 @@ impl Sums {
     };
 }
 
+/// A state (η, η̇) at a period: what [`Estimate::step`] returns.
+pub type StateAt = ([f32; 6], [f32; 6]);
+
 /// A period as an [`Estimate`] counts it ([`Estimate::period`], Choice 568): the tick, and
 /// the tick in periods from the memory's anchor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
