@@ -662,9 +662,15 @@ impl Estimate {
 
     /// The state predicted from `from` (the stamp) to `to` with the accelerations applied
     /// since and the disturbance (constant over it, Choice 510): the position as its offset
-    /// from the anchor, and the velocity. Periods older than the ring weigh zero. Fixed work
-    /// (Choice 430).
-    fn predicted(&self, gains: &EstimatorGains, from: u32, to: u32) -> ([f32; 6], [f32; 6]) {
+    /// from the anchor (`ANCHORED`: the position itself, the anchor added axis by axis as the
+    /// loop goes, Choice 568), and the velocity. Periods older than the ring weigh zero. Fixed
+    /// work (Choice 430).
+    fn predicted<const ANCHORED: bool>(
+        &self,
+        gains: &EstimatorGains,
+        from: u32,
+        to: u32,
+    ) -> ([f32; 6], [f32; 6]) {
         let t = gains.period;
         let dt = periods(to.saturating_sub(from)) * t;
         let lo = from.max(self.oldest());
@@ -685,6 +691,9 @@ impl Estimate {
             let d = self.disturbance[i];
             p[i] += (v[i] + 0.5 * d * dt) * dt + t * t * (eb - sb - n * sa);
             v[i] += d * dt + t * (ea - sa);
+            if ANCHORED {
+                p[i] = self.anchor[i] + p[i];
+            }
         };
         if s.past > 0 && e.past > 0 {
             // Both ends past the last period recorded (the prediction to the current period
@@ -772,7 +781,7 @@ impl Estimate {
                 self.valid = true;
             } else if stamp > self.stamp {
                 // The prior at the stamp, its position as an offset from the old anchor.
-                let (o, v) = self.predicted(gains, self.stamp, stamp);
+                let (o, v) = self.predicted::<false>(gains, self.stamp, stamp);
                 // Corrected in place (Choice 566), the state held for a posterior that is
                 // not finite (Choice 527), which is not kept.
                 let held = (self.offset, self.velocity, self.disturbance);
@@ -807,8 +816,7 @@ impl Estimate {
         if !self.valid {
             return None;
         }
-        let (o, v) = self.predicted(gains, self.stamp, now);
-        Some((core::array::from_fn(|i| self.anchor[i] + o[i]), v))
+        Some(self.predicted::<true>(gains, self.stamp, now))
     }
 
     /// The oldest period the record of period `ticks` keeps for a prediction to start from:
@@ -861,7 +869,7 @@ impl Estimate {
         let fresh = self.last == NONE || ticks - self.last > 1;
         let keep_from = self.kept_from(ticks);
         if self.valid && self.stamp < keep_from {
-            let (o, v) = self.predicted(gains, self.stamp, keep_from);
+            let (o, v) = self.predicted::<false>(gains, self.stamp, keep_from);
             self.offset = o;
             self.velocity = v;
             self.stamp = keep_from;
