@@ -98,9 +98,10 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 639 on the survey's golden vectors,
         // against 445 for the closed forms.
         stages: [500, 720, 680, 930, 480],
-        // Measured 4 520 on the largest fixed work, 4 511 one period late (Choices 561, 566,
+        // Measured 4 472 on the largest fixed work, 4 462 one period late (Choices 561, 566,
         // 568: the solution stage forms only η̇, the correction made in place, the period
-        // counted once and the prediction past the last period recorded reading its sums once;
+        // counted once, the prediction past the last period recorded reading its sums once and
+        // the prediction to the period adding the anchor as it goes (4 520 and 4 511 without it);
         // 4 652 and 4 644 before them; Choice 499: the
         // estimator's periods as u32 counts; 4 760 and 4 751 before it; Choice 572:
         // `fly` records the output before returning it, no 196-byte copy; Choice 513: wrap_pi's
@@ -113,9 +114,9 @@ pub const BUDGETS: [StepBudget; 3] = [
         // 491, and the estimator's finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
         // 510, before Choices 520–522 and 524; 6 273 before both, 7 200 before Choices
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
-        // 1 900 of it and the law on the estimate ≈ 2 620 (docs/law.md#the-state-estimator).
+        // 1 850 of it and the law on the estimate ≈ 2 620 (docs/law.md#the-state-estimator).
         update_from_solution: 4_900,
-        // solution, filter, estimate, record: measured 351, 945, 364, 243 (391, 1 029, 348,
+        // solution, filter, estimate, record: measured 351, 892, 364, 243 (391, 1 029, 348,
         // 260 before Choices 561, 566 and 568: the estimate alone +16, as it now also forms J
         // on the path that flies the solution as told; 390, 1 127, 348,
         // 266 before Choice 499's u32 periods; 393, 1 134, 354,
@@ -124,7 +125,7 @@ pub const BUDGETS: [StepBudget; 3] = [
         // on Choice 494's case before Choice 492; 1 249 and 532 before Choice 527's finiteness
         // sums; the filter's disturbance state, Choice 510, adds about 210: its correction and
         // d·Δt²/2, d·Δt in both predictions).
-        estimator_stages: [410, 1_090, 420, 280],
+        estimator_stages: [410, 1_030, 420, 280],
         // Measured 35 960 (the whole patch host-sim sends, protocol 8: 71 bytes of the law's
         // settings more to decode, a digest over 190 bytes, 120 before, and the rebuild's
         // Lyapunov solve and loop-rate rule on the law sent, Choice 508; 29 160 with protocol
@@ -143,17 +144,17 @@ pub const BUDGETS: [StepBudget; 3] = [
         // maps take no cbrtf since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
         stages: [8_400, 6_200, 1_000, 930, 500],
-        // Measured 24 004 one period late, 23 923 on the largest fixed work (Choices 561, 566,
+        // Measured 23 968 one period late, 23 887 on the largest fixed work (Choices 561, 566,
         // 568; 24 153 and 24 071 before them; Choice 499; 24 259
         // and 24 177 before it; 24 453 and 24 362
         // before Choices 513 and 572; Choice 554;
         // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
         // before Choice 493); solution,
-        // filter, estimate, record: 7 503, 947, 7 513, 245 (7 535, 1 023, 7 504, 256 before
+        // filter, estimate, record: 7 502, 894, 7 512, 245 (7 535, 1 023, 7 504, 256 before
         // them; 1 131 and 268 before Choice 499; 603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
         // attitude).
         update_from_solution: 25_400,
-        estimator_stages: [8_400, 1_090, 8_400, 290],
+        estimator_stages: [8_400, 1_030, 8_400, 290],
         // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
         // cosf in the rebuild, its sin/cos in the waypoint build).
         work: WorkBudget {
@@ -169,16 +170,16 @@ pub const BUDGETS: [StepBudget; 3] = [
         // path's trajectory stage the 570, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
         stages: [450, 680, 700, 930, 480],
-        // Measured 4 380 one period late, 4 352 on the largest fixed work (Choices 561, 566,
+        // Measured 4 344 one period late, 4 317 on the largest fixed work (Choices 561, 566,
         // 568; 4 515 and 4 488 before them; Choice 499; 4 623
         // and 4 595 before it; 4 818 and 4 799
         // before Choices 513 and 572; Choice 554; 4 790
         // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
         // Choice 493); solution, filter,
-        // estimate, record: 315, 947, 324, 245 (343, 1 025, 325, 258 before them; 1 129 and
+        // estimate, record: 315, 894, 324, 245 (343, 1 025, 325, 258 before them; 1 129 and
         // 267 before Choice 499; 606 before Choice 554).
         update_from_solution: 4_750,
-        estimator_stages: [370, 1_090, 380, 290],
+        estimator_stages: [370, 1_030, 380, 290],
         // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
         work: WorkBudget {
             set_config: 41_000,
