@@ -456,7 +456,7 @@ impl Sums {
 /// A state (η, η̇) at a period: what [`Estimate::step`] returns.
 pub type StateAt = ([f32; 6], [f32; 6]);
 
-/// A period as an [`Estimate`] counts it ([`Estimate::period`], Choice 568): the tick, and
+/// A period as an [`Estimate`] counts it (`Estimate::period`, Choice 568): the tick, and
 /// the tick in periods from the memory's anchor.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct Period {
@@ -692,7 +692,8 @@ impl Estimate {
             p[i] += (v[i] + 0.5 * d * dt) * dt + t * t * (eb - sb - n * sa);
             v[i] += d * dt + t * (ea - sa);
             if ANCHORED {
-                p[i] = self.anchor[i] + p[i];
+                // anchor + offset (IEEE addition commutes: the same bits).
+                p[i] += self.anchor[i];
             }
         };
         if s.past > 0 && e.past > 0 {
@@ -736,7 +737,7 @@ impl Estimate {
     /// [`Estimate::applied_in`] in the same period. **Choice 568:** the controller converts
     /// its u64 tick once a period, not once in each (the conversion may move the anchor, which
     /// nothing else does, so the count holds until the next period's).
-    pub fn period(&mut self, ticks: u64) -> Period {
+    pub(crate) fn period(&mut self, ticks: u64) -> Period {
         Period {
             ticks,
             now: self.now(ticks),
@@ -746,7 +747,7 @@ impl Estimate {
     /// [`Estimate::step`] in `period` (made by [`Estimate::period`] of this memory for this
     /// period).
     #[inline]
-    pub fn step_in(
+    pub(crate) fn step_in(
         &mut self,
         gains: &EstimatorGains,
         period: Period,
@@ -855,7 +856,7 @@ impl Estimate {
 
     /// [`Estimate::applied`] in `period` (made by [`Estimate::period`] of this memory for this
     /// period).
-    pub fn applied_in(&mut self, gains: &EstimatorGains, period: Period, a: &[f32; 6]) {
+    pub(crate) fn applied_in(&mut self, gains: &EstimatorGains, period: Period, a: &[f32; 6]) {
         let finite = times_zero(a) == 0.0;
         let ticks = period.now;
         if self.last != NONE && ticks <= self.last {
