@@ -12,7 +12,7 @@ use crate::allocation::{Allocated, Allocator, PseudoInverse};
 use crate::axes::ACTUATED;
 use crate::config::{BBound, ConfigError, ControllerConfig};
 use crate::effectiveness::THRUSTERS;
-use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind};
+use crate::estimator::{self, Estimate, EstimatorGains, EstimatorKind, Period, StateAt};
 use crate::kinematics::{Attitude, Kinematics};
 use crate::law::{self, AxisLyapunov, DeltaConstants, DeltaInputs, RobustLaw};
 use crate::math::times_zero;
@@ -263,6 +263,7 @@ enum LawInput<'a> {
 struct Recording<'a> {
     parts: &'a EstimatorParts,
     memory: &'a mut Estimate,
+    period: Period,
     est: &'a Estimated,
 }
 
@@ -508,10 +509,10 @@ impl Controller {
         if let Some(r) = record {
             match &stepped {
                 Ok(out) if finite => {
-                    Self::estimator_record_stage(r.parts, r.memory, ticks, r.est, out)
+                    Self::estimator_record_stage(r.parts, r.memory, r.period, r.est, out)
                 }
                 // The fail-safe below: nothing applied (the record stage's fault case).
-                _ => r.memory.applied(&r.parts.gains, ticks, &[0.0; 6]),
+                _ => r.memory.applied_in(&r.parts.gains, r.period, &[0.0; 6]),
             }
         }
         match stepped {
@@ -550,18 +551,28 @@ impl Controller {
         let Some(parts) = &self.estimator else {
             return self.update(ticks, &solution.eta, &solution.nu, trajectory);
         };
-        let estimated = self.estimator_solution_stage(solution).and_then(|told| {
-            let state = Self::estimator_filter_stage(parts, memory, ticks, solution, &told);
-            self.estimator_estimate_stage(state, &told)
-        });
-        // By reference: the estimate stays where its stage left it (a move copied it).
-        match &estimated {
+        let eta_dot = match self.estimator_solution_stage(solution) {
+            Ok(eta_dot) => eta_dot,
             Err(fault) => {
                 memory.applied(&parts.gains, ticks, &[0.0; 6]);
+                return Output::fail_safe(fault);
+            }
+        };
+        let (period, state) =
+            Self::estimator_filter_stage(parts, memory, ticks, solution, &eta_dot);
+        // By reference: the estimate stays where its stage left it (a move copied it).
+        match &self.estimator_estimate_stage(state, solution, &eta_dot) {
+            Err(fault) => {
+                memory.applied_in(&parts.gains, period, &[0.0; 6]);
                 Output::fail_safe(*fault)
             }
             Ok(est) => {
-                let record = Recording { parts, memory, est };
+                let record = Recording {
+                    parts,
+                    memory,
+                    period,
+                    est,
+                };
                 self.fly(ticks, &LawInput::Estimated(est), trajectory, Some(record))
             }
         }
@@ -574,24 +585,20 @@ impl Controller {
     }
 
     /// Stage [`EstimatorStage::Solution`]: the solution checked as [`Controller::update`]
-    /// checks it, J at its attitude and its η̇ = J(η)ν, as an [`Estimated`] state (the law
-    /// flies it so before any solution is taken).
+    /// checks it and its η̇ = J(η)ν, what the filter takes. **Choice 561:** only η̇: J at the
+    /// solution's attitude is formed again by the estimate stage on the one path that flies
+    /// the solution as told (before any is taken), rather than kept alive through the filter.
     #[doc(hidden)]
     #[inline]
-    pub fn estimator_solution_stage(&self, solution: &Solution) -> Result<Estimated, Fault> {
+    pub fn estimator_solution_stage(&self, solution: &Solution) -> Result<[f32; 6], Fault> {
         check_inputs(&solution.eta, &solution.nu)?;
-        let (kin, cos_theta_abs) = self.checked_kinematics(&solution.eta)?;
-        Ok(Estimated {
-            eta: solution.eta,
-            nu: solution.nu,
-            eta_dot: kin.eta_dot(&Vector6::from(solution.nu)),
-            kin,
-            cos_theta_abs,
-        })
+        let (kin, _) = self.checked_kinematics(&solution.eta)?;
+        Ok(kin.eta_dot(&Vector6::from(solution.nu)).into())
     }
 
-    /// Stage [`EstimatorStage::Filter`]: the solution (η, η̇ of `told`) taken into `memory` at
-    /// its stamp and the state predicted to `ticks` ([`Estimate::step`]).
+    /// Stage [`EstimatorStage::Filter`]: the solution (its η, and `eta_dot` its η̇) taken into
+    /// `memory` at its stamp and the state predicted to `ticks` ([`Estimate::step`]), with the
+    /// period as the memory counts it, for the record stage (Choice 568).
     #[doc(hidden)]
     #[inline]
     pub fn estimator_filter_stage(
@@ -599,29 +606,34 @@ impl Controller {
         memory: &mut Estimate,
         ticks: u64,
         solution: &Solution,
-        told: &Estimated,
-    ) -> Option<([f32; 6], [f32; 6])> {
-        memory.step(
-            &parts.gains,
-            ticks,
-            solution.stamp,
-            &solution.eta,
-            &told.eta_dot.into(),
-        )
+        eta_dot: &[f32; 6],
+    ) -> (Period, Option<StateAt>) {
+        let period = memory.period(ticks);
+        let state = memory.step_in(&parts.gains, period, solution.stamp, &solution.eta, eta_dot);
+        (period, state)
     }
 
     /// Stage [`EstimatorStage::Estimate`]: the state the law flies on: the filter's (η̂, η̂̇)
-    /// with J(η̂) (pitch limit checked) and ν̂ = J(η̂)⁻¹η̂̇, or the solution as told (`told`)
-    /// before any could be taken.
+    /// with J(η̂) (pitch limit checked) and ν̂ = J(η̂)⁻¹η̂̇, or, before any solution could be
+    /// taken, the solution as told (with `told_eta_dot` its η̇, J at its attitude: no more work
+    /// than the estimate's).
     #[doc(hidden)]
     #[inline]
     pub fn estimator_estimate_stage(
         &self,
         state: Option<([f32; 6], [f32; 6])>,
-        told: &Estimated,
+        solution: &Solution,
+        told_eta_dot: &[f32; 6],
     ) -> Result<Estimated, Fault> {
         let Some((eta, eta_dot)) = state else {
-            return Ok(*told);
+            let (kin, cos_theta_abs) = self.checked_kinematics(&solution.eta)?;
+            return Ok(Estimated {
+                eta: solution.eta,
+                nu: solution.nu,
+                eta_dot: Vector6::from(*told_eta_dot),
+                kin,
+                cos_theta_abs,
+            });
         };
         if times_zero(&eta) + times_zero(&eta_dot) != 0.0 {
             return Err(Fault::NonFiniteResult);
@@ -639,13 +651,13 @@ impl Controller {
 
     /// Stage [`EstimatorStage::Record`]: the acceleration the applied thrust gives under the
     /// nominal model at the estimate ([`estimator::applied_acceleration`], zero after a
-    /// fault) recorded into `memory` for period `ticks`.
+    /// fault) recorded into `memory` for `period` (the filter stage's).
     #[doc(hidden)]
     #[inline]
     pub fn estimator_record_stage(
         parts: &EstimatorParts,
         memory: &mut Estimate,
-        ticks: u64,
+        period: Period,
         est: &Estimated,
         out: &Output,
     ) {
@@ -660,7 +672,7 @@ impl Controller {
             .into(),
             Status::Fault(_) => [0.0; 6],
         };
-        memory.applied(&parts.gains, ticks, &accel);
+        memory.applied_in(&parts.gains, period, &accel);
     }
 
     /// J(η)'s kinematics and |cos θ|, with the pitch limit (η finite).

@@ -453,6 +453,17 @@ impl Sums {
     };
 }
 
+/// A state (η, η̇) at a period: what [`Estimate::step`] returns.
+pub type StateAt = ([f32; 6], [f32; 6]);
+
+/// A period as an [`Estimate`] counts it (`Estimate::period`, Choice 568): the tick, and
+/// the tick in periods from the memory's anchor.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Period {
+    ticks: u64,
+    now: u32,
+}
+
 /// Where a set's sums at a period are: the sums at a held period, and how many periods past
 /// it (0: the sums themselves; m > 0: the last period recorded, its acceleration added, then
 /// m − 1 periods without one, B′ = B + (m − 1)·A).
@@ -565,6 +576,7 @@ impl Estimate {
     /// and what it holds moves with it, unless some of it was more than that old (2³⁰
     /// periods, 124 days at 100 Hz: a solution not renewed for as long is forgotten, as in a
     /// new mission). Below 2³¹ periods from 0 the anchor never moves.
+    #[inline]
     fn now(&mut self, ticks: u64) -> u32 {
         let d = ticks.wrapping_sub(self.epoch);
         if d < SPAN {
@@ -574,6 +586,8 @@ impl Estimate {
     }
 
     /// [`Estimate::now`]'s rare case: time went back past the anchor or ran 2³¹ past it.
+    #[cold]
+    #[inline(never)]
     fn move_epoch(&mut self, ticks: u64) -> u32 {
         if ticks < self.epoch {
             self.reset();
@@ -648,9 +662,15 @@ impl Estimate {
 
     /// The state predicted from `from` (the stamp) to `to` with the accelerations applied
     /// since and the disturbance (constant over it, Choice 510): the position as its offset
-    /// from the anchor, and the velocity. Periods older than the ring weigh zero. Fixed work
-    /// (Choice 430).
-    fn predicted(&self, gains: &EstimatorGains, from: u32, to: u32) -> ([f32; 6], [f32; 6]) {
+    /// from the anchor (`ANCHORED`: the position itself, the anchor added axis by axis as the
+    /// loop goes, Choice 568), and the velocity. Periods older than the ring weigh zero. Fixed
+    /// work (Choice 430).
+    fn predicted<const ANCHORED: bool>(
+        &self,
+        gains: &EstimatorGains,
+        from: u32,
+        to: u32,
+    ) -> ([f32; 6], [f32; 6]) {
         let t = gains.period;
         let dt = periods(to.saturating_sub(from)) * t;
         let lo = from.max(self.oldest());
@@ -666,12 +686,31 @@ impl Estimate {
         let (s, e) = (self.at(k, lo), self.at(k, hi));
         let mut p = self.offset;
         let mut v = self.velocity;
-        for i in 0..6 {
-            let (sa, sb) = self.sums_at(&s, i);
-            let (ea, eb) = self.sums_at(&e, i);
+        // η += (η̇ + d·Δt/2)·Δt + T²·(B(τ) − B(s) − n·A(s)), η̇ += d·Δt + T·(A(τ) − A(s)).
+        let mut advance = |i: usize, (sa, sb): (f32, f32), (ea, eb): (f32, f32)| {
             let d = self.disturbance[i];
             p[i] += (v[i] + 0.5 * d * dt) * dt + t * t * (eb - sb - n * sa);
             v[i] += d * dt + t * (ea - sa);
+            if ANCHORED {
+                // anchor + offset (IEEE addition commutes: the same bits).
+                p[i] += self.anchor[i];
+            }
+        };
+        if s.past > 0 && e.past > 0 {
+            // Both ends past the last period recorded (the prediction to the current period
+            // from a stamp after it): one set of sums, the last period's acceleration added
+            // once for both (`Estimate::sums_at`'s operations, shared; Choice 568).
+            let (ms, me) = (periods(s.past - 1), periods(e.past - 1));
+            for i in 0..6 {
+                let (a, b) = (e.sums.a[i], e.sums.b[i]);
+                let a1 = a + self.accel[i];
+                let c = b + a + 0.5 * self.accel[i];
+                advance(i, (a1, c + ms * a1), (a1, c + me * a1));
+            }
+        } else {
+            for i in 0..6 {
+                advance(i, self.sums_at(&s, i), self.sums_at(&e, i));
+            }
         }
         (p, v)
     }
@@ -690,7 +729,33 @@ impl Estimate {
         eta: &[f32; 6],
         eta_dot: &[f32; 6],
     ) -> Option<([f32; 6], [f32; 6])> {
-        let now = self.now(ticks);
+        let period = self.period(ticks);
+        self.step_in(gains, period, stamp, eta, eta_dot)
+    }
+
+    /// Period `ticks` as this memory counts it (Choice 499), for [`Estimate::step_in`] and
+    /// [`Estimate::applied_in`] in the same period. **Choice 568:** the controller converts
+    /// its u64 tick once a period, not once in each (the conversion may move the anchor, which
+    /// nothing else does, so the count holds until the next period's).
+    pub(crate) fn period(&mut self, ticks: u64) -> Period {
+        Period {
+            ticks,
+            now: self.now(ticks),
+        }
+    }
+
+    /// [`Estimate::step`] in `period` (made by [`Estimate::period`] of this memory for this
+    /// period).
+    #[inline]
+    pub(crate) fn step_in(
+        &mut self,
+        gains: &EstimatorGains,
+        period: Period,
+        stamp: u64,
+        eta: &[f32; 6],
+        eta_dot: &[f32; 6],
+    ) -> Option<([f32; 6], [f32; 6])> {
+        let Period { ticks, now } = period;
         if self.valid && now < self.stamp {
             // Time went back: a new mission.
             self.reset();
@@ -717,10 +782,11 @@ impl Estimate {
                 self.valid = true;
             } else if stamp > self.stamp {
                 // The prior at the stamp, its position as an offset from the old anchor.
-                let (o, v) = self.predicted(gains, self.stamp, stamp);
-                let mut offset = [0.0f32; 6];
-                let mut vel = v;
-                let mut dist = self.disturbance;
+                let (o, v) = self.predicted::<false>(gains, self.stamp, stamp);
+                // Corrected in place (Choice 566), the state held for a posterior that is
+                // not finite (Choice 527), which is not kept.
+                let held = (self.offset, self.velocity, self.disturbance);
+                let mut zero = 0.0f32;
                 for i in 0..6 {
                     // z − prior = (z − anchor) − offset: near each other, so exact first.
                     let mut dz = (eta[i] - self.anchor[i]) - o[i];
@@ -730,26 +796,28 @@ impl Estimate {
                     let dv = eta_dot[i] - v[i];
                     let k = &gains.axes[i].k;
                     // Posterior − z, with z the new anchor: (prior − z) + K₀·[dz, dv].
-                    offset[i] = (k[(0, 0)] - 1.0) * dz + k[(0, 1)] * dv;
-                    vel[i] = v[i] + k[(1, 0)] * dz + k[(1, 1)] * dv;
+                    let offset = (k[(0, 0)] - 1.0) * dz + k[(0, 1)] * dv;
+                    let vel = v[i] + k[(1, 0)] * dz + k[(1, 1)] * dv;
                     let kd = &gains.axes[i].kd;
-                    dist[i] += kd[0] * dz + kd[1] * dv;
+                    let dist = self.disturbance[i] + (kd[0] * dz + kd[1] * dv);
+                    // Finiteness as Σ x·0 (Choice 527) over the posterior.
+                    zero += (eta[i] + offset) * 0.0 + vel * 0.0 + dist * 0.0;
+                    self.offset[i] = offset;
+                    self.velocity[i] = vel;
+                    self.disturbance[i] = dist;
                 }
-                let posterior: [f32; 6] = core::array::from_fn(|i| eta[i] + offset[i]);
-                if times_zero(&posterior) + times_zero(&vel) + times_zero(&dist) == 0.0 {
+                if zero == 0.0 {
                     self.anchor = *eta;
-                    self.offset = offset;
-                    self.velocity = vel;
-                    self.disturbance = dist;
                     self.stamp = stamp;
+                } else {
+                    (self.offset, self.velocity, self.disturbance) = held;
                 }
             }
         }
         if !self.valid {
             return None;
         }
-        let (o, v) = self.predicted(gains, self.stamp, now);
-        Some((core::array::from_fn(|i| self.anchor[i] + o[i]), v))
+        Some(self.predicted::<true>(gains, self.stamp, now))
     }
 
     /// The oldest period the record of period `ticks` keeps for a prediction to start from:
@@ -782,8 +850,15 @@ impl Estimate {
     /// stamped before that first missed period is then refused as not newer than the last
     /// taken.
     pub fn applied(&mut self, gains: &EstimatorGains, ticks: u64, a: &[f32; 6]) {
+        let period = self.period(ticks);
+        self.applied_in(gains, period, a);
+    }
+
+    /// [`Estimate::applied`] in `period` (made by [`Estimate::period`] of this memory for this
+    /// period).
+    pub(crate) fn applied_in(&mut self, gains: &EstimatorGains, period: Period, a: &[f32; 6]) {
         let finite = times_zero(a) == 0.0;
-        let ticks = self.now(ticks);
+        let ticks = period.now;
         if self.last != NONE && ticks <= self.last {
             if ticks == self.last {
                 self.accel = if finite { *a } else { [0.0; 6] };
@@ -795,7 +870,7 @@ impl Estimate {
         let fresh = self.last == NONE || ticks - self.last > 1;
         let keep_from = self.kept_from(ticks);
         if self.valid && self.stamp < keep_from {
-            let (o, v) = self.predicted(gains, self.stamp, keep_from);
+            let (o, v) = self.predicted::<false>(gains, self.stamp, keep_from);
             self.offset = o;
             self.velocity = v;
             self.stamp = keep_from;

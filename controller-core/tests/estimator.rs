@@ -7,7 +7,8 @@
 #![allow(clippy::field_reassign_with_default)]
 
 use controller_core::estimator::{
-    steady_state_gain, Estimate, EstimatorConfig, EstimatorGains, EstimatorKind, HORIZON, MAX_AGE,
+    steady_state_gain, Estimate, EstimatorConfig, EstimatorGains, EstimatorKind, DISTURBANCE_TIME,
+    HORIZON, MAX_AGE,
 };
 use controller_core::{
     ConfigError, Controller, ControllerConfig, Solution, Status, Table1Case, Trajectory,
@@ -554,6 +555,53 @@ fn a_solution_too_old_repeated_or_from_the_future_is_refused_and_the_state_held(
         assert!(e.iter().chain(ed.iter()).all(|x| x.is_finite()));
         // Held and predicted one period: x + v T.
         assert!((e[0] - (1.0 + 0.5 * 0.01)).abs() < 1e-6);
+    }
+}
+
+/// Choice 527: a finite solution whose correction is not finite (the innovation overflows f32)
+/// is not kept: the state, its stamp and its disturbance are those held before, and the
+/// estimate is the held state predicted, bit for bit what a refused solution gives (on both
+/// filters; the correction is made in place and the held state put back, Choice 566).
+#[test]
+fn a_correction_that_is_not_finite_leaves_the_held_state_predicted() {
+    for (g, with_disturbance) in [
+        (gains(0.005, 0.002, 0.02), false),
+        (gains_with(0.005, 0.002, 0.02, DISTURBANCE_TIME), true),
+    ] {
+        let mut memory = Estimate::new();
+        let z = [3.0e38f32, 2.0, 3.0, 0.0, 0.1, 0.2];
+        let zd = [0.5f32, 0.0, 0.0, 0.0, 0.0, 0.1];
+        memory.step(&g, 100, 100, &z, &zd).unwrap();
+        memory.applied(&g, 100, &[0.1; 6]);
+        memory.step(&g, 101, 101, &z, &zd).unwrap();
+        memory.applied(&g, 101, &[0.2; 6]);
+        let held = (memory.at_stamp(), memory.disturbance(), memory.stamp());
+        assert_eq!(
+            held.1 != [0.0; 6],
+            with_disturbance,
+            "the disturbance state moved: its hold is tested"
+        );
+        // −3·10³⁸ − 3·10³⁸ overflows: the innovation, the posterior and the gain's terms are
+        // infinite.
+        let mut overflow = z;
+        overflow[0] = -3.0e38;
+        let mut refused = z;
+        refused[0] = f32::NAN;
+        let mut taken = memory;
+        let mut reference = memory;
+        let estimate = taken.step(&g, 103, 102, &overflow, &zd).unwrap();
+        let expected = reference.step(&g, 103, 102, &refused, &zd).unwrap();
+        assert_eq!((taken.at_stamp(), taken.disturbance(), taken.stamp()), held);
+        assert_eq!(taken, reference);
+        let bits = |(e, ed): ([f32; 6], [f32; 6])| {
+            e.iter().chain(&ed).map(|x| x.to_bits()).collect::<Vec<_>>()
+        };
+        assert_eq!(bits(estimate), bits(expected));
+        assert!(estimate.0.iter().chain(&estimate.1).all(|x| x.is_finite()));
+        // And a finite correction at the same stamp is kept.
+        let mut m = memory;
+        m.step(&g, 103, 102, &z, &zd).unwrap();
+        assert_eq!(m.stamp(), 102);
     }
 }
 

@@ -99,8 +99,9 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 627 on the survey's golden vectors,
         // against 435 for the closed forms.
         stages: [500, 720, 640, 600, 480],
-        // Measured 4 272 on the largest fixed work, 4 253 one period late (Choices 571, 573 and
-        // 574, the law's stages: 4 652 and 4 644 before them; Choice 499: the
+        // Measured XXXX_K_WHOLE on the largest fixed work, XXXX_K_LATE one period late (Choices 561, 566
+        // and 568, the estimator's stages, and 571, 573 and 574, the law's: 4 652 and 4 644
+        // before them; Choice 499: the
         // estimator's periods as u32 counts; 4 760 and 4 751 before it; Choice 572:
         // `fly` records the output before returning it, no 196-byte copy; Choice 513: wrap_pi's
         // floor by the FPU; 4 942 and 4 937 before them). Choice 554: a
@@ -112,16 +113,18 @@ pub const BUDGETS: [StepBudget; 3] = [
         // 491, and the estimator's finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
         // 510, before Choices 520–522 and 524; 6 273 before both, 7 200 before Choices
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
-        // 2 030 of it and the law on the estimate ≈ 2 240 (docs/law.md#the-state-estimator).
+        // XXXX_K_EST of it and the law on the estimate ≈ XXXX_K_LAW (docs/law.md#the-state-estimator).
         update_from_solution: 4_900,
-        // solution, filter, estimate, record: measured 391, 1 029, 348, 260 (390, 1 127, 348,
+        // solution, filter, estimate, record: measured 351, 892, 364, 243 (391, 1 029, 348,
+        // 260 before Choices 561, 566 and 568: the estimate alone +16, as it now also forms J
+        // on the path that flies the solution as told; 390, 1 127, 348,
         // 266 before Choice 499's u32 periods; 393, 1 134, 354,
         // 264 before Choices 513 and 572; the record 605
         // before Choice 554, whose acceptance test adds 27 to the filter; 3 132
         // on Choice 494's case before Choice 492; 1 249 and 532 before Choice 527's finiteness
         // sums; the filter's disturbance state, Choice 510, adds about 210: its correction and
         // d·Δt²/2, d·Δt in both predictions).
-        estimator_stages: [450, 1_190, 410, 300],
+        estimator_stages: [410, 1_030, 420, 280],
         // Measured 35 960 (the whole patch host-sim sends, protocol 8: 71 bytes of the law's
         // settings more to decode, a digest over 190 bytes, 120 before, and the rebuild's
         // Lyapunov solve and loop-rate rule on the law sent, Choice 508; 29 160 with protocol
@@ -142,16 +145,17 @@ pub const BUDGETS: [StepBudget; 3] = [
         // since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
         stages: [8_400, 6_200, 930, 600, 490],
-        // Measured 23 836 one period late, 23 703 on the largest fixed work (Choices 571, 573
-        // and 574: 24 153 and 24 071 before them; Choice 499; 24 259
+        // Measured XXXX_L_LATE one period late, XXXX_L_WHOLE on the largest fixed work (Choices 561,
+        // 566, 568, 571, 573 and 574: 24 153 and 24 071 before them; Choice 499; 24 259
         // and 24 177 before it; 24 453 and 24 362
         // before Choices 513 and 572; Choice 554;
         // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
-        // before Choice 493); solution, filter, estimate, record: 7 535, 1 023, 7 504, 256
-        // (1 131 and 268 before Choice 499; 603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
+        // before Choice 493); solution,
+        // filter, estimate, record: 7 502, 894, 7 512, 245 (7 535, 1 023, 7 504, 256 before
+        // them; 1 131 and 268 before Choice 499; 603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
         // attitude).
         update_from_solution: 25_400,
-        estimator_stages: [8_400, 1_190, 8_400, 300],
+        estimator_stages: [8_400, 1_030, 8_400, 290],
         // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
         // cosf in the rebuild, its sin/cos in the waypoint build).
         work: WorkBudget {
@@ -169,15 +173,16 @@ pub const BUDGETS: [StepBudget; 3] = [
         // path's trajectory stage the 554, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
         stages: [450, 640, 660, 600, 480],
-        // Measured 4 171 one period late, 4 165 on the largest fixed work (Choices 571, 573 and
-        // 574: 4 515 and 4 488 before them; Choice 499; 4 623
+        // Measured XXXX_M_LATE one period late, XXXX_M_WHOLE on the largest fixed work (Choices 561,
+        // 566, 568, 571, 573 and 574: 4 515 and 4 488 before them; Choice 499; 4 623
         // and 4 595 before it; 4 818 and 4 799
         // before Choices 513 and 572; Choice 554; 4 790
         // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
-        // Choice 493); solution, filter, estimate, record: 343, 1 025, 325, 258 (1 129 and
+        // Choice 493); solution, filter,
+        // estimate, record: 315, 894, 324, 245 (343, 1 025, 325, 258 before them; 1 129 and
         // 267 before Choice 499; 606 before Choice 554).
         update_from_solution: 4_750,
-        estimator_stages: [400, 1_190, 380, 300],
+        estimator_stages: [370, 1_030, 380, 290],
         // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
         work: WorkBudget {
             set_config: 41_000,

@@ -105,14 +105,14 @@ pub fn run(counter: &Counter) -> bool {
         share = share.max(count.saturating_sub(plain));
 
         // The stages on this vector's own intermediate values, in order.
-        let Ok(told) = c.estimator_solution_stage(&solution) else {
+        let Ok(eta_dot) = c.estimator_solution_stage(&solution) else {
             continue;
         };
         // `memory` again: the memory after the filter, which the record stage starts from.
         memory = before;
-        let state =
-            Controller::estimator_filter_stage(&parts, &mut memory, ticks, &solution, &told);
-        let Ok(est) = c.estimator_estimate_stage(state, &told) else {
+        let (period, state) =
+            Controller::estimator_filter_stage(&parts, &mut memory, ticks, &solution, &eta_dot);
+        let Ok(est) = c.estimator_estimate_stage(state, &solution, &eta_dot) else {
             continue;
         };
         for (i, stage) in EstimatorStage::ALL.into_iter().enumerate() {
@@ -128,20 +128,24 @@ pub fn run(counter: &Counter) -> bool {
                             black_box(&mut m),
                             black_box(ticks),
                             black_box(&solution),
-                            black_box(&told),
+                            black_box(&eta_dot),
                         )
                     })
                     .saturating_sub(copy),
-                EstimatorStage::Estimate => {
-                    counter.count(|| c.estimator_estimate_stage(black_box(state), black_box(&told)))
-                }
+                EstimatorStage::Estimate => counter.count(|| {
+                    c.estimator_estimate_stage(
+                        black_box(state),
+                        black_box(&solution),
+                        black_box(&eta_dot),
+                    )
+                }),
                 EstimatorStage::Record => counter
                     .count(|| {
                         let mut m = *black_box(&memory);
                         Controller::estimator_record_stage(
                             black_box(&parts),
                             black_box(&mut m),
-                            black_box(ticks),
+                            black_box(period),
                             black_box(&est),
                             black_box(&o),
                         );
