@@ -1835,12 +1835,13 @@ mod tests {
             format!("{out:?}")
         };
         let flown = term(false);
-        let before = REPLAYED.with(std::cell::Cell::get);
+        let before = (REPLAYED.with(Cell::get), ALIKE.with(Cell::get));
         let replayed = term(true);
         assert!(
-            REPLAYED.with(std::cell::Cell::get) > before + 10_000,
+            REPLAYED.with(Cell::get) > before.0 + 10_000,
             "nothing replayed"
         );
+        assert!(ALIKE.with(Cell::get) > before.1 + 100, "no sample alike");
         assert_eq!(replayed, flown);
     }
 
