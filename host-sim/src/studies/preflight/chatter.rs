@@ -56,6 +56,7 @@ use controller_core::{Mission, Trajectory};
 use nalgebra::{RowVector2, SMatrix, Vector3, Vector6};
 use serde::{Deserialize, Serialize};
 
+use super::bits::BitsMap;
 use super::path_budget::{
     axis_noise, current_corners, period_maps, redraw, reference_samples, AxisNoise, Cov, Loop,
     PeriodMaps, PlantCache, RefSample, N,
@@ -391,8 +392,26 @@ fn crossing_probability_carried(
 }
 
 /// A crossing's inputs where the mean stands still (the mean, the two σ, the covariance, the
-/// level), by their bits.
-type CrossingKey = [u64; 5];
+/// level), by their bits. Compared and hashed word by word: the array's own `==` is a call to
+/// `memcmp` per probe and its hash one byte-slice write, ~5 % of `check` on the survey
+/// between them (**Choice 578**); what a lookup finds is the same.
+#[derive(Clone, Copy, Eq)]
+struct CrossingKey([u64; 5]);
+
+impl PartialEq for CrossingKey {
+    fn eq(&self, other: &Self) -> bool {
+        let (a, b) = (&self.0, &other.0);
+        ((a[0] ^ b[0]) | (a[1] ^ b[1]) | (a[2] ^ b[2]) | (a[3] ^ b[3]) | (a[4] ^ b[4])) == 0
+    }
+}
+
+impl std::hash::Hash for CrossingKey {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        for w in self.0 {
+            state.write_u64(w);
+        }
+    }
+}
 /// The Φ pair a crossing carries to the next period ([`crossing_probability_carried`]).
 type Carry = Option<(u64, (f64, f64))>;
 
@@ -426,7 +445,7 @@ impl Crossings {
         if m[0].to_bits() != m[1].to_bits() {
             return crossing_probability_carried(m, s, cov, level, carry);
         }
-        let key = [m[0], s[0], s[1], cov, level].map(f64::to_bits);
+        let key = CrossingKey([m[0], s[0], s[1], cov, level].map(f64::to_bits));
         if let Some(&(p, after)) = self.0.get(&key) {
             *carry = after;
             return p;
@@ -436,6 +455,102 @@ impl Crossings {
             self.0.insert(key, (p, *carry));
         }
         p
+    }
+}
+
+/// What one period of a still stretch adds ([`Still`]): each edge's crossing probability and
+/// the total variation's term, and what it leaves for the next period (the carries, v₁).
+#[derive(Clone, Copy)]
+struct StillPeriod {
+    crossings: [[f64; 2]; THRUSTERS],
+    tv: [f64; THRUSTERS],
+    carry: [[Carry; 2]; THRUSTERS],
+    v1: [f64; THRUSTERS],
+}
+
+/// A stretch where every thruster's mean stands still (its bits equal from one period to the
+/// next: a leg at a constant speed), replayed by the cycle of the noise's statistics
+/// (**Choice 580**). There a period's inputs are the mean's bits and the statistics at its
+/// phase n mod `cycle` (the lcm of the axes' cycles), so what it adds to the sums (each
+/// crossing's probability, whatever it carried, Choice 517; the total variation's
+/// slope·E|Δu| at Δm = 0) and what it carries are those of the period one cycle before:
+/// the first cycle of a stretch is flown and recorded, the rest adds the recorded terms in
+/// the same order — the same sums, bit for bit, without their square roots, Φ and exp
+/// (and its σ and step maxima are the first cycle's).
+struct Still {
+    /// The statistics' cycle (periods); 0: too long to record ([`MAX_STILL_CYCLE`]).
+    cycle: u64,
+    /// The stretch's mean (bits) and first period; `None`: not in a still stretch.
+    at: Option<([u64; THRUSTERS], u64)>,
+    rec: Vec<StillPeriod>,
+    /// The record the last replayed period read: its carries and v₁ are the flight's.
+    replayed: Option<usize>,
+}
+
+/// The longest statistics' cycle [`Still`] records (periods, about 500 bytes each).
+const MAX_STILL_CYCLE: u64 = 1 << 12;
+
+#[cfg(test)]
+thread_local! {
+    /// Tests: fly every period and form every sample's mean thrusts (the reference
+    /// Choices 579 and 580 are tested against).
+    static NO_REPLAY: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Tests: the periods replayed so far.
+    static REPLAYED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    /// Tests: the samples whose mean thrusts were an alike one's.
+    static ALIKE: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+impl Still {
+    fn new(stats: &[AxisStats; 6]) -> Self {
+        let cycle = stats
+            .iter()
+            .map(|s| s.var.len() as u64)
+            .filter(|&l| l > 0)
+            .try_fold(1u64, |c, l| {
+                let c = c / gcd(c, l) * l;
+                (c <= MAX_STILL_CYCLE).then_some(c)
+            })
+            .unwrap_or(0);
+        #[cfg(test)]
+        let cycle = if NO_REPLAY.with(std::cell::Cell::get) {
+            0
+        } else {
+            cycle
+        };
+        Still {
+            cycle,
+            at: None,
+            rec: Vec::new(),
+            replayed: None,
+        }
+    }
+
+    /// Period `n`, from mean `m0` to `m1`: the index of its record if the stretch has a whole
+    /// cycle recorded (replay it), else `None` (fly it; [`Still::recording`] says whether to
+    /// record it).
+    fn replay(&mut self, n: u64, m0: &[f64; THRUSTERS], m1: &[f64; THRUSTERS]) -> Option<usize> {
+        let bits = m0.map(f64::to_bits);
+        if self.cycle == 0 || m1.map(f64::to_bits) != bits {
+            self.at = None;
+            return None;
+        }
+        match self.at {
+            Some((b, start)) if b == bits => {
+                let i = n - start;
+                (i >= self.cycle).then(|| (i % self.cycle) as usize)
+            }
+            _ => {
+                self.at = Some((bits, n));
+                self.rec.clear();
+                None
+            }
+        }
+    }
+
+    /// Whether period `n` (flown) is to be recorded: in a still stretch's first cycle.
+    fn recording(&self, n: u64) -> bool {
+        self.at.is_some_and(|(_, start)| n - start < self.cycle)
     }
 }
 
@@ -805,6 +920,10 @@ impl<'a> Chatter<'a> {
         let mut delta = 0.0f64;
         let mut out = vec![Vec::with_capacity(self.samples.len()); self.currents.len()];
         let mut plant = PlantCache::default();
+        // The samples met so far with the same plant (the cache's), by the bits of what
+        // their thrusts read besides it (Choice 579): their δ and index.
+        let mut alike: BitsMap<[u64; 16], (f32, usize)> = BitsMap::default();
+        let mut alike_params = None;
         for (j, r) in self.samples.iter().enumerate() {
             if j % 4096 == 0 {
                 super::poll()?;
@@ -813,6 +932,31 @@ impl<'a> Chatter<'a> {
             // The vehicle holds the heel of its payload (roll is not actuated), as the force
             // check evaluates it ([`super::attitude::heel`]).
             let level = crate::plant::static_heel(&params, r.eta[PITCH]).unwrap_or(0.0);
+            if alike_params != Some(params) {
+                alike.clear();
+                alike_params = Some(params);
+            }
+            let mut key = [level.to_bits(); 16];
+            for (w, x) in key[1..]
+                .iter_mut()
+                .zip(r.eta.iter().skip(ROLL).chain(&r.eta_dot).chain(&r.eta_ddot))
+            {
+                *w = x.to_bits();
+            }
+            #[cfg(test)]
+            let reference = NO_REPLAY.with(std::cell::Cell::get);
+            #[cfg(not(test))]
+            let reference = false;
+            if let Some(&(d, first)) = alike.get(&key).filter(|_| !reference) {
+                delta = delta.max(f64::from(d));
+                #[cfg(test)]
+                ALIKE.with(|c| c.set(c.get() + 1));
+                for o in out.iter_mut() {
+                    let thrusts = o[first];
+                    o.push(thrusts);
+                }
+                continue;
+            }
             let (state, nu_dot) = state_at(r, k, level);
             let (att, nu) = (Attitude::from_eta(&state.eta), state.nu);
             let jjn = kinematics::jinv_jdot_nu(&att, &nu).unwrap_or_else(|_| Vector6::zeros());
@@ -834,6 +978,7 @@ impl<'a> Chatter<'a> {
                 let tau = truth.required_force(&state, &nu_dot, c).cast::<f32>();
                 o.push(alloc.thrusts(&tau).map(f64::from));
             }
+            alike.insert(key, (d, j));
         }
         let delta_max = f64::from(controller.config().delta_max);
         Ok((
@@ -1045,6 +1190,7 @@ impl<'a> Chatter<'a> {
             (0..6).map(|a| c[a] * next[a].0).sum::<f64>() * scale2
         });
         let mut slopes: [Option<(u64, f64)>; THRUSTERS] = [None; THRUSTERS];
+        let mut still = Still::new(stats);
         for n in 0..flown {
             if n == from {
                 before = (crossings, tv);
@@ -1062,6 +1208,24 @@ impl<'a> Chatter<'a> {
                 }
             }
             let m1 = at(n + 1);
+            if let Some(i) = still.replay(n, &m0, &m1) {
+                let r = &still.rec[i];
+                for j in 0..THRUSTERS {
+                    for (sum, p) in crossings[j].iter_mut().zip(&r.crossings[j]) {
+                        *sum += p;
+                    }
+                    tv[j] += r.tv[j];
+                }
+                still.replayed = Some(i);
+                #[cfg(test)]
+                REPLAYED.with(|c| c.set(c.get() + 1));
+                continue;
+            }
+            if let Some(i) = still.replayed.take() {
+                // Flying again after a replay: what the replayed period left.
+                (carry, v_next) = (still.rec[i].carry, still.rec[i].v1);
+                next = std::array::from_fn(|a| stats[a].at(n));
+            }
             if held && m1 != m0 {
                 // A step: the kept crossings were the last stretch's (their mean is gone).
                 kept.0.clear();
@@ -1070,6 +1234,12 @@ impl<'a> Chatter<'a> {
             // the same expressions of the same inputs, carried rather than formed twice.
             let now = next;
             next = std::array::from_fn(|a| stats[a].at(n + 1));
+            let mut added = StillPeriod {
+                crossings: [[0.0; 2]; THRUSTERS],
+                tv: [0.0; THRUSTERS],
+                carry: [[None; 2]; THRUSTERS],
+                v1: [0.0; THRUSTERS],
+            };
             for j in 0..THRUSTERS {
                 let c = &self.coeff[j];
                 let v0 = v_next[j];
@@ -1081,8 +1251,9 @@ impl<'a> Chatter<'a> {
                 sigma[j] = sigma[j].max(s[0]);
                 step[j] = step[j].max(dvar.sqrt());
                 for (e, level) in self.band[j].iter().enumerate() {
-                    crossings[j][e] +=
-                        kept.crossing([m0[j], m1[j]], s, cov, *level, &mut carry[j][e]);
+                    let p = kept.crossing([m0[j], m1[j]], s, cov, *level, &mut carry[j][e]);
+                    crossings[j][e] += p;
+                    added.crossings[j][e] = p;
                 }
                 let dm = m1[j] - m0[j];
                 // The slope at the last period's mean again where the mean stands still.
@@ -1091,7 +1262,12 @@ impl<'a> Chatter<'a> {
                     _ => self.slope(j, m0[j]),
                 };
                 slopes[j] = Some((m0[j].to_bits(), slope));
-                tv[j] += slope * mean_abs(dm, dvar.sqrt());
+                added.tv[j] = slope * mean_abs(dm, dvar.sqrt());
+                tv[j] += added.tv[j];
+            }
+            if still.recording(n) {
+                (added.carry, added.v1) = (carry, v_next);
+                still.rec.push(added);
             }
             m0 = m1;
         }
@@ -1632,6 +1808,41 @@ mod tests {
             "{reversals} reversals vs {bound}"
         );
         assert!(reversals > 0);
+    }
+
+    /// Choices 579–580: the term with alike samples' mean thrusts formed once and still
+    /// stretches replayed by the noise's cycle is the term formed sample by sample and flown
+    /// period by period, bit for bit (the survey's legs and turns under its navigation, the
+    /// mean moving and held, another scale and noise), and it does replay.
+    #[test]
+    fn replayed_still_stretches_are_the_flown_ones() {
+        use std::cell::Cell;
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenarios/real/survey-200x100.toml");
+        let survey = crate::scenario::load_scenario(&path).expect("the survey");
+        let survey = survey
+            .with(|c| c.duration = 300.0)
+            .expect("a shorter survey");
+        let term = |replay: bool| {
+            NO_REPLAY.with(|c| c.set(!replay));
+            let chatter = Chatter::new(&survey).expect("a term").expect("a bound");
+            let out = [
+                chatter.evaluate().expect("the term"),
+                chatter.slowest_held().expect("held"),
+                chatter.predict_with(1.3, 0.7, false).expect("at 1.3"),
+            ];
+            NO_REPLAY.with(|c| c.set(false));
+            format!("{out:?}")
+        };
+        let flown = term(false);
+        let before = (REPLAYED.with(Cell::get), ALIKE.with(Cell::get));
+        let replayed = term(true);
+        assert!(
+            REPLAYED.with(Cell::get) > before.0 + 10_000,
+            "nothing replayed"
+        );
+        assert!(ALIKE.with(Cell::get) > before.1 + 100, "no sample alike");
+        assert_eq!(replayed, flown);
     }
 
     /// E|x| of a Gaussian: σ√(2/π) at μ = 0, |μ| when σ → 0.

@@ -828,11 +828,12 @@ impl<'a> Checker<'a> {
     /// first violation of the margin envelope.
     fn judge(&self, margin: &Margin, t: f64, tau: &Vector6<f32>, full: bool, out: &mut Sweep) {
         let allocation = self.scenario.controller().allocation();
-        if let Some(span) = out.span.as_mut() {
-            span.add(&allocation.thrusts(tau));
+        // The pseudo-inverse's thrusts once for the span and the peaks (Choice 578).
+        let thrusts = (out.span.is_some() || full).then(|| allocation.thrusts(tau));
+        if let (Some(span), Some(thrusts)) = (out.span.as_mut(), &thrusts) {
+            span.add(thrusts);
         }
-        if full {
-            let thrusts = allocation.thrusts(tau);
+        if let (true, Some(thrusts)) = (full, &thrusts) {
             for (i, p) in out.peaks.iter_mut().enumerate() {
                 let x = f64::from(thrusts[i]);
                 if x < p.0 {
