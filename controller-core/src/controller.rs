@@ -186,6 +186,7 @@ impl Output {
     /// NaN through a sum: the sum of every field times 0 is zero exactly when every field is
     /// finite — two instructions a value on the board where a test and branch each took four
     /// (Choice 524).
+    #[cfg(test)]
     fn all_finite(&self) -> bool {
         let vectors = [
             &self.tau,
@@ -264,6 +265,70 @@ struct Recording<'a> {
     parts: &'a EstimatorParts,
     memory: &'a mut Estimate,
     est: &'a Estimated,
+}
+
+/// Records the stages' results (`applied`; `None`: the fail-safe, nothing applied) when
+/// dropped, at the end of [`Controller::fly`].
+struct Recorder<'a> {
+    recording: Recording<'a>,
+    ticks: u64,
+    applied: Option<&'a Stepped>,
+}
+
+impl Drop for Recorder<'_> {
+    #[inline]
+    fn drop(&mut self) {
+        let r = &mut self.recording;
+        let applied = self
+            .applied
+            .map(|p| (&p.law.u, &p.law.tau, &p.tau_achieved));
+        Controller::record_applied(r.parts, r.memory, self.ticks, r.est, applied);
+    }
+}
+
+/// The stages' results of one step, before they are assembled into the [`Output`].
+struct Stepped {
+    eta_d: Vector6<f32>,
+    law: StepLaw,
+    alloc: Allocated,
+    act: Actuation,
+    tau_achieved: Vector6<f32>,
+}
+
+impl Stepped {
+    /// Every field the output takes finite, as [`Output::all_finite`] checks it (Choice 524),
+    /// but τ: the law stage has checked it.
+    #[inline]
+    fn finite(&self) -> bool {
+        let vectors = [&self.tau_achieved, &self.eta_d, &self.law.e1, &self.law.u];
+        let mut zero = (self.law.delta * 0.0) + (self.law.w_norm * 0.0);
+        for v in vectors {
+            zero += times_zero(&(*v).into());
+        }
+        zero += times_zero(&self.alloc.unallocated);
+        zero += times_zero(&self.act.thrusts) + times_zero(&self.act.voltages);
+        zero == 0.0
+    }
+
+    /// The output of these results (`robust`: Δu on, so a δ clamp is reported).
+    #[inline]
+    fn output(&self, robust: bool) -> Output {
+        Output {
+            status: Status::Ok,
+            tau: self.law.tau.into(),
+            tau_achieved: self.tau_achieved.into(),
+            tau_unallocated: self.alloc.unallocated,
+            thrust: self.act.thrusts,
+            voltage: self.act.voltages,
+            saturated: self.alloc.saturated | self.act.saturated,
+            delta: self.law.delta,
+            delta_clamped: robust && self.law.delta_clamped,
+            w_norm: self.law.w_norm,
+            eta_d: self.eta_d.into(),
+            e1: self.law.e1.into(),
+            u: self.law.u.into(),
+        }
+    }
 }
 
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
@@ -503,21 +568,21 @@ impl Controller {
         trajectory: &Trajectory,
         record: Option<Recording>,
     ) -> Output {
-        let stepped = self.step(ticks, input, trajectory);
-        let finite = matches!(&stepped, Ok(out) if out.all_finite());
-        if let Some(r) = record {
-            match &stepped {
-                Ok(out) if finite => {
-                    Self::estimator_record_stage(r.parts, r.memory, ticks, r.est, out)
-                }
-                // The fail-safe below: nothing applied (the record stage's fault case).
-                _ => r.memory.applied(&r.parts.gains, ticks, &[0.0; 6]),
-            }
-        }
-        match stepped {
-            Ok(out) if finite => out,
-            Ok(_) => Output::fail_safe(Fault::NonFiniteResult),
-            Err(fault) => Output::fail_safe(fault),
+        let stepped = match self.step(ticks, input, trajectory) {
+            Ok(parts) if parts.finite() => Ok(parts),
+            Ok(_) => Err(Fault::NonFiniteResult),
+            Err(fault) => Err(fault),
+        };
+        // Recorded when `_recorder` is dropped: after the output below is written to the
+        // return value, which then holds it (not the stack across the record's call).
+        let _recorder = record.map(|recording| Recorder {
+            recording,
+            ticks,
+            applied: stepped.as_ref().ok(),
+        });
+        match &stepped {
+            Ok(parts) => parts.output(self.config.robust),
+            Err(fault) => Output::fail_safe(*fault),
         }
     }
 
@@ -649,16 +714,37 @@ impl Controller {
         est: &Estimated,
         out: &Output,
     ) {
-        let accel = match out.status {
-            Status::Ok => estimator::applied_acceleration(
-                &Vector6::from(out.u),
-                &est.kin,
-                &parts.m_diag_inv,
-                &Vector6::from(out.tau),
-                &Vector6::from(out.tau_achieved),
-            )
-            .into(),
-            Status::Fault(_) => [0.0; 6],
+        let applied = match out.status {
+            Status::Ok => Some((
+                Vector6::from(out.u),
+                Vector6::from(out.tau),
+                Vector6::from(out.tau_achieved),
+            )),
+            Status::Fault(_) => None,
+        };
+        let applied = applied
+            .as_ref()
+            .map(|(u, tau, achieved)| (u, tau, achieved));
+        Self::record_applied(parts, memory, ticks, est, applied);
+    }
+
+    /// The record stage on the law's u, τ and the achieved τ (`None`: a fault, nothing
+    /// applied): what [`Controller::fly`] records from the stages' parts, before the output
+    /// is assembled.
+    #[inline]
+    fn record_applied(
+        parts: &EstimatorParts,
+        memory: &mut Estimate,
+        ticks: u64,
+        est: &Estimated,
+        applied: Option<(&Vector6<f32>, &Vector6<f32>, &Vector6<f32>)>,
+    ) {
+        let accel = match applied {
+            Some((u, tau, achieved)) => {
+                estimator::applied_acceleration(u, &est.kin, &parts.m_diag_inv, tau, achieved)
+                    .into()
+            }
+            None => [0.0; 6],
         };
         memory.applied(&parts.gains, ticks, &accel);
     }
@@ -675,7 +761,12 @@ impl Controller {
     }
 
     /// The stages of [`Stage::ALL`] in order, then the output.
-    fn step(&self, ticks: u64, input: &LawInput, trajectory: &Trajectory) -> Result<Output, Fault> {
+    fn step(
+        &self,
+        ticks: u64,
+        input: &LawInput,
+        trajectory: &Trajectory,
+    ) -> Result<Stepped, Fault> {
         let kin = match input {
             LawInput::Told { eta, nu } => self.kinematics_stage(eta, nu)?,
             LawInput::Estimated(est) => self.estimated_kinematics(est)?,
@@ -684,20 +775,12 @@ impl Controller {
         let law = self.law_stage(&kin, &desired, trajectory)?;
         let alloc = self.allocation_stage(&law.tau);
         let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
-        Ok(Output {
-            status: Status::Ok,
-            tau: law.tau.into(),
-            tau_achieved: tau_achieved.into(),
-            tau_unallocated: alloc.unallocated,
-            thrust: act.thrusts,
-            voltage: act.voltages,
-            saturated: alloc.saturated | act.saturated,
-            delta: law.delta,
-            delta_clamped: self.config.robust && law.delta_clamped,
-            w_norm: law.w_norm,
-            eta_d: desired.eta.into(),
-            e1: law.e1.into(),
-            u: law.u.into(),
+        Ok(Stepped {
+            eta_d: desired.eta,
+            law,
+            alloc,
+            act,
+            tau_achieved,
         })
     }
 
