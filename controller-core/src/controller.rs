@@ -297,16 +297,17 @@ struct Stepped {
 
 impl Stepped {
     /// Every field the output takes finite, as [`Output::all_finite`] checks it (Choice 524),
-    /// but τ: the law stage has checked it.
+    /// but those the stages have already made finite (**Choice 581**): τ (the law stage's
+    /// check), δ (δ_raw checked finite, δ_max finite by the configuration's checks) and the
+    /// thrusts and voltages ([`thruster::actuate_within`]: every output finite for a finite
+    /// voltage limit > 0, which the configuration checks).
     #[inline]
     fn finite(&self) -> bool {
         let vectors = [&self.tau_achieved, &self.eta_d, &self.law.e1, &self.law.u];
-        let mut zero = (self.law.delta * 0.0) + (self.law.w_norm * 0.0);
+        let mut zero = (self.law.w_norm * 0.0) + times_zero(&self.alloc.unallocated);
         for v in vectors {
             zero += times_zero(&(*v).into());
         }
-        zero += times_zero(&self.alloc.unallocated);
-        zero += times_zero(&self.act.thrusts) + times_zero(&self.act.voltages);
         zero == 0.0
     }
 
