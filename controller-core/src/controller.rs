@@ -181,28 +181,6 @@ impl Output {
             u: [0.0; 6],
         }
     }
-
-    /// Every field finite. x·0 is ±0 for a finite x and NaN for ±∞ and NaN, and a NaN stays
-    /// NaN through a sum: the sum of every field times 0 is zero exactly when every field is
-    /// finite — two instructions a value on the board where a test and branch each took four
-    /// (Choice 524).
-    #[cfg(test)]
-    fn all_finite(&self) -> bool {
-        let vectors = [
-            &self.tau,
-            &self.tau_achieved,
-            &self.tau_unallocated,
-            &self.eta_d,
-            &self.e1,
-            &self.u,
-        ];
-        let mut zero = (self.delta * 0.0) + (self.w_norm * 0.0);
-        for v in vectors {
-            zero += times_zero(v);
-        }
-        zero += times_zero(&self.thrust) + times_zero(&self.voltage);
-        zero == 0.0
-    }
 }
 
 /// A validated configuration with everything `update` needs precomputed.
@@ -287,6 +265,7 @@ impl Drop for Recorder<'_> {
 }
 
 /// The stages' results of one step, before they are assembled into the [`Output`].
+#[derive(Clone, Copy)]
 struct Stepped {
     eta_d: Vector6<f32>,
     law: StepLaw,
@@ -296,7 +275,7 @@ struct Stepped {
 }
 
 impl Stepped {
-    /// Every field the output takes finite, as [`Output::all_finite`] checks it (Choice 524),
+    /// Every field the output takes finite, as a sum of x·0 (Choice 524: zero exactly when every x is finite),
     /// but those the stages have already made finite (**Choice 581**): τ (the law stage's
     /// check), δ (δ_raw checked finite, δ_max finite by the configuration's checks) and the
     /// thrusts and voltages ([`thruster::actuate_within`]: every output finite for a finite
@@ -1087,30 +1066,40 @@ mod tests {
     /// Choice 524: the sum-times-zero check finds a non-finite value in every field and at
     /// every position, ±∞ and NaN alike, and passes finite values of any size and sign.
     #[test]
-    fn all_finite_finds_every_non_finite_value() {
-        let finite = Output {
-            tau: [f32::MAX, -f32::MAX, 0.0, -0.0, f32::MIN_POSITIVE, 1.0],
-            ..Output::fail_safe(Fault::NonFiniteResult)
+    fn the_finite_check_finds_every_non_finite_value_it_checks() {
+        let zero = Vector6::zeros();
+        let finite = Stepped {
+            eta_d: Vector6::from([f32::MAX, -f32::MAX, 0.0, -0.0, f32::MIN_POSITIVE, 1.0]),
+            law: StepLaw {
+                u: zero,
+                tau: zero,
+                delta: 0.0,
+                delta_clamped: false,
+                w_norm: 0.0,
+                e1: zero,
+            },
+            alloc: Allocated {
+                thrusts: [0.0; THRUSTERS],
+                saturated: 0,
+                unallocated: [0.0; 6],
+            },
+            act: Actuation::OFF,
+            tau_achieved: zero,
         };
-        assert!(finite.all_finite());
-        let fields = 6 * 6 + 2 * 5 + 2;
-        for k in 0..fields {
+        assert!(finite.finite());
+        for k in 0..5 * 6 + 1 {
             for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
-                let mut o = finite;
+                let mut p = finite;
                 let slot = match k {
-                    0..=5 => &mut o.tau[k],
-                    6..=11 => &mut o.tau_achieved[k - 6],
-                    12..=17 => &mut o.tau_unallocated[k - 12],
-                    18..=22 => &mut o.thrust[k - 18],
-                    23..=27 => &mut o.voltage[k - 23],
-                    28..=33 => &mut o.eta_d[k - 28],
-                    34..=39 => &mut o.e1[k - 34],
-                    40..=45 => &mut o.u[k - 40],
-                    46 => &mut o.delta,
-                    _ => &mut o.w_norm,
+                    0..=5 => &mut p.tau_achieved[k],
+                    6..=11 => &mut p.alloc.unallocated[k - 6],
+                    12..=17 => &mut p.eta_d[k - 12],
+                    18..=23 => &mut p.law.e1[k - 18],
+                    24..=29 => &mut p.law.u[k - 24],
+                    _ => &mut p.law.w_norm,
                 };
                 *slot = bad;
-                assert!(!o.all_finite(), "field slot {k}: {bad}");
+                assert!(!p.finite(), "field slot {k}: {bad}");
             }
         }
     }
