@@ -276,7 +276,7 @@ struct Stepped {
 
 impl Stepped {
     /// Every field the output takes finite, as a sum of x·0 (Choice 524: zero exactly when every x is finite),
-    /// but those the stages have already made finite (**Choice 581**): τ (the law stage's
+    /// but those the stages have already made finite (**Choice 582**): τ (the law stage's
     /// check), δ (δ_raw checked finite, δ_max finite by the configuration's checks) and the
     /// thrusts and voltages ([`thruster::actuate_within`]: every output finite for a finite
     /// voltage limit > 0, which the configuration checks).
