@@ -275,14 +275,18 @@ struct Stepped {
 }
 
 impl Stepped {
-    /// Every field the output takes finite, as a sum of x·0 (Choice 524: zero exactly when every x is finite),
-    /// but those the stages have already made finite (**Choice 582**): τ (the law stage's
-    /// check), δ (δ_raw checked finite, δ_max finite by the configuration's checks) and the
-    /// thrusts and voltages ([`thruster::actuate_within`]: every output finite for a finite
-    /// voltage limit > 0, which the configuration checks).
+    /// Every field the output takes finite, as a sum of x·0 (Choice 524: zero exactly when
+    /// every x is finite), but those the stages have already made finite (**Choice 582**):
+    /// τ (the law stage's check); δ (δ_raw checked finite, δ_max finite by the
+    /// configuration's checks); the thrusts and voltages ([`thruster::actuate_within`]: every
+    /// output finite for a finite voltage limit > 0, which the configuration checks); u, since
+    /// J⁻¹ and M̂ (invertible) take every uᵢ into some τⱼ, and ±∞ or NaN times or plus any
+    /// value is not finite; and e₁, which enters u through ū = η̈_d − K₁e₁ − K₂e₂ (Eq 17;
+    /// the yaw's wrap keeps a non-finite value non-finite). η_d reaches τ the same way through
+    /// e₁ but stays in: without it the compiler lays `fly` out anew, 313 instructions dearer.
     #[inline]
     fn finite(&self) -> bool {
-        let vectors = [&self.tau_achieved, &self.eta_d, &self.law.e1, &self.law.u];
+        let vectors = [&self.tau_achieved, &self.eta_d];
         let mut zero = (self.law.w_norm * 0.0) + times_zero(&self.alloc.unallocated);
         for v in vectors {
             zero += times_zero(&(*v).into());
@@ -1087,19 +1091,51 @@ mod tests {
             tau_achieved: zero,
         };
         assert!(finite.finite());
-        for k in 0..5 * 6 + 1 {
+        for k in 0..3 * 6 + 1 {
             for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
                 let mut p = finite;
                 let slot = match k {
                     0..=5 => &mut p.tau_achieved[k],
                     6..=11 => &mut p.alloc.unallocated[k - 6],
                     12..=17 => &mut p.eta_d[k - 12],
-                    18..=23 => &mut p.law.e1[k - 18],
-                    24..=29 => &mut p.law.u[k - 24],
                     _ => &mut p.law.w_norm,
                 };
                 *slot = bad;
                 assert!(!p.finite(), "field slot {k}: {bad}");
+            }
+        }
+    }
+
+    /// Choice 582's grounds for leaving u and e₁ out of the finite check: a non-finite uᵢ
+    /// gives a non-finite τ (which the law stage checks) at any attitude within the pitch
+    /// limit, and a non-finite e₁ᵢ a non-finite ūᵢ (the yaw's through its wrap).
+    #[test]
+    fn a_non_finite_u_or_e1_makes_tau_non_finite() {
+        let c = Controller::new(ControllerConfig::default()).expect("paper defaults");
+        let zero = Vector6::zeros();
+        let nu = Vector6::from([0.5, -0.2, 0.1, 0.05, -0.03, 0.2]);
+        for eta in [
+            [0.0; 6],
+            [1.0, -2.0, 3.0, 0.4, -0.5, 3.0],
+            [0.0, 0.0, 0.0, 0.0, 1.2, -2.0],
+        ] {
+            let kin = Kinematics::new(Attitude::from_eta_f32(&Vector6::from(eta))).unwrap();
+            let jinv_jdot_nu = kin.jinv_jdot_nu(&nu);
+            for i in 0..6 {
+                for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+                    let mut u = zero;
+                    u[i] = bad;
+                    let tau =
+                        law::body_force(&c.m_hat, &c.config.params, &kin, &nu, &u, &jinv_jdot_nu);
+                    assert!(times_zero(&tau.into()) != 0.0, "u[{i}] = {bad} at {eta:?}");
+                    let mut e1 = zero;
+                    e1[i] = bad;
+                    if i == crate::axes::YAW {
+                        e1[i] = crate::math::wrap_pi(bad);
+                    }
+                    let u_bar = law::nominal_input(&zero, &c.k1, &c.k2, &e1, &zero);
+                    assert!(!u_bar[i].is_finite(), "e1[{i}] = {bad}");
+                }
             }
         }
     }
