@@ -181,27 +181,6 @@ impl Output {
             u: [0.0; 6],
         }
     }
-
-    /// Every field finite. x·0 is ±0 for a finite x and NaN for ±∞ and NaN, and a NaN stays
-    /// NaN through a sum: the sum of every field times 0 is zero exactly when every field is
-    /// finite — two instructions a value on the board where a test and branch each took four
-    /// (Choice 524).
-    fn all_finite(&self) -> bool {
-        let vectors = [
-            &self.tau,
-            &self.tau_achieved,
-            &self.tau_unallocated,
-            &self.eta_d,
-            &self.e1,
-            &self.u,
-        ];
-        let mut zero = (self.delta * 0.0) + (self.w_norm * 0.0);
-        for v in vectors {
-            zero += times_zero(v);
-        }
-        zero += times_zero(&self.thrust) + times_zero(&self.voltage);
-        zero == 0.0
-    }
 }
 
 /// A validated configuration with everything `update` needs precomputed.
@@ -265,6 +244,75 @@ struct Recording<'a> {
     memory: &'a mut Estimate,
     period: Period,
     est: &'a Estimated,
+}
+
+/// Records the stages' results (`applied`; `None`: the fail-safe, nothing applied) when
+/// dropped, at the end of [`Controller::fly`].
+struct Recorder<'a> {
+    recording: Recording<'a>,
+    applied: Option<&'a Stepped>,
+}
+
+impl Drop for Recorder<'_> {
+    #[inline]
+    fn drop(&mut self) {
+        let r = &mut self.recording;
+        let applied = self
+            .applied
+            .map(|p| (&p.law.u, &p.law.tau, &p.tau_achieved));
+        Controller::record_applied(r.parts, r.memory, r.period, r.est, applied);
+    }
+}
+
+/// The stages' results of one step, before they are assembled into the [`Output`].
+#[derive(Clone, Copy)]
+struct Stepped {
+    eta_d: Vector6<f32>,
+    law: StepLaw,
+    alloc: Allocated,
+    act: Actuation,
+    tau_achieved: Vector6<f32>,
+}
+
+impl Stepped {
+    /// Every field the output takes finite, as a sum of x·0 (Choice 524: zero exactly when
+    /// every x is finite), but those the stages have already made finite (**Choice 582**):
+    /// τ (the law stage's check); δ (δ_raw checked finite, δ_max finite by the
+    /// configuration's checks); the thrusts and voltages ([`thruster::actuate_within`]: every
+    /// output finite for a finite voltage limit > 0, which the configuration checks); u, since
+    /// J⁻¹ and M̂ (invertible) take every uᵢ into some τⱼ, and ±∞ or NaN times or plus any
+    /// value is not finite; and e₁, which enters u through ū = η̈_d − K₁e₁ − K₂e₂ (Eq 17;
+    /// the yaw's wrap keeps a non-finite value non-finite). η_d reaches τ the same way through
+    /// e₁ but stays in: without it the compiler lays `fly` out anew, 313 instructions dearer.
+    #[inline]
+    fn finite(&self) -> bool {
+        let vectors = [&self.tau_achieved, &self.eta_d];
+        let mut zero = (self.law.w_norm * 0.0) + times_zero(&self.alloc.unallocated);
+        for v in vectors {
+            zero += times_zero(&(*v).into());
+        }
+        zero == 0.0
+    }
+
+    /// The output of these results (`robust`: Δu on, so a δ clamp is reported).
+    #[inline]
+    fn output(&self, robust: bool) -> Output {
+        Output {
+            status: Status::Ok,
+            tau: self.law.tau.into(),
+            tau_achieved: self.tau_achieved.into(),
+            tau_unallocated: self.alloc.unallocated,
+            thrust: self.act.thrusts,
+            voltage: self.act.voltages,
+            saturated: self.alloc.saturated | self.act.saturated,
+            delta: self.law.delta,
+            delta_clamped: robust && self.law.delta_clamped,
+            w_norm: self.law.w_norm,
+            eta_d: self.eta_d.into(),
+            e1: self.law.e1.into(),
+            u: self.law.u.into(),
+        }
+    }
 }
 
 /// A navigation solution as the board is told it: η, ν and the tick (mission clock) the
@@ -504,21 +552,20 @@ impl Controller {
         trajectory: &Trajectory,
         record: Option<Recording>,
     ) -> Output {
-        let stepped = self.step(ticks, input, trajectory);
-        let finite = matches!(&stepped, Ok(out) if out.all_finite());
-        if let Some(r) = record {
-            match &stepped {
-                Ok(out) if finite => {
-                    Self::estimator_record_stage(r.parts, r.memory, r.period, r.est, out)
-                }
-                // The fail-safe below: nothing applied (the record stage's fault case).
-                _ => r.memory.applied_in(&r.parts.gains, r.period, &[0.0; 6]),
-            }
-        }
-        match stepped {
-            Ok(out) if finite => out,
-            Ok(_) => Output::fail_safe(Fault::NonFiniteResult),
-            Err(fault) => Output::fail_safe(fault),
+        let stepped = match self.step(ticks, input, trajectory) {
+            Ok(parts) if parts.finite() => Ok(parts),
+            Ok(_) => Err(Fault::NonFiniteResult),
+            Err(fault) => Err(fault),
+        };
+        // Recorded when `_recorder` is dropped: after the output below is written to the
+        // return value, which then holds it (not the stack across the record's call).
+        let _recorder = record.map(|recording| Recorder {
+            recording,
+            applied: stepped.as_ref().ok(),
+        });
+        match &stepped {
+            Ok(parts) => parts.output(self.config.robust),
+            Err(fault) => Output::fail_safe(*fault),
         }
     }
 
@@ -661,16 +708,37 @@ impl Controller {
         est: &Estimated,
         out: &Output,
     ) {
-        let accel = match out.status {
-            Status::Ok => estimator::applied_acceleration(
-                &Vector6::from(out.u),
-                &est.kin,
-                &parts.m_diag_inv,
-                &Vector6::from(out.tau),
-                &Vector6::from(out.tau_achieved),
-            )
-            .into(),
-            Status::Fault(_) => [0.0; 6],
+        let applied = match out.status {
+            Status::Ok => Some((
+                Vector6::from(out.u),
+                Vector6::from(out.tau),
+                Vector6::from(out.tau_achieved),
+            )),
+            Status::Fault(_) => None,
+        };
+        let applied = applied
+            .as_ref()
+            .map(|(u, tau, achieved)| (u, tau, achieved));
+        Self::record_applied(parts, memory, period, est, applied);
+    }
+
+    /// The record stage on the law's u, τ and the achieved τ (`None`: a fault, nothing
+    /// applied): what [`Controller::fly`] records from the stages' parts, before the output
+    /// is assembled.
+    #[inline]
+    fn record_applied(
+        parts: &EstimatorParts,
+        memory: &mut Estimate,
+        period: Period,
+        est: &Estimated,
+        applied: Option<(&Vector6<f32>, &Vector6<f32>, &Vector6<f32>)>,
+    ) {
+        let accel = match applied {
+            Some((u, tau, achieved)) => {
+                estimator::applied_acceleration(u, &est.kin, &parts.m_diag_inv, tau, achieved)
+                    .into()
+            }
+            None => [0.0; 6],
         };
         memory.applied_in(&parts.gains, period, &accel);
     }
@@ -687,7 +755,12 @@ impl Controller {
     }
 
     /// The stages of [`Stage::ALL`] in order, then the output.
-    fn step(&self, ticks: u64, input: &LawInput, trajectory: &Trajectory) -> Result<Output, Fault> {
+    fn step(
+        &self,
+        ticks: u64,
+        input: &LawInput,
+        trajectory: &Trajectory,
+    ) -> Result<Stepped, Fault> {
         let kin = match input {
             LawInput::Told { eta, nu } => self.kinematics_stage(eta, nu)?,
             LawInput::Estimated(est) => self.estimated_kinematics(est)?,
@@ -696,20 +769,12 @@ impl Controller {
         let law = self.law_stage(&kin, &desired, trajectory)?;
         let alloc = self.allocation_stage(&law.tau);
         let (act, tau_achieved) = self.maps_stage(&alloc.thrusts);
-        Ok(Output {
-            status: Status::Ok,
-            tau: law.tau.into(),
-            tau_achieved: tau_achieved.into(),
-            tau_unallocated: alloc.unallocated,
-            thrust: act.thrusts,
-            voltage: act.voltages,
-            saturated: alloc.saturated | act.saturated,
-            delta: law.delta,
-            delta_clamped: self.config.robust && law.delta_clamped,
-            w_norm: law.w_norm,
-            eta_d: desired.eta.into(),
-            e1: law.e1.into(),
-            u: law.u.into(),
+        Ok(Stepped {
+            eta_d: desired.eta,
+            law,
+            alloc,
+            act,
+            tau_achieved,
         })
     }
 
@@ -1015,30 +1080,72 @@ mod tests {
     /// Choice 524: the sum-times-zero check finds a non-finite value in every field and at
     /// every position, ±∞ and NaN alike, and passes finite values of any size and sign.
     #[test]
-    fn all_finite_finds_every_non_finite_value() {
-        let finite = Output {
-            tau: [f32::MAX, -f32::MAX, 0.0, -0.0, f32::MIN_POSITIVE, 1.0],
-            ..Output::fail_safe(Fault::NonFiniteResult)
+    fn the_finite_check_finds_every_non_finite_value_it_checks() {
+        let zero = Vector6::zeros();
+        let finite = Stepped {
+            eta_d: Vector6::from([f32::MAX, -f32::MAX, 0.0, -0.0, f32::MIN_POSITIVE, 1.0]),
+            law: StepLaw {
+                u: zero,
+                tau: zero,
+                delta: 0.0,
+                delta_clamped: false,
+                w_norm: 0.0,
+                e1: zero,
+            },
+            alloc: Allocated {
+                thrusts: [0.0; THRUSTERS],
+                saturated: 0,
+                unallocated: [0.0; 6],
+            },
+            act: Actuation::OFF,
+            tau_achieved: zero,
         };
-        assert!(finite.all_finite());
-        let fields = 6 * 6 + 2 * 5 + 2;
-        for k in 0..fields {
+        assert!(finite.finite());
+        for k in 0..3 * 6 + 1 {
             for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
-                let mut o = finite;
+                let mut p = finite;
                 let slot = match k {
-                    0..=5 => &mut o.tau[k],
-                    6..=11 => &mut o.tau_achieved[k - 6],
-                    12..=17 => &mut o.tau_unallocated[k - 12],
-                    18..=22 => &mut o.thrust[k - 18],
-                    23..=27 => &mut o.voltage[k - 23],
-                    28..=33 => &mut o.eta_d[k - 28],
-                    34..=39 => &mut o.e1[k - 34],
-                    40..=45 => &mut o.u[k - 40],
-                    46 => &mut o.delta,
-                    _ => &mut o.w_norm,
+                    0..=5 => &mut p.tau_achieved[k],
+                    6..=11 => &mut p.alloc.unallocated[k - 6],
+                    12..=17 => &mut p.eta_d[k - 12],
+                    _ => &mut p.law.w_norm,
                 };
                 *slot = bad;
-                assert!(!o.all_finite(), "field slot {k}: {bad}");
+                assert!(!p.finite(), "field slot {k}: {bad}");
+            }
+        }
+    }
+
+    /// Choice 582's grounds for leaving u and e₁ out of the finite check: a non-finite uᵢ
+    /// gives a non-finite τ (which the law stage checks) at any attitude within the pitch
+    /// limit, and a non-finite e₁ᵢ a non-finite ūᵢ (the yaw's through its wrap).
+    #[test]
+    fn a_non_finite_u_or_e1_makes_tau_non_finite() {
+        let c = Controller::new(ControllerConfig::default()).expect("paper defaults");
+        let zero = Vector6::zeros();
+        let nu = Vector6::from([0.5, -0.2, 0.1, 0.05, -0.03, 0.2]);
+        for eta in [
+            [0.0; 6],
+            [1.0, -2.0, 3.0, 0.4, -0.5, 3.0],
+            [0.0, 0.0, 0.0, 0.0, 1.2, -2.0],
+        ] {
+            let kin = Kinematics::new(Attitude::from_eta_f32(&Vector6::from(eta))).unwrap();
+            let jinv_jdot_nu = kin.jinv_jdot_nu(&nu);
+            for i in 0..6 {
+                for bad in [f32::INFINITY, f32::NEG_INFINITY, f32::NAN] {
+                    let mut u = zero;
+                    u[i] = bad;
+                    let tau =
+                        law::body_force(&c.m_hat, &c.config.params, &kin, &nu, &u, &jinv_jdot_nu);
+                    assert!(times_zero(&tau.into()) != 0.0, "u[{i}] = {bad} at {eta:?}");
+                    let mut e1 = zero;
+                    e1[i] = bad;
+                    if i == crate::axes::YAW {
+                        e1[i] = crate::math::wrap_pi(bad);
+                    }
+                    let u_bar = law::nominal_input(&zero, &c.k1, &c.k2, &e1, &zero);
+                    assert!(!u_bar[i].is_finite(), "e1[{i}] = {bad}");
+                }
             }
         }
     }

@@ -191,7 +191,7 @@ proptest! {
         let out = c.update(ticks, &eta, &nu, &tr);
         let scalars = [out.delta, out.w_norm];
         let all = out.tau.iter().chain(&out.tau_achieved).chain(&out.thrust).chain(&out.voltage)
-            .chain(&out.eta_d).chain(&out.e1).chain(&scalars);
+            .chain(&out.tau_unallocated).chain(&out.eta_d).chain(&out.e1).chain(&out.u).chain(&scalars);
         for x in all {
             prop_assert!(x.is_finite());
         }
