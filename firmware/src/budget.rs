@@ -90,8 +90,8 @@ pub const BUDGETS: [StepBudget; 3] = [
     StepBudget {
         backend: "kernels",
         update: 4_000,
-        // kinematics, trajectory, law, allocation, voltage maps: measured 447, 627, 555, 518,
-        // 430 (Choices 571, 573 and 574: the trajectory 630, the law 597 and the allocation
+        // kinematics, trajectory, law, allocation, voltage maps: measured 448, 627, 555, 519,
+        // 428 (Choices 571, 573 and 574: the trajectory 630, the law 597 and the allocation
         // 809 before them; the allocation 891 before Choice 493; Choices 520–522, 524 and 526
         // took them from 499, 639, 682, 888, 1 112; an unclamped tunnel reports its command, no
         // Cardano root on the step). The trajectory stage's 720:
@@ -99,8 +99,8 @@ pub const BUDGETS: [StepBudget; 3] = [
         // segment's sextic, docs/missions.md#lookup-and-the-local-parameter) measured 627 on the survey's golden vectors,
         // against 435 for the closed forms.
         stages: [500, 720, 640, 600, 480],
-        // Measured XXXX_K_WHOLE on the largest fixed work, XXXX_K_LATE one period late (Choices 561, 566
-        // and 568, the estimator's stages, and 571, 573 and 574, the law's: 4 652 and 4 644
+        // Measured 4 076 on the largest fixed work, 4 056 one period late (Choices 561, 566
+        // and 568, the estimator's stages, 571, 573 and 574, the law's, 581 and 582, the output's: 4 652 and 4 644
         // before them; Choice 499: the
         // estimator's periods as u32 counts; 4 760 and 4 751 before it; Choice 572:
         // `fly` records the output before returning it, no 196-byte copy; Choice 513: wrap_pi's
@@ -113,9 +113,9 @@ pub const BUDGETS: [StepBudget; 3] = [
         // 491, and the estimator's finiteness tests, before Choices 526–527; 6 492 with the disturbance state, Choice
         // 510, before Choices 520–522 and 524; 6 273 before both, 7 200 before Choices
         // 430–431). Issue 28's target is ≤ 4 000, not met: the estimator's stages are about
-        // XXXX_K_EST of it and the law on the estimate ≈ XXXX_K_LAW (docs/law.md#the-state-estimator).
-        update_from_solution: 4_900,
-        // solution, filter, estimate, record: measured 351, 892, 364, 243 (391, 1 029, 348,
+        // 1 860 of it and the law on the estimate ≈ 2 220 (docs/law.md#the-state-estimator).
+        update_from_solution: 4_280,
+        // solution, filter, estimate, record: measured 353, 893, 365, 246 (391, 1 029, 348,
         // 260 before Choices 561, 566 and 568: the estimate alone +16, as it now also forms J
         // on the path that flies the solution as told; 390, 1 127, 348,
         // 266 before Choice 499's u32 periods; 393, 1 134, 354,
@@ -139,22 +139,22 @@ pub const BUDGETS: [StepBudget; 3] = [
     // libm's sinf/cosf/cbrtf evaluate in soft-float f64 (kinematics, trajectory, maps).
     StepBudget {
         backend: "libm",
-        // Measured 14 920 (the SysTick count; 15 240 before Choices 571, 573 and 574); stages
-        // 7 541, 5 470, 805, 517, 426 (the law 849
+        // Measured 14 872 (the SysTick count; 15 240 before Choices 571, 573, 574, 581 and 582); stages
+        // 7 540, 5 470, 804, 517, 425 (the law 849
         // and the allocation 890 before Choices 573 and 574; the voltage maps take no cbrtf
         // since Choice 526, no libm sqrtf since Choice 520).
         update: 17_000,
         stages: [8_400, 6_200, 930, 600, 490],
-        // Measured XXXX_L_LATE one period late, XXXX_L_WHOLE on the largest fixed work (Choices 561,
-        // 566, 568, 571, 573 and 574: 24 153 and 24 071 before them; Choice 499; 24 259
+        // Measured 23 634 one period late, 23 500 on the largest fixed work (Choices 561,
+        // 566, 568, 571, 573, 574, 581 and 582: 24 153 and 24 071 before them; Choice 499; 24 259
         // and 24 177 before it; 24 453 and 24 362
         // before Choices 513 and 572; Choice 554;
         // 24 426 and 24 597 on Choice 494's case before it, 24 683 before Choice 492, 24 757
         // before Choice 493); solution,
-        // filter, estimate, record: 7 502, 894, 7 512, 245 (7 535, 1 023, 7 504, 256 before
+        // filter, estimate, record: 7 500, 894, 7 507, 245 (7 535, 1 023, 7 504, 256 before
         // them; 1 131 and 268 before Choice 499; 603 before Choice 554; libm's sinf/cosf in the solution's and the estimate's
         // attitude).
-        update_from_solution: 25_400,
+        update_from_solution: 24_800,
         estimator_stages: [8_400, 1_030, 8_400, 290],
         // Measured 48 040 (34 720 with protocol 7's patch; the law alone 40 560), 1 281 440 and 1 448 480 (libm's
         // cosf in the rebuild, its sin/cos in the waypoint build).
@@ -167,21 +167,21 @@ pub const BUDGETS: [StepBudget; 3] = [
     // micromath takes the kernels' cbrt (it has none), so its maps cost the kernels'.
     StepBudget {
         backend: "micromath",
-        // Measured 2 600 (the SysTick count; 3 000 before Choices 571, 573 and 574); stages 379,
-        // 554, 577, 519, 429 (the trajectory
+        // Measured 2 549 (the SysTick count; 3 000 before Choices 571, 573, 574, 581 and 582); stages
+        // 377, 553, 575, 517, 429 (the trajectory
         // 570, the law 618 and the allocation 890 before Choices 571, 573 and 574; the waypoint
         // path's trajectory stage the 554, docs/board.md#the-self-test-and-its-budgets).
         update: 4_200,
         stages: [450, 640, 660, 600, 480],
-        // Measured XXXX_M_LATE one period late, XXXX_M_WHOLE on the largest fixed work (Choices 561,
-        // 566, 568, 571, 573 and 574: 4 515 and 4 488 before them; Choice 499; 4 623
+        // Measured 3 965 one period late, 3 957 on the largest fixed work (Choices 561,
+        // 566, 568, 571, 573, 574, 581 and 582: 4 515 and 4 488 before them; Choice 499; 4 623
         // and 4 595 before it; 4 818 and 4 799
         // before Choices 513 and 572; Choice 554; 4 790
         // and 5 043 on Choice 494's case before it, 5 047 before Choice 492, 5 124 before
         // Choice 493); solution, filter,
-        // estimate, record: 315, 894, 324, 245 (343, 1 025, 325, 258 before them; 1 129 and
+        // estimate, record: 316, 895, 325, 247 (343, 1 025, 325, 258 before them; 1 129 and
         // 267 before Choice 499; 606 before Choice 554).
-        update_from_solution: 4_750,
+        update_from_solution: 4_160,
         estimator_stages: [370, 1_030, 380, 290],
         // Measured as the kernels: 35 960 (29 160 with protocol 7's), 1 051 200 and 1 218 200.
         work: WorkBudget {
