@@ -522,6 +522,16 @@ pub struct PresetFigures {
     pub median_ratio: f64,
 }
 
+/// A median conservativeness as the reports print it: `1.12×`, or `—` when no mission was flown
+/// within its bound (the median of nothing; `NaN` in the figures, `null` in JSON).
+pub fn median_text(ratio: f64) -> String {
+    if ratio.is_finite() {
+        format!("{ratio:.2}×")
+    } else {
+        "—".to_string()
+    }
+}
+
 impl PresetFigures {
     fn of(navigation: Preset, done: &[&MissionResult]) -> Self {
         let mut ratios: Vec<f64> = done.iter().filter_map(|m| m.ratio()).collect();
@@ -539,13 +549,13 @@ impl PresetFigures {
     /// One line: `survey: 392 missions, 380 flown, 12 refused, false feasible 0, median 1.10×`.
     pub fn line(&self) -> String {
         format!(
-            "{}: {} missions, {} flown, {} refused, false feasible {}, conservativeness median {:.2}×",
+            "{}: {} missions, {} flown, {} refused, false feasible {}, conservativeness median {}",
             self.navigation.name(),
             self.missions,
             self.flown,
             self.refused,
             self.false_feasible,
-            self.median_ratio
+            median_text(self.median_ratio)
         )
     }
 }
@@ -568,13 +578,13 @@ impl Validation {
     pub fn headline(&self) -> String {
         format!(
             "preflight contract: {} missions{}, {} flown at the proposed time scale, {} refused; \
-             false feasible {}; conservativeness median {:.2}× (proposed / smallest flying scale)",
+             false feasible {}; conservativeness median {} (proposed / smallest flying scale)",
             self.missions.len(),
             if self.partial { " (PARTIAL)" } else { "" },
             self.flown,
             self.refused,
             self.false_feasible,
-            self.median_ratio
+            median_text(self.median_ratio)
         ) + &self
             .per_preset
             .iter()
@@ -588,7 +598,7 @@ impl Validation {
             "## The preflight's contract (docs/real-vehicle.md#the-preflights-contract)\n\n\
              {} missions{}: {} flown at the time scale `check` proposes, {} refused (no feasible \
              scale). **False feasible: {}** (called feasible, missed the bound when flown). \
-             **Conservativeness: median {:.2}×** (the proposed scale over the smallest that \
+             **Conservativeness: median {}** (the proposed scale over the smallest that \
              flies within the bound, found by flying).\n\n\
              {}\n\n\
              | mission | mounting | verdict at k = 1 | proposed k | max path (m) | saturated | \
@@ -602,7 +612,7 @@ impl Validation {
             self.flown,
             self.refused,
             self.false_feasible,
-            self.median_ratio,
+            median_text(self.median_ratio),
             self.per_preset
                 .iter()
                 .map(|p| format!("- {}", p.line()))
@@ -628,5 +638,32 @@ impl Validation {
             );
         }
         s
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A preset under which every mission was refused (the contract's `low-cost`) has no
+    /// median: its line says so instead of printing `NaN×`.
+    #[test]
+    fn a_preset_with_nothing_flown_prints_no_median() {
+        let refused = MissionResult {
+            name: "random-000-low-cost".to_string(),
+            navigation: Preset::LowCost,
+            mounting: 0,
+            verdict: Verdict::StaticallyInfeasible,
+            proposed: None,
+            max_path: None,
+            saturated: None,
+            within: None,
+            smallest_flying: None,
+            sampled: true,
+        };
+        let line = PresetFigures::of(Preset::LowCost, &[&refused]).line();
+        assert!(line.ends_with("conservativeness median —"), "{line}");
+        assert!(!line.contains("NaN"), "{line}");
+        assert_eq!(median_text(1.1234), "1.12×");
     }
 }
