@@ -250,28 +250,34 @@ fn check_json_prints_the_verdict_so_far_when_interrupted() {
 /// checked on one period (Choices 393, 538), in milliseconds to seconds.
 const LONG: &str = "name = \"day\"\nduration = 36000\n[trajectory]\nkind = \"lawn-mower\"\nscale = 1\n[variation]\nprofile = \"abs-sin\"\n";
 
+/// [`LONG`]'s path at half its size flown for twenty hours (at full size it would leave the
+/// ±10 km the controller accepts): its preflight as written takes about 12 s of an idle
+/// machine's CPU, twice [`LONG`]'s since Choices 579–580 took that to about 6 s, where a SIGINT
+/// at 6 s could land after it, in the flight.
+const LONGER: &str = "name = \"day\"\nduration = 72000\n[trajectory]\nkind = \"lawn-mower\"\nscale = 0.5\n[variation]\nprofile = \"abs-sin\"\n";
+
 /// SIGINT 1.5 s into a ten-hour run used to act after about 80 s (the preflight did
 /// not look at the flag). Measured after the fix: ≈ 0.1 s. The bound is generous for a loaded
 /// machine and still fails the old behaviour.
 #[test]
 fn an_interrupt_before_the_first_period_acts_at_once() {
-    interrupted_in_the_preflight("early-int", 1500);
+    interrupted_in_the_preflight("early-int", LONG, 1500);
 }
 
-/// The same 6 s in: there the preflight matched each of the mission's 7.2·10⁵ samples to its
+/// The same 6 s into [`LONGER`]'s: there the preflight matched each of the mission's 7.2·10⁵ samples to its
 /// plant by searching every plant before it (quadratic, no look at the flag: hours), and a
 /// SIGINT went unanswered (CI hung on the test above under load, 2026-12-05). Now by the
 /// parameters' bits.
 #[test]
 fn an_interrupt_while_the_preflight_matches_samples_to_plants_acts_at_once() {
-    interrupted_in_the_preflight("match-int", 6000);
+    interrupted_in_the_preflight("match-int", LONGER, 6000);
 }
 
-/// SIGINT `after_ms` into a `run` of the [`LONG`] mission, still in its preflight: the run
+/// SIGINT `after_ms` into a `run` of `mission` (a long one), still in its preflight: the run
 /// stops within 10 s, exit 130, its report says nothing was simulated, nothing half-written.
-fn interrupted_in_the_preflight(tag: &str, after_ms: u64) {
+fn interrupted_in_the_preflight(tag: &str, mission: &str, after_ms: u64) {
     let dir = tempdir(tag);
-    let s = scenario(&dir, "day", LONG);
+    let s = scenario(&dir, "day", mission);
     let out = dir.join("out");
     let child = spawn_run(&s, &out);
     std::thread::sleep(std::time::Duration::from_millis(after_ms));
