@@ -13,28 +13,17 @@
 //! open half, ignored until the preflight gives it:
 //! `cargo test --profile host -p host-sim --test falsified_open -- --ignored`.
 
-// Only `mission` of the shared helpers is used here.
-#[allow(dead_code)]
 #[path = "common/falsified.rs"]
 mod falsified;
 
-use falsified::mission;
-use host_sim::sim::{self, bound, LocalController, Recording};
+use falsified::{fly, mission};
+use host_sim::sim::bound;
 use host_sim::studies::preflight::{self, DEFAULT_MARGIN};
 
 const FILES: [&str; 2] = [
     "falsified-open-lawn-mower-lag-random-r2.toml",
     "falsified-open-figure-eight-lag-ce-r2.toml",
 ];
-
-fn fly(s: &host_sim::scenario::Scenario) -> sim::RunResult {
-    sim::fly(
-        s,
-        &mut LocalController::new(s),
-        &mut (),
-        Recording::MetricsOnly,
-    )
-}
 
 #[test]
 fn each_open_falsifier_misses_its_bound_at_the_scale_written() {

@@ -9,22 +9,13 @@
 #[path = "common/falsified.rs"]
 mod falsified;
 
-use falsified::{at_scale, mission};
-use host_sim::sim::{self, bound, LocalController, Recording};
+use falsified::{at_scale, fly, mission};
+use host_sim::sim::bound;
 use host_sim::studies::preflight::{self, DEFAULT_MARGIN};
 
 const FILE: &str = "falsified-path-survey-r4.toml";
 /// The scale `check` proposed before, at which the flight missed.
 const PROPOSED_BEFORE: f64 = 1.05;
-
-fn fly(s: &host_sim::scenario::Scenario) -> sim::RunResult {
-    sim::fly(
-        s,
-        &mut LocalController::new(s),
-        &mut (),
-        Recording::MetricsOnly,
-    )
-}
 
 #[test]
 fn the_path_falsifier_is_refused_where_it_missed_and_flies_where_proposed() {

@@ -1,7 +1,11 @@
-//! What the tests of falsified missions share (tests/falsified_missions.rs,
-//! tests/falsified_lag.rs): a mission from tests/data, and the same path at another time scale.
+//! What the tests of falsified missions share (tests/falsified_*.rs): a mission from
+//! tests/data, the same path at another time scale, and a flight of it that keeps its metrics.
+
+// Each test binary uses some of these.
+#![allow(dead_code)]
 
 use host_sim::scenario::{load_scenario, Scenario};
+use host_sim::sim::{self, LocalController, Recording};
 
 /// A falsifying mission as `falsify` wrote it, from `host-sim/tests/data`.
 pub fn mission(file: &str) -> Scenario {
@@ -19,4 +23,14 @@ pub fn at_scale(s: &Scenario, k: f64) -> Scenario {
         c.duration = span * k;
     })
     .unwrap()
+}
+
+/// `s` flown with the law on the host, metrics only.
+pub fn fly(s: &Scenario) -> sim::RunResult {
+    sim::fly(
+        s,
+        &mut LocalController::new(s),
+        &mut (),
+        Recording::MetricsOnly,
+    )
 }
